@@ -1,0 +1,53 @@
+// One dispatch adds one sample per pixel to the accumulation buffer.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_scalar_block_layout : require
+
+#include "lib/bindings.glsl"
+
+layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
+
+#include "lib/random.glsl"
+#include "lib/ray.glsl"
+#include "lib/camera.glsl"
+#include "lib/intersect.glsl"
+#include "lib/scene.glsl"
+#include "lib/accumulate.glsl"
+#include "lib/whitted.glsl"
+
+// lavapipe hands each worker thread one contiguous run of workgroups; walking
+// the tiles with a stride coprime to their count gives every thread a share of
+// every part of the image, so no core idles on the cheap sky.
+uvec2 scatteredPixel()
+{
+    uint tilesX = (u.width + WORKGROUP_SIZE_X - 1u) / WORKGROUP_SIZE_X;
+    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    uint tile = (group * u.tileStride) % u.tileCount;
+    uvec2 tileOrigin = uvec2(tile % tilesX, tile / tilesX) * uvec2(WORKGROUP_SIZE_X, WORKGROUP_SIZE_Y);
+    return tileOrigin + gl_LocalInvocationID.xy;
+}
+
+void reportLoopIterations()
+{
+    atomicMax(stats.maxLoopIterations, g_loopIterations);
+    if (g_loopIterations >= LOOP_BUDGET)
+        atomicAdd(stats.budgetExceeded, 1u);
+}
+
+void main()
+{
+    uvec2 pixel = scatteredPixel();
+    if (pixel.x >= u.width || pixel.y >= u.height)
+        return;
+    uint pixelIndex = pixel.y * u.width + pixel.x;
+    Sampler rng = samplerCreate(pixelIndex, frame.frameIndex, frame.seed);
+    vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? sampleNext2D(rng) : vec2(0.5);
+    vec3 radiance = traceWhitted(cameraRay(pixel, subpixel), rng);
+#ifdef VKRT_TEST_INJECT_NONFINITE
+    // Test hook: poison every 7th pixel so the rejection path is exercised.
+    if (pixelIndex % 7u == 0u)
+        radiance = vec3(uintBitsToFloat(0x7fc00000u));
+#endif
+    accumulateSample(pixelIndex, radiance);
+    reportLoopIterations();
+}

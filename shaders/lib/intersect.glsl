@@ -1,0 +1,131 @@
+// Robust ray-primitive tests in float32 (see shared/NUMERICS.md of the team
+// notes and docs/robustness.md). Each returns the hit distance in (0, tMax) or
+// false. Directions are unit length.
+#ifndef VKRT_INTERSECT_GLSL
+#define VKRT_INTERSECT_GLSL
+
+// Sphere: the discriminant as r^2 - |f - (f.d)d|^2 and the near root as c/q
+// with q = b + sign(b) sqrt(disc) avoid catastrophic cancellation (Haines et
+// al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems
+// ch. 7). The naive form misclassifies near-silhouette rays from afar.
+bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit)
+{
+    vec3 f = r.origin - s.center;
+    float b = -dot(f, r.dir);
+    vec3 l = f + b * r.dir;
+    float r2 = s.radius * s.radius;
+    float disc = r2 - dot(l, l);
+    if (disc < 0.0)
+        return false;
+    float c = dot(f, f) - r2;
+    float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
+    float tNear = c / q;
+    float tFar = q;
+    if (tNear > tFar) {
+        float tmp = tNear;
+        tNear = tFar;
+        tFar = tmp;
+    }
+    tHit = tNear > 0.0 ? tNear : tFar;
+    return tHit > 0.0 && tHit < tMax;
+}
+
+int argMax3(vec3 v) { return (v.x >= v.y && v.x >= v.z) ? 0 : (v.y >= v.z ? 1 : 2); }
+int argMin3(vec3 v) { return (v.x <= v.y && v.x <= v.z) ? 0 : (v.y <= v.z ? 1 : 2); }
+
+// Slab test that stays defined when a direction component is exactly zero
+// (0 * inf would be NaN): such an axis either rejects the ray or imposes no
+// limit. tFar is widened by 1 + 2*gamma(3) so that rounding cannot open a gap
+// at edges (Ize, "Robust BVH Ray Traversal", JCGT 2013).
+bool intersectBox(Box b, Ray r, float tMax, out float tHit, out vec3 normal)
+{
+    bvec3 parallel = equal(r.dir, vec3(0.0));
+    bvec3 outside = bvec3(uvec3(lessThan(r.origin, b.lower)) | uvec3(greaterThan(r.origin, b.upper)));
+    if (any(bvec3(uvec3(parallel) & uvec3(outside))))
+        return false;
+    vec3 invDir = 1.0 / r.dir;
+    vec3 tLower = (b.lower - r.origin) * invDir;
+    vec3 tUpper = (b.upper - r.origin) * invDir;
+    vec3 tNearAxis = mix(min(tLower, tUpper), vec3(-FLT_MAX), parallel);
+    vec3 tFarAxis = mix(max(tLower, tUpper), vec3(FLT_MAX), parallel);
+    float tNear = max(tNearAxis.x, max(tNearAxis.y, tNearAxis.z));
+    const float gamma3 = 3.0 * 5.96046448e-8 / (1.0 - 3.0 * 5.96046448e-8);
+    float tFarExact = min(tFarAxis.x, min(tFarAxis.y, tFarAxis.z));
+    float tFar = tFarExact * (1.0 + 2.0 * gamma3);
+    if (tNear > tFar)
+        return false;
+    bool entering = tNear > 0.0;
+    tHit = entering ? tNear : tFar;
+    if (!(tHit > 0.0 && tHit < tMax))
+        return false;
+    // The face hit lies on the axis that set the entry (or exit) distance;
+    // its outward normal points against the ray on entry, along it on exit.
+    int axis = entering ? argMax3(tNearAxis) : argMin3(tFarAxis);
+    normal = vec3(0.0);
+    normal[axis] = entering ? -sign(r.dir[axis]) : sign(r.dir[axis]);
+    return true;
+}
+
+// Per-ray set-up of the watertight triangle test.
+struct TriangleRay {
+    int kx, ky, kz;
+    vec3 shear; // (Sx, Sy, Sz)
+};
+
+TriangleRay triangleRaySetup(Ray r)
+{
+    vec3 a = abs(r.dir);
+    int kz = (a.x > a.y) ? ((a.x > a.z) ? 0 : 2) : ((a.y > a.z) ? 1 : 2);
+    int kx = (kz + 1) % 3;
+    int ky = (kx + 1) % 3;
+    if (r.dir[kz] < 0.0) {
+        int tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    return TriangleRay(kx, ky, kz, vec3(r.dir[kx] / r.dir[kz], r.dir[ky] / r.dir[kz], 1.0 / r.dir[kz]));
+}
+
+// Watertight ray/triangle test (Woop, Benthin & Wald, JCGT 2013): edge
+// functions are evaluated in a ray-aligned frame so that a ray through a shared
+// edge hits at least one of the two triangles. Degenerate triangles have
+// det == 0 and are never hit. Both faces are hit.
+bool intersectTriangle(vec3 v0, vec3 v1, vec3 v2, Ray r, TriangleRay tr, float tMax, out float tHit)
+{
+    vec3 A = v0 - r.origin;
+    vec3 B = v1 - r.origin;
+    vec3 C = v2 - r.origin;
+    float Ax = A[tr.kx] - tr.shear.x * A[tr.kz];
+    float Ay = A[tr.ky] - tr.shear.y * A[tr.kz];
+    float Bx = B[tr.kx] - tr.shear.x * B[tr.kz];
+    float By = B[tr.ky] - tr.shear.y * B[tr.kz];
+    float Cx = C[tr.kx] - tr.shear.x * C[tr.kz];
+    float Cy = C[tr.ky] - tr.shear.y * C[tr.kz];
+    float U = Cx * By - Cy * Bx;
+    float V = Ax * Cy - Ay * Cx;
+    float W = Bx * Ay - By * Ax;
+    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0))
+        return false;
+    float det = U + V + W;
+    if (det == 0.0)
+        return false;
+    float T = U * (tr.shear.z * A[tr.kz]) + V * (tr.shear.z * B[tr.kz]) + W * (tr.shear.z * C[tr.kz]);
+    // t = T / det must lie in (0, tMax); compare before dividing to keep signs exact.
+    float signedT = det < 0.0 ? -T : T;
+    float absDet = abs(det);
+    if (signedT <= 0.0 || signedT >= tMax * absDet)
+        return false;
+    tHit = T / det;
+    return tHit > 0.0 && tHit < tMax;
+}
+
+bool intersectPlane(Plane p, Ray r, float tMax, out float tHit)
+{
+    float denom = dot(r.dir, p.normal);
+    if (denom == 0.0)
+        return false;
+    tHit = dot(p.point - r.origin, p.normal) / denom;
+    return tHit > 0.0 && tHit < tMax;
+}
+
+#endif

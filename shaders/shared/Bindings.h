@@ -1,0 +1,34 @@
+// Descriptor binding indices, workgroup shape and per-invocation limits: the
+// single definition used by the kernel builder (C++) and the kernels (GLSL).
+#ifndef VKRT_SHARED_BINDINGS_H
+#define VKRT_SHARED_BINDINGS_H
+#include "Interop.h"
+
+VKRT_BEGIN_NAMESPACE
+
+// All kernels use descriptor set 0.
+VKRT_CONSTANT(uint, BINDING_UNIFORMS, 0)        // SceneUniforms (uniform buffer)
+VKRT_CONSTANT(uint, BINDING_ACCUMULATION, 1)    // AccumPixel[width*height]
+VKRT_CONSTANT(uint, BINDING_STATS, 2)           // RenderStats
+VKRT_CONSTANT(uint, BINDING_MATERIALS, 3)       // Material[]
+VKRT_CONSTANT(uint, BINDING_SPHERES, 4)         // Sphere[]
+VKRT_CONSTANT(uint, BINDING_BOXES, 5)           // Box[]
+VKRT_CONSTANT(uint, BINDING_TRIANGLES, 6)       // Triangle[]
+VKRT_CONSTANT(uint, BINDING_PLANES, 7)          // Plane[]
+VKRT_CONSTANT(uint, BINDING_POINT_LIGHTS, 8)    // PointLight[]
+VKRT_CONSTANT(uint, BINDING_TRIANGLE_LIGHTS, 9) // TriangleLight[]
+VKRT_CONSTANT(uint, BINDING_COUNT, 10)
+
+// 8x8 workgroups: lavapipe runs 8-wide subgroups and 64 invocations per group
+// measured fastest (shared/NUMERICS.md); square tiles keep rays coherent.
+VKRT_CONSTANT(uint, WORKGROUP_SIZE_X, 8)
+VKRT_CONSTANT(uint, WORKGROUP_SIZE_Y, 8)
+
+// lavapipe silently ends every loop of an invocation after 65,535 iterations in
+// total. Kernels count their loop iterations; the host refuses scenes whose
+// worst case could exceed this budget and reports any kernel that reaches it.
+VKRT_CONSTANT(uint, LOOP_BUDGET, 65535)
+
+VKRT_END_NAMESPACE
+
+#endif

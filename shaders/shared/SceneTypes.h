@@ -1,0 +1,120 @@
+// GPU scene records. Layout rule: GLSL `scalar` block layout
+// (GL_EXT_scalar_block_layout), which matches C++'s natural layout of these
+// structs; the host static_asserts every size (src/gpu/SharedTypes.cpp) and a
+// test compares every offset with glslang's reflection.
+// Positions are camera-relative (the eye is the origin), computed in double
+// on the host, so precision does not depend on where the scene sits in space.
+#ifndef VKRT_SHARED_SCENE_TYPES_H
+#define VKRT_SHARED_SCENE_TYPES_H
+#include "Interop.h"
+
+VKRT_BEGIN_NAMESPACE
+
+// Material::type
+VKRT_CONSTANT(uint, MATERIAL_LAMBERT, 0)
+VKRT_CONSTANT(uint, MATERIAL_PHONG, 1)
+VKRT_CONSTANT(uint, MATERIAL_MIRROR, 2)
+VKRT_CONSTANT(uint, MATERIAL_GLOSSY, 3)
+VKRT_CONSTANT(uint, MATERIAL_DIELECTRIC, 4)
+
+// Material::fresnel
+VKRT_CONSTANT(uint, FRESNEL_NONE, 0)
+VKRT_CONSTANT(uint, FRESNEL_SCHLICK, 1)
+VKRT_CONSTANT(uint, FRESNEL_EXACT, 2)
+
+struct Material {
+    vec3 diffuse;
+    uint type;
+    vec3 specular;
+    float exponent;
+    vec3 absorption;
+    float ior;
+    uint fresnel;
+};
+
+struct Sphere {
+    vec3 center;
+    float radius;
+    uint material;
+};
+
+struct Box {
+    vec3 lower;
+    uint material;
+    vec3 upper;
+};
+
+struct Triangle {
+    vec3 v0;
+    uint material;
+    vec3 v1;
+    vec3 v2;
+};
+
+struct Plane {
+    vec3 point;
+    uint material;
+    vec3 normal;
+};
+
+struct PointLight {
+    vec3 position;
+    vec3 intensity;
+};
+
+struct TriangleLight {
+    vec3 v0;
+    float area;
+    vec3 v1;
+    uint twoSided;
+    vec3 v2;
+    vec3 radiance;
+};
+
+// SceneUniforms::flags
+VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
+
+/// Per-render constants. Camera ray for pixel coordinate (x, y) in [0,w]x[0,h]:
+/// normalize(ndc.x * cameraRight + ndc.y * cameraUp + cameraForward).
+struct SceneUniforms {
+    vec3 cameraRight;   // scaled by tan(fov/2) * aspect
+    uint width;
+    vec3 cameraUp;      // scaled by tan(fov/2)
+    uint height;
+    vec3 cameraForward;
+    uint flags;
+    vec3 backgroundColor;
+    uint maxDepth;
+    uint sphereCount;
+    uint boxCount;
+    uint triangleCount;
+    uint planeCount;
+    uint pointLightCount;
+    uint triangleLightCount;
+    uint tileCount;     // workgroup tiles in the image
+    uint tileStride;    // coprime to tileCount: scatters tiles over the image
+};
+
+/// Per-dispatch values (push constants). Used only as hash inputs, never in
+/// control flow, so lavapipe never specializes on them.
+struct FrameConstants {
+    uint frameIndex;
+    uint seed;
+};
+
+/// One pixel's running sum: Kahan-compensated, over `count` accepted samples.
+struct AccumPixel {
+    vec3 sum;
+    uint count;
+    vec3 compensation;
+};
+
+/// Counters written by kernels with atomics.
+struct RenderStats {
+    uint maxLoopIterations; // largest per-invocation loop count seen
+    uint budgetExceeded;    // invocations that would have crossed LOOP_BUDGET
+};
+
+VKRT_END_NAMESPACE
+
+#endif

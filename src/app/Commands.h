@@ -1,0 +1,26 @@
+#pragma once
+// Subcommands of the vkrt executable. Each registers its options on the CLI11
+// app and returns the function that runs it (returning the exit code).
+#include <functional>
+
+namespace CLI {
+class App;
+}
+
+namespace vkrt {
+
+using CommandRunner = std::function<int()>;
+
+CommandRunner addRenderCommand(CLI::App& app);
+CommandRunner addDevicesCommand(CLI::App& app);
+
+/// Process exit codes.
+enum ExitCode : int {
+    kExitOk = 0,
+    kExitFailure = 1,      ///< GPU, driver or internal failure
+    kExitBadInput = 2,     ///< scene file, option or input image error
+    kExitValidation = 3,   ///< Vulkan validation layer reported messages
+    kExitInterrupted = 130 ///< SIGINT; partial results were written
+};
+
+} // namespace vkrt

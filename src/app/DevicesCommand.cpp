@@ -1,0 +1,46 @@
+// `vkrt devices`: every Vulkan device, which one vkrt would pick, and why any
+// device cannot be used.
+#include "app/Commands.h"
+#include "gpu/VulkanContext.h"
+#include "util/Error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <optional>
+
+namespace vkrt {
+
+namespace {
+
+std::optional<uint32_t> defaultChoice(const std::vector<DeviceInfo>& devices)
+{
+    try {
+        return defaultDeviceIndex(devices);
+    } catch (const GpuError&) {
+        return std::nullopt; // every device is listed below with its reason
+    }
+}
+
+} // namespace
+
+CommandRunner addDevicesCommand(CLI::App& app)
+{
+    app.add_subcommand("devices", "List Vulkan devices and whether vkrt can use them");
+    return [] {
+        tuneSoftwareRasterizerThreads();
+        auto devices = listVulkanDevices();
+        auto chosen = defaultChoice(devices);
+        for (const DeviceInfo& d : devices) {
+            std::printf("%s%u: %s (%s, Vulkan %s, %s)\n", chosen == d.index ? "* " : "  ", d.index, d.name.c_str(),
+                        d.typeName().c_str(), d.apiVersionString().c_str(), d.driver.c_str());
+            if (!d.suitable()) std::printf("     unsuitable: it %s\n", d.unsuitableReason.c_str());
+        }
+        if (devices.empty()) std::printf("no Vulkan devices (install mesa-vulkan-drivers for lavapipe)\n");
+        if (!chosen) return int(kExitFailure);
+        std::printf("(* = default; choose another with --device INDEX|NAME)\n");
+        return int(kExitOk);
+    };
+}
+
+} // namespace vkrt

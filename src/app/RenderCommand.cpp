@@ -1,0 +1,170 @@
+// `vkrt render SCENE`: renders a scene progressively and writes an EXR (and
+// optionally a PNG preview). Ctrl-C stops early and still writes what was
+// accumulated, with its true spp in the metadata.
+#include "app/Commands.h"
+#include "io/ExrFile.h"
+#include "io/PngFile.h"
+#include "render/Progress.h"
+#include "render/RenderLoop.h"
+#include "scene/SceneParser.h"
+#include "util/Error.h"
+#include "util/Hash.h"
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <unistd.h>
+
+namespace vkrt {
+
+namespace {
+
+struct RenderCommandOptions {
+    std::string scenePath;
+    std::string output;
+    uint32_t spp = 64;
+    std::optional<uint32_t> width;
+    std::optional<uint32_t> height;
+    uint32_t seed = 0;
+    std::string device;
+    std::string png;
+    float exposure = 0.0f;
+    bool validation = false;
+    bool uber = false;
+    bool pixelCenters = false;
+};
+
+std::atomic<bool> g_interrupted{false};
+
+extern "C" void onInterrupt(int) { g_interrupted.store(true); }
+
+bool environmentFlag(const char* name)
+{
+    const char* value = std::getenv(name);
+    return value && *value && std::string(value) != "0";
+}
+
+std::string defaultOutputFor(const std::string& scenePath)
+{
+    return std::filesystem::path(scenePath).stem().string() + ".exr";
+}
+
+void applyResolution(Scene& scene, const RenderCommandOptions& options)
+{
+    if (options.width) scene.camera.width = *options.width;
+    if (options.height) scene.camera.height = *options.height;
+    uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
+    if (pixels > SceneLimits::maxImagePixels)
+        throw InputError("--width/--height: " + std::to_string(pixels) + " pixels exceeds the limit of " +
+                         std::to_string(SceneLimits::maxImagePixels));
+}
+
+Metadata describeRender(const Scene& scene, const VulkanContext& context, const Renderer& renderer,
+                        const RenderCommandOptions& options, const LoopResult& loop, const RenderCounters& counters)
+{
+    return Metadata{
+        {"vkrtVersion", std::string(VKRT_VERSION)},
+        {"spp", int64_t(renderer.completedFrames())},
+        {"seed", int64_t(options.seed)},
+        {"renderSeconds", loop.renderSeconds},
+        {"stoppedBy", stopReasonName(loop.reason)},
+        {"device", context.deviceInfo().name},
+        {"driver", context.deviceInfo().driver},
+        {"scene", scene.path},
+        {"sceneHash", "fnv1a64:" + toHex(scene.fileHash)},
+        {"integrator", integratorName(scene.render.integrator)},
+        {"kernelVariant", renderer.features().describe() + (options.uber ? " (uber)" : "")},
+        {"rejectedSamples", int64_t(counters.rejectedSamples)},
+    };
+}
+
+void printSummary(const Renderer& renderer, const VulkanContext& context, const LoopResult& loop,
+                  const RenderCounters& counters, double startupSeconds, const std::string& output)
+{
+    double samples = double(renderer.completedFrames()) * renderer.width() * renderer.height();
+    std::fprintf(stderr, "%u spp  %.2f s  %ssamples/s  %s  (start-up %.2f s%s)  -> %s\n", renderer.completedFrames(),
+                 loop.renderSeconds, humanCount(loop.renderSeconds > 0 ? samples / loop.renderSeconds : 0).c_str(),
+                 context.deviceInfo().name.c_str(), startupSeconds,
+                 renderer.kernel().fromCache ? ", kernel cached" : ", kernel compiled", output.c_str());
+    if (counters.rejectedSamples)
+        std::fprintf(stderr, "warning: %llu non-finite samples were rejected\n",
+                     static_cast<unsigned long long>(counters.rejectedSamples));
+    if (counters.budgetExceeded)
+        std::fprintf(stderr, "warning: %u invocations reached lavapipe's loop budget; the image may be wrong\n",
+                     counters.budgetExceeded);
+}
+
+int reportValidation(const VulkanContext& context)
+{
+    auto messages = context.validationMessages();
+    for (const auto& m : messages) std::fprintf(stderr, "%s\n", m.c_str());
+    return messages.empty() ? kExitOk : kExitValidation;
+}
+
+int runRender(const RenderCommandOptions& options)
+{
+    auto start = std::chrono::steady_clock::now();
+    Scene scene = parseSceneFile(options.scenePath);
+    applyResolution(scene, options);
+    std::string output = options.output.empty() ? defaultOutputFor(options.scenePath) : options.output;
+
+    VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
+    RenderOptions renderOptions;
+    renderOptions.seed = options.seed;
+    renderOptions.jitter = !options.pixelCenters;
+    renderOptions.uber = options.uber;
+    Renderer renderer(context, scene, renderOptions);
+    double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    g_interrupted.store(false);
+    std::signal(SIGINT, onInterrupt);
+    Progress progress(options.spp, uint64_t(scene.camera.width) * scene.camera.height, isatty(STDERR_FILENO));
+    LoopResult loop = runRenderLoop(renderer, {options.spp, &g_interrupted},
+                                    [&](uint32_t done) { progress.update(done); });
+    progress.finish();
+    std::signal(SIGINT, SIG_DFL);
+
+    if (renderer.completedFrames() == 0) {
+        std::fprintf(stderr, "vkrt: interrupted before the first frame finished; nothing written\n");
+        return kExitInterrupted;
+    }
+    RenderCounters counters = renderer.counters();
+    Image image = renderer.mean();
+    writeExr(output, image, describeRender(scene, context, renderer, options, loop, counters));
+    if (!options.png.empty()) writePng(options.png, image, options.exposure);
+    printSummary(renderer, context, loop, counters, startupSeconds, output);
+    if (int status = reportValidation(context); status != kExitOk) return status;
+    return loop.reason == StopReason::Interrupted ? kExitInterrupted : kExitOk;
+}
+
+} // namespace
+
+CommandRunner addRenderCommand(CLI::App& app)
+{
+    auto options = std::make_shared<RenderCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("render", "Render a scene file to an OpenEXR image");
+    cmd->add_option("scene", options->scenePath, "Scene file (TOML, see docs/scene-format.md)")->required();
+    cmd->add_option("-o,--output", options->output, "Output EXR (default: SCENE's name with .exr, here)");
+    cmd->add_option("--spp", options->spp, "Samples per pixel")->check(CLI::Range(1u, 1u << 30));
+    cmd->add_option("--width", options->width, "Image width (overrides the scene)")
+        ->check(CLI::Range(1u, SceneLimits::maxImageSide));
+    cmd->add_option("--height", options->height, "Image height (overrides the scene)")
+        ->check(CLI::Range(1u, SceneLimits::maxImageSide));
+    cmd->add_option("--seed", options->seed, "Random seed (same seed, same image)");
+    cmd->add_option("--device", options->device, "Vulkan device index or name (see `vkrt devices`)");
+    cmd->add_option("--png", options->png, "Also write a tone-mapped 8-bit sRGB PNG preview");
+    cmd->add_option("--exposure", options->exposure, "PNG exposure in stops (x 2^E)")->check(CLI::Range(-64.0, 64.0));
+    cmd->add_flag("--validation", options->validation,
+                  "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
+    cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");
+    cmd->add_flag("--pixel-centers", options->pixelCenters, "Sample pixel centres only (no anti-aliasing jitter)");
+    return [options] { return runRender(*options); };
+}
+
+} // namespace vkrt

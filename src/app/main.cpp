@@ -1,0 +1,39 @@
+// vkrt: a Vulkan compute ray tracer. This file only wires subcommands.
+#include "app/Commands.h"
+#include "util/Error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+int main(int argc, char** argv)
+{
+    CLI::App app("vkrt - Vulkan compute ray tracer", "vkrt");
+    app.set_version_flag("--version", VKRT_VERSION);
+    app.require_subcommand(1);
+    std::vector<std::pair<CLI::App*, vkrt::CommandRunner>> commands;
+    // Each add*Command registers one subcommand: pair it with its runner.
+    auto add = [&](vkrt::CommandRunner runner) {
+        commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(runner));
+    };
+    add(vkrt::addRenderCommand(app));
+    add(vkrt::addDevicesCommand(app));
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        int code = app.exit(e);
+        return code == 0 ? vkrt::kExitOk : vkrt::kExitBadInput;
+    }
+    try {
+        for (auto& [command, run] : commands)
+            if (command->parsed()) return run();
+    } catch (const vkrt::InputError& e) {
+        std::fprintf(stderr, "vkrt: error: %s\n", e.what());
+        return vkrt::kExitBadInput;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "vkrt: error: %s\n", e.what());
+        return vkrt::kExitFailure;
+    }
+    return vkrt::kExitFailure;
+}

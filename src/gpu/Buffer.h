@@ -1,0 +1,52 @@
+#pragma once
+// A VkBuffer with its own memory. Memory is declared first so the buffer is
+// destroyed before the memory it is bound to.
+#include "gpu/VulkanContext.h"
+
+#include <cstring>
+#include <span>
+#include <vector>
+
+namespace vkrt {
+
+enum class MemoryUse {
+    Device,   ///< GPU-local; host access through staging copies
+    Readback, ///< host-visible, host-cached when possible
+};
+
+class Buffer {
+public:
+    Buffer(const VulkanContext& context, vk::DeviceSize size, vk::BufferUsageFlags usage, MemoryUse use);
+
+    vk::Buffer handle() const { return *m_buffer; }
+    vk::DeviceSize size() const { return m_size; }
+    /// Host pointer when the memory is host-visible (always on lavapipe), else null.
+    void* mapped() const { return m_mapped; }
+
+    /// Copies `bytes` to offset 0, directly when mapped, else through a staging buffer.
+    void upload(const VulkanContext& context, std::span<const std::byte> bytes);
+    /// Fills the whole buffer with zeros (vkCmdFillBuffer).
+    void clear(const VulkanContext& context);
+    /// Copies the whole buffer to host memory.
+    std::vector<std::byte> download(const VulkanContext& context) const;
+
+private:
+    vk::DeviceSize m_size = 0;
+    bool m_hostCoherent = false;
+    vk::raii::DeviceMemory m_memory = nullptr;
+    vk::raii::Buffer m_buffer = nullptr;
+    void* m_mapped = nullptr;
+};
+
+/// A storage or uniform buffer initialised from a vector of GPU records.
+template <typename T>
+Buffer makeBufferFrom(const VulkanContext& context, const std::vector<T>& records, vk::BufferUsageFlags usage)
+{
+    // Vulkan forbids zero-sized buffers; an empty array still gets one record.
+    vk::DeviceSize size = std::max<vk::DeviceSize>(sizeof(T), records.size() * sizeof(T));
+    Buffer buffer(context, size, usage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Device);
+    buffer.upload(context, std::as_bytes(std::span(records)));
+    return buffer;
+}
+
+} // namespace vkrt

@@ -1,0 +1,40 @@
+#pragma once
+// A compute pipeline with its descriptor set. The layout is derived from the
+// list of binding indices the kernel variant uses (shaders/shared/Bindings.h),
+// so no pipeline set-up is ever written twice.
+#include "gpu/Buffer.h"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace vkrt {
+
+class ComputeKernel {
+public:
+    /// `bindings`: indices from shaders/shared/Bindings.h; `pushConstantSize` in bytes.
+    ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv, std::vector<uint32_t> bindings,
+                  uint32_t pushConstantSize);
+
+    /// Points `binding` at `buffer` (the whole buffer).
+    void bind(uint32_t binding, const Buffer& buffer);
+    /// Records bind + push constants + dispatch of `groups`.
+    void recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, vk::Extent2D groups) const;
+    const std::vector<uint32_t>& bindings() const { return m_bindings; }
+
+private:
+    const VulkanContext& m_context;
+    std::vector<uint32_t> m_bindings;
+    uint32_t m_pushConstantSize;
+    vk::raii::ShaderModule m_module = nullptr;
+    vk::raii::DescriptorSetLayout m_setLayout = nullptr;
+    vk::raii::PipelineLayout m_pipelineLayout = nullptr;
+    vk::raii::Pipeline m_pipeline = nullptr;
+    vk::raii::DescriptorPool m_pool = nullptr;
+    vk::raii::DescriptorSet m_set = nullptr;
+};
+
+/// The descriptor type each binding index has in every kernel.
+vk::DescriptorType descriptorTypeOf(uint32_t binding);
+
+} // namespace vkrt

@@ -1,0 +1,29 @@
+// Host-side checks of the GPU record layouts in shaders/shared. The kernels use
+// the GLSL scalar block layout, in which every member here is aligned to 4
+// bytes; C++ lays the same members out identically as long as no padding
+// appears, which these asserts guarantee. tests/gpu/shared_layout_test.cpp
+// compares every member offset with glslang's reflection.
+#include "shared/Bindings.h"
+#include "shared/SceneTypes.h"
+
+#include <cstddef>
+
+namespace vkrt::gpu {
+
+static_assert(alignof(vec3) == 4 && sizeof(vec3) == 12, "GLM vec3 must be three packed floats");
+static_assert(sizeof(Material) == 52);
+static_assert(sizeof(Sphere) == 20);
+static_assert(sizeof(Box) == 28);
+static_assert(sizeof(Triangle) == 40);
+static_assert(sizeof(Plane) == 28);
+static_assert(sizeof(PointLight) == 24);
+static_assert(sizeof(TriangleLight) == 56);
+static_assert(sizeof(SceneUniforms) == 96);
+static_assert(sizeof(FrameConstants) == 8);
+static_assert(sizeof(AccumPixel) == 28);
+static_assert(sizeof(RenderStats) == 8);
+static_assert(offsetof(SceneUniforms, tileStride) == 92);
+static_assert(offsetof(Material, fresnel) == 48);
+static_assert(offsetof(TriangleLight, radiance) == 44);
+
+} // namespace vkrt::gpu

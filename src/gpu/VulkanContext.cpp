@@ -1,0 +1,252 @@
+#include "gpu/VulkanContext.h"
+
+#include "util/Error.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <thread>
+
+namespace vkrt {
+
+namespace {
+
+constexpr uint32_t kRequiredApiVersion = VK_API_VERSION_1_2;
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+std::string lowercase(std::string text)
+{
+    std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+    return text;
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void* user)
+{
+    std::string level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning";
+    static_cast<ValidationLog*>(user)->add("validation " + level + ": " + (data->pMessage ? data->pMessage : ""));
+    return VK_FALSE;
+}
+
+bool hasLayer(const vk::raii::Context& context, const char* name)
+{
+    for (const auto& layer : context.enumerateInstanceLayerProperties())
+        if (std::string(layer.layerName.data()) == name) return true;
+    return false;
+}
+
+std::optional<uint32_t> findComputeQueueFamily(const vk::raii::PhysicalDevice& device)
+{
+    auto families = device.getQueueFamilyProperties();
+    // Prefer a compute family without graphics: on GPUs it is the async queue.
+    std::optional<uint32_t> any;
+    for (uint32_t i = 0; i < families.size(); ++i) {
+        if (!(families[i].queueFlags & vk::QueueFlagBits::eCompute)) continue;
+        if (!(families[i].queueFlags & vk::QueueFlagBits::eGraphics)) return i;
+        if (!any) any = i;
+    }
+    return any;
+}
+
+std::string unsuitableReason(const vk::raii::PhysicalDevice& device, const DeviceInfo& info)
+{
+    if (info.apiVersion < kRequiredApiVersion)
+        return "supports Vulkan " + info.apiVersionString() + ", vkrt needs 1.2";
+    if (!info.computeQueueFamily) return "has no compute queue";
+    auto features = device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features>();
+    if (!features.get<vk::PhysicalDeviceVulkan12Features>().scalarBlockLayout)
+        return "lacks the scalarBlockLayout feature (GPU structs use the scalar layout)";
+    return {};
+}
+
+DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index)
+{
+    auto chain = device.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
+    const auto& props = chain.get<vk::PhysicalDeviceProperties2>().properties;
+    const auto& driver = chain.get<vk::PhysicalDeviceDriverProperties>();
+    DeviceInfo info;
+    info.index = index;
+    info.name = props.deviceName.data();
+    info.type = props.deviceType;
+    info.driver = std::string(driver.driverName.data()) + ": " + driver.driverInfo.data();
+    info.apiVersion = props.apiVersion;
+    info.computeQueueFamily = findComputeQueueFamily(device);
+    info.unsuitableReason = unsuitableReason(device, info);
+    return info;
+}
+
+std::string deviceList(const std::vector<DeviceInfo>& devices)
+{
+    std::string text;
+    for (const auto& d : devices) text += "\n  " + std::to_string(d.index) + ": " + d.name;
+    return text.empty() ? "\n  (none)" : text;
+}
+
+} // namespace
+
+std::string DeviceInfo::typeName() const
+{
+    switch (type) {
+    case vk::PhysicalDeviceType::eDiscreteGpu: return "discrete GPU";
+    case vk::PhysicalDeviceType::eIntegratedGpu: return "integrated GPU";
+    case vk::PhysicalDeviceType::eVirtualGpu: return "virtual GPU";
+    case vk::PhysicalDeviceType::eCpu: return "CPU";
+    default: return "other";
+    }
+}
+
+std::string DeviceInfo::apiVersionString() const
+{
+    return std::to_string(VK_API_VERSION_MAJOR(apiVersion)) + "." + std::to_string(VK_API_VERSION_MINOR(apiVersion)) +
+           "." + std::to_string(VK_API_VERSION_PATCH(apiVersion));
+}
+
+void ValidationLog::add(std::string message)
+{
+    std::lock_guard lock(m_mutex);
+    m_messages.push_back(std::move(message));
+}
+
+std::vector<std::string> ValidationLog::messages() const
+{
+    std::lock_guard lock(m_mutex);
+    return m_messages;
+}
+
+void tuneSoftwareRasterizerThreads()
+{
+    unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    setenv("LP_NUM_THREADS", std::to_string(4 * cores).c_str(), /*overwrite=*/0);
+}
+
+VulkanContext::VulkanContext(const ContextOptions& options) : m_validation(options.validation)
+{
+    tuneSoftwareRasterizerThreads();
+    createInstance();
+    chooseDevice(options.deviceSelector);
+    createDevice();
+}
+
+void VulkanContext::createInstance()
+{
+    if (m_validation && !hasLayer(m_context, kValidationLayer))
+        throw GpuError("validation requested but VK_LAYER_KHRONOS_validation is not installed "
+                       "(Debian package vulkan-validationlayers)");
+    vk::ApplicationInfo app("vkrt", 1, "vkrt", 1, kRequiredApiVersion);
+    std::vector<const char*> layers, extensions;
+    if (m_validation) {
+        layers.push_back(kValidationLayer);
+        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    }
+    m_instance = vk::raii::Instance(m_context, vk::InstanceCreateInfo({}, &app, layers, extensions));
+    if (!m_validation) return;
+    using Severity = vk::DebugUtilsMessageSeverityFlagBitsEXT;
+    using Type = vk::DebugUtilsMessageTypeFlagBitsEXT;
+    vk::DebugUtilsMessengerCreateInfoEXT info({}, Severity::eWarning | Severity::eError,
+                                              Type::eGeneral | Type::eValidation | Type::ePerformance,
+                                              &onValidationMessage, m_validationLog.get());
+    m_messenger = vk::raii::DebugUtilsMessengerEXT(m_instance, info);
+}
+
+void VulkanContext::chooseDevice(const std::string& selector)
+{
+    vk::raii::PhysicalDevices physical(m_instance);
+    for (uint32_t i = 0; i < physical.size(); ++i) m_devices.push_back(describeDevice(physical[i], i));
+    if (m_devices.empty())
+        throw GpuError("no Vulkan device found; install mesa-vulkan-drivers for lavapipe (software Vulkan)");
+    m_deviceIndex = selector.empty() ? defaultDeviceIndex(m_devices) : selectDevice(m_devices, selector);
+    const DeviceInfo& chosen = m_devices[m_deviceIndex];
+    if (!chosen.suitable()) throw GpuError("device " + std::to_string(chosen.index) + " (" + chosen.name +
+                                           ") cannot run vkrt: it " + chosen.unsuitableReason);
+    m_physicalDevice = std::move(physical[m_deviceIndex]);
+}
+
+void VulkanContext::createDevice()
+{
+    float priority = 1.0f;
+    vk::DeviceQueueCreateInfo queueInfo({}, queueFamily(), 1, &priority);
+    vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan12Features> chain;
+    chain.get<vk::DeviceCreateInfo>().setQueueCreateInfos(queueInfo);
+    chain.get<vk::PhysicalDeviceVulkan12Features>().setScalarBlockLayout(true);
+    m_device = vk::raii::Device(m_physicalDevice, chain.get<vk::DeviceCreateInfo>());
+    m_queue = vk::raii::Queue(m_device, queueFamily(), 0);
+    m_commandPool = vk::raii::CommandPool(
+        m_device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer, queueFamily()));
+}
+
+uint32_t VulkanContext::findMemoryType(uint32_t typeBits, vk::MemoryPropertyFlags required,
+                                       vk::MemoryPropertyFlags preferred) const
+{
+    auto memory = m_physicalDevice.getMemoryProperties();
+    std::optional<uint32_t> fallback;
+    for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
+        if (!(typeBits & (1u << i))) continue;
+        auto flags = memory.memoryTypes[i].propertyFlags;
+        if ((flags & required) != required) continue;
+        if ((flags & preferred) == preferred) return i;
+        if (!fallback) fallback = i;
+    }
+    if (!fallback) throw GpuError("no Vulkan memory type with the required properties on " + deviceInfo().name);
+    return *fallback;
+}
+
+vk::raii::CommandBuffer VulkanContext::beginOneShot() const
+{
+    vk::raii::CommandBuffers buffers(m_device,
+                                     vk::CommandBufferAllocateInfo(*m_commandPool, vk::CommandBufferLevel::ePrimary, 1));
+    vk::raii::CommandBuffer cmd = std::move(buffers[0]);
+    cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+    return cmd;
+}
+
+void VulkanContext::endSubmitAndWait(const vk::raii::CommandBuffer& cmd) const
+{
+    cmd.end();
+    vk::raii::Fence fence(m_device, vk::FenceCreateInfo());
+    vk::CommandBuffer handle = *cmd;
+    m_queue.submit(vk::SubmitInfo({}, {}, handle), *fence);
+    if (m_device.waitForFences(*fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+        throw GpuError("vkWaitForFences did not complete");
+}
+
+std::vector<DeviceInfo> listVulkanDevices()
+{
+    vk::raii::Context context;
+    vk::ApplicationInfo app("vkrt", 1, "vkrt", 1, kRequiredApiVersion);
+    vk::raii::Instance instance(context, vk::InstanceCreateInfo({}, &app));
+    vk::raii::PhysicalDevices physical(instance);
+    std::vector<DeviceInfo> devices;
+    for (uint32_t i = 0; i < physical.size(); ++i) devices.push_back(describeDevice(physical[i], i));
+    return devices;
+}
+
+uint32_t defaultDeviceIndex(const std::vector<DeviceInfo>& devices)
+{
+    for (auto type : {vk::PhysicalDeviceType::eDiscreteGpu, vk::PhysicalDeviceType::eCpu})
+        for (const auto& d : devices)
+            if (d.suitable() && d.type == type) return d.index;
+    for (const auto& d : devices)
+        if (d.suitable()) return d.index;
+    std::string reasons;
+    for (const auto& d : devices) reasons += "\n  " + std::to_string(d.index) + ": " + d.name + ": " + d.unsuitableReason;
+    throw GpuError("no Vulkan device can run vkrt:" + reasons);
+}
+
+uint32_t selectDevice(const std::vector<DeviceInfo>& devices, const std::string& selector)
+{
+    bool numeric = !selector.empty() && std::all_of(selector.begin(), selector.end(), ::isdigit);
+    if (numeric) {
+        unsigned long index = std::stoul(selector);
+        if (index < devices.size()) return static_cast<uint32_t>(index);
+        throw InputError("--device " + selector + ": no device with that index; devices are:" + deviceList(devices));
+    }
+    std::vector<uint32_t> matches;
+    for (const auto& d : devices)
+        if (lowercase(d.name).find(lowercase(selector)) != std::string::npos) matches.push_back(d.index);
+    if (matches.size() == 1) return matches[0];
+    if (matches.empty())
+        throw InputError("--device " + selector + ": no device name contains it; devices are:" + deviceList(devices));
+    throw InputError("--device " + selector + ": matches several devices; use an index:" + deviceList(devices));
+}
+
+} // namespace vkrt

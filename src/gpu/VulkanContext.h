@@ -1,0 +1,113 @@
+#pragma once
+// The Vulkan instance, the chosen physical device, its logical device and a
+// compute queue. Members are declared in creation order, so RAII destroys
+// them in the reverse order Vulkan requires.
+#include <vulkan/vulkan_raii.hpp>
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vkrt {
+
+/// A physical device as `vkrt devices` shows it, with the reason it cannot run vkrt.
+struct DeviceInfo {
+    uint32_t index = 0;
+    std::string name;
+    vk::PhysicalDeviceType type = vk::PhysicalDeviceType::eOther;
+    std::string driver; ///< driver name and info, e.g. "llvmpipe: Mesa 22.3.6 (LLVM 15.0.6)"
+    uint32_t apiVersion = 0;
+    std::optional<uint32_t> computeQueueFamily;
+    std::string unsuitableReason; ///< empty when vkrt can use the device
+
+    bool suitable() const { return unsuitableReason.empty(); }
+    std::string typeName() const;
+    std::string apiVersionString() const;
+};
+
+struct ContextOptions {
+    /// Device index or case-insensitive name fragment; empty = default choice
+    /// (a discrete GPU if one is suitable, else a CPU device such as lavapipe).
+    std::string deviceSelector;
+    /// Enable VK_LAYER_KHRONOS_validation and record every message it emits.
+    bool validation = false;
+};
+
+/// Collects validation-layer messages (thread-safe; the layer may call from any thread).
+class ValidationLog {
+public:
+    void add(std::string message);
+    std::vector<std::string> messages() const;
+
+private:
+    mutable std::mutex m_mutex;
+    std::vector<std::string> m_messages;
+};
+
+class VulkanContext {
+public:
+    explicit VulkanContext(const ContextOptions& options = {});
+
+    /// Every physical device the loader reports, with suitability.
+    const std::vector<DeviceInfo>& devices() const { return m_devices; }
+    const DeviceInfo& deviceInfo() const { return m_devices[m_deviceIndex]; }
+    const vk::raii::PhysicalDevice& physicalDevice() const { return m_physicalDevice; }
+    const vk::raii::Device& device() const { return m_device; }
+    const vk::raii::Queue& queue() const { return m_queue; }
+    uint32_t queueFamily() const { return *deviceInfo().computeQueueFamily; }
+    const vk::raii::CommandPool& commandPool() const { return m_commandPool; }
+
+    bool validationEnabled() const { return m_validation; }
+    /// Messages the validation layer has emitted so far (empty when disabled).
+    std::vector<std::string> validationMessages() const { return m_validationLog->messages(); }
+
+    /// Index of a memory type with all `required` properties among `typeBits`,
+    /// preferring one that also has `preferred`; throws GpuError if none.
+    uint32_t findMemoryType(uint32_t typeBits, vk::MemoryPropertyFlags required,
+                            vk::MemoryPropertyFlags preferred = {}) const;
+
+    /// Records commands with `record`, submits them and waits for completion.
+    template <typename Record> void submitAndWait(Record&& record) const
+    {
+        vk::raii::CommandBuffer cmd = beginOneShot();
+        record(*cmd);
+        endSubmitAndWait(cmd);
+    }
+    vk::raii::CommandBuffer beginOneShot() const;
+    void endSubmitAndWait(const vk::raii::CommandBuffer& cmd) const;
+
+private:
+    bool m_validation = false;
+    std::unique_ptr<ValidationLog> m_validationLog = std::make_unique<ValidationLog>();
+    vk::raii::Context m_context;
+    vk::raii::Instance m_instance = nullptr;
+    vk::raii::DebugUtilsMessengerEXT m_messenger = nullptr;
+    std::vector<DeviceInfo> m_devices;
+    uint32_t m_deviceIndex = 0;
+    vk::raii::PhysicalDevice m_physicalDevice = nullptr;
+    vk::raii::Device m_device = nullptr;
+    vk::raii::Queue m_queue = nullptr;
+    vk::raii::CommandPool m_commandPool = nullptr;
+
+    void createInstance();
+    void chooseDevice(const std::string& selector);
+    void createDevice();
+};
+
+/// The device vkrt picks when none is named: a suitable discrete GPU, else a
+/// suitable CPU device (lavapipe), else any suitable device.
+uint32_t defaultDeviceIndex(const std::vector<DeviceInfo>& devices);
+/// Resolves `--device`: an index, or a case-insensitive fragment of one name.
+uint32_t selectDevice(const std::vector<DeviceInfo>& devices, const std::string& selector);
+
+/// Every physical device with its suitability, without creating a logical device.
+std::vector<DeviceInfo> listVulkanDevices();
+
+/// Lets lavapipe use more worker threads than cores (it splits each dispatch
+/// into one equal run per thread; more runs balance better). Must run before
+/// the Vulkan instance exists; never overrides a value the user set.
+void tuneSoftwareRasterizerThreads();
+
+} // namespace vkrt

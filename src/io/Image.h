@@ -1,0 +1,21 @@
+#pragma once
+// A linear float32 RGB image, rows top to bottom.
+#include <cstdint>
+#include <vector>
+
+namespace vkrt {
+
+struct Image {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<float> rgb; ///< width * height * 3 floats
+
+    Image() = default;
+    Image(uint32_t w, uint32_t h) : width(w), height(h), rgb(size_t(w) * h * 3, 0.0f) {}
+
+    size_t pixelCount() const { return size_t(width) * height; }
+    float* at(uint32_t x, uint32_t y) { return &rgb[(size_t(y) * width + x) * 3]; }
+    const float* at(uint32_t x, uint32_t y) const { return &rgb[(size_t(y) * width + x) * 3]; }
+};
+
+} // namespace vkrt

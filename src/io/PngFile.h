@@ -1,0 +1,20 @@
+#pragma once
+// 8-bit sRGB previews of linear HDR images.
+#include "io/Image.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace vkrt {
+
+/// Linear radiance -> display: scale by 2^exposure, clamp to [0,1], sRGB encode.
+uint8_t toneMapToSrgb8(float linear, float exposure);
+
+/// Tone-mapped RGBA8 pixels (alpha 255), rows top to bottom.
+std::vector<uint8_t> toneMapImage(const Image& image, float exposure);
+
+/// Writes a PNG atomically; throws InputError naming the path.
+void writePng(const std::filesystem::path& path, const Image& image, float exposure);
+
+} // namespace vkrt

@@ -1,0 +1,106 @@
+#include "render/GpuScene.h"
+
+#include "shared/Bindings.h"
+
+#include <cmath>
+#include <numeric>
+
+namespace vkrt {
+
+namespace {
+
+glm::vec3 toFloat(const glm::dvec3& v) { return glm::vec3(v); }
+
+/// World -> camera-relative float32.
+struct Relativizer {
+    glm::dvec3 eye;
+    glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3(p - eye); }
+};
+
+gpu::Material convertMaterial(const Material& m)
+{
+    gpu::Material g{};
+    g.diffuse = toFloat(m.diffuse);
+    g.type = uint32_t(m.type);
+    g.specular = toFloat(m.specular);
+    g.exponent = float(m.exponent);
+    g.absorption = toFloat(m.absorption);
+    g.ior = float(m.ior);
+    switch (m.fresnel) {
+    case FresnelMode::None: g.fresnel = gpu::FRESNEL_NONE; break;
+    case FresnelMode::Schlick: g.fresnel = gpu::FRESNEL_SCHLICK; break;
+    case FresnelMode::Exact: g.fresnel = gpu::FRESNEL_EXACT; break;
+    case FresnelMode::Default:
+        g.fresnel = m.type == MaterialType::Dielectric ? gpu::FRESNEL_SCHLICK : gpu::FRESNEL_NONE;
+        break;
+    }
+    return g;
+}
+
+void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
+{
+    glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
+    glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+    glm::dvec3 up = glm::cross(right, forward);
+    double halfHeight = std::tan(glm::radians(camera.fovY) / 2.0);
+    double halfWidth = halfHeight * double(camera.width) / double(camera.height);
+    u.cameraRight = toFloat(right * halfWidth);
+    u.cameraUp = toFloat(up * halfHeight);
+    u.cameraForward = toFloat(forward);
+    u.width = camera.width;
+    u.height = camera.height;
+}
+
+} // namespace
+
+uint32_t tileCountFor(uint32_t width, uint32_t height)
+{
+    uint32_t tilesX = (width + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
+    uint32_t tilesY = (height + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
+    return tilesX * tilesY;
+}
+
+uint32_t tileStrideFor(uint32_t tileCount)
+{
+    // Any stride coprime to the count visits every tile once; a prime above
+    // lavapipe's thread count sends each thread's run of workgroups across the
+    // whole image. Small enough that group * stride fits in 32 bits.
+    for (uint32_t stride : {17u, 19u, 23u, 29u, 31u, 37u, 41u, 43u, 47u})
+        if (std::gcd(stride, tileCount) == 1 && stride < tileCount) return stride;
+    return 1;
+}
+
+GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
+{
+    GpuSceneData data;
+    Relativizer rel{scene.camera.eye};
+    for (const auto& m : scene.materials) data.materials.push_back(convertMaterial(m));
+    for (const auto& s : scene.spheres) data.spheres.push_back({rel(s.center), float(s.radius), s.material});
+    for (const auto& b : scene.boxes) data.boxes.push_back({rel(b.min), b.material, rel(b.max)});
+    for (const auto& t : scene.triangles)
+        data.triangles.push_back({rel(t.vertices[0]), t.material, rel(t.vertices[1]), rel(t.vertices[2])});
+    for (const auto& p : scene.planes) data.planes.push_back({rel(p.point), p.material, toFloat(p.normal)});
+    for (const auto& l : scene.pointLights) data.pointLights.push_back({rel(l.position), toFloat(l.intensity)});
+    for (const auto& l : scene.triangleLights) {
+        double area = 0.5 * glm::length(glm::cross(l.vertices[1] - l.vertices[0], l.vertices[2] - l.vertices[0]));
+        data.triangleLights.push_back({rel(l.vertices[0]), float(area), rel(l.vertices[1]), l.twoSided ? 1u : 0u,
+                                       rel(l.vertices[2]), toFloat(l.radiance)});
+    }
+
+    gpu::SceneUniforms& u = data.uniforms;
+    convertCamera(scene.camera, u);
+    u.flags = settings.jitter ? gpu::RENDER_FLAG_JITTER : 0u;
+    u.backgroundColor = toFloat(scene.background.color);
+    u.maxDepth = uint32_t(scene.render.maxDepth);
+    u.sphereCount = uint32_t(data.spheres.size());
+    u.boxCount = uint32_t(data.boxes.size());
+    u.triangleCount = uint32_t(data.triangles.size());
+    u.planeCount = uint32_t(data.planes.size());
+    u.pointLightCount = uint32_t(data.pointLights.size());
+    u.triangleLightCount = uint32_t(data.triangleLights.size());
+    u.tileCount = tileCountFor(u.width, u.height);
+    u.tileStride = tileStrideFor(u.tileCount);
+    return data;
+}
+
+} // namespace vkrt

@@ -1,0 +1,34 @@
+#pragma once
+// Scene -> the GPU records of shaders/shared/SceneTypes.h. Positions are made
+// camera-relative in double precision before rounding to float32, so a scene
+// far from the world origin keeps full float precision near the camera.
+#include "scene/Scene.h"
+#include "shared/SceneTypes.h"
+
+#include <vector>
+
+namespace vkrt {
+
+struct GpuSceneData {
+    gpu::SceneUniforms uniforms{};
+    std::vector<gpu::Material> materials;
+    std::vector<gpu::Sphere> spheres;
+    std::vector<gpu::Box> boxes;
+    std::vector<gpu::Triangle> triangles;
+    std::vector<gpu::Plane> planes;
+    std::vector<gpu::PointLight> pointLights;
+    std::vector<gpu::TriangleLight> triangleLights;
+};
+
+struct FrameSettings {
+    bool jitter = true; ///< random point in each pixel; off = pixel centres
+};
+
+GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings);
+
+/// Workgroup tiles covering a width x height image.
+uint32_t tileCountFor(uint32_t width, uint32_t height);
+/// A stride coprime to tileCount that spreads consecutive workgroups over the image.
+uint32_t tileStrideFor(uint32_t tileCount);
+
+} // namespace vkrt

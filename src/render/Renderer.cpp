@@ -1,0 +1,139 @@
+#include "render/Renderer.h"
+
+#include "shared/Bindings.h"
+#include "util/Error.h"
+
+#include <algorithm>
+
+namespace vkrt {
+
+namespace {
+
+constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffer;
+
+FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
+{
+    checkLoopBudget(scene); // before any compilation or allocation
+    return options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
+}
+
+CompiledKernel compileVariant(const FeatureSet& features, const RenderOptions& options)
+{
+    KernelSource source{options.shaderRoot, "kernels/render.comp", features.defines()};
+    source.defines.insert(source.defines.end(), options.extraDefines.begin(), options.extraDefines.end());
+    return compileKernelCached(source, SpirvCache(options.cacheDirectory));
+}
+
+template <typename T> std::span<const std::byte> bytesOf(const T& value) { return std::as_bytes(std::span(&value, 1)); }
+
+} // namespace
+
+uint64_t worstCaseLoopIterations(const Scene& scene)
+{
+    // Whitted kernel: one camera ray over all primitives, then per point light
+    // one light-loop step plus a shadow ray over all primitives.
+    uint64_t primitives = scene.primitiveCount();
+    uint64_t lights = scene.pointLights.size();
+    return primitives + lights * (1 + primitives);
+}
+
+void checkLoopBudget(const Scene& scene)
+{
+    uint64_t worst = worstCaseLoopIterations(scene);
+    if (worst >= gpu::LOOP_BUDGET)
+        throw InputError(scene.path + ": scene too large: one pixel sample may need " + std::to_string(worst) +
+                         " loop iterations, but lavapipe stops every shader invocation at " +
+                         std::to_string(gpu::LOOP_BUDGET) + " (reduce primitives or lights)");
+}
+
+Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptions options)
+    : m_context(context),
+      m_options(std::move(options)),
+      m_features(chooseFeatures(scene, m_options)),
+      m_data(convertScene(scene, FrameSettings{m_options.jitter})),
+      m_compiled(compileVariant(m_features, m_options)),
+      m_accumulation(context, sizeof(gpu::AccumPixel) * size_t(scene.camera.width) * scene.camera.height,
+                     kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
+                     MemoryUse::Device),
+      m_stats(context, sizeof(gpu::RenderStats),
+              kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
+              MemoryUse::Device),
+      m_kernel(context, m_compiled.spirv, m_features.bindings(), sizeof(gpu::FrameConstants))
+{
+    m_accumulation.clear(context);
+    m_stats.clear(context);
+    bindSceneBuffers();
+}
+
+void Renderer::bindSceneBuffers()
+{
+    auto addBuffer = [&](uint32_t binding, auto&& records, vk::BufferUsageFlags usage) {
+        const auto& used = m_kernel.bindings();
+        if (std::find(used.begin(), used.end(), binding) == used.end()) return;
+        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, usage));
+        m_kernel.bind(binding, m_sceneBuffers.back());
+    };
+    m_sceneBuffers.reserve(gpu::BINDING_COUNT); // bind() keeps references: no reallocation
+    addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, vk::BufferUsageFlagBits::eUniformBuffer);
+    addBuffer(gpu::BINDING_MATERIALS, m_data.materials, kStorage);
+    addBuffer(gpu::BINDING_SPHERES, m_data.spheres, kStorage);
+    addBuffer(gpu::BINDING_BOXES, m_data.boxes, kStorage);
+    addBuffer(gpu::BINDING_TRIANGLES, m_data.triangles, kStorage);
+    addBuffer(gpu::BINDING_PLANES, m_data.planes, kStorage);
+    addBuffer(gpu::BINDING_POINT_LIGHTS, m_data.pointLights, kStorage);
+    addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, kStorage);
+    m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
+    m_kernel.bind(gpu::BINDING_STATS, m_stats);
+}
+
+void Renderer::recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const
+{
+    gpu::FrameConstants constants{frameIndex, m_options.seed};
+    uint32_t tilesX = (width() + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
+    uint32_t tilesY = (height() + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
+    m_kernel.recordDispatch(cmd, bytesOf(constants), vk::Extent2D(tilesX, tilesY));
+    // The next frame reads and writes the same accumulation pixels.
+    vk::MemoryBarrier barrier(vk::AccessFlagBits::eShaderWrite,
+                              vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
+                        barrier, nullptr, nullptr);
+}
+
+void Renderer::renderFrames(uint32_t frames)
+{
+    if (frames == 0) return;
+    m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+        for (uint32_t i = 0; i < frames; ++i) recordFrame(cmd, m_frames + i);
+    });
+    m_frames += frames;
+}
+
+Image Renderer::mean() const
+{
+    auto bytes = m_accumulation.download(m_context);
+    const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(bytes.data());
+    Image image(width(), height());
+    for (size_t i = 0; i < image.pixelCount(); ++i) {
+        const gpu::AccumPixel& p = pixels[i];
+        if (p.count == 0) continue; // every sample was non-finite: black, and counted
+        for (int c = 0; c < 3; ++c)
+            image.rgb[i * 3 + c] = float((double(p.sum[c]) - double(p.compensation[c])) / double(p.count));
+    }
+    return image;
+}
+
+RenderCounters Renderer::counters() const
+{
+    auto accumBytes = m_accumulation.download(m_context);
+    const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(accumBytes.data());
+    RenderCounters counters;
+    size_t pixelCount = size_t(width()) * height();
+    for (size_t i = 0; i < pixelCount; ++i) counters.rejectedSamples += m_frames - pixels[i].count;
+    auto statsBytes = m_stats.download(m_context);
+    const auto* stats = reinterpret_cast<const gpu::RenderStats*>(statsBytes.data());
+    counters.maxLoopIterations = stats->maxLoopIterations;
+    counters.budgetExceeded = stats->budgetExceeded;
+    return counters;
+}
+
+} // namespace vkrt

@@ -1,0 +1,70 @@
+#pragma once
+// Progressive renderer: owns the kernel variant for a scene, its GPU buffers
+// and the accumulation buffer; each frame adds one sample per pixel.
+#include "gpu/Buffer.h"
+#include "gpu/ComputeKernel.h"
+#include "gpu/ShaderCompiler.h"
+#include "io/Image.h"
+#include "render/GpuScene.h"
+#include "scene/FeatureSet.h"
+
+#include <filesystem>
+#include <optional>
+
+namespace vkrt {
+
+struct RenderOptions {
+    uint32_t seed = 0;
+    bool jitter = true;
+    bool uber = false;                 ///< all-features kernel instead of the scene's variant
+    std::vector<Define> extraDefines;  ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
+    std::filesystem::path shaderRoot = defaultShaderRoot();
+    std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
+};
+
+struct RenderCounters {
+    uint64_t rejectedSamples = 0;    ///< non-finite samples dropped (all pixels)
+    uint32_t maxLoopIterations = 0;  ///< largest per-invocation loop count seen
+    uint32_t budgetExceeded = 0;     ///< invocations that reached lavapipe's loop budget
+};
+
+class Renderer {
+public:
+    Renderer(const VulkanContext& context, const Scene& scene, RenderOptions options);
+
+    /// Adds `frames` samples per pixel (one dispatch each, one submission) and waits.
+    void renderFrames(uint32_t frames);
+    uint32_t completedFrames() const { return m_frames; }
+
+    /// Per-pixel mean of the accepted samples, resolved in double precision.
+    Image mean() const;
+    RenderCounters counters() const;
+
+    const FeatureSet& features() const { return m_features; }
+    const CompiledKernel& kernel() const { return m_compiled; }
+    uint32_t width() const { return m_data.uniforms.width; }
+    uint32_t height() const { return m_data.uniforms.height; }
+
+private:
+    const VulkanContext& m_context;
+    RenderOptions m_options;
+    FeatureSet m_features;
+    GpuSceneData m_data;
+    CompiledKernel m_compiled;
+    std::vector<Buffer> m_sceneBuffers;
+    Buffer m_accumulation;
+    Buffer m_stats;
+    ComputeKernel m_kernel;
+    uint32_t m_frames = 0;
+
+    void bindSceneBuffers();
+    void recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const;
+};
+
+/// Worst-case loop iterations one invocation of the scene's kernel can run.
+uint64_t worstCaseLoopIterations(const Scene& scene);
+
+/// Throws InputError naming the scene if its kernel could hit lavapipe's loop budget.
+void checkLoopBudget(const Scene& scene);
+
+} // namespace vkrt

@@ -1,0 +1,18 @@
+#pragma once
+// Reading scene files (TOML, documented in docs/scene-format.md) into a
+// validated Scene. All checking happens here so that the rest of vkrt can trust
+// every value it gets.
+#include "scene/Scene.h"
+
+#include <string>
+#include <string_view>
+
+namespace vkrt {
+
+/// Reads, parses and validates a scene file; throws SceneError (with file:line:column) or InputError (unreadable file).
+Scene parseSceneFile(const std::string& path);
+
+/// Same for text in memory; `path` is used in messages and to resolve relative paths (cubemap faces) against its directory.
+Scene parseSceneString(std::string_view text, const std::string& path = "<string>");
+
+} // namespace vkrt

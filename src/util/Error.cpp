@@ -1,0 +1,11 @@
+#include "util/Error.h"
+
+namespace vkrt {
+
+void failCheck(const char* expression, const char* file, int line)
+{
+    throw InternalError(std::string("internal error: check '") + expression + "' failed at " + file + ":" +
+                        std::to_string(line));
+}
+
+} // namespace vkrt
