@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -147,6 +148,13 @@ int runRender(const RenderCommandOptions& options)
 
 CommandRunner addRenderCommand(CLI::App& app)
 {
+    // CLI::Range lets NaN through (every comparison with it is false).
+    CLI::Validator finiteNumber(
+        [](const std::string& text) {
+            double value = std::strtod(text.c_str(), nullptr);
+            return std::isfinite(value) ? std::string() : "must be a finite number, got " + text;
+        },
+        "FINITE");
     auto options = std::make_shared<RenderCommandOptions>();
     CLI::App* cmd = app.add_subcommand("render", "Render a scene file to an OpenEXR image");
     cmd->add_option("scene", options->scenePath, "Scene file (TOML, see docs/scene-format.md)")->required();
@@ -159,7 +167,7 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--seed", options->seed, "Random seed (same seed, same image)");
     cmd->add_option("--device", options->device, "Vulkan device index or name (see `vkrt devices`)");
     cmd->add_option("--png", options->png, "Also write a tone-mapped 8-bit sRGB PNG preview");
-    cmd->add_option("--exposure", options->exposure, "PNG exposure in stops (x 2^E)")->check(CLI::Range(-64.0, 64.0));
+    cmd->add_option("--exposure", options->exposure, "PNG exposure in stops (x 2^E)")->check(finiteNumber)->check(CLI::Range(-64.0, 64.0));
     cmd->add_flag("--validation", options->validation,
                   "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");

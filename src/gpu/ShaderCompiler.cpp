@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <random>
 #include <sstream>
@@ -129,14 +130,22 @@ std::string glslangVersion()
 
 uint64_t glslangInvocationCount() { return g_glslangInvocations.load(); }
 
-std::vector<uint32_t> compileGlsl(const KernelSource& source)
+namespace {
+
+/// Parses and links one compute kernel; the shader must outlive the program.
+struct LinkedKernel {
+    glslang::TShader shader{EShLangCompute};
+    glslang::TProgram program;
+};
+
+std::unique_ptr<LinkedKernel> parseAndLink(const KernelSource& source)
 {
     initializeGlslangOnce();
-    ++g_glslangInvocations;
     auto text = readTextFile(source.shaderRoot / source.entryFile);
     if (!text) throw GpuError("cannot read kernel " + (source.shaderRoot / source.entryFile).string());
 
-    glslang::TShader shader(EShLangCompute);
+    auto linked = std::make_unique<LinkedKernel>();
+    glslang::TShader& shader = linked->shader;
     const char* strings[] = {text->c_str()};
     std::string name = displayName(source.entryFile);
     const char* names[] = {name.c_str()};
@@ -150,17 +159,37 @@ std::vector<uint32_t> compileGlsl(const KernelSource& source)
     RootedIncluder includer(source.shaderRoot);
     if (!shader.parse(GetDefaultResources(), 460, false, messages, includer))
         throw GpuError("GLSL compilation failed:\n" + std::string(shader.getInfoLog()) + variantSuffix(source));
+    linked->program.addShader(&shader);
+    if (!linked->program.link(messages))
+        throw GpuError("GLSL link failed:\n" + std::string(linked->program.getInfoLog()) + variantSuffix(source));
+    return linked;
+}
 
-    glslang::TProgram program;
-    program.addShader(&shader);
-    if (!program.link(messages))
-        throw GpuError("GLSL link failed:\n" + std::string(program.getInfoLog()) + variantSuffix(source));
+} // namespace
 
+std::vector<uint32_t> compileGlsl(const KernelSource& source)
+{
+    ++g_glslangInvocations;
+    auto linked = parseAndLink(source);
     std::vector<uint32_t> spirv;
     glslang::SpvOptions options;
     options.disableOptimizer = false;
-    glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), spirv, &options);
+    glslang::GlslangToSpv(*linked->program.getIntermediate(EShLangCompute), spirv, &options);
     return spirv;
+}
+
+std::vector<std::pair<std::string, int>> reflectBlockMemberOffsets(const KernelSource& source)
+{
+    auto linked = parseAndLink(source);
+    glslang::TProgram& program = linked->program;
+    if (!program.buildReflection(EShReflectionAllBlockVariables | EShReflectionSeparateBuffers))
+        throw GpuError("glslang reflection failed" + variantSuffix(source));
+    std::vector<std::pair<std::string, int>> offsets;
+    for (int i = 0; i < program.getNumUniformVariables(); ++i)
+        offsets.emplace_back(program.getUniform(i).name, program.getUniform(i).offset);
+    for (int i = 0; i < program.getNumBufferVariables(); ++i)
+        offsets.emplace_back(program.getBufferVariable(i).name, program.getBufferVariable(i).offset);
+    return offsets;
 }
 
 std::string kernelCacheKey(const KernelSource& source)

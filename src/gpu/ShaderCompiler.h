@@ -36,6 +36,10 @@ std::string describeDefines(const std::vector<Define>& defines);
 /// Compiles with glslang; throws GpuError with file:line messages and the defines.
 std::vector<uint32_t> compileGlsl(const KernelSource& source);
 
+/// Byte offset of every member of every uniform, storage and push-constant
+/// block as glslang lays it out, keyed "Block.member[0].field" as glslang names them.
+std::vector<std::pair<std::string, int>> reflectBlockMemberOffsets(const KernelSource& source);
+
 /// How many times compileGlsl ran in this process (tests check cache hits).
 uint64_t glslangInvocationCount();
 

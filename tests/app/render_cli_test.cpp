@@ -1,0 +1,199 @@
+// End-to-end tests of `vkrt render` and `vkrt devices` as a user runs them.
+#include "io/ExrFile.h"
+#include "support/TestSupport.h"
+
+#include <chrono>
+#include <fstream>
+#include <cmath>
+#include <csignal>
+#include <thread>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace vkrt::test {
+namespace {
+
+const std::string kDefaultScene = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/default.toml";
+
+class RenderCli : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        m_dir = freshTempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+        setenv("VKRT_CACHE_DIR", testCacheDir().c_str(), 1);
+    }
+    fs::path m_dir;
+
+    ProcessResult render(const std::string& output, std::vector<std::string> extra = {})
+    {
+        std::vector<std::string> args = {"render", kDefaultScene, "-o", (m_dir / output).string(),
+                                         "--width", "64", "--height", "48", "--validation"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const char* device = std::getenv("VKRT_TEST_DEVICE");
+        if (device && std::find(extra.begin(), extra.end(), "--device") == extra.end())
+            args.insert(args.end(), {"--device", device});
+        return runVkrt(args);
+    }
+
+    /// No leftovers such as temporary files in the output directory.
+    std::vector<std::string> filesInDir() const
+    {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(m_dir)) names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+};
+
+int64_t intAttribute(const Metadata& metadata, const std::string& name)
+{
+    auto it = metadata.find(name);
+    if (it == metadata.end() || !std::holds_alternative<int64_t>(it->second)) return -1;
+    return std::get<int64_t>(it->second);
+}
+
+std::string textAttribute(const Metadata& metadata, const std::string& name)
+{
+    auto it = metadata.find(name);
+    if (it == metadata.end() || !std::holds_alternative<std::string>(it->second)) return "";
+    return std::get<std::string>(it->second);
+}
+
+TEST_F(RenderCli, WritesExrWithMetadataAndPng)
+{
+    ProcessResult r = render("a.exr", {"--spp", "3", "--seed", "5", "--png", (m_dir / "a.png").string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    ExrContents exr = readExr(m_dir / "a.exr");
+    EXPECT_EQ(exr.image.width, 64u);
+    EXPECT_EQ(exr.image.height, 48u);
+    EXPECT_EQ(intAttribute(exr.metadata, "spp"), 3);
+    EXPECT_EQ(intAttribute(exr.metadata, "seed"), 5);
+    EXPECT_EQ(intAttribute(exr.metadata, "rejectedSamples"), 0);
+    EXPECT_EQ(textAttribute(exr.metadata, "stoppedBy"), "spp");
+    EXPECT_EQ(textAttribute(exr.metadata, "vkrtVersion"), VKRT_VERSION);
+    EXPECT_EQ(textAttribute(exr.metadata, "sceneHash").rfind("fnv1a64:", 0), 0u);
+    EXPECT_FALSE(textAttribute(exr.metadata, "device").empty());
+    EXPECT_FALSE(textAttribute(exr.metadata, "driver").empty());
+    EXPECT_TRUE(exr.metadata.count("renderSeconds"));
+    EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "a.png"}));
+    // Non-interactive runs print exactly one summary line.
+    EXPECT_NE(r.output.find("3 spp"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
+}
+
+TEST_F(RenderCli, SameSeedGivesIdenticalPixels)
+{
+    ASSERT_EQ(render("a.exr", {"--spp", "4", "--seed", "9"}).exitCode, 0);
+    ASSERT_EQ(render("b.exr", {"--spp", "4", "--seed", "9"}).exitCode, 0);
+    EXPECT_EQ(readExr(m_dir / "a.exr").image.rgb, readExr(m_dir / "b.exr").image.rgb);
+}
+
+// Different seeds give different noise but the same expected image: the mean
+// of the per-pixel differences is zero within its standard error (|z| < 4).
+TEST_F(RenderCli, DifferentSeedDifferentNoiseSameMean)
+{
+    ASSERT_EQ(render("a.exr", {"--spp", "4", "--seed", "1"}).exitCode, 0);
+    ASSERT_EQ(render("b.exr", {"--spp", "4", "--seed", "2"}).exitCode, 0);
+    Image a = readExr(m_dir / "a.exr").image, b = readExr(m_dir / "b.exr").image;
+    ASSERT_NE(a.rgb, b.rgb);
+    for (int c = 0; c < 3; ++c) {
+        double sum = 0, sumSq = 0;
+        size_t n = a.pixelCount();
+        for (size_t i = 0; i < n; ++i) {
+            double d = double(a.rgb[i * 3 + c]) - b.rgb[i * 3 + c];
+            sum += d;
+            sumSq += d * d;
+        }
+        double mean = sum / n, variance = (sumSq - n * mean * mean) / (n - 1);
+        ASSERT_GT(variance, 0.0);
+        EXPECT_LT(std::abs(mean / std::sqrt(variance / n)), 4.0) << "channel " << c;
+    }
+}
+
+TEST_F(RenderCli, InterruptWritesPartialImageWithTrueSpp)
+{
+    fs::path output = m_dir / "partial.exr";
+    pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        execl(VKRT_BINARY, "vkrt", "render", kDefaultScene.c_str(), "-o", output.c_str(), "--width", "64",
+              "--height", "48", "--spp", "1000000", (char*)nullptr);
+        _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    kill(child, SIGINT);
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    ExrContents exr = readExr(output);
+    int64_t spp = intAttribute(exr.metadata, "spp");
+    EXPECT_GT(spp, 0);
+    EXPECT_LT(spp, 1000000);
+    EXPECT_EQ(textAttribute(exr.metadata, "stoppedBy"), "interrupted");
+    EXPECT_EQ(filesInDir(), std::vector<std::string>{"partial.exr"});
+}
+
+TEST_F(RenderCli, BadOptionsNameTheOption)
+{
+    struct Case {
+        std::vector<std::string> args;
+        std::string expected;
+    } cases[] = {
+        {{"--spp", "0"}, "--spp"},
+        {{"--spp", "many"}, "--spp"},
+        {{"--width", "99999"}, "--width"},
+        {{"--height", "-3"}, "--height"},
+        {{"--exposure", "nan"}, "--exposure"},
+        {{"--device", "no-such-device"}, "--device no-such-device"},
+        {{"--bogus"}, "--bogus"},
+    };
+    for (const auto& c : cases) {
+        ProcessResult r = render("x.exr", c.args);
+        EXPECT_EQ(r.exitCode, 2) << c.args[0] << ": " << r.output;
+        EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
+    }
+    EXPECT_TRUE(filesInDir().empty());
+}
+
+TEST_F(RenderCli, SceneErrorsNameFileLineAndColumn)
+{
+    fs::path scene = m_dir / "bad.toml";
+    writeText(scene, "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, -1]\nfov = 200\n");
+    ProcessResult r = runVkrt({"render", scene.string(), "-o", (m_dir / "x.exr").string()});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find(scene.string() + ":4:7"), std::string::npos) << r.output;
+    ProcessResult missing = runVkrt({"render", (m_dir / "nope.toml").string()});
+    EXPECT_EQ(missing.exitCode, 2);
+    EXPECT_NE(missing.output.find("nope.toml"), std::string::npos) << missing.output;
+}
+
+TEST_F(RenderCli, FailedRunLeavesExistingOutputUntouched)
+{
+    writeText(m_dir / "keep.exr", "previous contents");
+    fs::path scene = m_dir / "bad.toml";
+    writeText(scene, "[camera]\nfov = 45\n");
+    ProcessResult r = runVkrt({"render", scene.string(), "-o", (m_dir / "keep.exr").string()});
+    EXPECT_EQ(r.exitCode, 2);
+    std::ifstream in(m_dir / "keep.exr");
+    std::string contents((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(contents, "previous contents");
+    ProcessResult noDir = render("missing-dir/x.exr", {"--spp", "1"});
+    EXPECT_EQ(noDir.exitCode, 2);
+    EXPECT_NE(noDir.output.find("missing-dir"), std::string::npos) << noDir.output;
+    EXPECT_EQ(filesInDir(), (std::vector<std::string>{"bad.toml", "keep.exr"}));
+}
+
+TEST(DevicesCli, ListsLavapipeAsUsable)
+{
+    ProcessResult r = runVkrt({"devices"});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("llvmpipe"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("* "), std::string::npos) << r.output;
+}
+
+} // namespace
+} // namespace vkrt::test

@@ -1,0 +1,92 @@
+// The C++ view of every GPU struct (shaders/shared) must match the layout
+// glslang gives the same struct in the real kernels: compare every member
+// offset with glslang's reflection of the all-features kernel.
+#include "gpu/ShaderCompiler.h"
+#include "scene/FeatureSet.h"
+#include "shared/Bindings.h"
+#include "shared/SceneTypes.h"
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <map>
+
+namespace vkrt::test {
+namespace {
+
+std::map<std::string, int> reflectedOffsets()
+{
+    KernelSource source{defaultShaderRoot(), "kernels/render.comp", FeatureSet::everything(Integrator::Whitted).defines()};
+    std::map<std::string, int> offsets;
+    for (const auto& [name, offset] : reflectBlockMemberOffsets(source)) offsets[name] = offset;
+    return offsets;
+}
+
+struct Member {
+    std::string reflectedName; // as glslang names it: element 0 of the array
+    size_t offset;             // offsetof in C++ plus the array element's base
+};
+
+#define ARRAY_MEMBER(array, Type, field) Member{#array "[0]." #field, offsetof(gpu::Type, field)}
+#define BLOCK_MEMBER(instance, Type, field) Member{#instance "." #field, offsetof(gpu::Type, field)}
+
+std::vector<Member> expectedMembers()
+{
+    return {
+        ARRAY_MEMBER(materials, Material, diffuse), ARRAY_MEMBER(materials, Material, type),
+        ARRAY_MEMBER(materials, Material, specular), ARRAY_MEMBER(materials, Material, exponent),
+        ARRAY_MEMBER(materials, Material, absorption), ARRAY_MEMBER(materials, Material, ior),
+        ARRAY_MEMBER(materials, Material, fresnel),
+        ARRAY_MEMBER(spheres, Sphere, center), ARRAY_MEMBER(spheres, Sphere, radius),
+        ARRAY_MEMBER(spheres, Sphere, material),
+        ARRAY_MEMBER(boxes, Box, lower), ARRAY_MEMBER(boxes, Box, material), ARRAY_MEMBER(boxes, Box, upper),
+        ARRAY_MEMBER(triangles, Triangle, v0), ARRAY_MEMBER(triangles, Triangle, material),
+        ARRAY_MEMBER(triangles, Triangle, v1), ARRAY_MEMBER(triangles, Triangle, v2),
+        ARRAY_MEMBER(planes, Plane, point), ARRAY_MEMBER(planes, Plane, material),
+        ARRAY_MEMBER(planes, Plane, normal),
+        ARRAY_MEMBER(pointLights, PointLight, position), ARRAY_MEMBER(pointLights, PointLight, intensity),
+        ARRAY_MEMBER(triangleLights, TriangleLight, v0), ARRAY_MEMBER(triangleLights, TriangleLight, area),
+        ARRAY_MEMBER(triangleLights, TriangleLight, v1), ARRAY_MEMBER(triangleLights, TriangleLight, twoSided),
+        ARRAY_MEMBER(triangleLights, TriangleLight, v2), ARRAY_MEMBER(triangleLights, TriangleLight, radiance),
+        ARRAY_MEMBER(accum, AccumPixel, sum), ARRAY_MEMBER(accum, AccumPixel, count),
+        ARRAY_MEMBER(accum, AccumPixel, compensation),
+        BLOCK_MEMBER(stats, RenderStats, maxLoopIterations), BLOCK_MEMBER(stats, RenderStats, budgetExceeded),
+        BLOCK_MEMBER(u, SceneUniforms, cameraRight), BLOCK_MEMBER(u, SceneUniforms, width),
+        BLOCK_MEMBER(u, SceneUniforms, cameraUp), BLOCK_MEMBER(u, SceneUniforms, height),
+        BLOCK_MEMBER(u, SceneUniforms, cameraForward), BLOCK_MEMBER(u, SceneUniforms, flags),
+        BLOCK_MEMBER(u, SceneUniforms, backgroundColor), BLOCK_MEMBER(u, SceneUniforms, maxDepth),
+        BLOCK_MEMBER(u, SceneUniforms, sphereCount), BLOCK_MEMBER(u, SceneUniforms, boxCount),
+        BLOCK_MEMBER(u, SceneUniforms, triangleCount), BLOCK_MEMBER(u, SceneUniforms, planeCount),
+        BLOCK_MEMBER(u, SceneUniforms, pointLightCount), BLOCK_MEMBER(u, SceneUniforms, triangleLightCount),
+        BLOCK_MEMBER(u, SceneUniforms, tileCount), BLOCK_MEMBER(u, SceneUniforms, tileStride),
+        BLOCK_MEMBER(frame, FrameConstants, frameIndex), BLOCK_MEMBER(frame, FrameConstants, seed),
+    };
+}
+
+TEST(SharedLayout, EveryMemberOffsetMatchesGlslangReflection)
+{
+    auto offsets = reflectedOffsets();
+    std::string names;
+    for (const auto& [name, offset] : offsets) names += name + "@" + std::to_string(offset) + " ";
+    for (const Member& m : expectedMembers()) {
+        auto it = offsets.find(m.reflectedName);
+        ASSERT_NE(it, offsets.end()) << m.reflectedName << " not reflected; glslang reported: " << names;
+        EXPECT_EQ(size_t(it->second), m.offset) << m.reflectedName;
+    }
+}
+
+// Each struct ends right after its last member (no tail padding on either side).
+TEST(SharedLayout, LastMemberEndsTheStruct)
+{
+    auto offsets = reflectedOffsets();
+    // glslang reports runtime arrays by their first element only; the
+    // stride is the struct size in the scalar layout, which static_asserts in
+    // src/gpu/SharedTypes.cpp pin. Here check the last member ends the struct.
+    EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
+    EXPECT_EQ(offsets.at("materials[0].fresnel") + 4, int(sizeof(gpu::Material)));
+    EXPECT_EQ(offsets.at("triangleLights[0].radiance") + 12, int(sizeof(gpu::TriangleLight)));
+    EXPECT_EQ(offsets.at("u.tileStride") + 4, int(sizeof(gpu::SceneUniforms)));
+}
+
+} // namespace
+} // namespace vkrt::test

@@ -1,0 +1,98 @@
+#include "support/TestSupport.h"
+
+#include "scene/SceneParser.h"
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace vkrt::test {
+
+namespace {
+
+bool validationLayerInstalled()
+{
+    vk::raii::Context context;
+    for (const auto& layer : context.enumerateInstanceLayerProperties())
+        if (std::string(layer.layerName.data()) == "VK_LAYER_KHRONOS_validation") return true;
+    return false;
+}
+
+std::string shellQuote(const std::string& arg)
+{
+    std::string quoted = "'";
+    for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+} // namespace
+
+const VulkanContext& gpu()
+{
+    static std::unique_ptr<VulkanContext> context = [] {
+        const char* device = std::getenv("VKRT_TEST_DEVICE");
+        return std::make_unique<VulkanContext>(ContextOptions{device ? device : "", validationLayerInstalled()});
+    }();
+    return *context;
+}
+
+void GpuTest::SetUp() { m_messagesBefore = gpu().validationMessages().size(); }
+
+void GpuTest::TearDown()
+{
+    auto messages = gpu().validationMessages();
+    for (size_t i = m_messagesBefore; i < messages.size(); ++i) ADD_FAILURE() << messages[i];
+}
+
+fs::path freshTempDir(const std::string& name)
+{
+    fs::path dir = fs::temp_directory_path() / ("vkrt-test-" + std::to_string(getpid()) + "-" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+fs::path testCacheDir()
+{
+    static fs::path dir = freshTempDir("spirv-cache");
+    return dir;
+}
+
+Scene sceneFromText(const std::string& text, const std::string& path) { return parseSceneString(text, path); }
+
+ProcessResult runVkrt(const std::vector<std::string>& args)
+{
+    std::string command = shellQuote(VKRT_BINARY);
+    for (const auto& arg : args) command += " " + shellQuote(arg);
+    command += " 2>&1";
+    ProcessResult result;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return result;
+    char buffer[4096];
+    size_t n;
+    while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) result.output.append(buffer, n);
+    int status = pclose(pipe);
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return result;
+}
+
+void writeText(const fs::path& path, const std::string& text)
+{
+    if (path.has_parent_path()) fs::create_directories(path.parent_path());
+    std::ofstream(path) << text;
+}
+
+double channelMean(const Image& image, int channel)
+{
+    double sum = 0.0;
+    for (size_t i = 0; i < image.pixelCount(); ++i) sum += image.rgb[i * 3 + channel];
+    return sum / double(image.pixelCount());
+}
+
+} // namespace vkrt::test

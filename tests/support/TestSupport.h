@@ -1,0 +1,55 @@
+#pragma once
+// Shared helpers for vkrt's tests: one Vulkan context per test process (with
+// validation on, so every GPU test also fails on any validation message),
+// scenes from text, and running the vkrt executable.
+#include "gpu/VulkanContext.h"
+#include "io/Image.h"
+#include "scene/Scene.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace vkrt::test {
+
+/// The device tests run on: $VKRT_TEST_DEVICE (default: vkrt's own choice).
+/// Validation is on whenever the Khronos layer is installed.
+const VulkanContext& gpu();
+
+/// Base for tests that use the GPU: fails the test if the validation layer
+/// reported anything while it ran.
+class GpuTest : public ::testing::Test {
+protected:
+    void SetUp() override;
+    void TearDown() override;
+
+private:
+    size_t m_messagesBefore = 0;
+};
+
+/// A fresh, empty directory removed at process exit is not guaranteed: tests use unique names.
+std::filesystem::path freshTempDir(const std::string& name);
+
+/// SPIR-V cache directory private to this test process.
+std::filesystem::path testCacheDir();
+
+/// Parses scene text (path used for messages and relative files).
+Scene sceneFromText(const std::string& text, const std::string& path = "test.toml");
+
+struct ProcessResult {
+    int exitCode = -1; ///< exit status, or 128 + signal
+    std::string output; ///< stdout and stderr interleaved
+};
+
+/// Runs the vkrt executable with `args` (each passed as one argument).
+ProcessResult runVkrt(const std::vector<std::string>& args);
+
+/// Writes text to a file (creating parent directories).
+void writeText(const std::filesystem::path& path, const std::string& text);
+
+/// Mean of one channel over all pixels.
+double channelMean(const Image& image, int channel);
+
+} // namespace vkrt::test
