@@ -13,6 +13,11 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/intersect.glsl"
 #include "lib/scene.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/fresnel.glsl"
+#include "lib/sampling.glsl"
+#include "lib/bsdf.glsl"
+#include "lib/environment.glsl"
+#include "lib/lights.glsl"
 #include "lib/whitted.glsl"
 
 // lavapipe hands each worker thread one contiguous run of workgroups; walking

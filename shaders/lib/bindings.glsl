@@ -30,6 +30,9 @@ layout(scalar, binding = BINDING_PLANES) readonly buffer PlaneBlock { Plane plan
 #ifdef VKRT_HAS_POINT_LIGHTS
 layout(scalar, binding = BINDING_POINT_LIGHTS) readonly buffer PointLightBlock { PointLight pointLights[]; };
 #endif
+#ifdef VKRT_HAS_CUBEMAP
+layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
+#endif
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
 layout(scalar, binding = BINDING_TRIANGLE_LIGHTS) readonly buffer TriangleLightBlock { TriangleLight triangleLights[]; };
 #endif

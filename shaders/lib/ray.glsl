@@ -5,6 +5,11 @@ const float FLT_MAX = 3.402823466e38;
 const float PI = 3.14159265358979323846;
 const float INV_PI = 0.31830988618379067154;
 
+// x^e with 0^0 = 1 (GLSL leaves pow(0, 0) undefined).
+float powSafe(float x, float e) { return e == 0.0 ? 1.0 : pow(max(x, 0.0), e); }
+
+float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
 struct Ray {
     vec3 origin;
     vec3 dir; // unit length

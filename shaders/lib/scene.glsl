@@ -11,12 +11,15 @@ const int SHAPE_SPHERE = 0;
 const int SHAPE_BOX = 1;
 const int SHAPE_TRIANGLE = 2;
 const int SHAPE_PLANE = 3;
+const int SHAPE_LIGHT = 4; // a triangle light: black, emitting, and opaque
 
 struct SurfaceHit {
     float t;
     vec3 position;
     vec3 normal; // unit geometric normal; outward for spheres and boxes
     uint material;
+    int shape;
+    uint index;
 };
 
 // The closest primitive along the ray: its shape kind, index and distance.
@@ -78,6 +81,20 @@ void closestPlanes(Ray r, inout HitId best)
 #endif
 }
 
+void closestLights(Ray r, inout HitId best)
+{
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    TriangleRay tr = triangleRaySetup(r);
+    for (uint i = 0u; i < u.triangleLightCount; ++i) {
+        ++g_loopIterations;
+        float t;
+        TriangleLight light = triangleLights[i];
+        if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, best.t, t))
+            best = HitId(SHAPE_LIGHT, i, t, vec3(0.0));
+    }
+#endif
+}
+
 HitId findClosest(Ray r, float tMax)
 {
     HitId best = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0));
@@ -85,8 +102,14 @@ HitId findClosest(Ray r, float tMax)
     closestBoxes(r, best);
     closestTriangles(r, best);
     closestPlanes(r, best);
+    closestLights(r, best);
     return best;
 }
+
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+// Unit normal of a triangle light: the side its counter-clockwise winding faces.
+vec3 triangleLightNormal(TriangleLight light) { return normalize(cross(light.v1 - light.v0, light.v2 - light.v0)); }
+#endif
 
 // Position, normal and material of the hit. Spheres and planes re-project the
 // point onto the surface, which removes the error of origin + t * dir.
@@ -95,6 +118,9 @@ SurfaceHit describeHit(Ray r, HitId id)
     SurfaceHit hit;
     hit.t = id.t;
     hit.position = r.origin + id.t * r.dir;
+    hit.shape = id.shape;
+    hit.index = id.index;
+    hit.material = 0u;
 #ifdef VKRT_HAS_SPHERES
     if (id.shape == SHAPE_SPHERE) {
         Sphere s = spheres[id.index];
@@ -124,6 +150,10 @@ SurfaceHit describeHit(Ray r, HitId id)
         hit.material = p.material;
     }
 #endif
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    if (id.shape == SHAPE_LIGHT)
+        hit.normal = triangleLightNormal(triangleLights[id.index]);
+#endif
     return hit;
 }
 
@@ -136,10 +166,5 @@ bool traceClosest(Ray r, float tMax, out SurfaceHit hit)
     return true;
 }
 
-// True when anything blocks the segment from r.origin to r.origin + tMax * r.dir.
-bool occluded(Ray r, float tMax)
-{
-    return findClosest(r, tMax).shape != SHAPE_NONE;
-}
 
 #endif

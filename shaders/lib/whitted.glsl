@@ -1,42 +1,69 @@
-// Whitted-style shading: direct light from point lights with hard shadows.
+// Whitted-style integrator, faithful to the seed renderer: at every surface,
+// direct light from point lights (hard shadows) and triangle lights (one
+// sample per light per frame: soft shadows converge over frames), then one
+// continuation ray chosen by the material's scattering model (perfect
+// specular, Lambert, glossy, Fresnel-weighted dielectric reflection or
+// refraction), up to max_depth. Lights hit by a continuation ray count only
+// after a specular bounce or from the camera, because direct lighting has
+// already accounted for them otherwise. Documented in docs/whitted.md.
 #ifndef VKRT_WHITTED_GLSL
 #define VKRT_WHITTED_GLSL
 
-// Radiance leaving a Lambert surface towards the viewer from all point lights:
-// sum of (albedo / pi) * I * cos(theta) / d^2 over unshadowed lights.
-vec3 directPointLights(SurfaceHit hit, vec3 facingNormal, vec3 albedo)
+struct PathState {
+    vec3 radiance;
+    vec3 throughput;
+    vec3 mediumAbsorption; // kappa of the dielectric the ray travels in (0 outside)
+    bool countEmission;
+};
+
+// Radiance a continuation ray picks up when it leaves the scene or hits a light.
+void addEscapedRadiance(inout PathState path, Ray ray, SurfaceHit hit, bool missed)
 {
-    vec3 radiance = vec3(0.0);
-#ifdef VKRT_HAS_POINT_LIGHTS
-    vec3 origin = offsetRayOrigin(hit.position, facingNormal);
-    for (uint i = 0u; i < u.pointLightCount; ++i) {
-        ++g_loopIterations;
-        PointLight light = pointLights[i];
-        vec3 toLight = light.position - origin;
-        float distSq = dot(toLight, toLight);
-        float dist = sqrt(distSq);
-        vec3 wi = toLight / dist;
-        float cosTheta = dot(facingNormal, wi);
-        if (cosTheta <= 0.0 || occluded(Ray(origin, wi), dist))
-            continue;
-        radiance += albedo * INV_PI * light.intensity * (cosTheta / distSq);
+    if (missed) {
+        path.radiance += path.throughput * environmentRadiance(ray.dir);
+        return;
     }
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    if (path.countEmission)
+        path.radiance += path.throughput * emittedRadiance(triangleLights[hit.index], -ray.dir);
 #endif
-    return radiance;
 }
 
 vec3 traceWhitted(Ray ray, inout Sampler rng)
 {
-#ifndef VKRT_HAS_MATERIALS
-    return u.backgroundColor; // a scene without objects
-#else
-    SurfaceHit hit;
-    if (!traceClosest(ray, FLT_MAX, hit))
-        return u.backgroundColor;
-    vec3 facingNormal = dot(hit.normal, ray.dir) < 0.0 ? hit.normal : -hit.normal;
-    Material m = materials[hit.material];
-    return directPointLights(hit, facingNormal, m.diffuse);
+    PathState path = PathState(vec3(0.0), vec3(1.0), vec3(0.0), true);
+    for (uint depth = 1u; depth <= u.maxDepth; ++depth) {
+        ++g_loopIterations;
+        SurfaceHit hit;
+        bool missed = !traceClosest(ray, FLT_MAX, hit);
+        // Beer-Lambert over the segment just travelled inside a dielectric.
+        path.throughput *= beerLambert(path.mediumAbsorption, missed ? FLT_MAX : hit.t);
+        if (missed || hit.shape == SHAPE_LIGHT) {
+            addEscapedRadiance(path, ray, hit, missed);
+            break;
+        }
+#ifdef VKRT_HAS_MATERIALS
+        Material m = materials[hit.material];
+        bool frontFace = dot(hit.normal, ray.dir) < 0.0;
+        vec3 n = frontFace ? hit.normal : -hit.normal;
+        vec3 wo = -ray.dir;
+        if (!isDeltaMaterial(m.type)) {
+            path.radiance += path.throughput * (directFromPointLights(m, hit.position, n, wo) +
+                                                directFromTriangleLights(m, hit.position, n, wo, rng));
+        }
+        if (depth == u.maxDepth)
+            break;
+        BsdfSample s = sampleBsdf(m, n, wo, frontFace, sampleNext4D(rng).xyz);
+        if (s.weight == vec3(0.0))
+            break;
+        path.throughput *= s.weight;
+        path.countEmission = s.specular;
+        if (s.transmitted)
+            path.mediumAbsorption = frontFace ? m.absorption : vec3(0.0);
+        ray = Ray(offsetRayOrigin(hit.position, s.transmitted ? -n : n), s.dir);
 #endif
+    }
+    return path.radiance;
 }
 
 #endif

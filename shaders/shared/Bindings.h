@@ -17,7 +17,8 @@ VKRT_CONSTANT(uint, BINDING_TRIANGLES, 6)       // Triangle[]
 VKRT_CONSTANT(uint, BINDING_PLANES, 7)          // Plane[]
 VKRT_CONSTANT(uint, BINDING_POINT_LIGHTS, 8)    // PointLight[]
 VKRT_CONSTANT(uint, BINDING_TRIANGLE_LIGHTS, 9) // TriangleLight[]
-VKRT_CONSTANT(uint, BINDING_COUNT, 10)
+VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 10)    // samplerCube of environment radiance
+VKRT_CONSTANT(uint, BINDING_COUNT, 11)
 
 // 8x8 workgroups: lavapipe runs 8-wide subgroups and 64 invocations per group
 // measured fastest (shared/NUMERICS.md); square tiles keep rays coherent.
@@ -28,6 +29,10 @@ VKRT_CONSTANT(uint, WORKGROUP_SIZE_Y, 8)
 // total. Kernels count their loop iterations; the host refuses scenes whose
 // worst case could exceed this budget and reports any kernel that reaches it.
 VKRT_CONSTANT(uint, LOOP_BUDGET, 65535)
+
+// A shadow ray passes through at most this many dielectric interfaces; a ray
+// that would cross more is treated as blocked (documented in docs/whitted.md).
+VKRT_CONSTANT(uint, MAX_SHADOW_CROSSINGS, 16)
 
 VKRT_END_NAMESPACE
 

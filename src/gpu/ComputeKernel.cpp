@@ -10,7 +10,9 @@ namespace vkrt {
 vk::DescriptorType descriptorTypeOf(uint32_t binding)
 {
     VKRT_CHECK(binding < gpu::BINDING_COUNT);
-    return binding == gpu::BINDING_UNIFORMS ? vk::DescriptorType::eUniformBuffer : vk::DescriptorType::eStorageBuffer;
+    if (binding == gpu::BINDING_UNIFORMS) return vk::DescriptorType::eUniformBuffer;
+    if (binding == gpu::BINDING_ENVIRONMENT) return vk::DescriptorType::eCombinedImageSampler;
+    return vk::DescriptorType::eStorageBuffer;
 }
 
 ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv,
@@ -46,6 +48,14 @@ void ComputeKernel::bind(uint32_t binding, const Buffer& buffer)
     VKRT_CHECK(std::find(m_bindings.begin(), m_bindings.end(), binding) != m_bindings.end());
     vk::DescriptorBufferInfo info(buffer.handle(), 0, VK_WHOLE_SIZE);
     vk::WriteDescriptorSet write(*m_set, binding, 0, descriptorTypeOf(binding), nullptr, info);
+    m_context.device().updateDescriptorSets(write, nullptr);
+}
+
+void ComputeKernel::bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler)
+{
+    VKRT_CHECK(std::find(m_bindings.begin(), m_bindings.end(), binding) != m_bindings.end());
+    vk::DescriptorImageInfo info(sampler, view, vk::ImageLayout::eShaderReadOnlyOptimal);
+    vk::WriteDescriptorSet write(*m_set, binding, 0, descriptorTypeOf(binding), info);
     m_context.device().updateDescriptorSets(write, nullptr);
 }
 

@@ -18,6 +18,8 @@ public:
 
     /// Points `binding` at `buffer` (the whole buffer).
     void bind(uint32_t binding, const Buffer& buffer);
+    /// Points a combined image-sampler `binding` at an image view.
+    void bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler);
     /// Records bind + push constants + dispatch of `groups`.
     void recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, vk::Extent2D groups) const;
     const std::vector<uint32_t>& bindings() const { return m_bindings; }

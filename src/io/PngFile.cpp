@@ -1,12 +1,15 @@
 #include "io/PngFile.h"
 
 #include "io/AtomicFile.h"
+#include "io/ExrFile.h"
 #include "util/Error.h"
 
+#include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace vkrt {
 
@@ -35,6 +38,37 @@ void writePng(const std::filesystem::path& path, const Image& image, float expos
                             int(image.width * 4)))
             throw InputError(path.string() + ": cannot write PNG");
     });
+}
+
+} // namespace vkrt
+
+namespace vkrt {
+
+float srgb8ToLinear(uint8_t value)
+{
+    float v = float(value) / 255.0f;
+    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+Image readPng(const std::filesystem::path& path)
+{
+    int width = 0, height = 0, channels = 0;
+    std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(path.c_str(), &width, &height, &channels, 3),
+                                                      stbi_image_free);
+    if (!pixels)
+        throw InputError(path.string() + ": cannot read PNG: " + (stbi_failure_reason() ? stbi_failure_reason() : "?"));
+    Image image{uint32_t(width), uint32_t(height)};
+    for (size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = srgb8ToLinear(pixels.get()[i]);
+    return image;
+}
+
+Image readRgbImage(const std::filesystem::path& path)
+{
+    std::string extension = path.extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension == ".exr") return readExr(path).image;
+    if (extension == ".png") return readPng(path);
+    throw InputError(path.string() + ": unsupported image type (expected .exr or .png)");
 }
 
 } // namespace vkrt

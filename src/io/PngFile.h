@@ -17,4 +17,13 @@ std::vector<uint8_t> toneMapImage(const Image& image, float exposure);
 /// Writes a PNG atomically; throws InputError naming the path.
 void writePng(const std::filesystem::path& path, const Image& image, float exposure);
 
+/// Exact sRGB decoding of an 8-bit value to linear.
+float srgb8ToLinear(uint8_t value);
+
+/// Reads an 8-bit sRGB PNG as linear RGB; throws InputError naming the path.
+Image readPng(const std::filesystem::path& path);
+
+/// Reads .exr (linear) or .png (sRGB) by extension; throws InputError naming the path.
+Image readRgbImage(const std::filesystem::path& path);
+
 } // namespace vkrt

@@ -17,7 +17,7 @@ struct Relativizer {
     glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3(p - eye); }
 };
 
-gpu::Material convertMaterial(const Material& m)
+gpu::Material convertMaterial(const Material& m, Integrator integrator)
 {
     gpu::Material g{};
     g.diffuse = toFloat(m.diffuse);
@@ -31,7 +31,9 @@ gpu::Material convertMaterial(const Material& m)
     case FresnelMode::Schlick: g.fresnel = gpu::FRESNEL_SCHLICK; break;
     case FresnelMode::Exact: g.fresnel = gpu::FRESNEL_EXACT; break;
     case FresnelMode::Default:
-        g.fresnel = m.type == MaterialType::Dielectric ? gpu::FRESNEL_SCHLICK : gpu::FRESNEL_NONE;
+        // The seed's Whitted renderer uses Schlick for glass; physics wants the exact form.
+        if (m.type != MaterialType::Dielectric) g.fresnel = gpu::FRESNEL_NONE;
+        else g.fresnel = integrator == Integrator::Path ? gpu::FRESNEL_EXACT : gpu::FRESNEL_SCHLICK;
         break;
     }
     return g;
@@ -52,6 +54,22 @@ void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
 }
 
 } // namespace
+
+double triangleArea(const std::array<glm::dvec3, 3>& v)
+{
+    return 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+}
+
+std::vector<TriangleLight> emittingTriangleLights(const Scene& scene)
+{
+    std::vector<TriangleLight> lights;
+    for (const auto& l : scene.triangleLights) {
+        double area = triangleArea(l.vertices);
+        // A light whose area is zero (or rounds to zero in float) emits nothing.
+        if (area > 0.0 && float(area) > 0.0 && std::isfinite(area)) lights.push_back(l);
+    }
+    return lights;
+}
 
 uint32_t tileCountFor(uint32_t width, uint32_t height)
 {
@@ -74,15 +92,15 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
 {
     GpuSceneData data;
     Relativizer rel{scene.camera.eye};
-    for (const auto& m : scene.materials) data.materials.push_back(convertMaterial(m));
+    for (const auto& m : scene.materials) data.materials.push_back(convertMaterial(m, scene.render.integrator));
     for (const auto& s : scene.spheres) data.spheres.push_back({rel(s.center), float(s.radius), s.material});
     for (const auto& b : scene.boxes) data.boxes.push_back({rel(b.min), b.material, rel(b.max)});
     for (const auto& t : scene.triangles)
         data.triangles.push_back({rel(t.vertices[0]), t.material, rel(t.vertices[1]), rel(t.vertices[2])});
     for (const auto& p : scene.planes) data.planes.push_back({rel(p.point), p.material, toFloat(p.normal)});
     for (const auto& l : scene.pointLights) data.pointLights.push_back({rel(l.position), toFloat(l.intensity)});
-    for (const auto& l : scene.triangleLights) {
-        double area = 0.5 * glm::length(glm::cross(l.vertices[1] - l.vertices[0], l.vertices[2] - l.vertices[0]));
+    for (const auto& l : emittingTriangleLights(scene)) {
+        double area = triangleArea(l.vertices);
         data.triangleLights.push_back({rel(l.vertices[0]), float(area), rel(l.vertices[1]), l.twoSided ? 1u : 0u,
                                        rel(l.vertices[2]), toFloat(l.radiance)});
     }

@@ -26,6 +26,12 @@ struct FrameSettings {
 
 GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings);
 
+/// Triangle lights that can emit: zero-area (degenerate) ones are dropped.
+std::vector<TriangleLight> emittingTriangleLights(const Scene& scene);
+
+/// Area of a triangle, computed in double.
+double triangleArea(const std::array<glm::dvec3, 3>& v);
+
 /// Workgroup tiles covering a width x height image.
 uint32_t tileCountFor(uint32_t width, uint32_t height);
 /// A stride coprime to tileCount that spreads consecutive workgroups over the image.

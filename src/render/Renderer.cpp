@@ -1,5 +1,6 @@
 #include "render/Renderer.h"
 
+#include "render/Environment.h"
 #include "shared/Bindings.h"
 #include "util/Error.h"
 
@@ -24,17 +25,29 @@ CompiledKernel compileVariant(const FeatureSet& features, const RenderOptions& o
     return compileKernelCached(source, SpirvCache(options.cacheDirectory));
 }
 
+Image constantFace(const glm::vec3& colour)
+{
+    Image face(1, 1);
+    face.rgb = {colour.x, colour.y, colour.z};
+    return face;
+}
+
 template <typename T> std::span<const std::byte> bytesOf(const T& value) { return std::as_bytes(std::span(&value, 1)); }
 
 } // namespace
 
 uint64_t worstCaseLoopIterations(const Scene& scene)
 {
-    // Whitted kernel: one camera ray over all primitives, then per point light
-    // one light-loop step plus a shadow ray over all primitives.
-    uint64_t primitives = scene.primitiveCount();
-    uint64_t lights = scene.pointLights.size();
-    return primitives + lights * (1 + primitives);
+    // Whitted kernel, per depth: one depth-loop step, a closest-hit query over
+    // every hittable (primitives and triangle lights), and per light one
+    // light-loop step plus a shadow query; with dielectrics a shadow query
+    // may repeat once per interface it crosses.
+    uint64_t hittables = scene.primitiveCount() + emittingTriangleLights(scene).size();
+    bool dielectrics = featuresOf(scene).has(MaterialType::Dielectric);
+    uint64_t shadowQuery = dielectrics ? gpu::MAX_SHADOW_CROSSINGS * (1 + hittables) : hittables;
+    uint64_t lights = scene.pointLights.size() + emittingTriangleLights(scene).size();
+    uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery);
+    return uint64_t(scene.render.maxDepth) * perDepth;
 }
 
 void checkLoopBudget(const Scene& scene)
@@ -58,7 +71,8 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, m_features.bindings(), sizeof(gpu::FrameConstants))
+      m_kernel(context, m_compiled.spirv, m_features.bindings(), sizeof(gpu::FrameConstants)),
+      m_cubemap(scene.background.cubemap)
 {
     m_accumulation.clear(context);
     m_stats.clear(context);
@@ -84,6 +98,16 @@ void Renderer::bindSceneBuffers()
     addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, kStorage);
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
+    const auto& used = m_kernel.bindings();
+    if (std::find(used.begin(), used.end(), gpu::BINDING_ENVIRONMENT) != used.end()) {
+        // The uber kernel samples a cubemap even for a constant background:
+        // give it a 1x1 cube of that colour.
+        std::array<Image, 6> faces;
+        if (m_cubemap) faces = loadCubemapFaces(*m_cubemap);
+        else faces.fill(constantFace(m_data.uniforms.backgroundColor));
+        m_environment.emplace(m_context, faces);
+        m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
+    }
 }
 
 void Renderer::recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const

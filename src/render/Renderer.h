@@ -3,6 +3,7 @@
 // and the accumulation buffer; each frame adds one sample per pixel.
 #include "gpu/Buffer.h"
 #include "gpu/ComputeKernel.h"
+#include "gpu/CubeTexture.h"
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
 #include "render/GpuScene.h"
@@ -55,6 +56,8 @@ private:
     Buffer m_accumulation;
     Buffer m_stats;
     ComputeKernel m_kernel;
+    std::optional<Cubemap> m_cubemap;
+    std::optional<CubeTexture> m_environment;
     uint32_t m_frames = 0;
 
     void bindSceneBuffers();

@@ -24,7 +24,7 @@ constexpr OptionalFeature kOptionalFeatures[] = {
     {&FeatureSet::planes, "VKRT_HAS_PLANES", int(gpu::BINDING_PLANES), "planes"},
     {&FeatureSet::pointLights, "VKRT_HAS_POINT_LIGHTS", int(gpu::BINDING_POINT_LIGHTS), "point-lights"},
     {&FeatureSet::triangleLights, "VKRT_HAS_TRIANGLE_LIGHTS", int(gpu::BINDING_TRIANGLE_LIGHTS), "triangle-lights"},
-    {&FeatureSet::cubemap, "VKRT_HAS_CUBEMAP", -1, "cubemap"},
+    {&FeatureSet::cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"},
 };
 
 std::string upper(std::string text)

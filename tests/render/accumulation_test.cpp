@@ -66,11 +66,14 @@ TEST_F(AccumulationTest, CleanRenderRejectsNothing)
     EXPECT_EQ(renderer.counters().rejectedSamples, 0u);
 }
 
-// One lit surface pixel runs: 3 primitive tests for the camera ray, then one
-// light-loop step and 3 primitive tests for the shadow ray.
+// With max_depth = 1 a lit surface pixel runs one depth-loop step, 3
+// primitive tests for the camera ray, then one light-loop step and 3
+// primitive tests for the shadow ray: 8 iterations.
 TEST_F(AccumulationTest, LoopCounterMatchesWorstCase)
 {
     Scene scene = sceneFromText(R"(
+[render]
+max_depth = 1
 [camera]
 eye = [0, 1, 4]
 target = [0, 0, 0]
@@ -103,7 +106,7 @@ intensity = 5
     renderer.renderFrames(2);
     RenderCounters counters = renderer.counters();
     EXPECT_EQ(counters.maxLoopIterations, worstCaseLoopIterations(scene));
-    EXPECT_EQ(counters.maxLoopIterations, 7u);
+    EXPECT_EQ(counters.maxLoopIterations, 8u);
     EXPECT_EQ(counters.budgetExceeded, 0u);
 }
 

@@ -28,7 +28,10 @@ glm::dvec3 pixelCentreRay(const Camera& c, uint32_t x, uint32_t y)
     return glm::normalize(sx * right + sy * up + forward);
 }
 
+// max_depth = 1: direct light only, so the closed forms below hold exactly.
 const char* kLambertPlaneScene = R"(
+[render]
+max_depth = 1
 [camera]
 eye = [0.3, 2.0, 3.0]
 target = [0.0, 0.0, -0.5]

@@ -1,0 +1,74 @@
+// Fresnel reflectance. Cosines are clamped to [0, 1], so inputs a rounding
+// step outside the range still give finite results.
+#ifndef VKRT_FRESNEL_GLSL
+#define VKRT_FRESNEL_GLSL
+
+// R0 = ((n - 1) / (n + 1))^2, divided before squaring so huge IORs stay finite.
+float schlickR0(float ior)
+{
+    float r = (ior - 1.0) / (ior + 1.0);
+    return r * r;
+}
+
+// Schlick's approximation R = R0 + (1 - R0)(1 - cos)^5.
+float fresnelSchlick(float cosTheta, float r0)
+{
+    float m = 1.0 - clamp(cosTheta, 0.0, 1.0);
+    float m2 = m * m;
+    return r0 + (1.0 - r0) * (m2 * m2 * m);
+}
+
+// Exact unpolarized Fresnel reflectance of a dielectric interface. `eta` is
+// n_incident / n_transmitted, cosI the incident cosine; 1 under total
+// internal reflection.
+float fresnelExact(float cosI, float eta)
+{
+    cosI = clamp(cosI, 0.0, 1.0);
+    float sin2T = eta * eta * (1.0 - cosI * cosI);
+    if (sin2T >= 1.0)
+        return 1.0;
+    float cosT = sqrt(1.0 - sin2T);
+    float rs = (eta * cosI - cosT) / (eta * cosI + cosT);
+    float rp = (cosI - eta * cosT) / (cosI + eta * cosT);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+// Schlick for a dielectric: the angle on the less dense side enters the
+// formula (the transmitted angle when light leaves the denser medium), and
+// total internal reflection gives 1.
+float fresnelSchlickDielectric(float cosI, float eta, float ior)
+{
+    cosI = clamp(cosI, 0.0, 1.0);
+    float sin2T = eta * eta * (1.0 - cosI * cosI);
+    if (sin2T >= 1.0)
+        return 1.0;
+    float cosT = sqrt(1.0 - sin2T);
+    return fresnelSchlick(eta > 1.0 ? cosT : cosI, schlickR0(ior));
+}
+
+// A dielectric's reflectance in its configured mode (eta = n_i / n_t).
+float dielectricReflectance(uint mode, float cosI, float eta, float ior)
+{
+    if (mode == FRESNEL_EXACT)
+        return fresnelExact(cosI, eta);
+    if (mode == FRESNEL_SCHLICK)
+        return fresnelSchlickDielectric(cosI, eta, ior);
+    return 0.0;
+}
+
+// Reflection strength of mirror and glossy surfaces (R0 from their IOR).
+float conductorLikeReflectance(uint mode, float cosTheta, float ior)
+{
+    return mode == FRESNEL_SCHLICK ? fresnelSchlick(cosTheta, schlickR0(ior)) : 1.0;
+}
+
+// Beer-Lambert transmittance exp(-kappa t). kappa = 0 gives 1 even when
+// t = inf (0 * inf would be NaN); exp(-huge) underflows to exactly 0.
+vec3 beerLambert(vec3 kappa, float t)
+{
+    return vec3(kappa.x > 0.0 ? exp(-kappa.x * t) : 1.0,
+                kappa.y > 0.0 ? exp(-kappa.y * t) : 1.0,
+                kappa.z > 0.0 ? exp(-kappa.z * t) : 1.0);
+}
+
+#endif
