@@ -3,9 +3,10 @@
 // sample per light per frame: soft shadows converge over frames), then one
 // continuation ray chosen by the material's scattering model (perfect
 // specular, Lambert, glossy, Fresnel-weighted dielectric reflection or
-// refraction), up to max_depth. Lights hit by a continuation ray count only
-// after a specular bounce or from the camera, because direct lighting has
-// already accounted for them otherwise. Documented in docs/whitted.md.
+// refraction), up to max_depth. A light is seen only along purely specular
+// chains from the camera (in mirrors and through glass); after any diffuse or
+// glossy bounce light arrives only through shadow rays, as in the seed, so
+// there are no caustics. Documented in docs/whitted.md.
 #ifndef VKRT_WHITTED_GLSL
 #define VKRT_WHITTED_GLSL
 
@@ -57,7 +58,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;
-        path.countEmission = s.specular;
+        path.countEmission = path.countEmission && s.specular;
         if (s.transmitted)
             path.mediumAbsorption = frontFace ? m.absorption : vec3(0.0);
         ray = Ray(offsetRayOrigin(hit.position, s.transmitted ? -n : n), s.dir);

@@ -15,8 +15,15 @@ vk::DescriptorType descriptorTypeOf(uint32_t binding)
     return vk::DescriptorType::eStorageBuffer;
 }
 
+std::vector<KernelBinding> renderKernelBindings(const std::vector<uint32_t>& indices)
+{
+    std::vector<KernelBinding> bindings;
+    for (uint32_t index : indices) bindings.push_back({index, descriptorTypeOf(index)});
+    return bindings;
+}
+
 ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv,
-                             std::vector<uint32_t> bindings, uint32_t pushConstantSize)
+                             std::vector<KernelBinding> bindings, uint32_t pushConstantSize)
     : m_context(context), m_bindings(std::move(bindings)), m_pushConstantSize(pushConstantSize)
 {
     const auto& device = context.device();
@@ -24,15 +31,17 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
 
     std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
     std::vector<vk::DescriptorPoolSize> poolSizes;
-    for (uint32_t binding : m_bindings) {
-        layoutBindings.emplace_back(binding, descriptorTypeOf(binding), 1, vk::ShaderStageFlagBits::eCompute);
-        poolSizes.emplace_back(descriptorTypeOf(binding), 1);
+    for (const KernelBinding& binding : m_bindings) {
+        layoutBindings.emplace_back(binding.index, binding.type, 1, vk::ShaderStageFlagBits::eCompute);
+        poolSizes.emplace_back(binding.type, 1);
     }
     m_setLayout = vk::raii::DescriptorSetLayout(device, vk::DescriptorSetLayoutCreateInfo({}, layoutBindings));
 
     vk::PushConstantRange pushRange(vk::ShaderStageFlagBits::eCompute, 0, pushConstantSize);
     vk::DescriptorSetLayout setLayout = *m_setLayout;
-    m_pipelineLayout = vk::raii::PipelineLayout(device, vk::PipelineLayoutCreateInfo({}, setLayout, pushRange));
+    vk::PipelineLayoutCreateInfo layoutInfo({}, setLayout, pushRange);
+    if (pushConstantSize == 0) layoutInfo.setPushConstantRanges({});
+    m_pipelineLayout = vk::raii::PipelineLayout(device, layoutInfo);
 
     vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *m_module, "main");
     m_pipeline = vk::raii::Pipeline(device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *m_pipelineLayout));
@@ -43,19 +52,29 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
     m_set = std::move(sets[0]);
 }
 
+bool ComputeKernel::uses(uint32_t binding) const
+{
+    return std::any_of(m_bindings.begin(), m_bindings.end(), [&](const KernelBinding& b) { return b.index == binding; });
+}
+
+vk::DescriptorType ComputeKernel::typeOf(uint32_t binding) const
+{
+    for (const KernelBinding& b : m_bindings)
+        if (b.index == binding) return b.type;
+    throw InternalError("kernel has no binding " + std::to_string(binding));
+}
+
 void ComputeKernel::bind(uint32_t binding, const Buffer& buffer)
 {
-    VKRT_CHECK(std::find(m_bindings.begin(), m_bindings.end(), binding) != m_bindings.end());
     vk::DescriptorBufferInfo info(buffer.handle(), 0, VK_WHOLE_SIZE);
-    vk::WriteDescriptorSet write(*m_set, binding, 0, descriptorTypeOf(binding), nullptr, info);
+    vk::WriteDescriptorSet write(*m_set, binding, 0, typeOf(binding), nullptr, info);
     m_context.device().updateDescriptorSets(write, nullptr);
 }
 
 void ComputeKernel::bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler)
 {
-    VKRT_CHECK(std::find(m_bindings.begin(), m_bindings.end(), binding) != m_bindings.end());
     vk::DescriptorImageInfo info(sampler, view, vk::ImageLayout::eShaderReadOnlyOptimal);
-    vk::WriteDescriptorSet write(*m_set, binding, 0, descriptorTypeOf(binding), info);
+    vk::WriteDescriptorSet write(*m_set, binding, 0, typeOf(binding), info);
     m_context.device().updateDescriptorSets(write, nullptr);
 }
 
@@ -65,8 +84,9 @@ void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::b
     VKRT_CHECK(pushConstants.size() == m_pushConstantSize);
     cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *m_pipeline);
     cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *m_pipelineLayout, 0, *m_set, nullptr);
-    cmd.pushConstants(*m_pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, uint32_t(pushConstants.size()),
-                      pushConstants.data());
+    if (!pushConstants.empty())
+        cmd.pushConstants(*m_pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, uint32_t(pushConstants.size()),
+                          pushConstants.data());
     cmd.dispatch(groups.width, groups.height, 1);
 }
 

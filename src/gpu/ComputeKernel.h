@@ -10,10 +10,19 @@
 
 namespace vkrt {
 
+/// One descriptor of a kernel's set 0.
+struct KernelBinding {
+    uint32_t index;
+    vk::DescriptorType type;
+};
+
+/// The render kernels' bindings: indices from shaders/shared/Bindings.h with their types.
+std::vector<KernelBinding> renderKernelBindings(const std::vector<uint32_t>& indices);
+
 class ComputeKernel {
 public:
-    /// `bindings`: indices from shaders/shared/Bindings.h; `pushConstantSize` in bytes.
-    ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv, std::vector<uint32_t> bindings,
+    /// `pushConstantSize` in bytes (0: no push constants).
+    ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv, std::vector<KernelBinding> bindings,
                   uint32_t pushConstantSize);
 
     /// Points `binding` at `buffer` (the whole buffer).
@@ -22,11 +31,12 @@ public:
     void bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler);
     /// Records bind + push constants + dispatch of `groups`.
     void recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, vk::Extent2D groups) const;
-    const std::vector<uint32_t>& bindings() const { return m_bindings; }
+    bool uses(uint32_t binding) const;
+    vk::DescriptorType typeOf(uint32_t binding) const;
 
 private:
     const VulkanContext& m_context;
-    std::vector<uint32_t> m_bindings;
+    std::vector<KernelBinding> m_bindings;
     uint32_t m_pushConstantSize;
     vk::raii::ShaderModule m_module = nullptr;
     vk::raii::DescriptorSetLayout m_setLayout = nullptr;
@@ -36,7 +46,7 @@ private:
     vk::raii::DescriptorSet m_set = nullptr;
 };
 
-/// The descriptor type each binding index has in every kernel.
+/// The descriptor type each binding index has in the render kernels.
 vk::DescriptorType descriptorTypeOf(uint32_t binding);
 
 } // namespace vkrt

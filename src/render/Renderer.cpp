@@ -71,7 +71,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, m_features.bindings(), sizeof(gpu::FrameConstants)),
+      m_kernel(context, m_compiled.spirv, renderKernelBindings(m_features.bindings()), sizeof(gpu::FrameConstants)),
       m_cubemap(scene.background.cubemap)
 {
     m_accumulation.clear(context);
@@ -82,8 +82,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
 void Renderer::bindSceneBuffers()
 {
     auto addBuffer = [&](uint32_t binding, auto&& records, vk::BufferUsageFlags usage) {
-        const auto& used = m_kernel.bindings();
-        if (std::find(used.begin(), used.end(), binding) == used.end()) return;
+        if (!m_kernel.uses(binding)) return;
         m_sceneBuffers.push_back(makeBufferFrom(m_context, records, usage));
         m_kernel.bind(binding, m_sceneBuffers.back());
     };
@@ -98,8 +97,7 @@ void Renderer::bindSceneBuffers()
     addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, kStorage);
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
-    const auto& used = m_kernel.bindings();
-    if (std::find(used.begin(), used.end(), gpu::BINDING_ENVIRONMENT) != used.end()) {
+    if (m_kernel.uses(gpu::BINDING_ENVIRONMENT)) {
         // The uber kernel samples a cubemap even for a constant background:
         // give it a 1x1 cube of that colour.
         std::array<Image, 6> faces;
