@@ -27,8 +27,13 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax)
             return vec3(0.0);
         bool exiting = dot(dir, hit.normal) > 0.0;
         vec3 n = exiting ? -hit.normal : hit.normal; // faces the arriving ray
-        float eta = exiting ? m.ior : 1.0 / m.ior;
-        transmittance *= 1.0 - dielectricReflectance(m.fresnel, -dot(dir, n), eta, m.ior);
+        // A shadow ray is a straight line, so its angle with the surface is
+        // the one light has on the outside of this interface (for a slab, the
+        // refracted ray inside meets the far side at the matching angle).
+        // Fresnel reflectance is the same from either side at that pair of
+        // angles, so evaluate it as entering from outside: (1 - F(theta))^2
+        // through a slab, and no spurious total internal reflection.
+        transmittance *= 1.0 - dielectricReflectance(m.fresnel, -dot(dir, n), 1.0 / m.ior, m.ior);
         if (exiting)
             transmittance *= beerLambert(m.absorption, hit.t);
         origin = offsetRayOrigin(hit.position, -n);
