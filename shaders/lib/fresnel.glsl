@@ -23,6 +23,8 @@ float fresnelSchlick(float cosTheta, float r0)
 // internal reflection.
 float fresnelExact(float cosI, float eta)
 {
+    if (eta == 1.0)
+        return 0.0; // index-matched: no interface (the formula would round to up to 1 near grazing)
     cosI = clamp(cosI, 0.0, 1.0);
     float sin2T = eta * eta * (1.0 - cosI * cosI);
     if (sin2T >= 1.0)

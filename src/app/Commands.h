@@ -13,6 +13,7 @@ using CommandRunner = std::function<int()>;
 
 CommandRunner addRenderCommand(CLI::App& app);
 CommandRunner addDevicesCommand(CLI::App& app);
+CommandRunner addInfoCommand(CLI::App& app);
 
 /// Process exit codes.
 enum ExitCode : int {

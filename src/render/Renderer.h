@@ -7,6 +7,7 @@
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
 #include "render/GpuScene.h"
+#include "shared/Bindings.h"
 #include "scene/FeatureSet.h"
 
 #include <filesystem>

@@ -1,5 +1,3 @@
-// Like fresnel.comp, but enables the include extension before the first
-// #include (fresnel.comp includes probe.glsl, which declares it, too late).
 // Invocation i evaluates the Fresnel functions for (cosI, eta, ior) =
 // inputs[3i .. 3i+2]: outputs[6i ..] = fresnelSchlick(cosI, schlickR0(ior)),
 // fresnelExact, fresnelSchlickDielectric, dielectricReflectance with

@@ -1,5 +1,6 @@
 // Common interface of the test probe kernels (tests/support/ProbeKernel.h).
-#extension GL_GOOGLE_include_directive : require
+// Kernels enable GL_GOOGLE_include_directive before including this file.
+
 #extension GL_EXT_scalar_block_layout : require
 
 layout(local_size_x = 64) in;

@@ -1,5 +1,4 @@
-// Like refraction.comp, but enables the include extension before the first
-// #include. Invocation i refracts direction -wo at a surface with outward
+// Invocation i refracts direction -wo at a surface with outward
 // normal n through sampleDielectric with u = 1 (always the refracted branch
 // unless total internal reflection): inputs[7i ..] = wo.xyz, n.xyz, ior; the
 // surface is hit from outside when dot(wo, n) > 0. outputs[4i ..] = dir.xyz,

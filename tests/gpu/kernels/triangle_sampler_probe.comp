@@ -1,5 +1,4 @@
-// Like triangle_sampler.comp, but enables the include extension before the
-// first #include. Invocation i draws one point on the triangle inputs[0..8]
+// Invocation i draws one point on the triangle inputs[0..8]
 // with the render kernels' sampler (pixel i, frame 0, seed inputs[9]) and
 // sampleTriangle: outputs[3i ..] = p.xyz.
 #version 460
