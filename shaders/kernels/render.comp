@@ -18,7 +18,11 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/bsdf.glsl"
 #include "lib/environment.glsl"
 #include "lib/lights.glsl"
+#ifdef VKRT_INTEGRATOR_PATH
+#include "lib/path.glsl"
+#else
 #include "lib/whitted.glsl"
+#endif
 
 // lavapipe hands each worker thread one contiguous run of workgroups; walking
 // the tiles with a stride coprime to their count gives every thread a share of
@@ -47,7 +51,15 @@ void main()
     uint pixelIndex = pixel.y * u.width + pixel.x;
     Sampler rng = samplerCreate(pixelIndex, frame.frameIndex, frame.seed);
     vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? sampleNext2D(rng) : vec2(0.5);
+#ifdef VKRT_INTEGRATOR_PATH
+    vec3 radiance = tracePath(cameraRay(pixel, subpixel), rng);
+#else
     vec3 radiance = traceWhitted(cameraRay(pixel, subpixel), rng);
+#endif
+#ifdef VKRT_TEST_ALTERNATING_SAMPLES
+    // Test hook: samples alternate between OFFSET and OFFSET + 1 frame by frame.
+    radiance = vec3(VKRT_TEST_ALTERNATING_SAMPLES + float(frame.frameIndex & 1u));
+#endif
 #ifdef VKRT_TEST_INJECT_NONFINITE
     // Test hook: poison every 7th pixel so the rejection path is exercised.
     if (pixelIndex % 7u == 0u)

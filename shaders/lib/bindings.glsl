@@ -11,6 +11,9 @@ layout(scalar, binding = BINDING_UNIFORMS) uniform UniformBlock { SceneUniforms 
 layout(scalar, binding = BINDING_ACCUMULATION) buffer AccumBlock { AccumPixel accum[]; };
 layout(scalar, binding = BINDING_STATS) buffer StatsBlock { RenderStats stats; };
 layout(push_constant, scalar) uniform PushBlock { FrameConstants frame; };
+#ifdef VKRT_VARIANCE
+layout(scalar, binding = BINDING_MOMENTS) buffer MomentBlock { MomentPixel moments[]; };
+#endif
 
 #ifdef VKRT_HAS_MATERIALS
 layout(scalar, binding = BINDING_MATERIALS) readonly buffer MaterialBlock { Material materials[]; };

@@ -47,6 +47,30 @@ vec3 evalBsdf(Material m, vec3 n, vec3 wo, vec3 wi)
     return vec3(0.0);
 }
 
+// Solid-angle density with which sampleBsdf picks wi (non-delta materials);
+// multiple importance sampling weighs light samples against it.
+float pdfBsdf(Material m, vec3 n, vec3 wo, vec3 wi)
+{
+    float cosI = dot(n, wi);
+    if (cosI <= 0.0 || dot(n, wo) <= 0.0)
+        return 0.0;
+#ifdef VKRT_MATERIAL_LAMBERT
+    if (m.type == MATERIAL_LAMBERT)
+        return cosI * INV_PI;
+#endif
+#ifdef VKRT_MATERIAL_PHONG
+    if (m.type == MATERIAL_PHONG) {
+        float pd = phongDiffuseProbability(m);
+        return pd * cosI * INV_PI + (1.0 - pd) * phongLobePdf(dot(reflect(-wo, n), wi), m.exponent);
+    }
+#endif
+#ifdef VKRT_MATERIAL_GLOSSY
+    if (m.type == MATERIAL_GLOSSY)
+        return phongLobePdf(dot(reflect(-wo, n), wi), m.exponent);
+#endif
+    return 0.0;
+}
+
 BsdfSample noScatter() { return BsdfSample(vec3(0.0, 0.0, 1.0), vec3(0.0), false, false); }
 
 #ifdef VKRT_MATERIAL_PHONG

@@ -8,7 +8,9 @@
 // dielectric is attenuated by Beer-Lambert; any other surface blocks.
 vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax)
 {
-#ifndef VKRT_MATERIAL_DIELECTRIC
+    // The path integrator treats glass physically: a shadow ray cannot see a
+    // light through it (light arrives through glass by BSDF sampling).
+#if !defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_INTEGRATOR_PATH)
     return findClosest(Ray(origin, dir), tMax).shape == SHAPE_NONE ? vec3(1.0) : vec3(0.0);
 #else
     vec3 target = origin + dir * tMax;
@@ -54,15 +56,18 @@ vec3 directFromPointLights(Material m, vec3 position, vec3 n, vec3 wo)
     for (uint i = 0u; i < u.pointLightCount; ++i) {
         ++g_loopIterations;
         PointLight light = pointLights[i];
-        vec3 toLight = light.position - origin;
+        // Geometry from the surface point itself; only the shadow ray starts
+        // at the offset origin (measuring from it would bias 1/d^2 by the offset).
+        vec3 toLight = light.position - position;
         float distSq = dot(toLight, toLight);
-        float dist = sqrt(distSq);
-        vec3 wi = toLight / dist;
+        vec3 wi = toLight * inversesqrt(distSq);
         float cosTheta = dot(n, wi);
         if (cosTheta <= 0.0)
             continue;
         vec3 f = evalBsdf(m, n, wo, wi);
-        radiance += f * light.intensity * (cosTheta / distSq) * shadowTransmittance(origin, wi, dist);
+        vec3 shadowDir = light.position - origin;
+        float shadowDist = length(shadowDir);
+        radiance += f * light.intensity * (cosTheta / distSq) * shadowTransmittance(origin, shadowDir / shadowDist, shadowDist);
     }
 #endif
     return radiance;
@@ -77,8 +82,21 @@ vec3 emittedRadiance(TriangleLight light, vec3 towards)
 }
 #endif
 
+// Power-heuristic weight (Veach 1997, eq. 9.13) of a strategy with density
+// `pdf` against another with density `other`, one sample each.
+float powerHeuristic(float pdf, float other)
+{
+    float a = pdf * pdf, b = other * other;
+    return a > 0.0 ? a / (a + b) : 0.0;
+}
+
+// Density in solid angle of sampling `light` uniformly by area, seen from a
+// point at squared distance distSq along a direction with |cos| cosLight.
+float triangleLightPdf(float area, float distSq, float cosLight) { return distSq / (cosLight * area); }
+
 // Triangle lights: one uniformly sampled point per light (pdf = 1 / area):
-// f * Le * cos_surface * cos_light / d^2 * area * transmittance.
+// f * Le * cos_surface * cos_light / d^2 * area * transmittance; the path
+// integrator also weighs it against BSDF sampling (MIS).
 vec3 directFromTriangleLights(Material m, vec3 position, vec3 n, vec3 wo, inout Sampler rng)
 {
     vec3 radiance = vec3(0.0);
@@ -88,10 +106,9 @@ vec3 directFromTriangleLights(Material m, vec3 position, vec3 n, vec3 wo, inout 
         ++g_loopIterations;
         TriangleLight light = triangleLights[i];
         vec3 point = sampleTriangle(light.v0, light.v1, light.v2, sampleNext2D(rng));
-        vec3 toLight = point - origin;
+        vec3 toLight = point - position;
         float distSq = dot(toLight, toLight);
-        float dist = sqrt(distSq);
-        vec3 wi = toLight / dist;
+        vec3 wi = toLight * inversesqrt(distSq);
         float cosSurface = dot(n, wi);
         float cosLight = abs(dot(triangleLightNormal(light), wi));
         vec3 le = emittedRadiance(light, -wi);
@@ -99,8 +116,14 @@ vec3 directFromTriangleLights(Material m, vec3 position, vec3 n, vec3 wo, inout 
             continue;
         vec3 f = evalBsdf(m, n, wo, wi);
         // Stop just short of the light so it does not shadow itself.
-        float tMax = dist * (1.0 - 1.0 / 65536.0);
-        radiance += f * le * (cosSurface * cosLight * light.area / distSq) * shadowTransmittance(origin, wi, tMax);
+        vec3 shadowDir = point - origin;
+        float shadowDist = length(shadowDir);
+        float tMax = shadowDist * (1.0 - 1.0 / 65536.0);
+        vec3 contribution = f * le * (cosSurface * cosLight * light.area / distSq);
+#ifdef VKRT_INTEGRATOR_PATH
+        contribution *= powerHeuristic(triangleLightPdf(light.area, distSq, cosLight), pdfBsdf(m, n, wo, wi));
+#endif
+        radiance += contribution * shadowTransmittance(origin, shadowDir / shadowDist, tMax);
     }
 #endif
     return radiance;

@@ -109,6 +109,15 @@ struct AccumPixel {
     vec3 compensation;
 };
 
+/// One pixel's running variance (Welford): mean and the sum of squared
+/// deviations m2 over the same accepted samples as AccumPixel; m2 is
+/// Kahan-compensated so it stays accurate over millions of samples.
+struct MomentPixel {
+    vec3 mean;
+    vec3 m2;
+    vec3 m2Compensation;
+};
+
 /// Counters written by kernels with atomics.
 struct RenderStats {
     uint maxLoopIterations; // largest per-invocation loop count seen

@@ -39,6 +39,7 @@ struct RenderCommandOptions {
     bool validation = false;
     bool uber = false;
     bool pixelCenters = false;
+    bool variance = false;
 };
 
 std::atomic<bool> g_interrupted{false};
@@ -120,6 +121,7 @@ int runRender(const RenderCommandOptions& options)
     renderOptions.seed = options.seed;
     renderOptions.jitter = !options.pixelCenters;
     renderOptions.uber = options.uber;
+    renderOptions.variance = options.variance;
     Renderer renderer(context, scene, renderOptions);
     double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -137,7 +139,9 @@ int runRender(const RenderCommandOptions& options)
     }
     RenderCounters counters = renderer.counters();
     Image image = renderer.mean();
-    writeExr(output, image, describeRender(scene, context, renderer, options, loop, counters));
+    std::map<std::string, Image> layers;
+    if (options.variance) layers["variance"] = renderer.varianceOfMean();
+    writeExr(output, image, describeRender(scene, context, renderer, options, loop, counters), layers);
     if (!options.png.empty()) writePng(options.png, image, options.exposure);
     printSummary(renderer, context, loop, counters, startupSeconds, output);
     if (int status = reportValidation(context); status != kExitOk) return status;
@@ -172,6 +176,8 @@ CommandRunner addRenderCommand(CLI::App& app)
                   "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");
     cmd->add_flag("--pixel-centers", options->pixelCenters, "Sample pixel centres only (no anti-aliasing jitter)");
+    cmd->add_flag("--variance", options->variance,
+                  "Also estimate per-pixel variance and write the variance of each pixel's mean as layer 'variance'");
     return [options] { return runRender(*options); };
 }
 

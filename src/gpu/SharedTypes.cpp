@@ -22,6 +22,7 @@ static_assert(sizeof(SceneUniforms) == 96);
 static_assert(sizeof(FrameConstants) == 8);
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);
+static_assert(sizeof(MomentPixel) == 36);
 static_assert(offsetof(SceneUniforms, tileStride) == 92);
 static_assert(offsetof(Material, fresnel) == 48);
 static_assert(offsetof(TriangleLight, radiance) == 44);

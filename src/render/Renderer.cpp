@@ -5,6 +5,7 @@
 #include "util/Error.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace vkrt {
 
@@ -15,7 +16,9 @@ constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffe
 FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
 {
     checkLoopBudget(scene); // before any compilation or allocation
-    return options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
+    FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
+    features.variance = options.variance;
+    return features;
 }
 
 CompiledKernel compileVariant(const FeatureSet& features, const RenderOptions& options)
@@ -38,16 +41,19 @@ template <typename T> std::span<const std::byte> bytesOf(const T& value) { retur
 
 uint64_t worstCaseLoopIterations(const Scene& scene)
 {
-    // Whitted kernel, per depth: one depth-loop step, a closest-hit query over
-    // every hittable (primitives and triangle lights), and per light one
-    // light-loop step plus a shadow query; with dielectrics a shadow query
-    // may repeat once per interface it crosses.
+    // Per depth: one depth-loop step, a closest-hit query over every hittable
+    // (primitives and triangle lights), and per light one light-loop step plus
+    // a shadow query. Whitted shadow queries pass through glass, repeating once
+    // per interface crossed; the path integrator's stop at glass but its
+    // paths take one more closest-hit step after the last vertex.
     uint64_t hittables = scene.primitiveCount() + emittingTriangleLights(scene).size();
-    bool dielectrics = featuresOf(scene).has(MaterialType::Dielectric);
-    uint64_t shadowQuery = dielectrics ? gpu::MAX_SHADOW_CROSSINGS * (1 + hittables) : hittables;
+    bool whitted = scene.render.integrator == Integrator::Whitted;
+    bool glassShadows = whitted && featuresOf(scene).has(MaterialType::Dielectric);
+    uint64_t shadowQuery = glassShadows ? gpu::MAX_SHADOW_CROSSINGS * (1 + hittables) : hittables;
     uint64_t lights = scene.pointLights.size() + emittingTriangleLights(scene).size();
     uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery);
-    return uint64_t(scene.render.maxDepth) * perDepth;
+    uint64_t depth = uint64_t(scene.render.maxDepth);
+    return whitted ? depth * perDepth : depth * perDepth + 1 + hittables;
 }
 
 void checkLoopBudget(const Scene& scene)
@@ -76,6 +82,12 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
 {
     m_accumulation.clear(context);
     m_stats.clear(context);
+    if (m_features.variance) {
+        m_moments.emplace(context, sizeof(gpu::MomentPixel) * size_t(width()) * height(),
+                          kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
+                          MemoryUse::Device);
+        m_moments->clear(context);
+    }
     bindSceneBuffers();
 }
 
@@ -97,6 +109,7 @@ void Renderer::bindSceneBuffers()
     addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, kStorage);
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
+    if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
     if (m_kernel.uses(gpu::BINDING_ENVIRONMENT)) {
         // The uber kernel samples a cubemap even for a constant background:
         // give it a 1x1 cube of that colour.
@@ -140,6 +153,24 @@ Image Renderer::mean() const
         if (p.count == 0) continue; // every sample was non-finite: black, and counted
         for (int c = 0; c < 3; ++c)
             image.rgb[i * 3 + c] = float((double(p.sum[c]) - double(p.compensation[c])) / double(p.count));
+    }
+    return image;
+}
+
+Image Renderer::varianceOfMean() const
+{
+    VKRT_CHECK(m_moments.has_value());
+    auto accumBytes = m_accumulation.download(m_context);
+    auto momentBytes = m_moments->download(m_context);
+    const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(accumBytes.data());
+    const auto* moments = reinterpret_cast<const gpu::MomentPixel*>(momentBytes.data());
+    Image image(width(), height());
+    for (size_t i = 0; i < image.pixelCount(); ++i) {
+        double n = pixels[i].count;
+        for (int c = 0; c < 3; ++c) {
+            double m2 = std::max(0.0, double(moments[i].m2[c]) - double(moments[i].m2Compensation[c]));
+            image.rgb[i * 3 + c] = n >= 2 ? float(m2 / (n - 1) / n) : std::numeric_limits<float>::infinity();
+        }
     }
     return image;
 }

@@ -19,6 +19,7 @@ struct RenderOptions {
     uint32_t seed = 0;
     bool jitter = true;
     bool uber = false;                 ///< all-features kernel instead of the scene's variant
+    bool variance = false;             ///< also estimate per-pixel variance (a kernel-variant flag)
     std::vector<Define> extraDefines;  ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
@@ -40,6 +41,9 @@ public:
 
     /// Per-pixel mean of the accepted samples, resolved in double precision.
     Image mean() const;
+    /// Per-pixel variance of that mean (sample variance / count); needs
+    /// RenderOptions::variance. Pixels with fewer than 2 samples get +inf.
+    Image varianceOfMean() const;
     RenderCounters counters() const;
 
     const FeatureSet& features() const { return m_features; }
@@ -56,6 +60,7 @@ private:
     std::vector<Buffer> m_sceneBuffers;
     Buffer m_accumulation;
     Buffer m_stats;
+    std::optional<Buffer> m_moments;
     ComputeKernel m_kernel;
     std::optional<Cubemap> m_cubemap;
     std::optional<CubeTexture> m_environment;

@@ -25,6 +25,7 @@ constexpr OptionalFeature kOptionalFeatures[] = {
     {&FeatureSet::pointLights, "VKRT_HAS_POINT_LIGHTS", int(gpu::BINDING_POINT_LIGHTS), "point-lights"},
     {&FeatureSet::triangleLights, "VKRT_HAS_TRIANGLE_LIGHTS", int(gpu::BINDING_TRIANGLE_LIGHTS), "triangle-lights"},
     {&FeatureSet::cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"},
+    {&FeatureSet::variance, "VKRT_VARIANCE", int(gpu::BINDING_MOMENTS), "variance"},
 };
 
 std::string upper(std::string text)
@@ -53,6 +54,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
 {
     FeatureSet all;
     for (const auto& feature : kOptionalFeatures) all.*feature.flag = true;
+    all.variance = false; // a render option, not scene content
     all.materialTypes.fill(true);
     all.integrator = integrator;
     return all;

@@ -84,6 +84,23 @@ TEST_F(RenderCli, WritesExrWithMetadataAndPng)
     EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
 }
 
+TEST_F(RenderCli, VarianceOptionWritesAVarianceLayer)
+{
+    ASSERT_EQ(render("v.exr", {"--spp", "4", "--variance"}).exitCode, 0);
+    ExrContents exr = readExr(m_dir / "v.exr");
+    ASSERT_TRUE(exr.layers.count("variance"));
+    const Image& variance = exr.layers.at("variance");
+    EXPECT_EQ(variance.width, exr.image.width);
+    size_t positive = 0;
+    for (float v : variance.rgb) {
+        ASSERT_TRUE(v >= 0.0f && std::isfinite(v));
+        positive += v > 0.0f;
+    }
+    EXPECT_GT(positive, variance.rgb.size() / 4) << "a noisy render must show variance";
+    ASSERT_EQ(render("plain.exr", {"--spp", "4"}).exitCode, 0);
+    EXPECT_TRUE(readExr(m_dir / "plain.exr").layers.empty());
+}
+
 TEST_F(RenderCli, SameSeedGivesIdenticalPixels)
 {
     ASSERT_EQ(render("a.exr", {"--spp", "4", "--seed", "9"}).exitCode, 0);

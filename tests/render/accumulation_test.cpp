@@ -58,6 +58,40 @@ TEST_F(AccumulationTest, NonFiniteSamplesAreRejectedAndCounted)
     EXPECT_EQ(renderer.counters().rejectedSamples, poisoned * 5);
 }
 
+// Samples alternating between c and c + 1 have sample variance n / (4 (n - 1)).
+// With c = 1e4 the textbook E[x^2] - E[x]^2 in float32 loses every digit;
+// Welford's update with a compensated m2 keeps the variance within 1 %.
+TEST_F(AccumulationTest, VarianceOfTheMeanIsAccurateOnALargeOffset)
+{
+    for (const char* offset : {"0.0", "10000.0"}) {
+        Scene scene = sceneFromText(emptySceneWithBackground("0", 8, 8));
+        RenderOptions options = testOptions();
+        options.variance = true;
+        options.extraDefines = {{"VKRT_TEST_ALTERNATING_SAMPLES", offset}};
+        Renderer renderer(gpu(), scene, options);
+        const uint32_t n = 1000;
+        renderer.renderFrames(n);
+        Image mean = renderer.mean(), variance = renderer.varianceOfMean();
+        double expectedVarianceOfMean = double(n) / (4.0 * (n - 1)) / n;
+        for (size_t i = 0; i < variance.rgb.size(); ++i) {
+            ASSERT_NEAR(mean.rgb[i], std::stod(offset) + 0.5, 1e-6 * (std::stod(offset) + 1)) << offset;
+            ASSERT_NEAR(variance.rgb[i], expectedVarianceOfMean, 0.01 * expectedVarianceOfMean) << offset;
+        }
+    }
+}
+
+TEST_F(AccumulationTest, VarianceNeedsTwoSamples)
+{
+    Scene scene = sceneFromText(emptySceneWithBackground("0.5", 4, 4));
+    RenderOptions options = testOptions();
+    options.variance = true;
+    Renderer renderer(gpu(), scene, options);
+    renderer.renderFrames(1);
+    for (float v : renderer.varianceOfMean().rgb) EXPECT_TRUE(std::isinf(v));
+    renderer.renderFrames(1);
+    for (float v : renderer.varianceOfMean().rgb) EXPECT_EQ(v, 0.0f);
+}
+
 TEST_F(AccumulationTest, CleanRenderRejectsNothing)
 {
     Scene scene = sceneFromText(emptySceneWithBackground("0.5", 16, 16));

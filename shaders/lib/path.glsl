@@ -1,0 +1,95 @@
+// Unbiased path tracing (`integrator = "path"`). At each non-specular vertex:
+// next-event estimation for every point light and one area-sampled point on
+// every triangle light, weighted against BSDF sampling with the power
+// heuristic; then one BSDF-sampled continuation. A continuation that hits a
+// light adds its emission with the complementary MIS weight (full weight after
+// a specular bounce or from the camera); one that escapes adds the environment.
+// Russian roulette from the fourth vertex on keeps long paths unbiased.
+// max_depth counts surface interactions with light sampling, so the longest
+// path has max_depth + 1 segments (Mitsuba's max_depth = ours + 1).
+#ifndef VKRT_PATH_GLSL
+#define VKRT_PATH_GLSL
+
+struct PathVertexState {
+    vec3 radiance;
+    vec3 throughput;
+    vec3 mediumAbsorption; // kappa of the dielectric the ray travels in (0 outside)
+    bool specular;         // the last scattering was a delta event (or the camera)
+    float bsdfPdf;         // solid-angle pdf of the last BSDF sample
+};
+
+// Emission of a light hit by a BSDF-sampled ray, MIS-weighted against having
+// sampled that light directly from the previous vertex.
+vec3 emissionOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
+{
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    TriangleLight light = triangleLights[hit.index];
+    vec3 le = emittedRadiance(light, -ray.dir);
+    if (path.specular || le == vec3(0.0))
+        return le;
+    float cosLight = abs(dot(triangleLightNormal(light), ray.dir));
+    float lightPdf = triangleLightPdf(light.area, hit.t * hit.t, cosLight);
+    return le * powerHeuristic(path.bsdfPdf, lightPdf);
+#else
+    return vec3(0.0);
+#endif
+}
+
+// Russian roulette: continue with probability q = min(1, max throughput
+// component) and divide by q, so the estimate stays unbiased.
+bool survivesRoulette(inout PathVertexState path, uint depth, float u)
+{
+    if (depth < 4u)
+        return true;
+    float q = min(1.0, max(path.throughput.x, max(path.throughput.y, path.throughput.z)));
+    if (u >= q)
+        return false;
+    path.throughput /= q;
+    return true;
+}
+
+vec3 tracePath(Ray ray, inout Sampler rng)
+{
+    PathVertexState path = PathVertexState(vec3(0.0), vec3(1.0), vec3(0.0), true, 0.0);
+    for (uint depth = 1u; depth <= u.maxDepth + 1u; ++depth) {
+        ++g_loopIterations;
+        SurfaceHit hit;
+        bool missed = !traceClosest(ray, FLT_MAX, hit);
+        path.throughput *= beerLambert(path.mediumAbsorption, missed ? FLT_MAX : hit.t);
+        if (missed) {
+            path.radiance += path.throughput * environmentRadiance(ray.dir);
+            break;
+        }
+        if (hit.shape == SHAPE_LIGHT) {
+            path.radiance += path.throughput * emissionOnHit(path, ray, hit);
+            break;
+        }
+        if (depth == u.maxDepth + 1u)
+            break; // a light or the sky could still end this path, a surface cannot
+#ifdef VKRT_HAS_MATERIALS
+        Material m = materials[hit.material];
+        bool frontFace = dot(hit.normal, ray.dir) < 0.0;
+        vec3 n = frontFace ? hit.normal : -hit.normal;
+        vec3 wo = -ray.dir;
+        if (!isDeltaMaterial(m.type)) {
+            path.radiance += path.throughput * (directFromPointLights(m, hit.position, n, wo) +
+                                                directFromTriangleLights(m, hit.position, n, wo, rng));
+        }
+        vec4 u4 = sampleNext4D(rng);
+        BsdfSample s = sampleBsdf(m, n, wo, frontFace, u4.xyz);
+        if (s.weight == vec3(0.0))
+            break;
+        path.throughput *= s.weight;
+        path.specular = s.specular;
+        path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, n, wo, s.dir);
+        if (s.transmitted)
+            path.mediumAbsorption = frontFace ? m.absorption : vec3(0.0);
+        if (!survivesRoulette(path, depth, u4.w))
+            break;
+        ray = Ray(offsetRayOrigin(hit.position, s.transmitted ? -n : n), s.dir);
+#endif
+    }
+    return path.radiance;
+}
+
+#endif

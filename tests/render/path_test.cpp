@@ -1,0 +1,227 @@
+// The path integrator against closed forms: furnaces, pbrt-v4's analytic
+// sphere, and direct light from a triangle emitter (MIS of light and BSDF
+// sampling), with statistical tests where the estimate is noisy.
+#include "render/Renderer.h"
+#include "support/TestSupport.h"
+
+#include <cmath>
+
+namespace vkrt::test {
+namespace {
+
+RenderOptions options(uint32_t seed = 1, bool jitter = false)
+{
+    RenderOptions o;
+    o.seed = seed;
+    o.jitter = jitter;
+    o.cacheDirectory = testCacheDir();
+    return o;
+}
+
+/// Per-pixel mean and the renderer's own estimate of its variance.
+struct Estimate {
+    Image mean;
+    std::vector<double> varianceOfMean; ///< per float of mean.rgb
+};
+
+Estimate estimate(const Scene& scene, uint32_t frames)
+{
+    RenderOptions o = options(7);
+    o.variance = true;
+    Renderer renderer(gpu(), scene, o);
+    renderer.renderFrames(frames);
+    EXPECT_EQ(renderer.counters().rejectedSamples, 0u);
+    Image variance = renderer.varianceOfMean();
+    return {renderer.mean(), std::vector<double>(variance.rgb.begin(), variance.rgb.end())};
+}
+
+/// Fraction of values whose |z| stays under the Sidak-corrected threshold
+/// for alpha = 0.01 over all tested values.
+double fractionPassingZTest(const Estimate& e, const std::vector<double>& expected)
+{
+    size_t n = expected.size(), pass = 0;
+    double alpha = 1.0 - std::pow(1.0 - 0.01, 1.0 / double(n));
+    // Two-sided normal quantile for alpha by bisection on erfc.
+    double lo = 0.0, hi = 40.0;
+    for (int i = 0; i < 200; ++i) {
+        double mid = 0.5 * (lo + hi);
+        (std::erfc(mid / std::sqrt(2.0)) > alpha ? lo : hi) = mid;
+    }
+    double threshold = lo;
+    for (size_t i = 0; i < n; ++i) {
+        double sigma = std::sqrt(e.varianceOfMean[i]);
+        double diff = std::abs(e.mean.rgb[i] - expected[i]);
+        if (sigma == 0.0 ? diff <= 1e-5 * std::abs(expected[i]) + 1e-7 : diff / sigma < threshold) ++pass;
+    }
+    return double(pass) / double(n);
+}
+
+class PathTest : public GpuTest {};
+
+std::string furnace(const std::string& material, int maxDepth)
+{
+    return "[render]\nintegrator = \"path\"\nmax_depth = " + std::to_string(maxDepth) + R"(
+[camera]
+eye = [0, 0, 3]
+target = [0, 0, 0]
+fov = 40
+width = 24
+height = 24
+[background]
+color = 1
+[materials.m]
+)" + material + R"(
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "m"
+)";
+}
+
+TEST_F(PathTest, WhiteFurnaceLambertMirrorAndGlassAreInvisible)
+{
+    struct Case {
+        const char* material;
+        double expected;
+    } cases[] = {
+        {"type = \"lambert\"\nalbedo = 1", 1.0},
+        {"type = \"lambert\"\nalbedo = 0.5", 0.5},
+        {"type = \"mirror\"\nreflectance = 1", 1.0},
+        {"type = \"dielectric\"\nior = 1.5", 1.0},
+        {"type = \"dielectric\"\nior = 1.33\nfresnel = \"exact\"", 1.0},
+    };
+    for (const Case& c : cases) {
+        Scene scene = sceneFromText(furnace(c.material, 32));
+        Estimate e = estimate(scene, 64);
+        std::vector<double> expected(e.mean.rgb.size(), c.expected);
+        // Pixels off the sphere see the environment (1): expected there too for albedo 1.
+        for (uint32_t y = 0; y < 24; ++y)
+            for (uint32_t x = 0; x < 24; ++x) {
+                double sx = (2.0 * (x + 0.5) / 24 - 1) * std::tan(M_PI / 9), sy = (1 - 2.0 * (y + 0.5) / 24) * std::tan(M_PI / 9);
+                double b = 3.0 / std::sqrt(1 + sx * sx + sy * sy); // distance of closest approach test
+                bool hits = 9.0 - b * b < 1.0;
+                for (int k = 0; k < 3; ++k) expected[(y * 24 + x) * 3 + k] = hits ? c.expected : 1.0;
+            }
+        EXPECT_GE(fractionPassingZTest(e, expected), 0.9975) << c.material;
+    }
+}
+
+// pbrt-v4's analytic test: camera inside a diffuse sphere (Kd = 0.5) with a
+// point light of intensity pi at its centre sees L = 1 - 0.5^k with k
+// bounces: direct light 0.5 / r^2 = 0.5, each interreflection half the last.
+TEST_F(PathTest, InsideDiffuseSphereWithCentralPointLight)
+{
+    for (int k : {1, 2, 3, 6, 40}) {
+        std::string text = "[render]\nintegrator = \"path\"\nmax_depth = " + std::to_string(k) + R"(
+[camera]
+eye = [0, 0, 0]
+target = [0, 0, -1]
+fov = 60
+width = 16
+height = 16
+[materials.m]
+type = "lambert"
+albedo = 0.5
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "m"
+[[lights]]
+type = "point"
+position = [0, 0, 0]
+intensity = 3.14159265358979
+)";
+        Estimate e = estimate(sceneFromText(text), 128);
+        double expected = 1.0 - std::pow(0.5, k);
+        // Every pixel has the same expectation: pool them for a tight check.
+        double sum = 0, var = 0;
+        for (size_t i = 0; i < e.mean.rgb.size(); ++i) sum += e.mean.rgb[i], var += e.varianceOfMean[i];
+        double n = double(e.mean.rgb.size());
+        double mean = sum / n, standardError = std::sqrt(var) / n;
+        EXPECT_NEAR(mean, expected, 4.0 * standardError + 1e-5 * expected) << "k = " << k;
+        // From the fourth vertex on, Russian roulette makes each pixel's
+        // samples strongly skewed (most paths end at 0.9375, a few far above),
+        // so a per-pixel normal test is only valid before it.
+        if (k <= 3)
+            EXPECT_GE(fractionPassingZTest(e, std::vector<double>(e.mean.rgb.size(), expected)), 0.9975) << "k = " << k;
+    }
+}
+
+/// Irradiance at p (normal n) from a uniformly emitting polygon of radiance 1
+/// (Lambert's formula): E = 1/2 |sum_i angle(u_i, u_i+1) n . unit(u_i x u_i+1)|.
+double polygonIrradiance(const glm::dvec3& p, const glm::dvec3& n, const std::vector<glm::dvec3>& vertices)
+{
+    double sum = 0.0;
+    for (size_t i = 0; i < vertices.size(); ++i) {
+        glm::dvec3 a = glm::normalize(vertices[i] - p), b = glm::normalize(vertices[(i + 1) % vertices.size()] - p);
+        glm::dvec3 c = glm::cross(a, b);
+        sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) * glm::dot(n, c / glm::length(c));
+    }
+    return 0.5 * std::abs(sum);
+}
+
+/// Moller-Trumbore in double, for deciding which pixels see the light.
+bool hitsTriangle(const glm::dvec3& o, const glm::dvec3& d, const std::vector<glm::dvec3>& v)
+{
+    glm::dvec3 e1 = v[1] - v[0], e2 = v[2] - v[0], p = glm::cross(d, e2);
+    double det = glm::dot(e1, p);
+    glm::dvec3 s = o - v[0];
+    double a = glm::dot(s, p) / det;
+    glm::dvec3 q = glm::cross(s, e1);
+    double b = glm::dot(d, q) / det, t = glm::dot(e2, q) / det;
+    return a >= 0 && b >= 0 && a + b <= 1 && t > 0;
+}
+
+// A Lambert floor lit by one triangle light, direct light only: each pixel's
+// estimate (light sampling and BSDF sampling combined by MIS in the path
+// integrator, light sampling alone in Whitted) must match rho/pi * Le * E.
+TEST_F(PathTest, TriangleLightOverLambertFloorMatchesPolygonFormula)
+{
+    for (const char* integrator : {"path", "whitted"}) {
+        std::string text = std::string("[render]\nintegrator = \"") + integrator + R"("
+max_depth = 1
+[camera]
+eye = [0, 3, 3]
+target = [0, 0, 0]
+fov = 50
+width = 24
+height = 18
+[materials.floor]
+type = "lambert"
+albedo = 0.6
+[[objects]]
+shape = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+[[lights]]
+type = "triangle"
+vertices = [[-0.5, 1.2, 0.3], [0.3, 1.0, 0.8], [0.6, 1.4, -0.4]]
+radiance = [4, 2, 1]
+two_sided = true
+)";
+        Scene scene = sceneFromText(text);
+        Estimate e = estimate(scene, 256);
+        std::vector<glm::dvec3> light = {{-0.5, 1.2, 0.3}, {0.3, 1.0, 0.8}, {0.6, 1.4, -0.4}};
+        std::vector<double> expected(e.mean.rgb.size());
+        const Camera& c = scene.camera;
+        glm::dvec3 forward = glm::normalize(c.target - c.eye), right = glm::normalize(glm::cross(forward, c.up));
+        glm::dvec3 up = glm::cross(right, forward);
+        double t = std::tan(c.fovY * M_PI / 360.0);
+        for (uint32_t y = 0; y < c.height; ++y)
+            for (uint32_t x = 0; x < c.width; ++x) {
+                double sx = (2.0 * (x + 0.5) / c.width - 1) * t * c.width / c.height, sy = (1 - 2.0 * (y + 0.5) / c.height) * t;
+                glm::dvec3 d = glm::normalize(sx * right + sy * up + forward);
+                glm::dvec3 p = c.eye + (-c.eye.y / d.y) * d;
+                // Pixels whose centre ray meets the (two-sided) light see its radiance.
+                double factor = hitsTriangle(c.eye, d, light) ? 1.0 : 0.6 / M_PI * polygonIrradiance(p, {0, 1, 0}, light);
+                for (int k = 0; k < 3; ++k) expected[(y * c.width + x) * 3 + k] = factor * glm::dvec3(4, 2, 1)[k];
+            }
+        EXPECT_GE(fractionPassingZTest(e, expected), 0.9975) << integrator;
+    }
+}
+
+} // namespace
+} // namespace vkrt::test

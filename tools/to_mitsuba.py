@@ -1,0 +1,807 @@
+#!/usr/bin/env python3
+"""Convert a vkrt scene (TOML, docs/scene-format.md) to a Mitsuba 3 scene.
+
+    tools/to_mitsuba.py SCENE.toml -o scene.xml     # XML plus a scene_files/ folder
+    tools/to_mitsuba.py SCENE.toml --print-dict     # the Python dict, for inspection
+
+As a module (Mitsuba must be importable; a variant is chosen if none is set):
+
+    import to_mitsuba
+    scene_dict = to_mitsuba.convert("scene.toml")
+    scene = mitsuba.load_dict(scene_dict)
+
+The conversion follows the semantics of vkrt's path integrator
+(`[render] integrator = "path"`); see scenes/validation/README.md:
+
+* camera: `perspective`, vertical `fov`, `look_at(eye, target, up)`, `hdrfilm`
+  with a one-pixel `box` reconstruction filter (each sample lands in its own
+  pixel, as in vkrt);
+* `max_depth`: Mitsuba's max_depth = vkrt's max_depth + 1 (vkrt counts surface
+  interactions, Mitsuba counts path segments);
+* lambert -> `diffuse`; mirror (fresnel = "none") -> `conductor`, material
+  "none"; dielectric (exact Fresnel) -> `dielectric` with int_ior = ior and
+  ext_ior = 1; absorption κ -> a `homogeneous` interior medium with
+  sigma_t = κ and albedo 0, rendered with `volpath`. vkrt shades both sides of
+  every surface, so diffuse and conductor BSDFs are wrapped in `twosided`;
+* point light -> `point` (intensity, W/sr); triangle light -> a one-triangle
+  mesh with an `area` emitter and a black diffuse BSDF; a two-sided light is two
+  such triangles with opposite windings, the back one displaced by 1e-5 of the
+  light's size behind the front one so that each side of the light hits the
+  triangle that emits towards it;
+* background colour -> `constant`; cubemap -> an equirectangular `envmap`
+  resampled from the six faces with Vulkan's seamless bilinear cube lookup;
+* sphere -> `sphere`; box -> `cube` with a scale+translate to_world; triangle ->
+  a one-triangle PLY mesh; infinite plane -> a large `rectangle` (an
+  approximation: see --plane-half-size).
+
+What has no Mitsuba equivalent (phong, glossy, Schlick Fresnel, the Whitted
+integrator) is refused with an error naming the scene file, table and key.
+"""
+from __future__ import annotations
+
+import argparse
+import atexit
+import math
+import os
+import shutil
+import sys
+import tempfile
+import tomllib
+from pathlib import Path
+
+DEFAULT_PLANE_HALF_SIZE = 1e4
+ABSORPTION_FLOOR = 1e-7  # see the dielectric case in convert()
+FACE_KEYS = ("px", "nx", "py", "ny", "pz", "nz")  # Vulkan face order
+
+
+class ConversionError(Exception):
+    """A scene that cannot be converted; the message names file, table and key."""
+
+
+# ----------------------------------------------------------------------------
+# Small helpers
+# ----------------------------------------------------------------------------
+
+def _note(message: str) -> None:
+    print(f"to_mitsuba: note: {message}", file=sys.stderr)
+
+
+class _Reader:
+    """Type-checked access to the TOML data with error messages in vkrt's style."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, where: str, message: str):
+        raise ConversionError(f"{self.path}: {where}: {message}")
+
+    def table(self, data, where):
+        if not isinstance(data, dict):
+            self.fail(where, "expected a table")
+        return data
+
+    def check_keys(self, data: dict, where: str, allowed):
+        for key in data:
+            if key not in allowed:
+                self.fail(f"{where}.{key}" if where else key,
+                          f"unknown key '{key}' (expected one of: {', '.join(allowed)})")
+
+    def number(self, data: dict, key: str, where: str, default=None):
+        if key not in data:
+            if default is None:
+                self.fail(where, f"missing required key '{key}'")
+            return float(default)
+        v = data[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            self.fail(f"{where}.{key}", f"expected a finite number, got {v!r}")
+        return float(v)
+
+    def integer(self, data: dict, key: str, where: str, default=None):
+        if key not in data:
+            if default is None:
+                self.fail(where, f"missing required key '{key}'")
+            return int(default)
+        v = data[key]
+        if isinstance(v, bool) or not isinstance(v, int):
+            self.fail(f"{where}.{key}", f"expected an integer, got {v!r}")
+        return v
+
+    def string(self, data: dict, key: str, where: str, default=None):
+        if key not in data:
+            if default is None:
+                self.fail(where, f"missing required key '{key}'")
+            return default
+        v = data[key]
+        if not isinstance(v, str):
+            self.fail(f"{where}.{key}", f"expected a string, got {v!r}")
+        return v
+
+    def boolean(self, data: dict, key: str, where: str, default: bool):
+        v = data.get(key, default)
+        if not isinstance(v, bool):
+            self.fail(f"{where}.{key}", f"expected true or false, got {v!r}")
+        return v
+
+    def vector(self, data: dict, key: str, where: str, default=None):
+        if key not in data:
+            if default is None:
+                self.fail(where, f"missing required key '{key}'")
+            return [float(x) for x in default]
+        return self._vec3(data[key], f"{where}.{key}")
+
+    def _vec3(self, v, where):
+        if not isinstance(v, list) or len(v) != 3:
+            self.fail(where, f"expected [x, y, z], got {v!r}")
+        out = []
+        for i, x in enumerate(v):
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                self.fail(f"{where}[{i}]", f"expected a finite number, got {x!r}")
+            out.append(float(x))
+        return out
+
+    def color(self, data: dict, key: str, where: str, default=None, lo=0.0, hi=None):
+        if key not in data:
+            if default is None:
+                self.fail(where, f"missing required key '{key}'")
+            c = [float(default)] * 3
+        else:
+            v = data[key]
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                if not math.isfinite(v):
+                    self.fail(f"{where}.{key}", f"expected a finite number, got {v!r}")
+                c = [float(v)] * 3
+            else:
+                c = self._vec3(v, f"{where}.{key}")
+        for i, x in enumerate(c):
+            if x < lo or (hi is not None and x > hi):
+                rng = f"[{lo:g}, {hi:g}]" if hi is not None else f">= {lo:g}"
+                self.fail(f"{where}.{key}", f"every channel must be {rng}, got {c}")
+        return c
+
+    def triangle(self, data: dict, key: str, where: str):
+        if key not in data:
+            self.fail(where, f"missing required key '{key}'")
+        v = data[key]
+        if not isinstance(v, list) or len(v) != 3:
+            self.fail(f"{where}.{key}", f"expected three points, got {v!r}")
+        return [self._vec3(p, f"{where}.{key}[{i}]") for i, p in enumerate(v)]
+
+
+def _quote(name: str) -> str:
+    bare = name and all(c.isalnum() or c in "_-" for c in name)
+    return name if bare else '"' + name.replace('"', '\\"') + '"'
+
+
+def _sub(a, b):
+    return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+
+
+def _cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _norm(a):
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+def _rgb(c):
+    return {"type": "rgb", "value": [float(x) for x in c]}
+
+
+def _mitsuba():
+    import mitsuba as mi  # noqa: PLC0415 (deferred so --help works without Mitsuba)
+
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    return mi
+
+
+# ----------------------------------------------------------------------------
+# Cubemap -> equirectangular environment map
+# ----------------------------------------------------------------------------
+
+def _face_direction(face, sc, tc):
+    """Unnormalised direction of face coordinates sc, tc in [-1, 1] (CubeFaces.h)."""
+    import numpy as np
+
+    one = np.ones_like(sc)
+    if face == 0:
+        return np.stack([one, -tc, -sc], -1)
+    if face == 1:
+        return np.stack([-one, -tc, sc], -1)
+    if face == 2:
+        return np.stack([sc, one, tc], -1)
+    if face == 3:
+        return np.stack([sc, -one, -tc], -1)
+    if face == 4:
+        return np.stack([sc, -tc, one], -1)
+    return np.stack([-sc, -tc, -one], -1)
+
+
+def _select_face(d):
+    """Vulkan cube face selection: face index and s, t in [0, 1] for directions d[..., 3]."""
+    import numpy as np
+
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    ax, ay, az = np.abs(x), np.abs(y), np.abs(z)
+    face = np.where((ax >= ay) & (ax >= az), np.where(x >= 0, 0, 1),
+                    np.where(ay >= az, np.where(y >= 0, 2, 3), np.where(z >= 0, 4, 5)))
+    ma = np.choose(face, [ax, ax, ay, ay, az, az])
+    sc = np.choose(face, [-z, z, x, x, x, -x])
+    tc = np.choose(face, [-y, -y, z, -z, -y, -y])
+    ma = np.maximum(ma, 1e-300)
+    return face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)
+
+
+def _padded_faces(faces):
+    """Faces with a one-texel border taken from the adjacent faces (Vulkan's cube
+    map edge handling); a border corner is the mean of the three texels that meet
+    there. Shape (6, n + 2, n + 2, 3)."""
+    import numpy as np
+
+    n = faces.shape[1]
+    padded = np.zeros((6, n + 2, n + 2, 3), dtype=np.float64)
+    padded[:, 1:-1, 1:-1] = faces
+    idx = np.arange(-1, n + 1)
+    jj, ii = np.meshgrid(idx, idx, indexing="ij")  # jj: row (t), ii: column (s)
+    border = (ii < 0) | (ii >= n) | (jj < 0) | (jj >= n)
+    corner = ((ii < 0) | (ii >= n)) & ((jj < 0) | (jj >= n))
+    edge = border & ~corner
+    for f in range(6):
+        sc = 2.0 * (ii[edge] + 0.5) / n - 1.0
+        tc = 2.0 * (jj[edge] + 0.5) / n - 1.0
+        g, s, t = _select_face(_face_direction(f, sc, tc))
+        si = np.clip(np.floor(s * n).astype(int), 0, n - 1)
+        ti = np.clip(np.floor(t * n).astype(int), 0, n - 1)
+        padded[f][edge] = faces[g, ti, si]
+        for cj, ci, dj, di in ((0, 0, 1, 1), (0, n + 1, 1, -1), (n + 1, 0, -1, 1), (n + 1, n + 1, -1, -1)):
+            padded[f, cj, ci] = (padded[f, cj + dj, ci + di] + padded[f, cj, ci + di] + padded[f, cj + dj, ci]) / 3.0
+    return padded
+
+
+def cube_lookup(faces, d):
+    """Bilinear, seamless lookup of the cubemap (6, n, n, 3) in directions d[..., 3],
+    as Vulkan's textureLod(samplerCube, d, 0) with linear filtering does."""
+    import numpy as np
+
+    n = faces.shape[1]
+    padded = _padded_faces(faces)
+    face, s, t = _select_face(d)
+    x = s * n - 0.5 + 1.0  # padded texel coordinates
+    y = t * n - 0.5 + 1.0
+    x0 = np.clip(np.floor(x).astype(int), 0, n)
+    y0 = np.clip(np.floor(y).astype(int), 0, n)
+    ax = (x - x0)[..., None]
+    ay = (y - y0)[..., None]
+    v00 = padded[face, y0, x0]
+    v01 = padded[face, y0, x0 + 1]
+    v10 = padded[face, y0 + 1, x0]
+    v11 = padded[face, y0 + 1, x0 + 1]
+    return (1 - ay) * ((1 - ax) * v00 + ax * v01) + ay * ((1 - ax) * v10 + ax * v11)
+
+
+def envmap_column_offset(mi) -> float:
+    """Where Mitsuba's envmap puts column i: u = (i + offset) / width. Mitsuba
+    3.7+ centres columns (offset 0.5); older versions put column i at u = i /
+    width. Probed on a tiny map rather than assumed."""
+    import numpy as np
+
+    w, h = 8, 5
+    data = np.zeros((h, w, 3), dtype=np.float32)
+    data[:, 2] = 1.0  # column 2 only
+    emitter = mi.load_dict({"type": "envmap", "bitmap": mi.Bitmap(data)})
+    for offset in (0.5, 0.0):
+        u = (2 + offset) / w
+        phi, theta = 2 * math.pi * u, 0.5 * math.pi
+        d = [math.sin(phi) * math.sin(theta), math.cos(theta), -math.cos(phi) * math.sin(theta)]
+        si = mi.SurfaceInteraction3f()
+        si.wi = mi.Vector3f(-d[0], -d[1], -d[2])
+        value = np.array(emitter.eval(si)).ravel()
+        if abs(float(value[0]) - 1.0) < 1e-4:
+            return offset
+    raise ConversionError("cannot determine the column convention of this Mitsuba's envmap plugin")
+
+
+def equirect_from_cubemap(faces, width: int, column_offset: float):
+    """Equirectangular image (height = width / 2 + 1) in Mitsuba's envmap layout:
+    column i at u = (i + column_offset) / width, row j at v = j / (height - 1)
+    (row 0 is the +y pole), direction (sin φ sin θ, cos θ, -cos φ sin θ) with
+    φ = 2πu, θ = πv."""
+    import numpy as np
+
+    height = width // 2 + 1
+    u = (np.arange(width) + column_offset) / width
+    v = np.arange(height) / (height - 1)
+    phi = 2 * np.pi * u[None, :]
+    theta = np.pi * v[:, None]
+    d = np.stack(np.broadcast_arrays(np.sin(phi) * np.sin(theta), np.cos(theta) + 0 * phi,
+                                     -np.cos(phi) * np.sin(theta)), -1)
+    return cube_lookup(faces, d).astype(np.float32)
+
+
+def load_cubemap_faces(reader: _Reader, paths):
+    """The six faces as float64 (6, n, n, 3) linear RGB, checked as vkrt checks them."""
+    import numpy as np
+
+    mi = _mitsuba()
+    faces = []
+    for key, path in zip(FACE_KEYS, paths):
+        where = f"background.cubemap.{key}"
+        try:
+            bmp = mi.Bitmap(str(path))
+        except Exception as e:  # noqa: BLE001 (Mitsuba raises RuntimeError and friends)
+            reader.fail(where, f"cannot read '{path}': {e}")
+        # PNG is sRGB-encoded; convert() with srgb_gamma=False linearises it.
+        bmp = bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
+        a = np.array(bmp, dtype=np.float64).reshape(bmp.height(), bmp.width(), 3)
+        if a.shape[0] != a.shape[1] or a.shape[0] == 0:
+            reader.fail(where, f"{path}: a cube face must be square, got {a.shape[1]}x{a.shape[0]}")
+        if faces and a.shape != faces[0].shape:
+            reader.fail(where, f"{path}: all faces must have the same size ({faces[0].shape[0]} for px), "
+                               f"got {a.shape[0]}")
+        if not np.all(np.isfinite(a)) or np.any(a < 0):
+            reader.fail(where, f"{path}: contains a negative or non-finite value")
+        faces.append(a)
+    return np.stack(faces)
+
+
+# ----------------------------------------------------------------------------
+# Geometry files
+# ----------------------------------------------------------------------------
+
+def _write_ply(path: Path, vertices):
+    with open(path, "w", encoding="ascii") as f:
+        f.write("ply\nformat ascii 1.0\ncomment written by vkrt tools/to_mitsuba.py\n")
+        f.write(f"element vertex {len(vertices)}\nproperty float x\nproperty float y\nproperty float z\n")
+        f.write(f"element face {len(vertices) // 3}\nproperty list uchar int vertex_indices\nend_header\n")
+        for v in vertices:
+            f.write(f"{v[0]!r} {v[1]!r} {v[2]!r}\n")
+        for i in range(0, len(vertices), 3):
+            f.write(f"3 {i} {i + 1} {i + 2}\n")
+
+
+def _matrix_transform(mi, m):
+    return mi.ScalarTransform4f(mi.ScalarMatrix4f(m))
+
+
+# ----------------------------------------------------------------------------
+# Conversion
+# ----------------------------------------------------------------------------
+
+def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF_SIZE,
+            envmap_width: int | None = None, allow_whitted: bool = False, spp: int = 64) -> dict:
+    """Convert the vkrt scene at `path` to a Mitsuba 3 scene dict.
+
+    Triangles are written as PLY files and a cubemap as an equirectangular EXR
+    into `files_dir` (a temporary folder removed at exit when None); the dict
+    refers to them by absolute path.
+    """
+    import numpy as np
+
+    mi = _mitsuba()
+    path = Path(path)
+    r = _Reader(path)
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except OSError as e:
+        raise ConversionError(f"cannot read scene file '{path}': {e.strerror}") from e
+    except tomllib.TOMLDecodeError as e:
+        raise ConversionError(f"{path}: invalid TOML: {e}") from e
+
+    if files_dir is None:
+        files_dir = Path(tempfile.mkdtemp(prefix="vkrt-mitsuba-"))
+        atexit.register(shutil.rmtree, files_dir, True)
+    files_dir = Path(files_dir)
+    files_dir.mkdir(parents=True, exist_ok=True)
+
+    r.check_keys(data, "", ["render", "camera", "materials", "objects", "lights", "background"])
+
+    # [render]
+    render = r.table(data.get("render", {}), "render")
+    r.check_keys(render, "render", ["integrator", "max_depth"])
+    integrator = r.string(render, "integrator", "render", "whitted")
+    if integrator not in ("whitted", "path"):
+        r.fail("render.integrator", f"unknown integrator '{integrator}' (expected whitted or path)")
+    if integrator == "whitted" and not allow_whitted:
+        r.fail("render.integrator" if "integrator" in render else "render",
+               "the Whitted integrator has no Mitsuba equivalent; set integrator = \"path\" "
+               "(or pass --allow-whitted to convert the scene as if it were a path-traced one)")
+    max_depth = r.integer(render, "max_depth", "render", 5)
+    if not 1 <= max_depth <= 64:
+        r.fail("render.max_depth", f"must be in [1, 64], got {max_depth}")
+
+    # [camera]
+    if "camera" not in data:
+        r.fail("camera", "missing required table")
+    cam = r.table(data["camera"], "camera")
+    r.check_keys(cam, "camera", ["eye", "target", "up", "fov", "width", "height"])
+    eye = r.vector(cam, "eye", "camera")
+    target = r.vector(cam, "target", "camera")
+    up = r.vector(cam, "up", "camera", [0, 1, 0])
+    fov = r.number(cam, "fov", "camera")
+    width = r.integer(cam, "width", "camera", 640)
+    height = r.integer(cam, "height", "camera", 480)
+    if not 0 < fov < 180:
+        r.fail("camera.fov", f"must be strictly between 0 and 180, got {fov:g}")
+    forward = _sub(target, eye)
+    if _norm(forward) == 0:
+        r.fail("camera.target", "must differ from eye")
+    if _norm(_cross(forward, up)) < 1e-6 * _norm(forward) * _norm(up):
+        r.fail("camera.up", "must not be parallel to target - eye")
+
+    # [materials]
+    materials = r.table(data.get("materials", {}), "materials")
+    for name, m in materials.items():
+        where = f"materials.{_quote(name)}"
+        r.table(m, where)
+        r.string(m, "type", where)
+
+    # Objects first, so that only materials in use must be convertible.
+    objects = data.get("objects", [])
+    if not isinstance(objects, list):
+        r.fail("objects", "expected an array of tables")
+    used = {}
+    for i, o in enumerate(objects):
+        where = f"objects[{i}]"
+        r.table(o, where)
+        name = r.string(o, "material", where)
+        if name not in materials:
+            r.fail(f"{where}.material", f"unknown material '{name}'")
+        used.setdefault(name, where)
+
+    scene: dict = {"type": "scene"}
+    bsdf_ids: dict[str, str] = {}
+    media_ids: dict[str, str] = {}
+    needs_volpath = False
+    for index, (name, m) in enumerate(materials.items()):
+        where = f"materials.{_quote(name)}"
+        mtype = m["type"]
+        if name not in used:
+            _note(f"{path}: {where}: not used by any object; skipped")
+            continue
+        bsdf_id = f"mat{index}"
+        if mtype == "lambert":
+            r.check_keys(m, where, ["type", "albedo"])
+            albedo = r.color(m, "albedo", where, 0.8, 0.0, 1.0)
+            bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": _rgb(albedo)}}
+        elif mtype == "mirror":
+            r.check_keys(m, where, ["type", "reflectance", "fresnel", "ior"])
+            fresnel = r.string(m, "fresnel", where, "none")
+            if fresnel != "none":
+                r.fail(f"{where}.fresnel", f"mirror with fresnel = \"{fresnel}\" has no Mitsuba equivalent "
+                                           "(only fresnel = \"none\" converts, to a conductor with material = \"none\")")
+            refl = r.color(m, "reflectance", where, 1.0, 0.0, 1.0)
+            bsdf = {"type": "twosided", "bsdf": {"type": "conductor", "material": "none",
+                                                 "specular_reflectance": _rgb(refl)}}
+        elif mtype == "dielectric":
+            r.check_keys(m, where, ["type", "ior", "absorption", "fresnel"])
+            fresnel = r.string(m, "fresnel", where, "exact")
+            if fresnel != "exact":
+                r.fail(f"{where}.fresnel", f"dielectric with fresnel = \"{fresnel}\" has no Mitsuba equivalent "
+                                           "(Mitsuba's dielectric uses the exact Fresnel equations; "
+                                           "use fresnel = \"exact\" or omit the key)")
+            ior = r.number(m, "ior", where, 1.5)
+            if not 1 <= ior <= 1e30:
+                r.fail(f"{where}.ior", f"must be in [1, 1e30], got {ior:g}")
+            absorption = r.color(m, "absorption", where, 0.0, 0.0)
+            bsdf = {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
+            if any(k > 0 for k in absorption):
+                media_ids[name] = f"medium{index}"
+                # volpath turns a channel with sigma_t = 0 and albedo 0 into NaN
+                # (0/0 in its albedo ratio); a floor of 1e-7 per unit length
+                # changes the transmittance by less than 1e-6 over 10 units.
+                sigma_t = [max(k, ABSORPTION_FLOOR) for k in absorption]
+                scene[media_ids[name]] = {"type": "homogeneous", "id": media_ids[name],
+                                          "albedo": 0.0, "sigma_t": _rgb(sigma_t), "scale": 1.0}
+                needs_volpath = True
+        elif mtype in ("phong", "glossy"):
+            r.fail(f"{where}.type", f"material type '{mtype}' has no Mitsuba equivalent "
+                                    f"(used by {used[name]}); only lambert, mirror (fresnel = \"none\") and "
+                                    "dielectric (exact Fresnel) convert")
+        else:
+            r.fail(f"{where}.type", f"unknown material type '{mtype}'")
+        bsdf["id"] = bsdf_id
+        scene[bsdf_id] = bsdf
+        bsdf_ids[name] = bsdf_id
+
+    def ref(i):
+        return {"type": "ref", "id": i}
+
+    # Bounds of finite geometry, for the camera's far clip.
+    extent_points = [eye, target]
+
+    black_id = None
+
+    def black_bsdf():
+        nonlocal black_id
+        if black_id is None:
+            black_id = "black"
+            scene[black_id] = {"type": "diffuse", "id": black_id, "reflectance": _rgb([0, 0, 0])}
+        return ref(black_id)
+
+    mesh_count = 0
+
+    def mesh(tris, key_prefix):
+        nonlocal mesh_count
+        file = files_dir / f"{key_prefix}.ply"
+        _write_ply(file, [v for t in tris for v in t])
+        mesh_count += 1
+        return {"type": "ply", "filename": str(file.resolve()), "face_normals": True}
+
+    plane_count = 0
+    for i, o in enumerate(objects):
+        where = f"objects[{i}]"
+        shape = r.string(o, "shape", where)
+        mat = o["material"]
+        shape_dict = None
+        if shape == "sphere":
+            r.check_keys(o, where, ["shape", "material", "center", "radius"])
+            c = r.vector(o, "center", where)
+            rad = r.number(o, "radius", where)
+            if rad <= 0:
+                r.fail(f"{where}.radius", f"must be > 0, got {rad:g}")
+            shape_dict = {"type": "sphere", "center": c, "radius": rad}
+            extent_points += [[c[k] + s * rad for k in range(3)] for s in (-1, 1)]
+        elif shape == "box":
+            r.check_keys(o, where, ["shape", "material", "min", "max"])
+            lo = r.vector(o, "min", where)
+            hi = r.vector(o, "max", where)
+            if not all(hi[k] > lo[k] for k in range(3)):
+                r.fail(f"{where}.max", "must be greater than min in every component")
+            c = [(lo[k] + hi[k]) / 2 for k in range(3)]
+            h = [(hi[k] - lo[k]) / 2 for k in range(3)]
+            m4 = [[h[0], 0, 0, c[0]], [0, h[1], 0, c[1]], [0, 0, h[2], c[2]], [0, 0, 0, 1]]
+            shape_dict = {"type": "cube", "to_world": _matrix_transform(mi, m4)}
+            extent_points += [lo, hi]
+        elif shape == "triangle":
+            r.check_keys(o, where, ["shape", "material", "vertices"])
+            v = r.triangle(o, "vertices", where)
+            if _norm(_cross(_sub(v[1], v[0]), _sub(v[2], v[0]))) == 0:
+                _note(f"{path}: {where}: degenerate triangle (zero area) skipped; it covers nothing")
+                continue
+            shape_dict = mesh([v], f"object{i}")
+            extent_points += v
+        elif shape == "plane":
+            r.check_keys(o, where, ["shape", "material", "point", "normal"])
+            p = r.vector(o, "point", where)
+            n = r.vector(o, "normal", where)
+            ln = _norm(n)
+            if ln == 0:
+                r.fail(f"{where}.normal", "must be non-zero")
+            n = [x / ln for x in n]
+            # Orthonormal basis (t, b, n) (Duff et al. 2017).
+            sign = 1.0 if n[2] >= 0 else -1.0
+            a = -1.0 / (sign + n[2])
+            b = n[0] * n[1] * a
+            t = [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]]
+            bt = [b, sign + n[1] * n[1] * a, -n[1]]
+            hs = plane_half_size
+            m4 = [[t[0] * hs, bt[0] * hs, n[0], p[0]], [t[1] * hs, bt[1] * hs, n[1], p[1]],
+                  [t[2] * hs, bt[2] * hs, n[2], p[2]], [0, 0, 0, 1]]
+            shape_dict = {"type": "rectangle", "to_world": _matrix_transform(mi, m4)}
+            extent_points += [[p[k] + s * hs * (t[k] + bt[k]) for k in range(3)] for s in (-1, 1)]
+            plane_count += 1
+        else:
+            r.fail(f"{where}.shape", f"unknown shape '{shape}' (expected sphere, box, triangle or plane)")
+        shape_dict["bsdf"] = ref(bsdf_ids[mat])
+        if mat in media_ids:
+            shape_dict["interior"] = ref(media_ids[mat])
+        scene[f"object{i}"] = shape_dict
+    if plane_count:
+        _note(f"{path}: {plane_count} infinite plane(s) approximated by square(s) of half-size "
+              f"{plane_half_size:g} (--plane-half-size)")
+
+    # [[lights]]
+    lights = data.get("lights", [])
+    if not isinstance(lights, list):
+        r.fail("lights", "expected an array of tables")
+    for i, light in enumerate(lights):
+        where = f"lights[{i}]"
+        r.table(light, where)
+        ltype = r.string(light, "type", where)
+        if ltype == "point":
+            r.check_keys(light, where, ["type", "position", "intensity"])
+            pos = r.vector(light, "position", where)
+            intensity = r.color(light, "intensity", where, None, 0.0)
+            scene[f"light{i}"] = {"type": "point", "position": pos, "intensity": _rgb(intensity)}
+            extent_points.append(pos)
+        elif ltype == "triangle":
+            r.check_keys(light, where, ["type", "vertices", "radiance", "two_sided"])
+            v = r.triangle(light, "vertices", where)
+            radiance = r.color(light, "radiance", where, None, 0.0)
+            two_sided = r.boolean(light, "two_sided", where, False)
+            nrm = _cross(_sub(v[1], v[0]), _sub(v[2], v[0]))
+            if _norm(nrm) == 0:
+                _note(f"{path}: {where}: zero-area light skipped (vkrt drops it too)")
+                continue
+            extent_points += v
+            emitter = {"type": "area", "radiance": _rgb(radiance)}
+            front = mesh([v], f"light{i}")
+            front.update({"bsdf": black_bsdf(), "emitter": emitter})
+            scene[f"light{i}"] = front
+            if two_sided:
+                # The reverse-wound twin emits on the other side. It sits a hair
+                # behind the front triangle so that rays from either side meet
+                # the triangle facing them first (coincident triangles would be
+                # hit in arbitrary order).
+                size = max(_norm(_sub(v[1], v[0])), _norm(_sub(v[2], v[1])), _norm(_sub(v[0], v[2])))
+                unit = [x / _norm(nrm) for x in nrm]
+                eps = 1e-5 * size
+                back = [[p[k] - eps * unit[k] for k in range(3)] for p in (v[0], v[2], v[1])]
+                back_dict = mesh([back], f"light{i}_back")
+                back_dict.update({"bsdf": black_bsdf(), "emitter": dict(emitter)})
+                scene[f"light{i}_back"] = back_dict
+        else:
+            r.fail(f"{where}.type", f"unknown light type '{ltype}' (expected point or triangle)")
+
+    # [background]
+    bg = r.table(data.get("background", {}), "background")
+    r.check_keys(bg, "background", ["color", "cubemap"])
+    if "cubemap" in bg:
+        if "color" in bg:
+            r.fail("background.cubemap", "cannot be combined with background.color")
+        cm = r.table(bg["cubemap"], "background.cubemap")
+        r.check_keys(cm, "background.cubemap", list(FACE_KEYS))
+        face_paths = []
+        for key in FACE_KEYS:
+            p = Path(r.string(cm, key, "background.cubemap"))
+            if not p.is_absolute():
+                p = path.parent / p
+            if not p.is_file():
+                r.fail(f"background.cubemap.{key}", f"'{p}' does not exist or is not a regular file")
+            if p.suffix.lower() not in (".exr", ".png"):
+                r.fail(f"background.cubemap.{key}", f"'{p}': expected a .exr or .png file")
+            face_paths.append(p)
+        faces = load_cubemap_faces(r, face_paths)
+        n = faces.shape[1]
+        w = envmap_width or min(4096, max(1024, 32 * n))
+        equirect = equirect_from_cubemap(faces, w, envmap_column_offset(mi))
+        env_file = files_dir / "environment.exr"
+        mi.Bitmap(equirect, mi.Bitmap.PixelFormat.RGB).write(str(env_file))
+        scene["environment"] = {"type": "envmap", "filename": str(env_file.resolve())}
+    else:
+        color = r.color(bg, "color", "background", 0.0, 0.0)
+        if any(c > 0 for c in color):
+            scene["environment"] = {"type": "constant", "radiance": _rgb(color)}
+
+    # Camera last: the far clip must reach all geometry.
+    far = 1e4
+    for p in extent_points:
+        far = max(far, 2.0 * _norm(_sub(p, eye)))
+    scene["integrator"] = {"type": "volpath" if needs_volpath else "path", "max_depth": max_depth + 1}
+    scene["sensor"] = {
+        "type": "perspective",
+        "fov": fov,
+        "fov_axis": "y",
+        "near_clip": 1e-3,
+        "far_clip": far,
+        "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=target, up=up),
+        "film": {"type": "hdrfilm", "width": width, "height": height, "rfilter": {"type": "box"},
+                 "pixel_format": "rgb", "component_format": "float32"},
+        "sampler": {"type": "independent", "sample_count": spp},
+    }
+    return scene
+
+
+_PLUGIN_TAGS = {
+    "twosided": "bsdf", "diffuse": "bsdf", "conductor": "bsdf", "dielectric": "bsdf",
+    "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape",
+    "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter",
+    "homogeneous": "medium", "perspective": "sensor", "hdrfilm": "film", "independent": "sampler",
+    "box": "rfilter", "path": "integrator", "volpath": "integrator",
+}
+
+
+def _xml_number(x) -> str:
+    return repr(float(x))
+
+
+def _xml_element(name, value, indent: str, base: Path) -> list[str]:
+    """One property or nested plugin as XML lines."""
+    from xml.sax.saxutils import quoteattr
+
+    q = quoteattr
+    if isinstance(value, dict):
+        kind = value.get("type")
+        if kind == "ref":
+            return [f"{indent}<ref name={q(name)} id={q(value['id'])}/>"]
+        if kind == "rgb":
+            return [f"{indent}<rgb name={q(name)} value=\"{' '.join(_xml_number(v) for v in value['value'])}\"/>"]
+        tag = _PLUGIN_TAGS[kind]
+        attrs = f"type={q(kind)}"
+        if "id" in value:
+            attrs += f" id={q(value['id'])}"
+        elif name is not None:
+            attrs += f" name={q(name)}"
+        lines = [f"{indent}<{tag} {attrs}>"]
+        for k, v in value.items():
+            if k not in ("type", "id"):
+                lines += _xml_element(k, v, indent + "    ", base)
+        lines.append(f"{indent}</{tag}>")
+        return lines
+    if isinstance(value, bool):
+        return [f"{indent}<boolean name={q(name)} value=\"{'true' if value else 'false'}\"/>"]
+    if isinstance(value, int):
+        return [f"{indent}<integer name={q(name)} value=\"{value}\"/>"]
+    if isinstance(value, float):
+        return [f"{indent}<float name={q(name)} value=\"{_xml_number(value)}\"/>"]
+    if isinstance(value, str):
+        if name == "filename":
+            value = os.path.relpath(value, base)
+        return [f"{indent}<string name={q(name)} value={q(value)}/>"]
+    if isinstance(value, list) and len(value) == 3:
+        x, y, z = (_xml_number(v) for v in value)
+        return [f"{indent}<point name={q(name)} x=\"{x}\" y=\"{y}\" z=\"{z}\"/>"]
+    if hasattr(value, "matrix"):  # ScalarTransform4f: write the full matrix, row-major
+        import numpy as np
+
+        m = np.array(value.matrix, dtype=np.float64).reshape(4, 4)
+        values = " ".join(_xml_number(v) for v in m.ravel())
+        return [f"{indent}<transform name={q(name)}>", f"{indent}    <matrix value=\"{values}\"/>",
+                f"{indent}</transform>"]
+    raise TypeError(f"cannot write {name} = {value!r} as Mitsuba XML")
+
+
+def write_xml(scene: dict, xml_path: Path) -> None:
+    """Write the dict as Mitsuba 3 XML; file references become paths relative to
+    the XML file, transforms full matrices."""
+    import mitsuba as mi
+
+    xml_path = Path(xml_path)
+    base = xml_path.parent.resolve()
+    lines = [f"<!-- Converted from a vkrt scene by tools/to_mitsuba.py -->",
+             f"<scene version=\"{mi.__version__}\">"]
+    for k, v in scene.items():
+        if k != "type":
+            lines += _xml_element(k, v, "    ", base)
+    lines.append("</scene>")
+    xml_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scene", help="vkrt scene (.toml)")
+    out = ap.add_mutually_exclusive_group(required=True)
+    out.add_argument("-o", "--output", help="Mitsuba XML file to write; meshes and the environment map go "
+                                            "into a folder next to it named after it (<stem>_files/)")
+    out.add_argument("--print-dict", action="store_true", help="print the Mitsuba scene dict")
+    ap.add_argument("--plane-half-size", type=float, default=DEFAULT_PLANE_HALF_SIZE,
+                    help="half-size of the squares that stand in for infinite planes (default %(default)g)")
+    ap.add_argument("--envmap-width", type=int, default=None,
+                    help="width of the equirectangular environment map made from a cubemap "
+                         "(default: 32 x face size, clamped to [1024, 4096])")
+    ap.add_argument("--allow-whitted", action="store_true",
+                    help="convert a Whitted scene as if it used integrator = \"path\"")
+    ap.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (default %(default)s)")
+    args = ap.parse_args(argv)
+    try:
+        import mitsuba as mi
+    except ImportError:
+        print("to_mitsuba: error: cannot import mitsuba; run it in the environment made by "
+              "tools/make_reference.py (.venv-mitsuba) or `pip install -r tools/requirements-mitsuba.txt`",
+              file=sys.stderr)
+        return 2
+    mi.set_variant(args.variant)
+    try:
+        if args.output:
+            xml = Path(args.output)
+            files = xml.parent / f"{xml.stem}_files"
+            scene = convert(args.scene, files_dir=files, plane_half_size=args.plane_half_size,
+                            envmap_width=args.envmap_width, allow_whitted=args.allow_whitted)
+            write_xml(scene, xml)
+            print(f"wrote {xml} (+ {files}/)")
+        else:
+            import pprint
+            scene = convert(args.scene, plane_half_size=args.plane_half_size,
+                            envmap_width=args.envmap_width, allow_whitted=args.allow_whitted)
+            pprint.pprint(scene, sort_dicts=False, width=110)
+    except ConversionError as e:
+        print(f"to_mitsuba: error: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
