@@ -491,9 +491,12 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 # volpath turns a channel with sigma_t = 0 and albedo 0 into NaN
                 # (0/0 in its albedo ratio); a floor of 1e-7 per unit length
                 # changes the transmittance by less than 1e-6 over 10 units.
+                # An RGB sigma_t is read as a reflectance (each channel <= 1),
+                # so pass κ / max(κ) and scale = max(κ).
                 sigma_t = [max(k, ABSORPTION_FLOOR) for k in absorption]
-                scene[media_ids[name]] = {"type": "homogeneous", "id": media_ids[name],
-                                          "albedo": 0.0, "sigma_t": _rgb(sigma_t), "scale": 1.0}
+                scale = max(sigma_t)
+                scene[media_ids[name]] = {"type": "homogeneous", "id": media_ids[name], "albedo": 0.0,
+                                          "sigma_t": _rgb([k / scale for k in sigma_t]), "scale": scale}
                 needs_volpath = True
         elif mtype in ("phong", "glossy"):
             r.fail(f"{where}.type", f"material type '{mtype}' has no Mitsuba equivalent "

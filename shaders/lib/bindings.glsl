@@ -36,6 +36,9 @@ layout(scalar, binding = BINDING_POINT_LIGHTS) readonly buffer PointLightBlock {
 #ifdef VKRT_HAS_CUBEMAP
 layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
 #endif
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+layout(scalar, binding = BINDING_ENVIRONMENT_CDF) readonly buffer EnvironmentCdfBlock { float environmentCdf[]; };
+#endif
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
 layout(scalar, binding = BINDING_TRIANGLE_LIGHTS) readonly buffer TriangleLightBlock { TriangleLight triangleLights[]; };
 #endif

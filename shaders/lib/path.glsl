@@ -35,6 +35,39 @@ vec3 emissionOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
 #endif
 }
 
+// Next-event estimation of the cubemap environment, MIS-weighted against
+// BSDF sampling (which finds the same light when a ray escapes).
+vec3 directFromEnvironment(Material m, vec3 position, vec3 n, vec3 wo, inout Sampler rng)
+{
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    float pdf;
+    vec3 wi = sampleEnvironment(sampleNext4D(rng).xyz, pdf);
+    float cosI = dot(n, wi);
+    if (pdf <= 0.0 || cosI <= 0.0)
+        return vec3(0.0);
+    vec3 f = evalBsdf(m, n, wo, wi);
+    if (f == vec3(0.0))
+        return vec3(0.0);
+    float weight = powerHeuristic(pdf, pdfBsdf(m, n, wo, wi));
+    vec3 visible = shadowTransmittance(offsetRayOrigin(position, n), wi, FLT_MAX);
+    return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
+#else
+    return vec3(0.0);
+#endif
+}
+
+// Environment radiance found by an escaping ray, MIS-weighted when the
+// environment is also sampled directly.
+vec3 environmentOnEscape(PathVertexState path, vec3 dir)
+{
+    vec3 le = environmentRadiance(dir);
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    if (!path.specular)
+        le *= powerHeuristic(path.bsdfPdf, environmentPdf(dir));
+#endif
+    return le;
+}
+
 // Russian roulette: continue with probability q = min(1, max throughput
 // component) and divide by q, so the estimate stays unbiased.
 bool survivesRoulette(inout PathVertexState path, uint depth, float u)
@@ -57,7 +90,7 @@ vec3 tracePath(Ray ray, inout Sampler rng)
         bool missed = !traceClosest(ray, FLT_MAX, hit);
         path.throughput *= beerLambert(path.mediumAbsorption, missed ? FLT_MAX : hit.t);
         if (missed) {
-            path.radiance += path.throughput * environmentRadiance(ray.dir);
+            path.radiance += path.throughput * environmentOnEscape(path, ray.dir);
             break;
         }
         if (hit.shape == SHAPE_LIGHT) {
@@ -73,7 +106,8 @@ vec3 tracePath(Ray ray, inout Sampler rng)
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
             path.radiance += path.throughput * (directFromPointLights(m, hit.position, n, wo) +
-                                                directFromTriangleLights(m, hit.position, n, wo, rng));
+                                                directFromTriangleLights(m, hit.position, n, wo, rng) +
+                                                directFromEnvironment(m, hit.position, n, wo, rng));
         }
         vec4 u4 = sampleNext4D(rng);
         BsdfSample s = sampleBsdf(m, n, wo, frontFace, u4.xyz);

@@ -19,7 +19,8 @@ VKRT_CONSTANT(uint, BINDING_POINT_LIGHTS, 8)    // PointLight[]
 VKRT_CONSTANT(uint, BINDING_TRIANGLE_LIGHTS, 9) // TriangleLight[]
 VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 10)    // samplerCube of environment radiance
 VKRT_CONSTANT(uint, BINDING_MOMENTS, 11)        // MomentPixel[width*height] (variance estimation)
-VKRT_CONSTANT(uint, BINDING_COUNT, 12)
+VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, 12) // float[6 N^2 + 1]: cumulative texel probabilities
+VKRT_CONSTANT(uint, BINDING_COUNT, 13)
 
 // 8x8 workgroups: lavapipe runs 8-wide subgroups and 64 invocations per group
 // measured fastest (shared/NUMERICS.md); square tiles keep rays coherent.

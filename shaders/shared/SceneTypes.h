@@ -93,6 +93,7 @@ struct SceneUniforms {
     uint triangleLightCount;
     uint tileCount;     // workgroup tiles in the image
     uint tileStride;    // coprime to tileCount: scatters tiles over the image
+    uint environmentSize; // cubemap face width N (0 without a cubemap)
 };
 
 /// Per-dispatch values (push constants). Used only as hash inputs, never in

@@ -18,7 +18,7 @@ static_assert(sizeof(Triangle) == 40);
 static_assert(sizeof(Plane) == 28);
 static_assert(sizeof(PointLight) == 24);
 static_assert(sizeof(TriangleLight) == 56);
-static_assert(sizeof(SceneUniforms) == 96);
+static_assert(sizeof(SceneUniforms) == 100);
 static_assert(sizeof(FrameConstants) == 8);
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);

@@ -1,6 +1,7 @@
 #include "render/Renderer.h"
 
 #include "render/Environment.h"
+#include "render/EnvironmentSampling.h"
 #include "shared/Bindings.h"
 #include "util/Error.h"
 
@@ -53,7 +54,10 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
     uint64_t lights = scene.pointLights.size() + emittingTriangleLights(scene).size();
     uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery);
     uint64_t depth = uint64_t(scene.render.maxDepth);
-    return whitted ? depth * perDepth : depth * perDepth + 1 + hittables;
+    if (whitted) return depth * perDepth;
+    // Cubemap sampling: a binary search over 6 N^2 texels and a shadow query.
+    uint64_t environment = scene.background.cubemap ? 1 + 32 + hittables : 0;
+    return depth * (perDepth + environment) + 1 + hittables;
 }
 
 void checkLoopBudget(const Scene& scene)
@@ -99,6 +103,17 @@ void Renderer::bindSceneBuffers()
         m_kernel.bind(binding, m_sceneBuffers.back());
     };
     m_sceneBuffers.reserve(gpu::BINDING_COUNT); // bind() keeps references: no reallocation
+    if (m_kernel.uses(gpu::BINDING_ENVIRONMENT)) {
+        // The uber kernel samples a cubemap even for a constant background:
+        // give it a 1x1 cube of that colour.
+        std::array<Image, 6> faces;
+        if (m_cubemap) faces = loadCubemapFaces(*m_cubemap);
+        else faces.fill(constantFace(m_data.uniforms.backgroundColor));
+        m_environment.emplace(m_context, faces);
+        m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
+        m_data.uniforms.environmentSize = faces[0].width;
+        addBuffer(gpu::BINDING_ENVIRONMENT_CDF, environmentCdf(faces), kStorage);
+    }
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, vk::BufferUsageFlagBits::eUniformBuffer);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, kStorage);
     addBuffer(gpu::BINDING_SPHERES, m_data.spheres, kStorage);
@@ -110,15 +125,6 @@ void Renderer::bindSceneBuffers()
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
     if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
-    if (m_kernel.uses(gpu::BINDING_ENVIRONMENT)) {
-        // The uber kernel samples a cubemap even for a constant background:
-        // give it a 1x1 cube of that colour.
-        std::array<Image, 6> faces;
-        if (m_cubemap) faces = loadCubemapFaces(*m_cubemap);
-        else faces.fill(constantFace(m_data.uniforms.backgroundColor));
-        m_environment.emplace(m_context, faces);
-        m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
-    }
 }
 
 void Renderer::recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const

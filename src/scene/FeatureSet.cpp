@@ -25,6 +25,8 @@ constexpr OptionalFeature kOptionalFeatures[] = {
     {&FeatureSet::pointLights, "VKRT_HAS_POINT_LIGHTS", int(gpu::BINDING_POINT_LIGHTS), "point-lights"},
     {&FeatureSet::triangleLights, "VKRT_HAS_TRIANGLE_LIGHTS", int(gpu::BINDING_TRIANGLE_LIGHTS), "triangle-lights"},
     {&FeatureSet::cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"},
+    {&FeatureSet::environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
+     "environment-sampling"},
     {&FeatureSet::variance, "VKRT_VARIANCE", int(gpu::BINDING_MOMENTS), "variance"},
 };
 
@@ -55,6 +57,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     FeatureSet all;
     for (const auto& feature : kOptionalFeatures) all.*feature.flag = true;
     all.variance = false; // a render option, not scene content
+    all.environmentSampling = integrator == Integrator::Path;
     all.materialTypes.fill(true);
     all.integrator = integrator;
     return all;
@@ -70,6 +73,7 @@ FeatureSet featuresOf(const Scene& scene)
     set.pointLights = !scene.pointLights.empty();
     set.triangleLights = !scene.triangleLights.empty();
     set.cubemap = scene.background.cubemap.has_value();
+    set.environmentSampling = set.cubemap && scene.render.integrator == Integrator::Path;
     set.integrator = scene.render.integrator;
     auto markUsed = [&](uint32_t material) { set.materialTypes[size_t(scene.materials[material].type)] = true; };
     for (const auto& s : scene.spheres) markUsed(s.material);

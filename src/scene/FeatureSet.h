@@ -19,6 +19,7 @@ struct FeatureSet {
     bool pointLights = false;
     bool triangleLights = false;
     bool cubemap = false;
+    bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
     bool variance = false; ///< per-pixel variance estimation (not a scene property: a render option)
     std::array<bool, 5> materialTypes{}; ///< indexed by MaterialType
     Integrator integrator = Integrator::Whitted;

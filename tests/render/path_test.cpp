@@ -1,7 +1,10 @@
 // The path integrator against closed forms: furnaces, pbrt-v4's analytic
 // sphere, and direct light from a triangle emitter (MIS of light and BSDF
 // sampling), with statistical tests where the estimate is noisy.
+#include "io/ExrFile.h"
+#include "render/CubeFaces.h"
 #include "render/Renderer.h"
+#include "scene/SceneParser.h"
 #include "support/TestSupport.h"
 
 #include <cmath>
@@ -56,6 +59,15 @@ double fractionPassingZTest(const Estimate& e, const std::vector<double>& expect
     return double(pass) / double(n);
 }
 
+/// z-score of the summed difference over all values: far more sensitive to a
+/// small bias everywhere than the per-value test.
+double pooledZ(const Estimate& e, const std::vector<double>& expected)
+{
+    double diff = 0.0, variance = 0.0;
+    for (size_t i = 0; i < expected.size(); ++i) diff += e.mean.rgb[i] - expected[i], variance += e.varianceOfMean[i];
+    return variance > 0.0 ? diff / std::sqrt(variance) : (std::abs(diff) < 1e-6 * expected.size() ? 0.0 : 1e30);
+}
+
 class PathTest : public GpuTest {};
 
 std::string furnace(const std::string& material, int maxDepth)
@@ -104,6 +116,7 @@ TEST_F(PathTest, WhiteFurnaceLambertMirrorAndGlassAreInvisible)
                 for (int k = 0; k < 3; ++k) expected[(y * 24 + x) * 3 + k] = hits ? c.expected : 1.0;
             }
         EXPECT_GE(fractionPassingZTest(e, expected), 0.9975) << c.material;
+        EXPECT_LT(std::abs(pooledZ(e, expected)), 4.0) << c.material;
     }
 }
 
@@ -144,8 +157,9 @@ intensity = 3.14159265358979
         // From the fourth vertex on, Russian roulette makes each pixel's
         // samples strongly skewed (most paths end at 0.9375, a few far above),
         // so a per-pixel normal test is only valid before it.
-        if (k <= 3)
+        if (k <= 3) {
             EXPECT_GE(fractionPassingZTest(e, std::vector<double>(e.mean.rgb.size(), expected)), 0.9975) << "k = " << k;
+        }
     }
 }
 
@@ -220,7 +234,88 @@ two_sided = true
                 for (int k = 0; k < 3; ++k) expected[(y * c.width + x) * 3 + k] = factor * glm::dvec3(4, 2, 1)[k];
             }
         EXPECT_GE(fractionPassingZTest(e, expected), 0.9975) << integrator;
+        EXPECT_LT(std::abs(pooledZ(e, expected)), 4.0) << integrator;
     }
+}
+
+// A Lambert sphere in a cubemap whose faces are six constant colours, one
+// bounce: each pixel on the sphere sees rho/pi times the irradiance of that
+// environment at its normal (integrated here over fine face grids), which
+// tests cubemap importance sampling, its pdf and MIS with BSDF sampling.
+TEST_F(PathTest, LambertSphereInFaceColouredCubemapMatchesIrradiance)
+{
+    const std::array<glm::dvec3, 6> colours = {glm::dvec3{2.0, 0.1, 0.1}, {0.1, 1.5, 0.1}, {4.0, 4.0, 3.5},
+                                               {0.05, 0.05, 0.05}, {0.3, 0.3, 1.2}, {1.0, 0.6, 0.2}};
+    std::filesystem::path dir = freshTempDir("env-irradiance");
+    const char* names[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+    std::string text = R"([render]
+integrator = "path"
+max_depth = 1
+[camera]
+eye = [0.3, 0.8, 3]
+target = [0, 0, 0]
+fov = 45
+width = 20
+height = 20
+[materials.m]
+type = "lambert"
+albedo = 0.8
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "m"
+[background.cubemap]
+)";
+    for (int f = 0; f < 6; ++f) {
+        Image face(4, 4);
+        for (size_t i = 0; i < face.pixelCount(); ++i)
+            for (int c = 0; c < 3; ++c) face.rgb[i * 3 + c] = float(colours[f][c]);
+        writeExr(dir / (std::string(names[f]) + ".exr"), face, {});
+        text += std::string(names[f]) + " = \"" + names[f] + ".exr\"\n";
+    }
+    Scene scene = parseSceneString(text, (dir / "scene.toml").string());
+    Estimate e = estimate(scene, 256);
+
+    auto irradiance = [&](const glm::dvec3& n) {
+        constexpr int kGrid = 200;
+        glm::dvec3 sum(0.0);
+        for (int f = 0; f < 6; ++f)
+            for (int j = 0; j < kGrid; ++j)
+                for (int i = 0; i < kGrid; ++i) {
+                    double s = (i + 0.5) / kGrid, t = (j + 0.5) / kGrid;
+                    double sc = 2 * s - 1, tc = 2 * t - 1, r = std::sqrt(sc * sc + tc * tc + 1);
+                    double solidAngle = 4.0 / (kGrid * kGrid) / (r * r * r);
+                    sum += colours[f] * std::max(0.0, glm::dot(n, cubeFaceDirection(f, s, t))) * solidAngle;
+                }
+        return sum;
+    };
+    const Camera& c = scene.camera;
+    glm::dvec3 forward = glm::normalize(c.target - c.eye), right = glm::normalize(glm::cross(forward, c.up));
+    glm::dvec3 up = glm::cross(right, forward);
+    double tanHalf = std::tan(c.fovY * M_PI / 360.0);
+    std::vector<double> expected;
+    std::vector<double> values, variances;
+    for (uint32_t y = 0; y < c.height; ++y)
+        for (uint32_t x = 0; x < c.width; ++x) {
+            glm::dvec3 d = glm::normalize((2.0 * (x + 0.5) / c.width - 1) * tanHalf * right +
+                                          (1 - 2.0 * (y + 0.5) / c.height) * tanHalf * up + forward);
+            double b = glm::dot(c.eye, d), disc = b * b - (glm::dot(c.eye, c.eye) - 1.0);
+            if (disc < 0.05) continue; // off the sphere or too close to its silhouette
+            glm::dvec3 n = glm::normalize(c.eye + (-b - std::sqrt(disc)) * d);
+            glm::dvec3 radiance = 0.8 / M_PI * irradiance(n);
+            for (int k = 0; k < 3; ++k) {
+                size_t i = (y * c.width + x) * 3 + k;
+                expected.push_back(radiance[k]);
+                values.push_back(e.mean.rgb[i]);
+                variances.push_back(e.varianceOfMean[i]);
+            }
+        }
+    ASSERT_GT(expected.size(), 300u);
+    Estimate onSphere{Image(uint32_t(values.size()), 1), variances};
+    for (size_t i = 0; i < values.size(); ++i) onSphere.mean.rgb[i] = float(values[i]);
+    EXPECT_GE(fractionPassingZTest(onSphere, expected), 0.9975);
+    EXPECT_LT(std::abs(pooledZ(onSphere, expected)), 4.0);
 }
 
 } // namespace
