@@ -14,6 +14,7 @@ using CommandRunner = std::function<int()>;
 CommandRunner addRenderCommand(CLI::App& app);
 CommandRunner addDevicesCommand(CLI::App& app);
 CommandRunner addInfoCommand(CLI::App& app);
+CommandRunner addCompareCommand(CLI::App& app);
 
 /// Process exit codes.
 enum ExitCode : int {
@@ -21,6 +22,7 @@ enum ExitCode : int {
     kExitFailure = 1,      ///< GPU, driver or internal failure
     kExitBadInput = 2,     ///< scene file, option or input image error
     kExitValidation = 3,   ///< Vulkan validation layer reported messages
+    kExitCompareFailed = 4, ///< `compare`: a threshold or the pixel test failed
     kExitInterrupted = 130 ///< SIGINT; partial results were written
 };
 

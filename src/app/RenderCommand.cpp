@@ -4,6 +4,7 @@
 #include "app/Commands.h"
 #include "io/ExrFile.h"
 #include "io/PngFile.h"
+#include "render/ConvergenceReport.h"
 #include "render/Progress.h"
 #include "render/RenderLoop.h"
 #include "scene/SceneParser.h"
@@ -40,6 +41,16 @@ struct RenderCommandOptions {
     bool uber = false;
     bool pixelCenters = false;
     bool variance = false;
+    std::optional<double> timeBudget;
+    std::optional<double> targetError;
+    std::string report;
+    std::string reference;
+    bool sppGiven = false;
+
+    /// Variance is needed for the layer, the report and the target-error rule.
+    bool needsVariance() const { return variance || targetError || !report.empty(); }
+    /// --spp caps the render; without it a time or error rule may run long.
+    uint32_t maxSpp() const { return sppGiven || !(timeBudget || targetError) ? spp : (1u << 30); }
 };
 
 std::atomic<bool> g_interrupted{false};
@@ -68,9 +79,10 @@ void applyResolution(Scene& scene, const RenderCommandOptions& options)
 }
 
 Metadata describeRender(const Scene& scene, const VulkanContext& context, const Renderer& renderer,
-                        const RenderCommandOptions& options, const LoopResult& loop, const RenderCounters& counters)
+                        const RenderCommandOptions& options, const LoopResult& loop, const RenderCounters& counters,
+                        const std::optional<EstimatedError>& estimated)
 {
-    return Metadata{
+    Metadata metadata{
         {"vkrtVersion", std::string(VKRT_VERSION)},
         {"spp", int64_t(renderer.completedFrames())},
         {"seed", int64_t(options.seed)},
@@ -84,6 +96,33 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
         {"kernelVariant", renderer.features().describe() + (options.uber ? " (uber)" : "")},
         {"rejectedSamples", int64_t(counters.rejectedSamples)},
     };
+    if (estimated) {
+        metadata["estimatedRmse"] = estimated->rmse;
+        metadata["estimatedRelMse"] = estimated->relMse;
+    }
+    if (options.timeBudget) metadata["timeBudgetSeconds"] = *options.timeBudget;
+    if (options.targetError) metadata["targetRelMse"] = *options.targetError;
+    return metadata;
+}
+
+/// The reference for --report, checked before any rendering starts.
+std::optional<Image> loadReference(const RenderCommandOptions& options, const Scene& scene)
+{
+    if (options.reference.empty()) return std::nullopt;
+    Image reference = readExr(options.reference).image;
+    if (reference.width != scene.camera.width || reference.height != scene.camera.height)
+        throw InputError("--reference " + options.reference + ": image is " + std::to_string(reference.width) + "x" +
+                         std::to_string(reference.height) + ", the render is " + std::to_string(scene.camera.width) +
+                         "x" + std::to_string(scene.camera.height));
+    return reference;
+}
+
+std::string reportHeader(const Scene& scene, const VulkanContext& context, double startupSeconds)
+{
+    char text[512];
+    std::snprintf(text, sizeof text, "vkrt %s convergence report; scene=%s; device=%s; startup_seconds=%.4f",
+                  VKRT_VERSION, scene.path.c_str(), context.deviceInfo().name.c_str(), startupSeconds);
+    return text;
 }
 
 void printSummary(const Renderer& renderer, const VulkanContext& context, const LoopResult& loop,
@@ -121,15 +160,30 @@ int runRender(const RenderCommandOptions& options)
     renderOptions.seed = options.seed;
     renderOptions.jitter = !options.pixelCenters;
     renderOptions.uber = options.uber;
-    renderOptions.variance = options.variance;
+    renderOptions.variance = options.needsVariance();
+    std::optional<Image> reference = loadReference(options, scene);
     Renderer renderer(context, scene, renderOptions);
+    renderer.warmUp();
     double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    std::optional<ConvergenceReport> report;
+    if (!options.report.empty())
+        report.emplace(options.report, reportHeader(scene, context, startupSeconds), std::move(reference));
+    uint32_t lastCheckpoint = 0;
+    auto onCheckpoint = [&](uint32_t spp, double seconds) {
+        if (!report && !options.targetError) return false;
+        Image mean = renderer.mean(), variance = renderer.varianceOfMean();
+        if (report) report->add(spp, seconds, mean, variance);
+        lastCheckpoint = spp;
+        return options.targetError && estimateError(mean, variance).relMse < *options.targetError;
+    };
 
     g_interrupted.store(false);
     std::signal(SIGINT, onInterrupt);
-    Progress progress(options.spp, uint64_t(scene.camera.width) * scene.camera.height, isatty(STDERR_FILENO));
-    LoopResult loop = runRenderLoop(renderer, {options.spp, &g_interrupted},
-                                    [&](uint32_t done) { progress.update(done); });
+    StopRules rules{options.maxSpp(), options.timeBudget, &g_interrupted};
+    Progress progress(rules.maxSpp, uint64_t(scene.camera.width) * scene.camera.height, isatty(STDERR_FILENO));
+    LoopResult loop = runRenderLoop(
+        renderer, rules, [&](uint32_t done) { progress.update(done); }, onCheckpoint);
     progress.finish();
     std::signal(SIGINT, SIG_DFL);
 
@@ -140,8 +194,15 @@ int runRender(const RenderCommandOptions& options)
     RenderCounters counters = renderer.counters();
     Image image = renderer.mean();
     std::map<std::string, Image> layers;
-    if (options.variance) layers["variance"] = renderer.varianceOfMean();
-    writeExr(output, image, describeRender(scene, context, renderer, options, loop, counters), layers);
+    std::optional<EstimatedError> estimated;
+    if (options.needsVariance()) {
+        Image variance = renderer.varianceOfMean();
+        estimated = estimateError(image, variance);
+        if (report && lastCheckpoint != renderer.completedFrames())
+            report->add(renderer.completedFrames(), loop.renderSeconds, image, variance); // the last row
+        if (options.variance) layers["variance"] = std::move(variance);
+    }
+    writeExr(output, image, describeRender(scene, context, renderer, options, loop, counters, estimated), layers);
     if (!options.png.empty()) writePng(options.png, image, options.exposure);
     printSummary(renderer, context, loop, counters, startupSeconds, output);
     if (int status = reportValidation(context); status != kExitOk) return status;
@@ -163,7 +224,9 @@ CommandRunner addRenderCommand(CLI::App& app)
     CLI::App* cmd = app.add_subcommand("render", "Render a scene file to an OpenEXR image");
     cmd->add_option("scene", options->scenePath, "Scene file (TOML, see docs/scene-format.md)")->required();
     cmd->add_option("-o,--output", options->output, "Output EXR (default: SCENE's name with .exr, here)");
-    cmd->add_option("--spp", options->spp, "Samples per pixel")->check(CLI::Range(1u, 1u << 30));
+    cmd->add_option("--spp", options->spp, "Samples per pixel (default 64; with --time-budget or --target-error: no limit)")
+        ->check(CLI::Range(1u, 1u << 30))
+        ->each([options](const std::string&) { options->sppGiven = true; });
     cmd->add_option("--width", options->width, "Image width (overrides the scene)")
         ->check(CLI::Range(1u, SceneLimits::maxImageSide));
     cmd->add_option("--height", options->height, "Image height (overrides the scene)")
@@ -176,6 +239,16 @@ CommandRunner addRenderCommand(CLI::App& app)
                   "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");
     cmd->add_flag("--pixel-centers", options->pixelCenters, "Sample pixel centres only (no anti-aliasing jitter)");
+    cmd->add_option("--time-budget", options->timeBudget, "Stop after this many seconds of rendering")
+        ->check(finiteNumber)
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--target-error", options->targetError,
+                    "Stop once the estimated relMSE falls below this (checked at 1, 2, 4, ... spp)")
+        ->check(finiteNumber)
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--report", options->report, "Write a convergence CSV (error against time, docs/convergence.md)");
+    cmd->add_option("--reference", options->reference, "Reference EXR for the report's true error")
+        ->needs(cmd->get_option("--report"));
     cmd->add_flag("--variance", options->variance,
                   "Also estimate per-pixel variance and write the variance of each pixel's mean as layer 'variance'");
     return [options] { return runRender(*options); };

@@ -18,6 +18,7 @@ int main(int argc, char** argv)
     };
     add(vkrt::addRenderCommand(app));
     add(vkrt::addInfoCommand(app));
+    add(vkrt::addCompareCommand(app));
     add(vkrt::addDevicesCommand(app));
 
     try {

@@ -2,50 +2,92 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace vkrt {
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
 
 constexpr double kTargetSubmitSeconds = 0.25;
 constexpr uint32_t kMaxFramesPerSubmit = 64;
 
 bool interrupted(const StopRules& rules) { return rules.interrupt && rules.interrupt->load(); }
 
-/// Frames for the next submission so that it takes about kTargetSubmitSeconds.
-uint32_t nextBatch(uint32_t batch, double seconds)
+/// Frames for the next submission: about kTargetSubmitSeconds of work, never
+/// past the next checkpoint or the spp limit, and never (by the measured
+/// frame time) past the time budget.
+uint32_t framesForNextBatch(uint32_t batch, uint32_t done, const StopRules& rules, double elapsed,
+                            double secondsPerFrame)
 {
-    if (seconds <= 0.0) return std::min(batch * 2, kMaxFramesPerSubmit);
-    double scaled = double(batch) * kTargetSubmitSeconds / seconds;
-    return uint32_t(std::clamp(scaled, 1.0, double(std::min(batch * 2, kMaxFramesPerSubmit))));
+    uint32_t frames = std::min({batch, rules.maxSpp - done, nextCheckpoint(done) - done});
+    if (rules.timeBudgetSeconds && secondsPerFrame > 0.0) {
+        double affordable = std::floor((*rules.timeBudgetSeconds - elapsed) / secondsPerFrame);
+        frames = std::min<uint32_t>(frames, uint32_t(std::clamp(affordable, 1.0, double(frames))));
+    }
+    return std::max(frames, 1u);
+}
+
+uint32_t grownBatch(uint32_t frames, double seconds)
+{
+    if (seconds <= 0.0) return std::min(frames * 2, kMaxFramesPerSubmit);
+    double scaled = double(frames) * kTargetSubmitSeconds / seconds;
+    return uint32_t(std::clamp(scaled, 1.0, double(std::min(frames * 2, kMaxFramesPerSubmit))));
 }
 
 } // namespace
 
-std::string stopReasonName(StopReason reason)
+uint32_t nextCheckpoint(uint32_t spp)
 {
-    return reason == StopReason::Interrupted ? "interrupted" : "spp";
+    uint32_t next = 1;
+    while (next <= spp && next < (1u << 31)) next *= 2;
+    return next;
 }
 
-LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules,
-                         const std::function<void(uint32_t)>& onProgress)
+std::string stopReasonName(StopReason reason)
 {
-    using Clock = std::chrono::steady_clock;
+    switch (reason) {
+    case StopReason::Interrupted: return "interrupted";
+    case StopReason::TimeBudget: return "time-budget";
+    case StopReason::TargetError: return "target-error";
+    case StopReason::SppReached: break;
+    }
+    return "spp";
+}
+
+LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules, const std::function<void(uint32_t)>& onProgress,
+                         const CheckpointHandler& onCheckpoint)
+{
     LoopResult result;
     uint32_t batch = 1;
-    auto start = Clock::now();
-    while (renderer.completedFrames() < rules.spp) {
+    double secondsPerFrame = 0.0;
+    while (true) {
+        uint32_t done = renderer.completedFrames();
+        if (done >= rules.maxSpp) break;
         if (interrupted(rules)) {
             result.reason = StopReason::Interrupted;
             break;
         }
-        uint32_t frames = std::min(batch, rules.spp - renderer.completedFrames());
-        auto before = Clock::now();
+        if (rules.timeBudgetSeconds && result.renderSeconds >= *rules.timeBudgetSeconds) {
+            result.reason = StopReason::TimeBudget;
+            break;
+        }
+        uint32_t frames = framesForNextBatch(batch, done, rules, result.renderSeconds, secondsPerFrame);
+        auto start = Clock::now();
         renderer.renderFrames(frames);
-        batch = nextBatch(batch, std::chrono::duration<double>(Clock::now() - before).count());
-        if (onProgress) onProgress(renderer.completedFrames());
+        double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        result.renderSeconds += seconds;
+        secondsPerFrame = seconds / frames;
+        batch = grownBatch(frames, seconds);
+        done = renderer.completedFrames();
+        if (onProgress) onProgress(done);
+        bool atCheckpoint = (done & (done - 1)) == 0 || done == rules.maxSpp;
+        if (atCheckpoint && onCheckpoint && onCheckpoint(done, result.renderSeconds)) {
+            result.reason = StopReason::TargetError;
+            break;
+        }
     }
-    result.renderSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     return result;
 }
 

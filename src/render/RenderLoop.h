@@ -1,29 +1,41 @@
 #pragma once
-// Drives a Renderer until a stop rule fires, batching frames into submissions
-// of about a quarter second so progress and Ctrl-C stay responsive without
-// paying a submission per frame.
+// Drives a Renderer until a stop rule fires. Frames are batched into
+// submissions of about a quarter second (so progress and Ctrl-C stay
+// responsive without paying a submission per frame), and batches end exactly
+// at the checkpoints 1, 2, 4, 8, ... spp, where convergence reports and the
+// target-error rule look at the image.
 #include "render/Renderer.h"
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace vkrt {
 
 struct StopRules {
-    uint32_t spp = 64;
+    uint32_t maxSpp = 64;
+    std::optional<double> timeBudgetSeconds;       ///< of rendering, start-up excluded
     const std::atomic<bool>* interrupt = nullptr; ///< set asynchronously (SIGINT)
 };
 
-enum class StopReason { SppReached, Interrupted };
+enum class StopReason { SppReached, TimeBudget, TargetError, Interrupted };
 std::string stopReasonName(StopReason reason);
 
 struct LoopResult {
     StopReason reason = StopReason::SppReached;
-    double renderSeconds = 0.0; ///< wall time spent in frames (no compile or set-up)
+    double renderSeconds = 0.0; ///< wall time spent in frames (no compile, set-up or checkpoint work)
 };
 
+/// Called at every checkpoint (spp a power of two, and the final spp) with
+/// the render time so far; returning true stops the render (target reached).
+using CheckpointHandler = std::function<bool(uint32_t spp, double renderSeconds)>;
+
 LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules,
-                         const std::function<void(uint32_t framesDone)>& onProgress = {});
+                         const std::function<void(uint32_t framesDone)>& onProgress = {},
+                         const CheckpointHandler& onCheckpoint = {});
+
+/// The next power of two strictly above `spp`.
+uint32_t nextCheckpoint(uint32_t spp);
 
 } // namespace vkrt

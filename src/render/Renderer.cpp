@@ -149,6 +149,16 @@ void Renderer::renderFrames(uint32_t frames)
     m_frames += frames;
 }
 
+void Renderer::warmUp()
+{
+    VKRT_CHECK(m_frames == 0);
+    renderFrames(1);
+    m_frames = 0;
+    m_accumulation.clear(m_context);
+    m_stats.clear(m_context);
+    if (m_moments) m_moments->clear(m_context);
+}
+
 Image Renderer::mean() const
 {
     auto bytes = m_accumulation.download(m_context);

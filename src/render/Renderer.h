@@ -37,6 +37,10 @@ public:
 
     /// Adds `frames` samples per pixel (one dispatch each, one submission) and waits.
     void renderFrames(uint32_t frames);
+    /// Renders and discards one frame, so that the driver's own shader
+    /// compilation (lavapipe compiles at the first dispatch) happens now and
+    /// not inside timed rendering. The image and counters start afresh.
+    void warmUp();
     uint32_t completedFrames() const { return m_frames; }
 
     /// Per-pixel mean of the accepted samples, resolved in double precision.

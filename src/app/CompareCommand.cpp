@@ -1,0 +1,101 @@
+// `vkrt compare A.exr B.exr`: error measures between two images, and with
+// variances a per-pixel statistical test; exits non-zero when a threshold is
+// exceeded so scripts and CI can rely on it.
+#include "app/Commands.h"
+#include "io/ExrFile.h"
+#include "render/ErrorMetrics.h"
+#include "util/Error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace vkrt {
+
+namespace {
+
+struct CompareOptions {
+    std::string a, b;
+    std::string varianceA, varianceB;
+    std::optional<double> maxRmse, maxRelMse;
+    double alpha = 0.01;
+    double minPass = 0.9975;
+};
+
+/// The variance image for one side: an explicit file, else the image's own
+/// "variance" layer, else none.
+std::optional<Image> varianceFor(const std::string& explicitPath, const ExrContents& image, const Image& shape,
+                                 const char* option)
+{
+    std::optional<Image> variance;
+    if (!explicitPath.empty()) variance = readExr(explicitPath).image;
+    else if (image.layers.count("variance")) variance = image.layers.at("variance");
+    if (variance && (variance->width != shape.width || variance->height != shape.height))
+        throw InputError(std::string(option) + " " + explicitPath + ": variance is " + std::to_string(variance->width) +
+                         "x" + std::to_string(variance->height) + ", the image is " + std::to_string(shape.width) +
+                         "x" + std::to_string(shape.height));
+    return variance;
+}
+
+void requireSameSize(const CompareOptions& o, const Image& a, const Image& b)
+{
+    if (a.width != b.width || a.height != b.height)
+        throw InputError("cannot compare " + o.a + " (" + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                         ") with " + o.b + " (" + std::to_string(b.width) + "x" + std::to_string(b.height) +
+                         "): sizes differ");
+}
+
+int runCompare(const CompareOptions& o)
+{
+    ExrContents a = readExr(o.a), b = readExr(o.b);
+    requireSameSize(o, a.image, b.image);
+    std::optional<Image> va = varianceFor(o.varianceA, a, a.image, "--variance-a");
+    std::optional<Image> vb = varianceFor(o.varianceB, b, b.image, "--variance-b");
+
+    MeasuredError e = measureError(a.image, b.image);
+    std::printf("A: %s\nB: %s (reference for relMSE and MAPE)\n", o.a.c_str(), o.b.c_str());
+    std::printf("size        %ux%u\n", a.image.width, a.image.height);
+    std::printf("RMSE        %.6g\nrelMSE      %.6g\nMAPE        %.6g\nmax |A-B|   %.6g\n", e.rmse, e.relMse, e.mape,
+                e.maxAbs);
+    std::printf("non-finite  A: %zu  B: %zu\n", e.nonFiniteA, e.nonFiniteB);
+
+    std::vector<std::string> failures;
+    if (e.nonFiniteA || e.nonFiniteB) failures.push_back("non-finite values");
+    if (o.maxRmse && !(e.rmse <= *o.maxRmse)) failures.push_back("RMSE exceeds --max-rmse " + std::to_string(*o.maxRmse));
+    if (o.maxRelMse && !(e.relMse <= *o.maxRelMse))
+        failures.push_back("relMSE exceeds --max-relmse " + std::to_string(*o.maxRelMse));
+    if (va || vb) {
+        Image zero(a.image.width, a.image.height);
+        PixelTestSummary t = pixelZTest(a.image, va ? *va : zero, b.image, vb ? *vb : zero, o.alpha);
+        std::printf("pixel test  %zu of %zu values pass (%.4f%%), |z| <= %.3f (alpha %.3g, Sidak); smallest p %.3g\n",
+                    t.passed, t.tested, 100.0 * t.fractionPassed(), t.threshold, o.alpha, t.minPValue);
+        if (t.fractionPassed() < o.minPass)
+            failures.push_back("fewer than " + std::to_string(100.0 * o.minPass) + "% of values pass the pixel test");
+    }
+    for (const auto& f : failures) std::printf("FAIL: %s\n", f.c_str());
+    if (failures.empty()) std::printf("OK\n");
+    return failures.empty() ? kExitOk : kExitCompareFailed;
+}
+
+} // namespace
+
+CommandRunner addCompareCommand(CLI::App& app)
+{
+    auto o = std::make_shared<CompareOptions>();
+    CLI::App* cmd = app.add_subcommand("compare", "Compare two EXR images (error measures and a per-pixel test)");
+    cmd->add_option("a", o->a, "Image A (EXR)")->required();
+    cmd->add_option("b", o->b, "Image B, the reference (EXR)")->required();
+    cmd->add_option("--variance-a", o->varianceA, "Variance of A's pixel means (default: A's 'variance' layer)");
+    cmd->add_option("--variance-b", o->varianceB, "Variance of B's pixel means (default: B's 'variance' layer)");
+    cmd->add_option("--max-rmse", o->maxRmse, "Fail when the RMSE exceeds this")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--max-relmse", o->maxRelMse, "Fail when the relMSE exceeds this")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--alpha", o->alpha, "Significance of the pixel test over all values")->check(CLI::Range(1e-12, 0.5));
+    cmd->add_option("--min-pass", o->minPass, "Fraction of values that must pass the pixel test")
+        ->check(CLI::Range(0.0, 1.0));
+    return [o] { return runCompare(*o); };
+}
+
+} // namespace vkrt

@@ -1,0 +1,45 @@
+#include "render/ConvergenceReport.h"
+
+#include "io/AtomicFile.h"
+#include "util/Error.h"
+
+#include <cstdio>
+#include <fstream>
+
+namespace vkrt {
+
+ConvergenceReport::ConvergenceReport(std::filesystem::path path, std::string header, std::optional<Image> reference)
+    : m_path(std::move(path)), m_header(std::move(header)), m_reference(std::move(reference))
+{
+}
+
+void ConvergenceReport::add(uint32_t spp, double renderSeconds, const Image& mean, const Image& varianceOfMean)
+{
+    ConvergenceRow row{spp, renderSeconds, estimateError(mean, varianceOfMean), std::nullopt};
+    if (m_reference) row.measured = measureError(mean, *m_reference);
+    m_rows.push_back(row);
+    std::string csv = text();
+    writeFileAtomically(m_path, [&](const std::filesystem::path& temporary) {
+        std::ofstream out(temporary, std::ios::binary);
+        out << csv;
+        if (!out) throw InputError(m_path.string() + ": cannot write report");
+    });
+}
+
+std::string ConvergenceReport::text() const
+{
+    std::string csv = "# " + m_header + "\n";
+    csv += m_reference ? "spp,seconds,est_rmse,est_relmse,rmse,relmse,mape\n" : "spp,seconds,est_rmse,est_relmse\n";
+    for (const ConvergenceRow& r : m_rows) {
+        char line[256];
+        int n = std::snprintf(line, sizeof line, "%u,%.6f,%.9g,%.9g", r.spp, r.renderSeconds, r.estimated.rmse,
+                              r.estimated.relMse);
+        if (r.measured)
+            std::snprintf(line + n, sizeof line - size_t(n), ",%.9g,%.9g,%.9g", r.measured->rmse, r.measured->relMse,
+                          r.measured->mape);
+        csv += std::string(line) + "\n";
+    }
+    return csv;
+}
+
+} // namespace vkrt

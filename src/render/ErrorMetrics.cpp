@@ -1,0 +1,79 @@
+#include "render/ErrorMetrics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vkrt {
+
+EstimatedError estimateError(const Image& mean, const Image& varianceOfMean)
+{
+    double sumVariance = 0.0, sumRelative = 0.0;
+    size_t n = 0;
+    for (size_t i = 0; i < mean.rgb.size(); ++i) {
+        double v = varianceOfMean.rgb[i], m = mean.rgb[i];
+        if (!std::isfinite(v) || !std::isfinite(m)) continue;
+        sumVariance += v;
+        sumRelative += v / (m * m + kRelMseEpsilon);
+        ++n;
+    }
+    if (n == 0) return {INFINITY, INFINITY};
+    return {std::sqrt(sumVariance / double(n)), sumRelative / double(n)};
+}
+
+MeasuredError measureError(const Image& image, const Image& reference)
+{
+    MeasuredError e;
+    double sumSq = 0.0, sumRel = 0.0, sumAbsRel = 0.0;
+    for (size_t i = 0; i < image.rgb.size(); ++i) {
+        double x = image.rgb[i], r = reference.rgb[i];
+        bool finiteX = std::isfinite(x), finiteR = std::isfinite(r);
+        e.nonFiniteA += !finiteX;
+        e.nonFiniteB += !finiteR;
+        if (!finiteX || !finiteR) continue;
+        double d = x - r;
+        sumSq += d * d;
+        sumRel += d * d / (r * r + kRelMseEpsilon);
+        sumAbsRel += std::abs(d) / (std::abs(r) + kRelMseEpsilon);
+        e.maxAbs = std::max(e.maxAbs, std::abs(d));
+        ++e.compared;
+    }
+    if (e.compared) {
+        double n = double(e.compared);
+        e.rmse = std::sqrt(sumSq / n);
+        e.relMse = sumRel / n;
+        e.mape = sumAbsRel / n;
+    }
+    return e;
+}
+
+double normalQuantileTwoSided(double p)
+{
+    // Bisection on erfc: P(|Z| > z) = erfc(z / sqrt 2), monotone in z.
+    double lo = 0.0, hi = 40.0;
+    for (int i = 0; i < 200; ++i) {
+        double mid = 0.5 * (lo + hi);
+        (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+PixelTestSummary pixelZTest(const Image& a, const Image& varianceA, const Image& b, const Image& varianceB,
+                            double alpha)
+{
+    PixelTestSummary s;
+    size_t n = a.rgb.size();
+    double perTest = 1.0 - std::pow(1.0 - alpha, 1.0 / double(std::max<size_t>(n, 1)));
+    s.threshold = normalQuantileTwoSided(perTest);
+    for (size_t i = 0; i < n; ++i) {
+        double d = double(a.rgb[i]) - b.rgb[i];
+        double sigma = std::sqrt(double(varianceA.rgb[i]) + double(varianceB.rgb[i]));
+        ++s.tested;
+        if (!std::isfinite(d) || !std::isfinite(sigma)) continue; // a non-finite value fails
+        double z = sigma > 0.0 ? std::abs(d) / sigma : (d == 0.0 ? 0.0 : INFINITY);
+        s.minPValue = std::min(s.minPValue, std::erfc(z / std::sqrt(2.0)));
+        if (z <= s.threshold) ++s.passed;
+    }
+    return s;
+}
+
+} // namespace vkrt

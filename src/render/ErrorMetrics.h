@@ -1,0 +1,51 @@
+#pragma once
+// Image error measures (docs/convergence.md): estimated from a render's own
+// variance, or measured against a reference.
+#include "io/Image.h"
+
+#include <cstddef>
+
+namespace vkrt {
+
+/// The epsilon in relMSE = (x - r)^2 / (r^2 + epsilon): keeps black pixels
+/// from dominating (the convention of Rousselle et al. and Mitsuba's tests).
+inline constexpr double kRelMseEpsilon = 0.01;
+
+struct EstimatedError {
+    double rmse = 0.0;   ///< sqrt(mean over values of Var[mean])
+    double relMse = 0.0; ///< mean of Var[mean] / (mean^2 + epsilon)
+};
+
+/// From per-pixel variance of the mean; non-finite variances are skipped.
+EstimatedError estimateError(const Image& mean, const Image& varianceOfMean);
+
+struct MeasuredError {
+    double rmse = 0.0;
+    double relMse = 0.0;
+    double mape = 0.0;     ///< mean of |x - r| / (|r| + epsilon)
+    double maxAbs = 0.0;   ///< largest |x - r|
+    size_t nonFiniteA = 0; ///< non-finite values in the image
+    size_t nonFiniteB = 0; ///< non-finite values in the reference
+    size_t compared = 0;   ///< values where both are finite
+};
+
+/// `image` against `reference` (same size: checked by the caller).
+MeasuredError measureError(const Image& image, const Image& reference);
+
+/// Per-pixel two-sided test of equal means, z = (a - b) / sqrt(va + vb),
+/// with a Sidak correction of alpha over all tested values.
+struct PixelTestSummary {
+    size_t tested = 0;
+    size_t passed = 0;
+    double threshold = 0.0;   ///< |z| limit after the correction
+    double minPValue = 1.0;   ///< smallest two-sided p-value
+    double fractionPassed() const { return tested ? double(passed) / double(tested) : 1.0; }
+};
+
+PixelTestSummary pixelZTest(const Image& a, const Image& varianceA, const Image& b, const Image& varianceB,
+                            double alpha = 0.01);
+
+/// Two-sided standard normal quantile: |z| with P(|Z| > |z|) = p.
+double normalQuantileTwoSided(double p);
+
+} // namespace vkrt

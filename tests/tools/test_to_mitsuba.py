@@ -1,0 +1,429 @@
+"""Checks of tools/to_mitsuba.py (the vkrt -> Mitsuba 3 scene converter).
+
+Not part of CI (CI has no Mitsuba). Run inside the environment that
+tools/make_reference.py creates:
+
+    .venv-mitsuba/bin/python tests/tools/test_to_mitsuba.py     # no pytest needed
+    .venv-mitsuba/bin/python -m pytest tests/tools/test_to_mitsuba.py   # if pytest is installed
+
+The refusal tests need only Python 3.11; the face-convention tests need numpy;
+the rest render small scenes with Mitsuba's scalar_rgb variant and compare
+them with closed forms (a few seconds each).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import tempfile
+import textwrap
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "tools"))
+
+import to_mitsuba  # noqa: E402
+
+try:
+    import numpy as np
+except ImportError:  # pragma: no cover
+    np = None
+try:
+    import mitsuba as mi
+except ImportError:  # pragma: no cover
+    mi = None
+
+
+class Skip(Exception):
+    pass
+
+
+_STANDALONE = False  # set when run as a script
+
+
+def _need(module, name):
+    if module is None:
+        if _STANDALONE:
+            raise Skip(f"{name} is not installed")
+        import pytest
+
+        pytest.skip(f"{name} is not installed")
+
+
+def _write(tmp: Path, text: str, name: str = "scene.toml") -> Path:
+    path = tmp / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+HEADER = """
+[render]
+integrator = "path"
+max_depth = 1
+[camera]
+eye = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+fov = 30
+width = 8
+height = 6
+"""
+
+
+def _refusal(material: str, key: str, extra: str = "", header: str = HEADER):
+    with tempfile.TemporaryDirectory() as tmp:
+        path = _write(Path(tmp), header + textwrap.dedent(f"""
+            [materials."odd one"]
+            {material}
+            [[objects]]
+            shape = "sphere"
+            material = "odd one"
+            center = [0.0, 0.0, 0.0]
+            radius = 1
+            """) + extra)
+        try:
+            to_mitsuba.convert(path)
+        except to_mitsuba.ConversionError as e:
+            message = str(e)
+        else:
+            raise AssertionError(f"{material!r} was converted")
+        assert str(path) in message, message
+        assert key in message, message
+        return message
+
+
+# ----------------------------------------------------------------------------
+# Refusals (plain Python)
+# ----------------------------------------------------------------------------
+
+def test_refuses_phong_and_glossy():
+    _refusal('type = "phong"', 'materials."odd one".type')
+    _refusal('type = "glossy"', 'materials."odd one".type')
+
+
+def test_refuses_schlick():
+    _refusal('type = "mirror"\nfresnel = "schlick"', 'materials."odd one".fresnel')
+    _refusal('type = "dielectric"\nfresnel = "schlick"', 'materials."odd one".fresnel')
+
+
+def test_refuses_whitted():
+    header = HEADER.replace('integrator = "path"', 'integrator = "whitted"')
+    _refusal('type = "lambert"', "render.integrator", header=header)
+    header = HEADER.replace('integrator = "path"\n', "")
+    _refusal('type = "lambert"', "render", header=header)
+
+
+def test_refuses_unknown_keys():
+    _refusal('type = "lambert"\nalbedo = 0.5\nshininess = 3', 'materials."odd one".shininess')
+
+
+# ----------------------------------------------------------------------------
+# Cube face convention (numpy)
+# ----------------------------------------------------------------------------
+
+def test_face_directions_follow_cubefaces_h():
+    _need(np, "numpy")
+    # Texel (s, t) = (0, 0) is the top-left of each stored face (CubeFaces.h).
+    expected = {0: (1, 1, 1), 1: (-1, 1, -1), 2: (-1, 1, -1), 3: (-1, -1, 1), 4: (-1, 1, 1), 5: (1, 1, -1)}
+    for face, d in expected.items():
+        got = to_mitsuba._face_direction(face, np.array(-1.0), np.array(-1.0))
+        assert np.allclose(got, d), (face, got, d)
+    rng = np.random.default_rng(1)
+    for face in range(6):
+        sc, tc = rng.uniform(-0.999, 0.999, (2, 100))
+        g, s, t = to_mitsuba._select_face(to_mitsuba._face_direction(face, sc, tc))
+        assert np.all(g == face)
+        assert np.allclose(2 * s - 1, sc) and np.allclose(2 * t - 1, tc)
+
+
+def test_cube_lookup_is_seamless():
+    _need(np, "numpy")
+    n = 4
+    faces = np.random.default_rng(2).uniform(0, 1, (6, n, n, 3))
+    # Approaching a cube edge from either face gives the same filtered value.
+    for d in ([1, 0.3, 1], [1, 1, -0.2], [-0.4, -1, -1], [1, 1, 1]):
+        d = np.array(d, float)
+        e = 1e-9
+        a = to_mitsuba.cube_lookup(faces, (d + [e, 0, 0])[None])
+        b = to_mitsuba.cube_lookup(faces, (d + [0, e, 0])[None])
+        c = to_mitsuba.cube_lookup(faces, (d + [0, 0, e])[None])
+        assert np.allclose(a, b, atol=1e-6) and np.allclose(a, c, atol=1e-6), (d, a, b, c)
+
+
+# ----------------------------------------------------------------------------
+# Renders compared with closed forms (Mitsuba, scalar_rgb)
+# ----------------------------------------------------------------------------
+
+def _render(tmp: Path, text: str, spp: int, max_depth_override=None, seed: int = 7):
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    d = to_mitsuba.convert(_write(tmp, text), files_dir=tmp / "files")
+    if max_depth_override is not None:
+        d["integrator"]["max_depth"] = max_depth_override
+    return np.array(mi.render(mi.load_dict(d), spp=spp, seed=seed), dtype=np.float64)
+
+
+def _camera_rays(eye, target, up, fov, w, h, sub):
+    """vkrt's pinhole camera (GpuScene.cpp, camera.glsl): sub x sub points per pixel."""
+    eye, target, up = (np.asarray(v, float) for v in (eye, target, up))
+    f = target - eye
+    f /= np.linalg.norm(f)
+    r = np.cross(f, up)
+    r /= np.linalg.norm(r)
+    u = np.cross(r, f)
+    hh = math.tan(math.radians(fov) / 2)
+    hw = hh * w / h
+    o = (np.arange(sub) + 0.5) / sub
+    sx, sy = np.meshgrid(o, o)
+    px = np.arange(w)[None, :, None] + sx.ravel()[None, None, :]
+    py = np.arange(h)[:, None, None] + sy.ravel()[None, None, :]
+    px, py = np.broadcast_arrays(px, py)
+    d = (2 * px / w - 1)[..., None] * hw * r + (1 - 2 * py / h)[..., None] * hh * u + f
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def _tl(v):
+    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+
+def test_point_light_on_lambert_floor_matches_closed_form():
+    """rho * I * cos / (pi d^2), averaged over each pixel; camera, pixel layout,
+    lambert albedo, point intensity and max_depth = 1 (Mitsuba 2) in one go."""
+    _need(mi, "mitsuba")
+    rho, intensity, light = np.array([0.5, 0.3, 0.8]), np.array([10.0, 5.0, 2.0]), np.array([0.7, 1.5, -0.4])
+    eye, target, fov, w, h = [0.3, 3.0, 2.5], [0.0, 0.0, 0.0], 50, 32, 24
+    text = f"""
+        [render]
+        integrator = "path"
+        max_depth = 1
+        [camera]
+        eye = {eye}
+        target = {target}
+        fov = {fov}
+        width = {w}
+        height = {h}
+        [materials.floor]
+        type = "lambert"
+        albedo = {_tl(rho)}
+        [materials.wall]
+        type = "lambert"
+        albedo = 0.9
+        [[objects]]
+        shape = "box"
+        material = "floor"
+        min = [-20, -1, -20]
+        max = [20, 0, 20]
+        [[objects]] # would add indirect light if max_depth were off by one
+        shape = "box"
+        material = "wall"
+        min = [-20, 0, -4]
+        max = [20, 5, -3]
+        [[lights]]
+        type = "point"
+        position = {_tl(light)}
+        intensity = {_tl(intensity)}
+        """
+    with tempfile.TemporaryDirectory() as tmp:
+        img = _render(Path(tmp), text, 1024)
+        black = _render(Path(tmp), text, 4, max_depth_override=1)
+    d = _camera_rays(eye, target, [0, 1, 0], fov, w, h, 16)
+    e = np.array(eye, float)
+    t = -e[1] / d[..., 1]
+    p = e + t[..., None] * d
+    v = light - p
+    dist2 = (v * v).sum(-1)
+    cos = np.clip(v[..., 1] / np.sqrt(dist2), 0, None)
+    expected = (rho * intensity * (cos / (math.pi * dist2))[..., None]).mean(2)
+    floor = (d[..., 1] < -0.05).all(2) & (p[..., 2] > -2.9).all(2)
+    rel = np.abs(img[floor] - expected[floor]) / expected[floor]
+    assert floor.sum() > 300
+    assert rel.mean() < 2e-3 and rel.max() < 1.5e-2, (rel.mean(), rel.max())
+    assert black.max() == 0.0  # Mitsuba max_depth 1 = emitters only
+
+
+def test_triangle_light_sidedness():
+    _need(mi, "mitsuba")
+    # cross(v1 - v0, v2 - v0) = cross((2, 0, 0), (1, 0, 2)) = (0, -4, 0): faces -y.
+    down = [[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, 1.0]]
+    def scene(verts, eye, two_sided):
+        return f"""
+            [render]
+            integrator = "path"
+            max_depth = 1
+            [camera]
+            eye = {eye}
+            target = [0.0, 0.0, -0.2]
+            up = [0.0, 0.0, -1.0]
+            fov = 10
+            width = 4
+            height = 4
+            [[lights]]
+            type = "triangle"
+            vertices = [{_tl(verts[0])}, {_tl(verts[1])}, {_tl(verts[2])}]
+            radiance = [3.0, 2.0, 1.0]
+            two_sided = {"true" if two_sided else "false"}
+            """
+    with tempfile.TemporaryDirectory() as tmp:
+        below = _render(Path(tmp), scene(down, [0.0, -3.0, -0.2], False), 4)
+        above = _render(Path(tmp), scene(down, [0.0, 3.0, -0.2], False), 4)
+        above2 = _render(Path(tmp), scene(down, [0.0, 3.0, -0.2], True), 4)
+        below2 = _render(Path(tmp), scene(down, [0.0, -3.0, -0.2], True), 4)
+    le = np.array([3.0, 2.0, 1.0])
+    assert np.allclose(below, le), below  # front side (counter-clockwise seen from below)
+    assert np.all(above == 0), above      # back side: black
+    assert np.allclose(above2, le) and np.allclose(below2, le)
+
+
+def test_environment_cubemap_orientation():
+    """Six flat-coloured faces: looking along each axis shows that face."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    colours = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [1, 0, 1], [0, 1, 1]], np.float32)
+    axes = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for key, c in zip(to_mitsuba.FACE_KEYS, colours):
+            mi.Bitmap(np.broadcast_to(c, (8, 8, 3)).copy(), mi.Bitmap.PixelFormat.RGB).write(str(tmp / f"{key}.exr"))
+        faces = "".join(f'{k} = "{k}.exr"\n' for k in to_mitsuba.FACE_KEYS)
+        for axis, c in zip(axes, colours):
+            up = [0, 0, 1] if axis[1] else [0, 1, 0]
+            img = _render(tmp, f"""
+                [render]
+                integrator = "path"
+                max_depth = 1
+                [camera]
+                eye = [0.0, 0.0, 0.0]
+                target = {_tl(axis)}
+                up = {_tl(up)}
+                fov = 20
+                width = 4
+                height = 4
+                [background.cubemap]
+                """ + faces, 4)
+            assert np.allclose(img[1:3, 1:3], c, atol=1e-4), (axis, img[1:3, 1:3])
+
+
+def test_environment_matches_bilinear_cube_lookup():
+    """Faces whose texels encode their direction: the rendered image equals the
+    Vulkan bilinear cube lookup of vkrt's camera rays."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    n = 16
+    o = (np.arange(n) + 0.5) / n
+    s, t = np.meshgrid(o, o)
+    eye, target, up, fov, w, h = [0, 0, 0], [0.3, 0.4, -1.0], [0, 1, 0], 70, 32, 24
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        stack = []
+        for f, key in enumerate(to_mitsuba.FACE_KEYS):
+            d = to_mitsuba._face_direction(f, 2 * s - 1, 2 * t - 1)
+            d /= np.linalg.norm(d, axis=-1, keepdims=True)
+            texels = (0.5 + 0.5 * d).astype(np.float32)
+            stack.append(texels)
+            mi.Bitmap(texels, mi.Bitmap.PixelFormat.RGB).write(str(tmp / f"{key}.exr"))
+        img = _render(tmp, f"""
+            [render]
+            integrator = "path"
+            max_depth = 1
+            [camera]
+            eye = {_tl(eye)}
+            target = {_tl(target)}
+            fov = {fov}
+            width = {w}
+            height = {h}
+            [background.cubemap]
+            """ + "".join(f'{k} = "{k}.exr"\n' for k in to_mitsuba.FACE_KEYS), 256)
+    rays = _camera_rays(eye, target, up, fov, w, h, 8)
+    expected = to_mitsuba.cube_lookup(np.stack(stack).astype(np.float64), rays).mean(2)
+    err = np.abs(img - expected)
+    assert err.mean() < 5e-4 and err.max() < 5e-3, (err.mean(), err.max())
+
+
+def test_glass_slab_with_absorption():
+    """Normal incidence through a slab: (1-R)^2 T / (1 - R^2 T^2), T = exp(-k d);
+    checks dielectric Fresnel, Beer-Lambert and the cancelling eta^2 factors."""
+    _need(mi, "mitsuba")
+    n, kappa, thick = 1.5, np.array([2.5, 0.2, 0.0]), 1.0
+    text = f"""
+        [render]
+        integrator = "path"
+        max_depth = 20
+        [camera]
+        eye = [0.0, 0.0, 5.0]
+        target = [0.0, 0.0, 0.0]
+        fov = 1
+        width = 4
+        height = 3
+        [materials.glass]
+        type = "dielectric"
+        ior = {n}
+        absorption = {_tl(kappa)}
+        [[objects]]
+        shape = "box"
+        material = "glass"
+        min = [-50.0, -50.0, -0.5]
+        max = [50.0, 50.0, 0.5]
+        [[lights]]
+        type = "triangle"
+        vertices = [[-100.0, -100.0, -2.0], [100.0, -100.0, -2.0], [0.0, 100.0, -2.0]]
+        radiance = 1
+        """
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = np.array([_render(Path(tmp), text, 4096, seed=k).mean((0, 1)) for k in range(8)])
+    r = ((n - 1) / (n + 1)) ** 2
+    tr = np.exp(-kappa * thick)
+    expected = (1 - r) ** 2 * tr / (1 - r * r * tr * tr)
+    got = runs.mean(0)
+    # volpath's spectral MIS makes samples far from 0/1: use the spread of the runs.
+    tol = 5 * runs.std(0, ddof=1) / np.sqrt(len(runs)) + 1e-5
+    assert np.all(np.abs(got - expected) < tol), (got, expected, tol)
+
+
+def test_single_glass_interface_scales_radiance_by_inverse_eta_squared():
+    """Documents Mitsuba's convention: radiance entering a dielectric is divided
+    by eta^2 (and multiplied by eta^2 on leaving). A camera outside looking at a
+    light through one interface (an open surface) sees (1 - R) / eta^2."""
+    _need(mi, "mitsuba")
+    n = 1.5
+    text = f"""
+        [render]
+        integrator = "path"
+        max_depth = 4
+        [camera]
+        eye = [0.0, 0.0, 5.0]
+        target = [0.0, 0.0, 0.0]
+        fov = 1
+        width = 4
+        height = 3
+        [materials.glass]
+        type = "dielectric"
+        ior = {n}
+        [[objects]]
+        shape = "triangle"
+        material = "glass"
+        vertices = [[-50.0, -50.0, 0.0], [50.0, -50.0, 0.0], [0.0, 50.0, 0.0]]
+        [[lights]]
+        type = "triangle"
+        vertices = [[-100.0, -100.0, -2.0], [100.0, -100.0, -2.0], [0.0, 100.0, -2.0]]
+        radiance = 1
+        """
+    with tempfile.TemporaryDirectory() as tmp:
+        img = _render(Path(tmp), text, 4096)
+    r = ((n - 1) / (n + 1)) ** 2
+    assert abs(img.mean() - (1 - r) / n**2) < 0.01, img.mean()
+
+
+if __name__ == "__main__":
+    _STANDALONE = True
+    failures = 0
+    for name, fn in list(globals().items()):
+        if name.startswith("test_") and callable(fn):
+            try:
+                fn()
+                print(f"PASS {name}")
+            except Skip as e:
+                print(f"SKIP {name}: {e}")
+            except Exception as e:  # noqa: BLE001
+                failures += 1
+                print(f"FAIL {name}: {type(e).__name__}: {e}")
+    sys.exit(1 if failures else 0)
