@@ -60,6 +60,13 @@ void main()
     // Test hook: samples alternate between OFFSET and OFFSET + 1 frame by frame.
     radiance = vec3(VKRT_TEST_ALTERNATING_SAMPLES + float(frame.frameIndex & 1u));
 #endif
+#ifdef VKRT_TEST_OUTLIER_SAMPLES
+    // Test hook: the constant VKRT_TEST_OUTLIER_SAMPLES, except that one
+    // (pixel, frame) in 10,000 carries an outlier a million times larger.
+    radiance = vec3(VKRT_TEST_OUTLIER_SAMPLES);
+    if ((pixelIndex * 7919u + frame.frameIndex) % 10000u == 0u)
+        radiance *= 1e6;
+#endif
 #ifdef VKRT_TEST_INJECT_NONFINITE
     // Test hook: poison every 7th pixel so the rejection path is exercised.
     if (pixelIndex % 7u == 0u)
