@@ -23,7 +23,9 @@ uint32_t framesForNextBatch(uint32_t batch, uint32_t done, const StopRules& rule
 {
     uint32_t frames = std::min({batch, rules.maxSpp - done, nextCheckpoint(done) - done});
     if (rules.timeBudgetSeconds && secondsPerFrame > 0.0) {
-        double affordable = std::floor((*rules.timeBudgetSeconds - elapsed) / secondsPerFrame);
+        // Spend half the remaining time per batch, and go one frame at a time
+        // at the end, so that a slow frame overshoots the budget by itself only.
+        double affordable = std::floor(0.5 * (*rules.timeBudgetSeconds - elapsed) / secondsPerFrame);
         frames = std::min<uint32_t>(frames, uint32_t(std::clamp(affordable, 1.0, double(frames))));
     }
     return std::max(frames, 1u);

@@ -71,6 +71,7 @@ void checkLoopBudget(const Scene& scene)
 
 Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptions options)
     : m_context(context),
+      m_scene(scene),
       m_options(std::move(options)),
       m_features(chooseFeatures(scene, m_options)),
       m_data(convertScene(scene, FrameSettings{m_options.jitter})),
@@ -92,28 +93,40 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
                           MemoryUse::Device);
         m_moments->clear(context);
     }
-    bindSceneBuffers();
+    m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
+    m_kernel.bind(gpu::BINDING_STATS, m_stats);
+    if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
+    bindEnvironment();
+    uploadSceneBuffers();
 }
 
-void Renderer::bindSceneBuffers()
+void Renderer::bindEnvironment()
+{
+    if (!m_kernel.uses(gpu::BINDING_ENVIRONMENT)) return;
+    // The uber kernel samples a cubemap even for a constant background:
+    // give it a 1x1 cube of that colour.
+    std::array<Image, 6> faces;
+    if (m_cubemap) faces = loadCubemapFaces(*m_cubemap);
+    else faces.fill(constantFace(m_data.uniforms.backgroundColor));
+    m_environment.emplace(m_context, faces);
+    m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
+    m_environmentSize = faces[0].width;
+    if (m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) {
+        m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), kStorage));
+        m_kernel.bind(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
+    }
+}
+
+void Renderer::uploadSceneBuffers()
 {
     auto addBuffer = [&](uint32_t binding, auto&& records, vk::BufferUsageFlags usage) {
         if (!m_kernel.uses(binding)) return;
         m_sceneBuffers.push_back(makeBufferFrom(m_context, records, usage));
         m_kernel.bind(binding, m_sceneBuffers.back());
     };
+    m_sceneBuffers.clear();
     m_sceneBuffers.reserve(gpu::BINDING_COUNT); // bind() keeps references: no reallocation
-    if (m_kernel.uses(gpu::BINDING_ENVIRONMENT)) {
-        // The uber kernel samples a cubemap even for a constant background:
-        // give it a 1x1 cube of that colour.
-        std::array<Image, 6> faces;
-        if (m_cubemap) faces = loadCubemapFaces(*m_cubemap);
-        else faces.fill(constantFace(m_data.uniforms.backgroundColor));
-        m_environment.emplace(m_context, faces);
-        m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
-        m_data.uniforms.environmentSize = faces[0].width;
-        addBuffer(gpu::BINDING_ENVIRONMENT_CDF, environmentCdf(faces), kStorage);
-    }
+    m_data.uniforms.environmentSize = m_environmentSize;
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, vk::BufferUsageFlagBits::eUniformBuffer);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, kStorage);
     addBuffer(gpu::BINDING_SPHERES, m_data.spheres, kStorage);
@@ -122,9 +135,23 @@ void Renderer::bindSceneBuffers()
     addBuffer(gpu::BINDING_PLANES, m_data.planes, kStorage);
     addBuffer(gpu::BINDING_POINT_LIGHTS, m_data.pointLights, kStorage);
     addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, kStorage);
-    m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
-    m_kernel.bind(gpu::BINDING_STATS, m_stats);
-    if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
+}
+
+void Renderer::reset()
+{
+    m_frames = 0;
+    m_accumulation.clear(m_context);
+    m_stats.clear(m_context);
+    if (m_moments) m_moments->clear(m_context);
+}
+
+void Renderer::moveCamera(const Camera& camera)
+{
+    VKRT_CHECK(camera.width == width() && camera.height == height());
+    m_scene.camera = camera;
+    m_data = convertScene(m_scene, FrameSettings{m_options.jitter});
+    uploadSceneBuffers();
+    reset();
 }
 
 void Renderer::recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const
@@ -153,10 +180,7 @@ void Renderer::warmUp()
 {
     VKRT_CHECK(m_frames == 0);
     renderFrames(1);
-    m_frames = 0;
-    m_accumulation.clear(m_context);
-    m_stats.clear(m_context);
-    if (m_moments) m_moments->clear(m_context);
+    reset();
 }
 
 Image Renderer::mean() const

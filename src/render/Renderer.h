@@ -43,6 +43,16 @@ public:
     void warmUp();
     uint32_t completedFrames() const { return m_frames; }
 
+    /// Discards everything accumulated so far (the next frame is frame 0).
+    void reset();
+    /// Moves the camera (same image size) and resets: the scene is re-made
+    /// camera-relative and re-uploaded; the kernel and environment stay.
+    void moveCamera(const Camera& camera);
+    const Scene& scene() const { return m_scene; }
+    const VulkanContext& context() const { return m_context; }
+    /// The accumulation buffer (AccumPixel per pixel), for display kernels.
+    const Buffer& accumulation() const { return m_accumulation; }
+
     /// Per-pixel mean of the accepted samples, resolved in double precision.
     Image mean() const;
     /// Per-pixel variance of that mean (sample variance / count); needs
@@ -57,6 +67,7 @@ public:
 
 private:
     const VulkanContext& m_context;
+    Scene m_scene;
     RenderOptions m_options;
     FeatureSet m_features;
     GpuSceneData m_data;
@@ -68,9 +79,12 @@ private:
     ComputeKernel m_kernel;
     std::optional<Cubemap> m_cubemap;
     std::optional<CubeTexture> m_environment;
+    std::optional<Buffer> m_environmentCdf;
+    uint32_t m_environmentSize = 0;
     uint32_t m_frames = 0;
 
-    void bindSceneBuffers();
+    void bindEnvironment();
+    void uploadSceneBuffers();
     void recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const;
 };
 
