@@ -17,6 +17,7 @@ int main(int argc, char** argv)
         commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(runner));
     };
     add(vkrt::addRenderCommand(app));
+    add(vkrt::addViewCommand(app));
     add(vkrt::addInfoCommand(app));
     add(vkrt::addCompareCommand(app));
     add(vkrt::addDevicesCommand(app));

@@ -78,6 +78,13 @@ void ComputeKernel::bind(uint32_t binding, vk::ImageView view, vk::Sampler sampl
     m_context.device().updateDescriptorSets(write, nullptr);
 }
 
+void ComputeKernel::bindStorageImage(uint32_t binding, vk::ImageView view)
+{
+    vk::DescriptorImageInfo info(nullptr, view, vk::ImageLayout::eGeneral);
+    vk::WriteDescriptorSet write(*m_set, binding, 0, typeOf(binding), info);
+    m_context.device().updateDescriptorSets(write, nullptr);
+}
+
 void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants,
                                    vk::Extent2D groups) const
 {

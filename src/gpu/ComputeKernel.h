@@ -29,6 +29,8 @@ public:
     void bind(uint32_t binding, const Buffer& buffer);
     /// Points a combined image-sampler `binding` at an image view.
     void bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler);
+    /// Points a storage-image `binding` at an image view in GENERAL layout.
+    void bindStorageImage(uint32_t binding, vk::ImageView view);
     /// Records bind + push constants + dispatch of `groups`.
     void recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, vk::Extent2D groups) const;
     bool uses(uint32_t binding) const;

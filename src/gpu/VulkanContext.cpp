@@ -35,8 +35,19 @@ bool hasLayer(const vk::raii::Context& context, const char* name)
     return false;
 }
 
-std::optional<uint32_t> findComputeQueueFamily(const vk::raii::PhysicalDevice& device)
+/// A family with graphics, compute and presentation to `surface`.
+std::optional<uint32_t> findPresentQueueFamily(const vk::raii::PhysicalDevice& device, vk::SurfaceKHR surface)
 {
+    auto families = device.getQueueFamilyProperties();
+    auto needed = vk::QueueFlagBits::eGraphics | vk::QueueFlagBits::eCompute;
+    for (uint32_t i = 0; i < families.size(); ++i)
+        if ((families[i].queueFlags & needed) == needed && device.getSurfaceSupportKHR(i, surface)) return i;
+    return std::nullopt;
+}
+
+std::optional<uint32_t> findComputeQueueFamily(const vk::raii::PhysicalDevice& device, vk::SurfaceKHR surface)
+{
+    if (surface) return findPresentQueueFamily(device, surface);
     auto families = device.getQueueFamilyProperties();
     // Prefer a compute family without graphics: on GPUs it is the async queue.
     std::optional<uint32_t> any;
@@ -48,18 +59,19 @@ std::optional<uint32_t> findComputeQueueFamily(const vk::raii::PhysicalDevice& d
     return any;
 }
 
-std::string unsuitableReason(const vk::raii::PhysicalDevice& device, const DeviceInfo& info)
+std::string unsuitableReason(const vk::raii::PhysicalDevice& device, const DeviceInfo& info, vk::SurfaceKHR surface)
 {
     if (info.apiVersion < kRequiredApiVersion)
         return "supports Vulkan " + info.apiVersionString() + ", vkrt needs 1.2";
-    if (!info.computeQueueFamily) return "has no compute queue";
+    if (!info.computeQueueFamily)
+        return surface ? "has no queue that can compute, blit and present to this window" : "has no compute queue";
     auto features = device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features>();
     if (!features.get<vk::PhysicalDeviceVulkan12Features>().scalarBlockLayout)
         return "lacks the scalarBlockLayout feature (GPU structs use the scalar layout)";
     return {};
 }
 
-DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index)
+DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index, vk::SurfaceKHR surface = {})
 {
     auto chain = device.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
     const auto& props = chain.get<vk::PhysicalDeviceProperties2>().properties;
@@ -70,8 +82,8 @@ DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index
     info.type = props.deviceType;
     info.driver = std::string(driver.driverName.data()) + ": " + driver.driverInfo.data();
     info.apiVersion = props.apiVersion;
-    info.computeQueueFamily = findComputeQueueFamily(device);
-    info.unsuitableReason = unsuitableReason(device, info);
+    info.computeQueueFamily = findComputeQueueFamily(device, surface);
+    info.unsuitableReason = unsuitableReason(device, info, surface);
     return info;
 }
 
@@ -122,12 +134,12 @@ void tuneSoftwareRasterizerThreads()
 VulkanContext::VulkanContext(const ContextOptions& options) : m_validation(options.validation)
 {
     tuneSoftwareRasterizerThreads();
-    createInstance();
+    createInstance(options.presentation);
     chooseDevice(options.deviceSelector);
     createDevice();
 }
 
-void VulkanContext::createInstance()
+void VulkanContext::createInstance(const std::optional<PresentationSupport>& presentation)
 {
     if (m_validation && !hasLayer(m_context, kValidationLayer))
         throw GpuError("validation requested but VK_LAYER_KHRONOS_validation is not installed "
@@ -138,7 +150,10 @@ void VulkanContext::createInstance()
         layers.push_back(kValidationLayer);
         extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
+    if (presentation)
+        for (const auto& e : presentation->instanceExtensions) extensions.push_back(e.c_str());
     m_instance = vk::raii::Instance(m_context, vk::InstanceCreateInfo({}, &app, layers, extensions));
+    if (presentation) m_surface = vk::raii::SurfaceKHR(m_instance, presentation->createSurface(*m_instance));
     if (!m_validation) return;
     using Severity = vk::DebugUtilsMessageSeverityFlagBitsEXT;
     using Type = vk::DebugUtilsMessageTypeFlagBitsEXT;
@@ -151,7 +166,7 @@ void VulkanContext::createInstance()
 void VulkanContext::chooseDevice(const std::string& selector)
 {
     vk::raii::PhysicalDevices physical(m_instance);
-    for (uint32_t i = 0; i < physical.size(); ++i) m_devices.push_back(describeDevice(physical[i], i));
+    for (uint32_t i = 0; i < physical.size(); ++i) m_devices.push_back(describeDevice(physical[i], i, *m_surface));
     if (m_devices.empty())
         throw GpuError("no Vulkan device found; install mesa-vulkan-drivers for lavapipe (software Vulkan)");
     m_deviceIndex = selector.empty() ? defaultDeviceIndex(m_devices) : selectDevice(m_devices, selector);
@@ -167,6 +182,8 @@ void VulkanContext::createDevice()
     vk::DeviceQueueCreateInfo queueInfo({}, queueFamily(), 1, &priority);
     vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan12Features> chain;
     chain.get<vk::DeviceCreateInfo>().setQueueCreateInfos(queueInfo);
+    const char* swapchainExtension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+    if (*m_surface) chain.get<vk::DeviceCreateInfo>().setPEnabledExtensionNames(swapchainExtension);
     chain.get<vk::PhysicalDeviceVulkan12Features>().setScalarBlockLayout(true);
     m_device = vk::raii::Device(m_physicalDevice, chain.get<vk::DeviceCreateInfo>());
     m_queue = vk::raii::Queue(m_device, queueFamily(), 0);

@@ -4,6 +4,7 @@
 // them in the reverse order Vulkan requires.
 #include <vulkan/vulkan_raii.hpp>
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -27,12 +28,22 @@ struct DeviceInfo {
     std::string apiVersionString() const;
 };
 
+/// What a window needs from the context: the instance extensions the window
+/// system asks for, and a function that creates the window's surface.
+struct PresentationSupport {
+    std::vector<std::string> instanceExtensions;
+    std::function<VkSurfaceKHR(VkInstance)> createSurface;
+};
+
 struct ContextOptions {
     /// Device index or case-insensitive name fragment; empty = default choice
     /// (a discrete GPU if one is suitable, else a CPU device such as lavapipe).
     std::string deviceSelector;
     /// Enable VK_LAYER_KHRONOS_validation and record every message it emits.
     bool validation = false;
+    /// Set for the viewer: the device must present to this window's surface
+    /// from a queue that also does graphics (blits) and compute.
+    std::optional<PresentationSupport> presentation;
 };
 
 /// Collects validation-layer messages (thread-safe; the layer may call from any thread).
@@ -58,6 +69,8 @@ public:
     const vk::raii::Queue& queue() const { return m_queue; }
     uint32_t queueFamily() const { return *deviceInfo().computeQueueFamily; }
     const vk::raii::CommandPool& commandPool() const { return m_commandPool; }
+    /// The window surface (viewer only; null otherwise).
+    const vk::raii::SurfaceKHR& surface() const { return m_surface; }
 
     bool validationEnabled() const { return m_validation; }
     /// Messages the validation layer has emitted so far (empty when disabled).
@@ -84,6 +97,7 @@ private:
     vk::raii::Context m_context;
     vk::raii::Instance m_instance = nullptr;
     vk::raii::DebugUtilsMessengerEXT m_messenger = nullptr;
+    vk::raii::SurfaceKHR m_surface = nullptr;
     std::vector<DeviceInfo> m_devices;
     uint32_t m_deviceIndex = 0;
     vk::raii::PhysicalDevice m_physicalDevice = nullptr;
@@ -91,7 +105,7 @@ private:
     vk::raii::Queue m_queue = nullptr;
     vk::raii::CommandPool m_commandPool = nullptr;
 
-    void createInstance();
+    void createInstance(const std::optional<PresentationSupport>& presentation);
     void chooseDevice(const std::string& selector);
     void createDevice();
 };

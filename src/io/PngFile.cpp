@@ -30,14 +30,19 @@ std::vector<uint8_t> toneMapImage(const Image& image, float exposure)
     return pixels;
 }
 
-void writePng(const std::filesystem::path& path, const Image& image, float exposure)
+void writePngPixels(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                    const std::vector<uint8_t>& rgba)
 {
-    std::vector<uint8_t> pixels = toneMapImage(image, exposure);
+    VKRT_CHECK(rgba.size() == size_t(width) * height * 4);
     writeFileAtomically(path, [&](const std::filesystem::path& temporary) {
-        if (!stbi_write_png(temporary.c_str(), int(image.width), int(image.height), 4, pixels.data(),
-                            int(image.width * 4)))
+        if (!stbi_write_png(temporary.c_str(), int(width), int(height), 4, rgba.data(), int(width * 4)))
             throw InputError(path.string() + ": cannot write PNG");
     });
+}
+
+void writePng(const std::filesystem::path& path, const Image& image, float exposure)
+{
+    writePngPixels(path, image.width, image.height, toneMapImage(image, exposure));
 }
 
 } // namespace vkrt

@@ -17,6 +17,10 @@ std::vector<uint8_t> toneMapImage(const Image& image, float exposure);
 /// Writes a PNG atomically; throws InputError naming the path.
 void writePng(const std::filesystem::path& path, const Image& image, float exposure);
 
+/// Writes already tone-mapped RGBA8 pixels (rows top to bottom) as a PNG, atomically.
+void writePngPixels(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                    const std::vector<uint8_t>& rgba);
+
 /// Exact sRGB decoding of an 8-bit value to linear.
 float srgb8ToLinear(uint8_t value);
 

@@ -24,14 +24,14 @@ bool validationLayerInstalled()
     return false;
 }
 
+} // namespace
+
 std::string shellQuote(const std::string& arg)
 {
     std::string quoted = "'";
     for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return quoted + "'";
 }
-
-} // namespace
 
 const VulkanContext& gpu()
 {
@@ -70,7 +70,12 @@ ProcessResult runVkrt(const std::vector<std::string>& args)
 {
     std::string command = shellQuote(VKRT_BINARY);
     for (const auto& arg : args) command += " " + shellQuote(arg);
-    command += " 2>&1";
+    return runShell(command);
+}
+
+ProcessResult runShell(const std::string& shellCommand)
+{
+    std::string command = shellCommand + " 2>&1";
     ProcessResult result;
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return result;

@@ -46,6 +46,12 @@ struct ProcessResult {
 /// Runs the vkrt executable with `args` (each passed as one argument).
 ProcessResult runVkrt(const std::vector<std::string>& args);
 
+/// Runs a shell command line as given (stdout and stderr captured together).
+ProcessResult runShell(const std::string& command);
+
+/// Single-quotes a string for the shell.
+std::string shellQuote(const std::string& arg);
+
 /// Writes text to a file (creating parent directories).
 void writeText(const std::filesystem::path& path, const std::string& text);
 

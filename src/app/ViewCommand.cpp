@@ -1,0 +1,37 @@
+// `vkrt view SCENE`: the progressive viewer (src/view/Viewer.cpp).
+#include "app/Commands.h"
+#include "util/Error.h"
+#include "view/Viewer.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <memory>
+
+namespace vkrt {
+
+CommandRunner addViewCommand(CLI::App& app)
+{
+    auto o = std::make_shared<ViewOptions>();
+    CLI::App* cmd = app.add_subcommand("view", "Watch a scene converge in a window (keys: press H)");
+    cmd->add_option("scene", o->scenePath, "Scene file")->required();
+    cmd->add_option("--device", o->device, "Vulkan device index or name");
+    cmd->add_option("--seed", o->seed, "Random seed");
+    cmd->add_option("--width", o->width, "Render width (default: the scene's)")->check(CLI::Range(1u, 8192u));
+    cmd->add_option("--height", o->height, "Render height (default: the scene's)")->check(CLI::Range(1u, 8192u));
+    cmd->add_option("--frames", o->frames, "Render this many frames, then exit")->check(CLI::Range(0u, 1u << 24));
+    cmd->add_option("--screenshot", o->screenshot, "With --frames: save the displayed image (PNG) before exiting")
+        ->needs(cmd->get_option("--frames"));
+    cmd->add_option("--script", o->script, "Run a scripted session (see src/view/ViewerScript.h)")
+        ->excludes(cmd->get_option("--frames"));
+    cmd->add_option("--exposure", o->exposure, "Display exposure in stops")->check(CLI::Range(-64.0, 64.0));
+    cmd->add_flag("--filmic", o->filmic, "Filmic tone curve instead of clamping");
+    cmd->add_flag("--variance", o->variance, "Estimate variance (shows the estimated error in the title)");
+    cmd->add_flag("--validation", o->validation, "Enable Vulkan validation; any message makes the exit status 3");
+    return [o] {
+        if (!std::isfinite(o->exposure)) throw InputError("--exposure: must be a finite number");
+        return runViewer(*o);
+    };
+}
+
+} // namespace vkrt

@@ -1,0 +1,454 @@
+#include "view/Viewer.h"
+
+#include "app/Commands.h"
+#include "io/ExrFile.h"
+#include "io/PngFile.h"
+#include "render/ErrorMetrics.h"
+#include "render/Progress.h"
+#include "render/Renderer.h"
+#include "scene/SceneParser.h"
+#include "util/Error.h"
+#include "util/Hash.h"
+#include "view/CameraControl.h"
+#include "view/DisplayPass.h"
+#include "view/Swapchain.h"
+#include "view/ViewerScript.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <memory>
+
+namespace vkrt {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string g_glfwError;
+
+void onGlfwError(int, const char* description) { g_glfwError = description ? description : "unknown GLFW error"; }
+
+/// glfwInit / glfwTerminate, and the clear message when there is no display.
+class GlfwSession {
+public:
+    GlfwSession()
+    {
+        glfwSetErrorCallback(onGlfwError);
+        if (!glfwInit())
+            throw std::runtime_error("cannot open a window: " + g_glfwError +
+                                     "\n(no display? `vkrt render SCENE` renders without one)");
+        if (!glfwVulkanSupported()) {
+            glfwTerminate();
+            throw std::runtime_error("GLFW finds no Vulkan loader for windows; `vkrt render SCENE` works without one");
+        }
+    }
+    ~GlfwSession() { glfwTerminate(); }
+    GlfwSession(const GlfwSession&) = delete;
+    GlfwSession& operator=(const GlfwSession&) = delete;
+};
+
+class Window {
+public:
+    Window(uint32_t width, uint32_t height, const std::string& title)
+    {
+        glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+        m_window = glfwCreateWindow(int(width), int(height), title.c_str(), nullptr, nullptr);
+        if (!m_window)
+            throw std::runtime_error("cannot create a window: " + g_glfwError + " (`vkrt render SCENE` needs none)");
+    }
+    ~Window() { glfwDestroyWindow(m_window); }
+    Window(const Window&) = delete;
+    Window& operator=(const Window&) = delete;
+    GLFWwindow* get() const { return m_window; }
+
+private:
+    GLFWwindow* m_window = nullptr;
+};
+
+PresentationSupport presentationFor(GLFWwindow* window)
+{
+    PresentationSupport support;
+    uint32_t count = 0;
+    const char** names = glfwGetRequiredInstanceExtensions(&count);
+    for (uint32_t i = 0; i < count; ++i) support.instanceExtensions.emplace_back(names[i]);
+    support.createSurface = [window](VkInstance instance) {
+        VkSurfaceKHR surface = VK_NULL_HANDLE;
+        if (glfwCreateWindowSurface(instance, window, nullptr, &surface) != VK_SUCCESS)
+            throw GpuError("cannot create a Vulkan surface for the window: " + g_glfwError);
+        return surface;
+    };
+    return support;
+}
+
+/// Limits one display refresh's rendering to about this much time.
+constexpr double kFrameSeconds = 1.0 / 30.0;
+
+} // namespace
+
+const char* viewerHelp()
+{
+    return "vkrt view keys:\n"
+           "  left drag          orbit around the target   scroll  zoom (field of view)\n"
+           "  right button held  W A S D fly forward/left/back/right, Q E fly down/up\n"
+           "  S                  save EXR + PNG            R       reset the accumulation\n"
+           "  I                  switch whitted/path       P       pause\n"
+           "  + -                exposure up/down          F       filmic tone curve on/off\n"
+           "  H                  this list                 Esc     quit\n";
+}
+
+/// All state of one viewer session. Members are declared in creation order.
+class Viewer {
+public:
+    explicit Viewer(const ViewOptions& options);
+    /// Runs `script` if it has commands, else the interactive loop.
+    int run(const std::vector<ViewerCommand>& script);
+    std::vector<std::string> validationMessages() const { return m_context.validationMessages(); }
+
+private:
+    ViewOptions m_options;
+    Scene m_scene;
+    GlfwSession m_glfw;
+    Window m_window;
+    VulkanContext m_context;
+    std::unique_ptr<Renderer> m_renderer;
+    std::unique_ptr<DisplayPass> m_display;
+    std::unique_ptr<Swapchain> m_swapchain;
+    vk::raii::Semaphore m_imageAvailable = nullptr;
+    vk::raii::Semaphore m_renderFinished = nullptr;
+    vk::raii::Fence m_presented = nullptr;
+
+    float m_exposure = 0.0f;
+    bool m_filmic = false;
+    bool m_paused = false;
+    bool m_swapchainStale = false;
+    uint32_t m_framesPerRefresh = 1;
+    std::deque<std::string> m_keys; ///< pressed keys not yet handled
+    bool m_dragging = false;
+    double m_lastX = 0, m_lastY = 0;
+    double m_pendingYaw = 0, m_pendingPitch = 0, m_pendingZoom = 1;
+    Clock::time_point m_rateStart = Clock::now();
+    uint64_t m_rateSamples = 0;
+    double m_samplesPerSecond = 0;
+    Clock::time_point m_lastTitle{};
+    int m_saveCount = 0;
+
+    void createRenderer();
+    void recreateSwapchain();
+    void installCallbacks();
+    void renderAndPresent(uint32_t frames);
+    void present();
+    bool handleKey(const std::string& key);
+    bool flying() const { return glfwGetMouseButton(m_window.get(), GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS; }
+    void applyCameraInput(double dt);
+    void setCamera(const Camera& camera);
+    void updateTitle(bool force = false);
+    void save(const std::string& exrPath);
+    void screenshot(const std::string& pngPath);
+    int runScript(const std::vector<ViewerCommand>& commands);
+    int runInteractive();
+};
+
+Scene sceneForViewer(const ViewOptions& options)
+{
+    Scene scene = parseSceneFile(options.scenePath);
+    if (options.width) scene.camera.width = *options.width;
+    if (options.height) scene.camera.height = *options.height;
+    return scene;
+}
+
+Viewer::Viewer(const ViewOptions& options)
+    : m_options(options),
+      m_scene(sceneForViewer(options)),
+      m_window(m_scene.camera.width, m_scene.camera.height, "vkrt view - " + options.scenePath),
+      m_context(ContextOptions{options.device, options.validation, presentationFor(m_window.get())}),
+      m_exposure(options.exposure),
+      m_filmic(options.filmic)
+{
+    createRenderer();
+    recreateSwapchain();
+    m_imageAvailable = vk::raii::Semaphore(m_context.device(), vk::SemaphoreCreateInfo());
+    m_renderFinished = vk::raii::Semaphore(m_context.device(), vk::SemaphoreCreateInfo());
+    m_presented = vk::raii::Fence(m_context.device(), vk::FenceCreateInfo(vk::FenceCreateFlagBits::eSignaled));
+    installCallbacks();
+}
+
+void Viewer::createRenderer()
+{
+    m_display.reset(); // it reads the old renderer's accumulation buffer
+    RenderOptions options;
+    options.seed = m_options.seed;
+    options.variance = m_options.variance;
+    m_renderer = std::make_unique<Renderer>(m_context, m_scene, options);
+    m_display = std::make_unique<DisplayPass>(m_context, m_renderer->accumulation(), m_renderer->width(),
+                                              m_renderer->height());
+}
+
+void Viewer::recreateSwapchain()
+{
+    m_context.device().waitIdle();
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(m_window.get(), &width, &height);
+    while ((width == 0 || height == 0) && !glfwWindowShouldClose(m_window.get())) {
+        glfwWaitEvents(); // minimized: nothing to present to
+        glfwGetFramebufferSize(m_window.get(), &width, &height);
+    }
+    m_swapchain.reset();
+    m_swapchain = std::make_unique<Swapchain>(m_context, vk::Extent2D(uint32_t(width), uint32_t(height)));
+    m_swapchainStale = false;
+}
+
+void Viewer::installCallbacks()
+{
+    GLFWwindow* w = m_window.get();
+    glfwSetWindowUserPointer(w, this);
+    glfwSetFramebufferSizeCallback(w, [](GLFWwindow* window, int, int) {
+        static_cast<Viewer*>(glfwGetWindowUserPointer(window))->m_swapchainStale = true;
+    });
+    glfwSetCharCallback(w, [](GLFWwindow* window, unsigned codepoint) {
+        auto* self = static_cast<Viewer*>(glfwGetWindowUserPointer(window));
+        if (codepoint < 128) self->m_keys.emplace_back(1, char(std::toupper(int(codepoint))));
+    });
+    glfwSetMouseButtonCallback(w, [](GLFWwindow* window, int button, int action, int) {
+        auto* self = static_cast<Viewer*>(glfwGetWindowUserPointer(window));
+        if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+        self->m_dragging = action == GLFW_PRESS;
+        glfwGetCursorPos(window, &self->m_lastX, &self->m_lastY);
+    });
+    glfwSetCursorPosCallback(w, [](GLFWwindow* window, double x, double y) {
+        auto* self = static_cast<Viewer*>(glfwGetWindowUserPointer(window));
+        if (!self->m_dragging) return;
+        self->m_pendingYaw -= 0.3 * (x - self->m_lastX);
+        self->m_pendingPitch += 0.3 * (y - self->m_lastY);
+        self->m_lastX = x, self->m_lastY = y;
+    });
+    glfwSetScrollCallback(w, [](GLFWwindow* window, double, double dy) {
+        static_cast<Viewer*>(glfwGetWindowUserPointer(window))->m_pendingZoom *= std::pow(0.9, dy);
+    });
+}
+
+void Viewer::setCamera(const Camera& camera)
+{
+    m_context.device().waitIdle();
+    m_renderer->moveCamera(camera);
+    m_scene.camera = camera;
+}
+
+void Viewer::applyCameraInput(double dt)
+{
+    GLFWwindow* w = m_window.get();
+    auto held = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS ? 1.0 : 0.0; };
+    // Flying needs the right button held, so that S alone can save.
+    double speed = flying() ? 0.6 * dt : 0.0;
+    double right = (held(GLFW_KEY_D) - held(GLFW_KEY_A)) * speed;
+    double up = (held(GLFW_KEY_E) - held(GLFW_KEY_Q)) * speed;
+    double forward = (held(GLFW_KEY_W) - held(GLFW_KEY_S)) * speed;
+    Camera camera = m_scene.camera;
+    bool changed = false;
+    if (right != 0 || up != 0 || forward != 0) camera = fly(camera, right, up, forward), changed = true;
+    if (m_pendingYaw != 0 || m_pendingPitch != 0) camera = orbit(camera, m_pendingYaw, m_pendingPitch), changed = true;
+    if (m_pendingZoom != 1) camera = zoom(camera, m_pendingZoom), changed = true;
+    m_pendingYaw = m_pendingPitch = 0, m_pendingZoom = 1;
+    if (changed) setCamera(camera);
+}
+
+bool Viewer::handleKey(const std::string& key)
+{
+    if (key == "H") std::fputs(viewerHelp(), stdout), std::fflush(stdout);
+    else if (key == "R") m_context.device().waitIdle(), m_renderer->reset();
+    else if (key == "P") m_paused = !m_paused;
+    else if (key == "+" || key == "=") m_exposure += 0.5f;
+    else if (key == "-") m_exposure -= 0.5f;
+    else if (key == "F") m_filmic = !m_filmic;
+    else if (key == "I") {
+        m_context.device().waitIdle();
+        bool path = m_scene.render.integrator == Integrator::Path;
+        m_scene.render.integrator = path ? Integrator::Whitted : Integrator::Path;
+        createRenderer();
+    } else if (key == "S") {
+        ++m_saveCount;
+        std::string stem = std::filesystem::path(m_scene.path).stem().string();
+        save(stem + "-view-" + std::to_string(m_saveCount) + ".exr");
+    } else {
+        return false;
+    }
+    updateTitle(true);
+    return true;
+}
+
+void Viewer::renderAndPresent(uint32_t frames)
+{
+    auto start = Clock::now();
+    if (frames) m_renderer->renderFrames(frames);
+    double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    m_rateSamples += uint64_t(frames) * m_renderer->width() * m_renderer->height();
+    if (frames && seconds > 0) // one display refresh holds about kFrameSeconds of rendering
+        m_framesPerRefresh = std::clamp(uint32_t(frames * kFrameSeconds / seconds), 1u, 64u);
+    present();
+    updateTitle();
+}
+
+void Viewer::present()
+{
+    if (m_swapchainStale) recreateSwapchain();
+    if (m_context.device().waitForFences(*m_presented, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+        throw GpuError("vkWaitForFences failed while presenting");
+    uint32_t index = 0;
+    try {
+        auto [result, acquired] = m_swapchain->raii().acquireNextImage(UINT64_MAX, *m_imageAvailable);
+        index = acquired;
+        if (result == vk::Result::eSuboptimalKHR) m_swapchainStale = true;
+    } catch (const vk::OutOfDateKHRError&) {
+        m_swapchainStale = true;
+        return;
+    }
+    m_context.device().resetFences(*m_presented);
+    vk::raii::CommandBuffer cmd = m_context.beginOneShot();
+    gpu::DisplayConstants constants{std::exp2(m_exposure), m_renderer->width(), m_renderer->height(),
+                                    m_filmic ? gpu::TONE_MAP_FILMIC : gpu::TONE_MAP_CLAMP};
+    m_display->recordToneMap(*cmd, constants);
+    m_display->recordBlit(*cmd, m_swapchain->image(index), m_swapchain->extent());
+    cmd.end();
+    vk::PipelineStageFlags waitStage = vk::PipelineStageFlagBits::eTransfer;
+    vk::CommandBuffer handle = *cmd;
+    vk::Semaphore wait = *m_imageAvailable, signal = *m_renderFinished;
+    m_context.queue().submit(vk::SubmitInfo(wait, waitStage, handle, signal), *m_presented);
+    vk::SwapchainKHR swapchain = m_swapchain->handle();
+    try {
+        if (m_context.queue().presentKHR(vk::PresentInfoKHR(signal, swapchain, index)) == vk::Result::eSuboptimalKHR)
+            m_swapchainStale = true;
+    } catch (const vk::OutOfDateKHRError&) {
+        m_swapchainStale = true;
+    }
+    if (m_context.device().waitForFences(*m_presented, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+        throw GpuError("vkWaitForFences failed after presenting");
+}
+
+void Viewer::updateTitle(bool force)
+{
+    auto now = Clock::now();
+    double since = std::chrono::duration<double>(now - m_rateStart).count();
+    if (since >= 0.5) {
+        m_samplesPerSecond = m_rateSamples / since;
+        m_rateStart = now, m_rateSamples = 0;
+    }
+    if (!force && std::chrono::duration<double>(now - m_lastTitle).count() < 0.25) return;
+    m_lastTitle = now;
+    std::string error;
+    if (m_options.variance && m_renderer->completedFrames() >= 2) {
+        char text[64];
+        std::snprintf(text, sizeof text, "  rel.MSE %.3g",
+                      estimateError(m_renderer->mean(), m_renderer->varianceOfMean()).relMse);
+        error = text;
+    }
+    char title[512];
+    std::snprintf(title, sizeof title, "vkrt view - %s - %s - %u spp - %ssamples/s%s - %s%s",
+                  std::filesystem::path(m_scene.path).filename().c_str(),
+                  integratorName(m_scene.render.integrator).c_str(), m_renderer->completedFrames(),
+                  humanCount(m_samplesPerSecond).c_str(), error.c_str(), m_context.deviceInfo().name.c_str(),
+                  m_paused ? " [paused]" : "");
+    glfwSetWindowTitle(m_window.get(), title);
+}
+
+void Viewer::save(const std::string& exrPath)
+{
+    m_context.device().waitIdle();
+    Metadata metadata{{"vkrtVersion", std::string(VKRT_VERSION)},
+                      {"spp", int64_t(m_renderer->completedFrames())},
+                      {"seed", int64_t(m_options.seed)},
+                      {"device", m_context.deviceInfo().name},
+                      {"driver", m_context.deviceInfo().driver},
+                      {"scene", m_scene.path},
+                      {"sceneHash", "fnv1a64:" + toHex(m_scene.fileHash)},
+                      {"integrator", integratorName(m_scene.render.integrator)},
+                      {"kernelVariant", m_renderer->features().describe()},
+                      {"rejectedSamples", int64_t(m_renderer->counters().rejectedSamples)},
+                      {"savedBy", std::string("vkrt view")}};
+    std::map<std::string, Image> layers;
+    if (m_options.variance) layers["variance"] = m_renderer->varianceOfMean();
+    writeExr(exrPath, m_renderer->mean(), metadata, layers);
+    std::filesystem::path png = std::filesystem::path(exrPath).replace_extension(".png");
+    screenshot(png.string());
+    std::printf("saved %s (%u spp) and %s\n", exrPath.c_str(), m_renderer->completedFrames(), png.c_str());
+    std::fflush(stdout);
+}
+
+void Viewer::screenshot(const std::string& pngPath)
+{
+    m_context.device().waitIdle();
+    writePngPixels(pngPath, m_renderer->width(), m_renderer->height(), m_display->readPixels());
+}
+
+int Viewer::runScript(const std::vector<ViewerCommand>& commands)
+{
+    for (const ViewerCommand& c : commands) {
+        if (c.name == "frames") {
+            for (uint32_t left = uint32_t(c.numbers[0]); left > 0;) {
+                uint32_t n = std::min(left, m_framesPerRefresh);
+                renderAndPresent(n);
+                left -= n;
+                glfwPollEvents();
+            }
+        } else if (c.name == "orbit") setCamera(orbit(m_scene.camera, c.numbers[0], c.numbers[1]));
+        else if (c.name == "fly") setCamera(fly(m_scene.camera, c.numbers[0], c.numbers[1], c.numbers[2]));
+        else if (c.name == "zoom") setCamera(zoom(m_scene.camera, c.numbers[0]));
+        else if (c.name == "exposure") m_exposure = float(c.numbers[0]);
+        else if (c.name == "key") handleKey(c.text);
+        else if (c.name == "save") save(c.text);
+        else if (c.name == "screenshot") present(), screenshot(c.text);
+    }
+    return kExitOk;
+}
+
+int Viewer::runInteractive()
+{
+    std::fputs(viewerHelp(), stdout);
+    auto last = Clock::now();
+    while (!glfwWindowShouldClose(m_window.get())) {
+        glfwPollEvents();
+        if (glfwGetKey(m_window.get(), GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
+        auto now = Clock::now();
+        applyCameraInput(std::chrono::duration<double>(now - last).count());
+        last = now;
+        while (!m_keys.empty()) {
+            std::string key = m_keys.front();
+            m_keys.pop_front();
+            if (!flying()) handleKey(key);
+        }
+        renderAndPresent(m_paused ? 0 : m_framesPerRefresh);
+        if (m_paused) glfwWaitEventsTimeout(0.05);
+    }
+    return kExitOk;
+}
+
+int Viewer::run(const std::vector<ViewerCommand>& script)
+{
+    return script.empty() ? runInteractive() : runScript(script);
+}
+
+/// The scripted part of a session: --script, or --frames [--screenshot].
+std::vector<ViewerCommand> scriptFor(const ViewOptions& options)
+{
+    if (!options.script.empty()) return readViewerScript(options.script);
+    std::vector<ViewerCommand> commands;
+    if (options.frames) {
+        commands.push_back({"frames", {double(*options.frames)}, "", 0});
+        if (!options.screenshot.empty()) commands.push_back({"screenshot", {}, options.screenshot, 0});
+    }
+    return commands;
+}
+
+int runViewer(const ViewOptions& options)
+{
+    std::vector<ViewerCommand> script = scriptFor(options); // mistakes surface before any window opens
+    Viewer viewer(options);
+    int status = viewer.run(script);
+    auto messages = viewer.validationMessages();
+    for (const auto& m : messages) std::fprintf(stderr, "%s\n", m.c_str());
+    return messages.empty() ? status : int(kExitValidation);
+}
+
+} // namespace vkrt

@@ -1,0 +1,31 @@
+#pragma once
+// `vkrt view`: a GLFW window showing the progressive render as it converges,
+// with camera controls, and scripted sessions for tests.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace vkrt {
+
+struct ViewOptions {
+    std::string scenePath;
+    std::string device;
+    uint32_t seed = 0;
+    std::optional<uint32_t> width;  ///< render size (default: the scene's)
+    std::optional<uint32_t> height;
+    std::optional<uint32_t> frames; ///< render this many frames, then exit (after --screenshot)
+    std::string screenshot;         ///< PNG of the displayed image at exit
+    std::string script;             ///< scripted session (src/view/ViewerScript.h)
+    float exposure = 0.0f;
+    bool filmic = false;
+    bool variance = false;
+    bool validation = false;
+};
+
+/// Runs the viewer; returns the process exit code.
+int runViewer(const ViewOptions& options);
+
+/// The key list printed by `H`.
+const char* viewerHelp();
+
+} // namespace vkrt

@@ -1,0 +1,151 @@
+// The progressive viewer under a real X display (Xvfb): its screenshot
+// matches `vkrt render`, scripted camera moves reset the accumulation, and a
+// missing display gives a clear message.
+#include "io/ExrFile.h"
+#include "io/PngFile.h"
+#include "support/TestSupport.h"
+#include "view/CameraControl.h"
+#include "view/ViewerScript.h"
+
+#include <stb/stb_image.h>
+
+namespace fs = std::filesystem;
+
+namespace vkrt::test {
+namespace {
+
+const std::string kScene = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/seed/glass-area-light.toml";
+
+bool haveXvfb() { return runShell("command -v xvfb-run").exitCode == 0; }
+
+/// Runs `vkrt view ARGS` under a private Xvfb display.
+ProcessResult runViewer(const std::vector<std::string>& args)
+{
+    std::string command = "xvfb-run -a -s '-screen 0 800x600x24' " + shellQuote(VKRT_BINARY) + " view";
+    for (const auto& arg : args) command += " " + shellQuote(arg);
+    return runShell(command);
+}
+
+std::vector<uint8_t> readPngPixels(const fs::path& path, int& width, int& height)
+{
+    int channels = 0;
+    stbi_uc* data = stbi_load(path.c_str(), &width, &height, &channels, 4);
+    if (!data) return {};
+    std::vector<uint8_t> pixels(data, data + size_t(width) * height * 4);
+    stbi_image_free(data);
+    return pixels;
+}
+
+class ViewCli : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        if (!haveXvfb()) GTEST_SKIP() << "xvfb-run is not installed (tools/install-deps.sh installs it)";
+        m_dir = freshTempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+        setenv("VKRT_CACHE_DIR", testCacheDir().c_str(), 1);
+    }
+    fs::path m_dir;
+};
+
+// 16 frames in the viewer and `vkrt render --spp 16` accumulate the same
+// samples (same seed); their 8-bit images may differ only by the rounding of
+// the tone map (GPU float vs host double mean): at most 1 step, on few values.
+TEST_F(ViewCli, ScreenshotMatchesRenderAfterToneMapping)
+{
+    ProcessResult view = runViewer({kScene, "--frames", "16", "--screenshot", (m_dir / "view.png").string(), "--width",
+                                    "160", "--height", "120", "--seed", "4", "--validation"});
+    ASSERT_EQ(view.exitCode, 0) << view.output;
+    ProcessResult render = runVkrt({"render", kScene, "--spp", "16", "--width", "160", "--height", "120", "--seed", "4",
+                                    "-o", (m_dir / "r.exr").string(), "--png", (m_dir / "render.png").string()});
+    ASSERT_EQ(render.exitCode, 0) << render.output;
+    int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+    auto a = readPngPixels(m_dir / "view.png", w1, h1), b = readPngPixels(m_dir / "render.png", w2, h2);
+    ASSERT_EQ(w1, 160);
+    ASSERT_EQ(h1, 120);
+    ASSERT_EQ(a.size(), b.size());
+    size_t differing = 0;
+    int worst = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        int d = std::abs(int(a[i]) - int(b[i]));
+        worst = std::max(worst, d);
+        differing += d != 0;
+    }
+    EXPECT_LE(worst, 1);
+    EXPECT_LT(differing, a.size() / 100);
+}
+
+TEST_F(ViewCli, CameraMoveResetsAccumulationAndSaveRecordsTrueSpp)
+{
+    fs::path script = m_dir / "session.txt";
+    writeText(script, "# a scripted session\nframes 4\nsave " + (m_dir / "before.exr").string() +
+                          "\norbit 15 5\nframes 3\nsave " + (m_dir / "after.exr").string() +
+                          "\nkey I\nframes 2\nsave " + (m_dir / "path.exr").string() + "\nkey R\nframes 1\nsave " +
+                          (m_dir / "reset.exr").string() + "\n");
+    ProcessResult r = runViewer({kScene, "--script", script.string(), "--width", "96", "--height", "72", "--validation"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    auto spp = [&](const char* name) { return std::get<int64_t>(readExr(m_dir / name).metadata.at("spp")); };
+    EXPECT_EQ(spp("before.exr"), 4);
+    EXPECT_EQ(spp("after.exr"), 3) << "a camera move must reset the accumulation";
+    EXPECT_EQ(spp("path.exr"), 2) << "switching the integrator starts afresh";
+    EXPECT_EQ(spp("reset.exr"), 1);
+    EXPECT_EQ(std::get<std::string>(readExr(m_dir / "path.exr").metadata.at("integrator")), "path");
+    EXPECT_TRUE(fs::exists(m_dir / "after.png"));
+    EXPECT_NE(readExr(m_dir / "before.exr").image.rgb, readExr(m_dir / "after.exr").image.rgb);
+}
+
+TEST_F(ViewCli, BadScriptNamesFileLineAndColumn)
+{
+    fs::path script = m_dir / "bad.txt";
+    writeText(script, "frames 2\norbit ten 5\n");
+    ProcessResult r = runViewer({kScene, "--script", script.string()});
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find(script.string() + ":2:7"), std::string::npos) << r.output;
+}
+
+TEST(ViewNoDisplay, SuggestsRender)
+{
+    std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " + shellQuote(kScene);
+    ProcessResult r = runShell(command);
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.output.find("vkrt render"), std::string::npos) << r.output;
+}
+
+TEST(ViewerScript, ParsesCommandsAndRejectsMistakes)
+{
+    auto commands = parseViewerScript("frames 3 # comment\n\norbit 1.5 -2\nkey +\nsave out.exr\n", "s.txt");
+    ASSERT_EQ(commands.size(), 4u);
+    EXPECT_EQ(commands[1].name, "orbit");
+    EXPECT_EQ(commands[1].numbers, (std::vector<double>{1.5, -2}));
+    EXPECT_EQ(commands[2].text, "+");
+    EXPECT_EQ(commands[3].line, 5);
+    for (auto [text, where] : {std::pair{"jump 3\n", "s.txt:1:1"}, {"frames -1\n", "s.txt:1:8"},
+                               {"frames 2 3\n", "s.txt:1:1"}, {"zoom 0\n", "s.txt:1:6"}, {"key X\n", "s.txt:1:5"},
+                               {"fly 1 nan 0\n", "s.txt:1:7"}}) {
+        try {
+            parseViewerScript(text, "s.txt");
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(CameraControl, OrbitKeepsDistanceAndStopsShortOfThePoles)
+{
+    Camera c;
+    c.eye = {0, 1, 5};
+    c.target = {0, 1, 0};
+    Camera o = orbit(c, 90, 0);
+    EXPECT_NEAR(glm::length(o.eye - o.target), 5.0, 1e-12);
+    EXPECT_NEAR(o.eye.x, 5.0, 1e-9) << "yaw 90 about +y turns +z towards +x";
+    Camera top = orbit(c, 0, 200);
+    double polar = std::acos(glm::dot(glm::normalize(top.eye - top.target), glm::dvec3(0, 1, 0)));
+    EXPECT_NEAR(glm::degrees(polar), 1.0, 1e-9);
+    Camera moved = fly(c, 0, 0, 0.2);
+    EXPECT_NEAR(moved.eye.z, 4.0, 1e-12);
+    EXPECT_NEAR(moved.target.z, -1.0, 1e-12);
+    EXPECT_EQ(zoom(c, 100).fovY, 170.0);
+}
+
+} // namespace
+} // namespace vkrt::test
