@@ -51,11 +51,17 @@ float fresnelSchlickDielectric(float cosI, float eta, float ior)
 // A dielectric's reflectance in its configured mode (eta = n_i / n_t).
 float dielectricReflectance(uint mode, float cosI, float eta, float ior)
 {
+    float f = 0.0;
     if (mode == FRESNEL_EXACT)
-        return fresnelExact(cosI, eta);
+        f = fresnelExact(cosI, eta);
     if (mode == FRESNEL_SCHLICK)
-        return fresnelSchlickDielectric(cosI, eta, ior);
-    return 0.0;
+        f = fresnelSchlickDielectric(cosI, eta, ior);
+#ifdef VKRT_TEST_FRESNEL_SCALE
+    // Test hook: a deliberately wrong Fresnel term, to prove the statistical
+    // tests catch a small bias.
+    f = min(1.0, f * VKRT_TEST_FRESNEL_SCALE);
+#endif
+    return f;
 }
 
 // Reflection strength of mirror and glossy surfaces (R0 from their IOR).
