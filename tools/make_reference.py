@@ -77,7 +77,10 @@ def find_libllvm() -> str | None:
     """The newest libLLVM >= 16 on this system, or None."""
     env = os.environ.get("DRJIT_LIBLLVM_PATH")
     if env:
-        return env if Path(env).exists() else None
+        if Path(env).exists():
+            return env
+        _log(f"DRJIT_LIBLLVM_PATH={env} does not exist; ignoring it")
+        del os.environ["DRJIT_LIBLLVM_PATH"]
     candidates = []
     patterns = ["/usr/lib/llvm-*/lib/libLLVM*.so*", "/usr/lib/*-linux-gnu/libLLVM*.so*", "/usr/lib64/libLLVM*.so*",
                 "/usr/local/lib/libLLVM*.so*", "/usr/lib/libLLVM*.so*"]

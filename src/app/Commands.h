@@ -16,6 +16,7 @@ CommandRunner addDevicesCommand(CLI::App& app);
 CommandRunner addInfoCommand(CLI::App& app);
 CommandRunner addCompareCommand(CLI::App& app);
 CommandRunner addViewCommand(CLI::App& app);
+CommandRunner addRegressCommand(CLI::App& app);
 
 /// Process exit codes.
 enum ExitCode : int {

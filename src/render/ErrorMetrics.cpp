@@ -57,6 +57,33 @@ double normalQuantileTwoSided(double p)
     return 0.5 * (lo + hi);
 }
 
+ReferenceTestResult testAgainstReference(const Image& mean, const Image& varianceOfMean, uint32_t spp,
+                                         const Image& reference, const Image& referenceVariance, uint64_t referenceSpp,
+                                         const ReferenceTestSettings& settings)
+{
+    ReferenceTestResult r;
+    size_t n = mean.rgb.size();
+    r.pValues = Image(mean.width, mean.height);
+    r.threshold = normalQuantileTwoSided(1.0 - std::pow(1.0 - settings.alpha, 1.0 / double(std::max<size_t>(n, 1))));
+    r.pooledThreshold = normalQuantileTwoSided(settings.pooledAlpha);
+    double sumDiff = 0.0, sumVariance = 0.0;
+    double scale = double(referenceSpp) / double(std::max(spp, 1u));
+    for (size_t i = 0; i < n; ++i) {
+        double x = mean.rgb[i], ref = reference.rgb[i], vr = referenceVariance.rgb[i];
+        double vx = std::isfinite(varianceOfMean.rgb[i]) ? double(varianceOfMean.rgb[i]) : INFINITY;
+        double variance = std::max(vx, vr * scale) + vr + std::pow(1e-6 * ref, 2);
+        double z = std::abs(x - ref) / std::sqrt(variance);
+        double p = (std::isfinite(x) && variance > 0.0) ? std::erfc(z / std::sqrt(2.0)) : (x == ref ? 1.0 : 0.0);
+        r.pValues.rgb[i] = float(p);
+        r.minPValue = std::min(r.minPValue, p);
+        ++r.tested;
+        if (std::isfinite(x) && z <= r.threshold) ++r.passed;
+        if (std::isfinite(x) && std::isfinite(variance)) sumDiff += x - ref, sumVariance += variance;
+    }
+    r.pooledZ = sumVariance > 0.0 ? sumDiff / std::sqrt(sumVariance) : (sumDiff == 0.0 ? 0.0 : INFINITY);
+    return r;
+}
+
 PixelTestSummary pixelZTest(const Image& a, const Image& varianceA, const Image& b, const Image& varianceB,
                             double alpha)
 {

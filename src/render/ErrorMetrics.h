@@ -3,6 +3,7 @@
 // variance, or measured against a reference.
 #include "io/Image.h"
 
+#include <cmath>
 #include <cstddef>
 
 namespace vkrt {
@@ -44,6 +45,40 @@ struct PixelTestSummary {
 
 PixelTestSummary pixelZTest(const Image& a, const Image& varianceA, const Image& b, const Image& varianceB,
                             double alpha = 0.01);
+
+/// A render against a reference, the rule of the validation and regression
+/// suites (docs/validation.md). Per value, z = (x - r) / sigma with
+///   sigma^2 = max(Var_x, Var_r * refSpp / spp) + Var_r + (1e-6 r)^2:
+/// the reference's per-sample variance, scaled to the render's spp, is a floor
+/// under the render's own estimate (a rare-event pixel can show zero sample
+/// variance at low spp), and the last term absorbs float rounding of
+/// deterministic pixels. It passes when at least `minFraction` of the values
+/// pass a Sidak-corrected two-sided test at `alpha`, and the pooled z of the
+/// summed difference stays within the two-sided `pooledAlpha` quantile (a
+/// small bias everywhere, invisible per pixel, shows there).
+struct ReferenceTestResult {
+    size_t tested = 0, passed = 0;
+    double threshold = 0.0;   ///< per-value |z| limit
+    double pooledZ = 0.0;
+    double pooledThreshold = 0.0;
+    double minPValue = 1.0;
+    Image pValues;            ///< per value, for failure reports
+    double fractionPassed() const { return tested ? double(passed) / double(tested) : 1.0; }
+    bool passedRule(double minFraction) const
+    {
+        return fractionPassed() >= minFraction && std::abs(pooledZ) <= pooledThreshold;
+    }
+};
+
+struct ReferenceTestSettings {
+    double alpha = 0.01;
+    double pooledAlpha = 0.001;
+    double minFraction = 0.9975;
+};
+
+ReferenceTestResult testAgainstReference(const Image& mean, const Image& varianceOfMean, uint32_t spp,
+                                         const Image& reference, const Image& referenceVariance, uint64_t referenceSpp,
+                                         const ReferenceTestSettings& settings = {});
 
 /// Two-sided standard normal quantile: |z| with P(|Z| > |z|) = p.
 double normalQuantileTwoSided(double p);

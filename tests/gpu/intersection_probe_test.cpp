@@ -201,7 +201,7 @@ struct SpawnCase {
     glm::vec3 local{0.0f, 0.0f, 1.0f}; ///< direction in the frame of the side normal, z > 0
     int mode = kBounce;
     float lightDistance = 0.0f;
-    double scale = 1.0;
+    double scale = 0.0;  ///< of the sweep's configuration (0: not from the sweep)
     double offset = 0.0;
 };
 
@@ -348,8 +348,9 @@ std::vector<SpawnCase> spawnCases(int raysPerConfigAndMode)
 std::string describe(const SpawnCase& c, const SpawnResult& r)
 {
     std::ostringstream text;
-    text << std::setprecision(9) << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode] << " offset "
-         << c.offset << " scale " << c.scale << " shape " << str(c.shape.p[0]) << " " << str(c.shape.p[1]) << " "
+    text << std::setprecision(9) << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode];
+    if (c.scale > 0.0) text << " offset " << c.offset << " scale " << c.scale;
+    text << " shape " << str(c.shape.p[0]) << " " << str(c.shape.p[1]) << " "
          << str(c.shape.p[2]) << " primary origin " << str(c.primaryOrigin) << " aim " << str(c.aim) << " local "
          << str(c.local) << " light distance " << c.lightDistance << " -> surface point " << str(r.position)
          << " new origin " << str(r.origin) << " dir " << str(r.dir) << " second hit " << r.secondHit << " at t "
@@ -357,8 +358,40 @@ std::string describe(const SpawnCase& c, const SpawnResult& r)
     return text.str();
 }
 
+/// Whether the primary ray arrives on the front side (outside a sphere or box, on
+/// the normal's side of a triangle or plane), from the exact geometry.
+bool frontFaceReference(const SpawnCase& c)
+{
+    glm::dvec3 o(c.primaryOrigin);
+    glm::dvec3 p0(c.shape.p[0]), p1(c.shape.p[1]), p2(c.shape.p[2]);
+    switch (c.shape.kind) {
+    case Kind::Sphere: return glm::length(o - p0) > p1.x;
+    case Kind::Box: return glm::any(glm::lessThan(o, p0)) || glm::any(glm::greaterThan(o, p1));
+    case Kind::Triangle: return glm::dot(o - p0, glm::cross(p1 - p0, p2 - p0)) > 0.0;
+    case Kind::Plane: return glm::dot(o - p0, p1) > 0.0;
+    }
+    return true;
+}
+
 class IntersectionProbeSelfIntersection : public GpuTest {};
 
+// For each shape, object offset (0, 1e3, 1e4 from the camera at the origin, half of
+// them along a coordinate axis) and scale (1e-3 ... 1e3): 1000 primary rays hit the
+// object and the renderer's describeHit gives the surface point (spheres and planes
+// re-projected, boxes and triangles origin + t dir); from there offsetRayOrigin and
+//  - bounce: a random direction into the hemisphere the primary ray came from
+//    (a quarter of them grazing, cos theta from 1e-4 to 0.1),
+//  - transmit: the same into the other hemisphere,
+//  - shadow: towards a point light above, as directFromPointLights does.
+// A convex shape must not be hit again by a bounce or shadow ray; a plane or
+// triangle by none; a ray transmitted into a sphere or box must reach the far side.
+//
+// BUG (reported): this fails today, for three causes isolated in
+// ReproducersOfFoundFailures below: the side of grazing sphere hits is taken from
+// dot(normal, dir) and comes out wrong far from the origin; box and triangle hit
+// points (origin + t dir) carry an error that grows with |origin| and t, which
+// offsetRayOrigin's 256 ulps of the point's own coordinates do not cover; and a
+// sphere far smaller than its position's ulp gets a NaN normal.
 TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
 {
     constexpr int kRays = 1000; // per shape, offset, scale and mode: 252,000 rays
@@ -368,9 +401,10 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     // failures[kind][mode]: a bounce or shadow ray that hits the surface it left, a
     // ray transmitted through a plane or triangle that hits it, or a ray transmitted
     // into a sphere or box whose exit is not where the reference puts it.
-    std::array<std::array<int64_t, 3>, 4> failures{}, tested{};
-    int64_t primaryMisses = 0, wrongHemisphere = 0, transmitSkipped = 0, configsTooFewHits = 0;
-    int printed = 0;
+    std::array<std::array<int64_t, 3>, 4> failures{}, tested{}, failuresWithFlip{};
+    std::array<int64_t, 4> flips{};
+    int64_t primaryMisses = 0, wrongHemisphere = 0, transmitSkipped = 0, configsTooFewHits = 0, nonFinite = 0;
+    std::vector<int64_t> configFailures(cases.size() / kRays, 0);
     for (size_t first = 0; first < cases.size(); first += kRays) {
         int64_t hits = 0;
         for (size_t i = first; i < first + kRays; ++i) {
@@ -382,12 +416,18 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
             }
             ++hits;
             int kind = int(c.shape.kind);
-            ASSERT_TRUE(finite(r.origin) && finite(r.dir) && finite(r.position)) << describe(c, r);
+            if (!(finite(r.origin) && finite(r.dir) && finite(r.position))) {
+                if (nonFinite++ < 3) ADD_FAILURE() << "non-finite surface point: " << describe(c, r);
+                ++configFailures[first / kRays];
+                continue;
+            }
             // The direction really leaves into the intended side (else the test proves nothing).
             if (!(r.cosSide > 0.0f)) {
                 ++wrongHemisphere;
                 continue;
             }
+            bool flipped = r.frontFace != frontFaceReference(c);
+            if (flipped) ++flips[kind];
             bool failed = false;
             if (c.mode != kTransmit || c.shape.kind == Kind::Triangle || c.shape.kind == Kind::Plane) {
                 failed = r.secondHit;
@@ -404,13 +444,15 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
                     continue;
                 }
                 failed = !r.secondHit || r.secondT < 0.5 * ref.t || r.secondT > 2.0 * ref.t;
-                if (failed && printed < 10)
+                if (failed && configFailures[first / kRays] < 2)
                     std::cout << "reference exit t " << ref.t << " for: " << describe(c, r) << std::endl;
             }
             ++tested[kind][c.mode];
             if (failed) {
                 ++failures[kind][c.mode];
-                if (printed++ < 10) ADD_FAILURE() << "self-intersection: " << describe(c, r);
+                if (flipped) ++failuresWithFlip[kind][c.mode];
+                ++configFailures[first / kRays];
+                if (configFailures[first / kRays] <= 2) ADD_FAILURE() << "self-intersection: " << describe(c, r);
             }
         }
         // At least half the primary rays must hit or the configuration tests little.
@@ -426,15 +468,113 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
         for (int mode = 0; mode < 3; ++mode) {
             report(std::string("Failures_") + kKindNames[kind] + "_" + kModeNames[mode], double(failures[kind][mode]));
             report(std::string("Tested_") + kKindNames[kind] + "_" + kModeNames[mode], double(tested[kind][mode]));
+            report(std::string("FailuresWithFlippedSide_") + kKindNames[kind] + "_" + kModeNames[mode], double(failuresWithFlip[kind][mode]));
             EXPECT_EQ(failures[kind][mode], 0) << kKindNames[kind] << " " << kModeNames[mode];
             EXPECT_GT(tested[kind][mode], 84 * kRays / 4 / 2) << kKindNames[kind] << " " << kModeNames[mode];
             total += failures[kind][mode];
         }
+    for (size_t k = 0; k < configFailures.size(); ++k)
+        if (configFailures[k] > 0) {
+            const SpawnCase& c = cases[k * kRays];
+            std::cout << "[   STAT   ] failures " << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode] << " offset "
+                      << c.offset << " scale " << c.scale << ": " << configFailures[k] << " of " << kRays << std::endl;
+        }
+    // BUG (reported): the side of grazing sphere hits far from the origin comes out
+    // wrong (see ReproducersOfFoundFailures); every failure for spheres is one of these.
+    for (int kind = 0; kind < 4; ++kind) {
+        report(std::string("FlippedSide_") + kKindNames[kind], double(flips[kind]));
+        EXPECT_EQ(flips[kind], 0) << "primary hits whose side disagrees with the geometry: " << kKindNames[kind];
+    }
     report("SelfIntersectionFailures", double(total));
+    report("NonFiniteSurfacePoints", double(nonFinite));
+    EXPECT_EQ(nonFinite, 0);
     report("PrimaryMisses", double(primaryMisses));
     report("TransmitSkipped", double(transmitSkipped));
     EXPECT_EQ(wrongHemisphere, 0);
     EXPECT_EQ(configsTooFewHits, 0);
+}
+
+// The smallest cases the sweep above found, one per cause, kept as fixed inputs
+// (float values printed with 9 significant digits, so they are exact).
+TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
+{
+    struct Reproducer {
+        const char* cause;
+        SpawnCase c;
+    };
+    auto make = [](Shape shape, glm::vec3 origin, glm::vec3 aim, glm::vec3 local, int mode, float light = 0.0f) {
+        SpawnCase c;
+        c.shape = shape;
+        c.primaryOrigin = origin;
+        c.aim = aim;
+        c.local = local;
+        c.mode = mode;
+        c.lightDistance = light;
+        return c;
+    };
+    const std::vector<Reproducer> cases = {
+        // BUG: describeHit/path.glsl take the side from dot(normal, ray.dir), whose sign
+        // is wrong for hits within ~1e-4 of grazing on a sphere 1000 units from the
+        // origin (the hit point's rounding, ~ulp(1000), tilts the normal). The ray is then
+        // spawned inside the sphere and the bounce or shadow ray hits it.
+        {"sphere side flipped at grazing incidence (bounce)",
+         make(sphereShape({0.0f, 0.0f, -1000.0f}, 1.0f), {0.0f, 0.0f, 0.0f}, {0.99981302f, 0.0193104576f, -999.998962f},
+              {-0.682120204f, -0.731239319f, 0.00106611324f}, kBounce)},
+        {"sphere side flipped at grazing incidence (bounce)",
+         make(sphereShape({-1000.0f, 0.0f, 0.0f}, 1.0f), {0.0f, 0.0f, 0.0f}, {-999.999207f, 0.781252742f, -0.624214292f},
+              {0.610685408f, 0.330188155f, 0.719749331f}, kBounce)},
+        // BUG: box hit points are origin + t * dir, whose error grows with |origin| and t,
+        // while offsetRayOrigin only moves by 256 ulps of the point's own coordinates: a
+        // face near a zero coordinate hit from 2500 units away stays inside the box.
+        {"box hit point error from a distant ray origin (bounce)",
+         make(boxShape({-171.171021f, 43.5685921f, -2.6492908f}, {1033.87146f, 1387.94019f, 1101.07117f}),
+              {567.65155f, -1833.38562f, -2530.28687f}, {-52.9118118f, 1228.44678f, 846.146606f},
+              {-0.460380584f, -0.200535625f, 0.864774644f}, kBounce)},
+        {"box hit point error from a distant ray origin (shadow)",
+         make(boxShape({-931.560303f, -1988.18872f, -471.464661f}, {931.560303f, -11.8112402f, 471.464661f}),
+              {-320.494263f, 2985.50073f, 114.316727f}, {-407.332581f, -1660.39868f, 319.405304f},
+              {0.426078171f, -0.904663861f, 0.00637634844f}, kShadow, 18929.1699f)},
+        // BUG: the same for triangles (origin + t * dir from 40 units away, point near 0).
+        {"triangle hit point error from a distant ray origin (transmit)",
+         make(triangleShape({9.75412464f, 0.67492187f, 2.09798217f}, {-9.19676113f, -0.786071777f, 3.84729338f},
+                            {-5.53187656f, -0.366248578f, -8.32251167f}),
+              {11.7228088f, -38.2417374f, -0.381302506f}, {1.97903275f, 0.081382215f, 2.30971622f},
+              {-0.259450257f, -0.570947707f, 0.778912246f}, kTransmit)},
+        // BUG: offsetRayOrigin truncates 256 * n per component, so a component with
+        // |n| < 1/256 gets no offset although its rounding error (ulp(1e4) here) still
+        // reaches the normal direction: n = (0.61, -0.0036, -0.79) at y = -1e4 with x, z
+        // ~ 0.05 leaves the new origin 2.2e-7 behind the triangle.
+        {"offset too small when coordinates differ in magnitude (bounce)",
+         make(triangleShape({-0.757167578f, -10000.4346f, -0.487904161f}, {-0.408449709f, -9999.11523f, -0.223367169f},
+                            {0.662743568f, -10000.4297f, 0.613372207f}),
+              {0.0f, 0.0f, 0.0f}, {-0.0614044517f, -10000.1641f, 0.0505194813f},
+              {-0.302943379f, 0.292625517f, 0.906970561f}, kBounce)},
+        // BUG: a sphere of radius 1e-3 at ~1e4: the hit point rounds onto the centre and
+        // describeHit's normalize(position - centre) is NaN.
+        {"NaN normal when the hit point rounds onto the sphere's centre",
+         make(sphereShape({-8358.68164f, 4315.56885f, -3392.39062f}, 0.001f), {0.0f, 0.0f, 0.0f},
+              {-8358.68066f, 4315.56836f, -3392.39038f}, {0.706838071f, 0.686744034f, 0.169595301f}, kTransmit)},
+    };
+    std::vector<SpawnCase> spawns;
+    for (const Reproducer& r : cases) spawns.push_back(r.c);
+    std::vector<SpawnResult> results = spawnOnGpu(spawns);
+    for (size_t i = 0; i < cases.size(); ++i) {
+        const SpawnCase& c = cases[i].c;
+        const SpawnResult& r = results[i];
+        std::string what = std::string(cases[i].cause) + ": " + describe(c, r) +
+                           " front face " + std::to_string(r.frontFace) + ", exact " +
+                           std::to_string(frontFaceReference(c));
+        ASSERT_TRUE(r.primaryHit) << what;
+        EXPECT_TRUE(finite(r.position) && finite(r.origin) && finite(r.dir)) << what;
+        EXPECT_EQ(r.frontFace, frontFaceReference(c)) << what;
+        if (c.mode == kTransmit && c.shape.kind == Kind::Sphere) {
+            // Into the sphere: the exit, not the entry point again.
+            RefHit ref = sphereReference(glm::dvec3(c.shape.p[0]), c.shape.p[1].x, glm::dvec3(r.origin), glm::dvec3(r.dir));
+            EXPECT_TRUE(!ref.hit || (r.secondHit && r.secondT > 0.5 * ref.t)) << what;
+        } else {
+            EXPECT_FALSE(r.secondHit) << what;
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -473,7 +613,7 @@ TEST_F(IntersectionProbeSilhouette, HitOrMissMatchesExactDistanceOutsideTinyBand
         }
     std::vector<Answer> answers = intersectOnGpu(queries);
 
-    int64_t misclassified = 0, outsideBand = 0, hits = 0, misses = 0, badDistance = 0;
+    int64_t misclassified = 0, outsideBand = 0, hits = 0, misses = 0, badDistance = 0, naiveOutsideBand = 0;
     double worstBand = 0.0, worstDistanceError = 0.0;
     for (size_t i = 0; i < queries.size(); ++i) {
         const Query& q = queries[i];
@@ -483,6 +623,14 @@ TEST_F(IntersectionProbeSilhouette, HitOrMissMatchesExactDistanceOutsideTinyBand
         double distance = lineDistance(c, o, d);
         bool expected = distance <= r;
         ASSERT_TRUE(a.rawFlag == 0.0f || a.rawFlag == 1.0f);
+        {
+            // The textbook discriminant b^2 - c in float32 (as a control: the band must
+            // reject it, or this test could not tell the two forms apart).
+            glm::vec3 f = q.origin - q.shape.p[0];
+            float b = glm::dot(f, q.dir), cc = glm::dot(f, f) - q.shape.p[1].x * q.shape.p[1].x;
+            bool naiveHit = b * b - cc >= 0.0f;
+            if (naiveHit != expected && std::abs(distance - r) / r >= kSilhouetteBand) ++naiveOutsideBand;
+        }
         (a.hit ? hits : misses) += 1;
         if (a.hit != expected) {
             ++misclassified;
@@ -506,6 +654,8 @@ TEST_F(IntersectionProbeSilhouette, HitOrMissMatchesExactDistanceOutsideTinyBand
     EXPECT_GT(misses, int64_t(queries.size()) / 3);
     EXPECT_EQ(outsideBand, 0) << "band " << kSilhouetteBand << " r";
     EXPECT_EQ(badDistance, 0) << "worst relative distance error " << worstDistanceError;
+    EXPECT_GT(naiveOutsideBand, int64_t(queries.size()) / 10) << "the naive discriminant would pass";
+    report("SilhouetteNaiveFormMisclassifiedOutsideBand", double(naiveOutsideBand));
     report("SilhouetteRays", double(queries.size()));
     report("SilhouetteMisclassified", double(misclassified));
     report("SilhouetteWorstBandOverR", worstBand);
@@ -517,90 +667,13 @@ TEST_F(IntersectionProbeSilhouette, HitOrMissMatchesExactDistanceOutsideTinyBand
 
 class IntersectionProbeWatertight : public GpuTest {};
 
-// A quad split on its diagonal into (v00, v10, v11) and (v00, v11, v01); rays aimed
-// at points of the shared edge v00-v11 (lerp of its end points in float) from random
-// origins on both sides, some nearly grazing, must hit at least one triangle.
-TEST_F(IntersectionProbeWatertight, SharedTriangleEdgeNeverLeaks)
-{
-    struct QuadConfig {
-        double offset;
-        double size;
-        bool fromCamera; ///< half the rays start at the camera (origin) instead
-    };
-    const std::array<QuadConfig, 5> configs = {
-        {{0.0, 1.0, false}, {0.0, 1e-3, false}, {1e3, 10.0, true}, {1e4, 1.0, true}, {37.0, 100.0, false}}};
-    constexpr int kRaysPerConfig = 8000; // 40,000 rays
-    Random rng(99u);
-    std::vector<Query> queries;
-    std::vector<glm::vec3> targets;
-    for (const QuadConfig& config : configs)
-        for (int k = 0; k < kRaysPerConfig; ++k) {
-            glm::dvec3 centre = config.offset * rng.unit();
-            glm::dvec3 e1 = config.size * rng.unit(), e2 = config.size * rng.unit();
-            if (glm::length(glm::cross(e1, e2)) < 0.3 * config.size * config.size) {
-                --k;
-                continue;
-            }
-            glm::vec3 v00(centre - 0.5 * (e1 + e2));
-            glm::vec3 v10 = v00 + glm::vec3(e1), v01 = v00 + glm::vec3(e2), v11 = v10 + glm::vec3(e2);
-            float s = float(rng.uniform(0.01, 0.99));
-            glm::vec3 p = glm::mix(v00, v11, s);
-            glm::dvec3 normal = glm::normalize(glm::cross(glm::dvec3(v10 - v00), glm::dvec3(v01 - v00)));
-            glm::vec3 origin;
-            if (config.fromCamera && k % 2 == 0) {
-                origin = glm::vec3(0.0f);
-            } else {
-                // Elevation above or below the quad from ~0.06 degrees (grazing) to 90.
-                glm::dvec3 w;
-                do {
-                    w = rng.unit();
-                } while (std::abs(glm::dot(w, normal)) < 1e-3);
-                origin = glm::vec3(glm::dvec3(p) + config.size * std::pow(10.0, rng.uniform(-1.0, 1.0)) * w);
-            }
-            glm::vec3 dir = glm::normalize(p - origin);
-            queries.push_back({triangleShape(v00, v10, v11), origin, dir});
-            queries.push_back({triangleShape(v00, v11, v01), origin, dir});
-            targets.push_back(p);
-        }
-    std::vector<Answer> answers = intersectOnGpu(queries);
-
-    int64_t leaks = 0, both = 0, badDistance = 0;
-    double worstDistanceError = 0.0;
-    for (size_t i = 0; i < targets.size(); ++i) {
-        const Answer& a = answers[2 * i];
-        const Answer& b = answers[2 * i + 1];
-        const Query& q = queries[2 * i];
-        if (!a.hit && !b.hit) {
-            if (leaks++ < 10)
-                ADD_FAILURE() << "leak: quad " << str(q.shape.p[0]) << " " << str(q.shape.p[1]) << " "
-                              << str(q.shape.p[2]) << " " << str(queries[2 * i + 1].shape.p[2]) << " origin "
-                              << str(q.origin) << " dir " << str(q.dir) << " target " << str(targets[i]);
-            continue;
-        }
-        if (a.hit && b.hit) ++both;
-        double expected = glm::length(glm::dvec3(targets[i]) - glm::dvec3(q.origin));
-        for (const Answer* h : {&a, &b})
-            if (h->hit) {
-                double err = std::abs(h->t - expected) / expected;
-                worstDistanceError = std::max(worstDistanceError, err);
-                if (!(err <= 1e-4)) ++badDistance;
-            }
-    }
-    EXPECT_EQ(leaks, 0);
-    EXPECT_EQ(badDistance, 0) << "worst relative distance error " << worstDistanceError;
-    report("SharedEdgeRays", double(targets.size()));
-    report("SharedEdgeLeaks", double(leaks));
-    report("SharedEdgeHitBoth", double(both));
-    report("SharedEdgeWorstRelativeDistanceError", worstDistanceError);
-}
-
 /// A float origin o = p - T d (T a power of two) exactly on the line through p along
 /// the float direction d, so the ray passes through p in exact arithmetic. d is a
 /// random float unit vector accepted by `accept`; retries until o is exact in float.
 bool exactRayThrough(const glm::vec3& p, double T, Random& rng, glm::vec3& origin, glm::vec3& dir,
                      const std::function<bool(const glm::vec3&)>& accept)
 {
-    for (int attempt = 0; attempt < 100000; ++attempt) {
+    for (int attempt = 0; attempt < 20000; ++attempt) {
         glm::vec3 d = glm::normalize(glm::vec3(rng.unit()));
         if (!accept(d)) continue;
         glm::dvec3 o = glm::dvec3(p) - T * glm::dvec3(d); // T * d is exact, the difference exact in double
@@ -611,6 +684,214 @@ bool exactRayThrough(const glm::vec3& p, double T, Random& rng, glm::vec3& origi
         return true;
     }
     return false;
+}
+
+/// Double-precision ray/triangle test (Moller-Trumbore) of the closed triangle, with
+/// `slack` on the barycentric bounds; t in units of d.
+RefHit triangleReference(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& o,
+                         const glm::dvec3& d, double slack = 0.0)
+{
+    glm::dvec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+    double det = glm::dot(e1, p);
+    if (det == 0.0) return {};
+    glm::dvec3 s = o - a, q = glm::cross(s, e1);
+    double u = glm::dot(s, p) / det, v = glm::dot(d, q) / det, t = glm::dot(e2, q) / det;
+    if (u < -slack || v < -slack || u + v > 1.0 + slack || !(t > 0.0)) return {};
+    return {true, t};
+}
+
+/// Distance from the ray to the line through a and b, measured in the plane
+/// orthogonal to the ray: how far the ray passes from that edge in projection.
+double projectedDistance(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b)
+{
+    glm::dvec3 n = glm::cross(b - a, d);
+    double length = glm::length(n);
+    if (length == 0.0) return 0.0;
+    return std::abs(glm::dot(a - o, n)) / length;
+}
+
+/// Spacing of float32 values around magnitude x.
+double floatUlp(double x)
+{
+    float f = float(std::abs(x));
+    return double(std::nextafter(f, std::numeric_limits<float>::infinity())) - double(f);
+}
+
+/// Moller-Trumbore in float32 with the usual edge conventions (u >= 0, v >= 0,
+/// u + v <= 1): a control that is not watertight along shared edges.
+bool mollerFloat(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& o, const glm::vec3& d)
+{
+    glm::vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+    float det = glm::dot(e1, p);
+    if (det == 0.0f) return false;
+    float inv = 1.0f / det;
+    glm::vec3 s = o - a;
+    float u = glm::dot(s, p) * inv;
+    if (u < 0.0f || u > 1.0f) return false;
+    glm::vec3 q = glm::cross(s, e1);
+    float v = glm::dot(d, q) * inv;
+    if (v < 0.0f || u + v > 1.0f) return false;
+    return glm::dot(e2, q) * inv > 0.0f;
+}
+
+// A quad split on its diagonal into (v00, v10, v11) and (v00, v11, v01); rays through
+// the shared edge v00-v11 from random origins on both sides. Two kinds of rays:
+//  - aimed at lerp(v00, v11, s) computed in float, direction normalized in float
+//    (so they pass within rounding of the edge), on random quads;
+//  - exactly through a point of the edge: dyadic vertices make v00 + k/64 (v11 - v00)
+//    exact, and the origin is that point minus a power of two times the float
+//    direction, exact in float.
+// Watertightness is a property of the shared edge: the edge function of v00-v11 is
+// computed identically (negated) for both triangles, so the ray is inside one of them
+// unless it is wrong about the other edges. Float32 cannot place the projected
+// vertices closer than a few ulps of their distance R from the ray origin, so a ray
+// that passes within 64 ulp(R) of the quad's outer boundary (in projection; this
+// includes views nearly edge-on) may go either way; every other ray that crosses the
+// quad in exact arithmetic must hit a triangle.
+TEST_F(IntersectionProbeWatertight, SharedTriangleEdgeNeverLeaks)
+{
+    struct QuadConfig {
+        double offset;
+        double size;
+        bool fromCamera; ///< half the rays start at the camera (origin) instead
+    };
+    const std::array<QuadConfig, 5> configs = {
+        {{0.0, 1.0, false}, {0.0, 1e-3, false}, {1e3, 10.0, true}, {1e4, 1.0, true}, {37.0, 100.0, false}}};
+    constexpr int kRaysPerConfig = 8000; // 40,000 float-aimed rays
+    constexpr int kExactRays = 20000;
+    Random rng(99u);
+    struct Quad {
+        glm::vec3 v00, v10, v11, v01;
+    };
+    std::vector<Quad> quads;
+    std::vector<Query> queries;
+    std::vector<int> exactRay;
+    auto addRay = [&](const Quad& q, const glm::vec3& origin, const glm::vec3& dir, bool exact) {
+        quads.push_back(q);
+        queries.push_back({triangleShape(q.v00, q.v10, q.v11), origin, dir});
+        queries.push_back({triangleShape(q.v00, q.v11, q.v01), origin, dir});
+        exactRay.push_back(exact);
+    };
+    for (const QuadConfig& config : configs)
+        for (int k = 0; k < kRaysPerConfig; ++k) {
+            glm::dvec3 centre = config.offset * rng.unit();
+            glm::dvec3 e1 = config.size * rng.unit(), e2 = config.size * rng.unit();
+            if (glm::length(glm::cross(e1, e2)) < 0.3 * config.size * config.size) {
+                --k;
+                continue;
+            }
+            Quad q;
+            q.v00 = glm::vec3(centre - 0.5 * (e1 + e2));
+            q.v10 = q.v00 + glm::vec3(e1);
+            q.v01 = q.v00 + glm::vec3(e2);
+            q.v11 = q.v10 + glm::vec3(e2);
+            glm::vec3 p = glm::mix(q.v00, q.v11, float(rng.uniform(0.01, 0.99)));
+            glm::vec3 origin(0.0f);
+            if (!config.fromCamera || k % 2 == 1) {
+                glm::dvec3 normal = glm::normalize(glm::cross(e1, e2)), w;
+                do {
+                    w = rng.unit();
+                } while (std::abs(glm::dot(w, normal)) < 1e-3);
+                origin = glm::vec3(glm::dvec3(p) + config.size * std::pow(10.0, rng.uniform(-1.0, 1.0)) * w);
+            }
+            addRay(q, origin, glm::normalize(p - origin), false);
+        }
+    for (int k = 0; k < kExactRays; ++k) {
+        // Dyadic quads: coordinates (offset + m / 16) * 2^e with small integers m.
+        double scale = std::ldexp(1.0, rng.index(13) - 6);
+        double offset = std::array<double, 4>{0.0, 0.0, 64.0, 1024.0}[rng.index(4)];
+        if (offset > 256.0 * scale) offset = 0.0;
+        auto coordinate = [&] { return glm::dvec3(rng.index(33) - 16, rng.index(33) - 16, rng.index(33) - 16) / 16.0; };
+        glm::dvec3 v00 = offset * glm::dvec3(1, -1, 1) + scale * coordinate();
+        glm::dvec3 e1 = scale * coordinate(), e2 = scale * coordinate();
+        if (glm::length(glm::cross(e1, e2)) < 0.1 * scale * scale) {
+            --k;
+            continue;
+        }
+        glm::dvec3 p = v00 + double(1 + rng.index(63)) / 64.0 * (e1 + e2);
+        Quad q{glm::vec3(v00), glm::vec3(v00 + e1), glm::vec3(v00 + e1 + e2), glm::vec3(v00 + e2)};
+        // All exact in float (else draw again).
+        if (glm::dvec3(q.v00) != v00 || glm::dvec3(q.v10) != v00 + e1 || glm::dvec3(q.v11) != v00 + e1 + e2 ||
+            glm::dvec3(q.v01) != v00 + e2 || glm::dvec3(glm::vec3(p)) != p) {
+            --k;
+            continue;
+        }
+        // Origins 1 to 8 times the larger of the quad's size and its distance from 0
+        // away (a power of two, so that an exact origin exists for most directions).
+        glm::vec3 origin, dir;
+        double extent = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), 2.0 * scale});
+        double T = std::ldexp(1.0, int(std::ceil(std::log2(extent))) + rng.index(4));
+        if (!exactRayThrough(glm::vec3(p), T, rng, origin, dir, [](const glm::vec3&) { return true; })) {
+            --k;
+            continue;
+        }
+        addRay(q, origin, dir, true);
+    }
+    std::vector<Answer> answers = intersectOnGpu(queries);
+
+    std::array<int64_t, 2> mustHit{}, leaks{}, excluded{}, excludedMisses{};
+    int64_t both = 0, badDistance = 0, mollerLeaks = 0;
+    double worstDistance = 0.0;
+    for (size_t i = 0; i < quads.size(); ++i) {
+        const Answer& a = answers[2 * i];
+        const Answer& b = answers[2 * i + 1];
+        const Query& q = queries[2 * i];
+        const Quad& quad = quads[i];
+        int kind = exactRay[i];
+        glm::dvec3 o(q.origin), d(q.dir);
+        glm::dvec3 v00(quad.v00), v10(quad.v10), v11(quad.v11), v01(quad.v01);
+        RefHit r1 = triangleReference(v00, v10, v11, o, d, 1e-9), r2 = triangleReference(v00, v11, v01, o, d, 1e-9);
+        double R = 0.0;
+        for (const glm::dvec3& v : {v00, v10, v11, v01})
+            for (int c = 0; c < 3; ++c) R = std::max(R, std::abs(v[c] - o[c]));
+        double margin = std::min({projectedDistance(o, d, v00, v10), projectedDistance(o, d, v10, v11),
+                                  projectedDistance(o, d, v11, v01), projectedDistance(o, d, v01, v00)});
+        bool robust = (r1.hit || r2.hit) && margin >= 64.0 * floatUlp(R);
+        if (!robust) {
+            ++excluded[kind];
+            if (!a.hit && !b.hit) ++excludedMisses[kind];
+            continue;
+        }
+        ++mustHit[kind];
+        if (!mollerFloat(quad.v00, quad.v10, quad.v11, q.origin, q.dir) &&
+            !mollerFloat(quad.v00, quad.v11, quad.v01, q.origin, q.dir))
+            ++mollerLeaks;
+        if (!a.hit && !b.hit) {
+            if (leaks[kind]++ < 5)
+                ADD_FAILURE() << "leak: quad " << str(quad.v00) << " " << str(quad.v10) << " " << str(quad.v11) << " "
+                              << str(quad.v01) << " origin " << str(q.origin) << " dir " << str(q.dir);
+            continue;
+        }
+        if (a.hit && b.hit) ++both;
+        // Distance: float32 places the plane to within a few ulp(R) along its normal,
+        // which moves t by that over the cosine of incidence.
+        glm::dvec3 n = glm::normalize(glm::cross(v10 - v00, v11 - v00));
+        double cosine = std::abs(glm::dot(n, glm::normalize(d)));
+        for (const auto& [hit, ref] : {std::pair{a, r1.hit ? r1 : r2}, std::pair{b, r2.hit ? r2 : r1}})
+            if (hit.hit) {
+                double tolerance = 1e-5 * ref.t + 16.0 * floatUlp(R) / cosine;
+                double ratio = std::abs(hit.t - ref.t) / tolerance;
+                worstDistance = std::max(worstDistance, ratio);
+                if (!(ratio <= 1.0)) ++badDistance;
+            }
+    }
+    for (int kind = 0; kind < 2; ++kind) {
+        std::string name = kind ? "Exact" : "FloatAimed";
+        EXPECT_EQ(leaks[kind], 0) << name;
+        report("SharedEdge" + name + "MustHitRays", double(mustHit[kind]));
+        report("SharedEdge" + name + "Leaks", double(leaks[kind]));
+        report("SharedEdge" + name + "NearBoundaryRays", double(excluded[kind]));
+        report("SharedEdge" + name + "NearBoundaryMisses", double(excludedMisses[kind]));
+    }
+    // The exclusion leaves most rays in: well over 20,000 of each kind must hit.
+    EXPECT_GT(mustHit[0], 30000);
+    EXPECT_GT(mustHit[1], 15000);
+    EXPECT_EQ(badDistance, 0) << "worst error / tolerance " << worstDistance;
+    report("SharedEdgeHitBoth", double(both));
+    report("SharedEdgeMollerFloatLeaks", double(mollerLeaks));
+    // Control: the same rays leak through a plain float Moller-Trumbore pair.
+    EXPECT_GT(mollerLeaks, 100);
+    report("SharedEdgeWorstDistanceErrorOverTolerance", worstDistance);
 }
 
 struct ExactBox {
@@ -639,6 +920,16 @@ glm::vec3 boxEdgePoint(const ExactBox& box, int edge, int corner, Random& rng)
     return p;
 }
 
+/// The slab test in float32 without intersectBox's widening of tFar (a control).
+bool slabWithoutWidening(const glm::vec3& lower, const glm::vec3& upper, const glm::vec3& o, const glm::vec3& d)
+{
+    glm::vec3 inv = 1.0f / d;
+    glm::vec3 t0 = (lower - o) * inv, t1 = (upper - o) * inv;
+    glm::vec3 tmin = glm::min(t0, t1), tmax = glm::max(t0, t1);
+    float tNear = std::max({tmin.x, tmin.y, tmin.z}), tFar = std::min({tmax.x, tmax.y, tmax.z});
+    return tNear <= tFar && tFar > 0.0f;
+}
+
 TEST_F(IntersectionProbeWatertight, RaysThroughBoxEdgesAndCornersHit)
 {
     Random rng(4242u);
@@ -656,12 +947,13 @@ TEST_F(IntersectionProbeWatertight, RaysThroughBoxEdgesAndCornersHit)
         }
     std::vector<Answer> answers = intersectOnGpu(queries);
     std::array<int64_t, 2> misses{}, counts{};
-    int64_t badDistance = 0;
+    int64_t badDistance = 0, unwidenedMisses = 0;
     double worstDistanceError = 0.0;
     for (size_t i = 0; i < queries.size(); ++i) {
         const Query& q = queries[i];
         const Answer& a = answers[i];
         ++counts[kindOf[i]];
+        if (!slabWithoutWidening(q.shape.p[0], q.shape.p[1], q.origin, q.dir)) ++unwidenedMisses;
         // The exact answer is a hit: the line passes through a point of the closed box.
         RefHit ref = boxReference(glm::dvec3(q.shape.p[0]), glm::dvec3(q.shape.p[1]), glm::dvec3(q.origin),
                                   glm::dvec3(q.dir), 1e-9);
@@ -685,6 +977,9 @@ TEST_F(IntersectionProbeWatertight, RaysThroughBoxEdgesAndCornersHit)
     report("BoxCornerRays", double(counts[1]));
     report("BoxCornerMisses", double(misses[1]));
     report("BoxEdgeWorstRelativeDistanceError", worstDistanceError);
+    report("BoxEdgeMissesWithoutWidening", double(unwidenedMisses));
+    // Control: without the widening of tFar by 1 + 2 gamma(3) these rays do miss.
+    EXPECT_GT(unwidenedMisses, 100);
 }
 
 // Boxes A = [l, m] x [y0, y1] x [z0, z1] and B = [m, u] x ... share the face x = m;
@@ -759,6 +1054,16 @@ TEST_F(IntersectionProbeWatertight, EdgeBetweenBoxesSharingAFaceNeverLeaks)
 
 class IntersectionProbeDegenerate : public GpuTest {};
 
+// Exactly collinear triangles (distinct vertices) and triangles with repeated
+// vertices, rays aimed at their vertices and at points of their segment, from
+// anywhere including along the segment's line: intersectTriangle must never report
+// a hit, and findClosest + describeHit must produce no NaN.
+//
+// BUG (reported): repeated vertices are safe (two edge functions cancel exactly, so
+// det == 0), but for collinear vertices the sheared projection rounds the three
+// points off their common line and about 12 % of the rays aimed at the segment hit a
+// triangle of float area ~0; describeHit's normalize(cross(e1, e2)) is then
+// normalize(0) = NaN, and so are the spawned ray's origin and direction.
 TEST_F(IntersectionProbeDegenerate, CollinearAndRepeatedVertexTrianglesAreNeverHit)
 {
     Random rng(31337u);
@@ -780,6 +1085,12 @@ TEST_F(IntersectionProbeDegenerate, CollinearAndRepeatedVertexTrianglesAreNeverH
         }
         if (e == glm::dvec3(0.0)) e.x = scale;
         glm::vec3 a(base), b(base + e), c(base + 2.5 * e), m(base + 0.75 * e);
+        // Keep only exactly representable vertices (then exactly collinear).
+        if (glm::dvec3(a) != base || glm::dvec3(b) != base + e || glm::dvec3(c) != base + 2.5 * e ||
+            glm::dvec3(m) != base + 0.75 * e) {
+            --k;
+            continue;
+        }
         // Collinear with distinct vertices, then zero-area with repeated vertices.
         triangles.push_back({{a, b, c}, a, c});
         triangles.push_back({{a, c, b}, a, c}); // middle vertex last
@@ -790,7 +1101,10 @@ TEST_F(IntersectionProbeDegenerate, CollinearAndRepeatedVertexTrianglesAreNeverH
         triangles.push_back({{a, a, a}, a, a});
     }
     std::vector<Query> queries;
-    for (const Degenerate& tri : triangles) {
+    std::vector<int> repeated; // 0: collinear, distinct vertices; 1: repeated vertices
+    std::vector<SpawnCase> spawns;
+    for (size_t t = 0; t < triangles.size(); ++t) {
+        const Degenerate& tri = triangles[t];
         glm::dvec3 a(tri.v[0]), b(tri.v[1]), c(tri.v[2]);
         ASSERT_EQ(glm::cross(b - a, c - a), glm::dvec3(0.0)) << "not exactly degenerate";
         glm::vec3 lo = tri.end0, hi = tri.end1;
@@ -808,26 +1122,48 @@ TEST_F(IntersectionProbeDegenerate, CollinearAndRepeatedVertexTrianglesAreNeverH
             }
             if (origin == target) continue;
             glm::vec3 dir = glm::normalize(target - origin);
-            queries.push_back({triangleShape(tri.v[0], tri.v[1], tri.v[2]), origin, dir});
+            Shape shape = triangleShape(tri.v[0], tri.v[1], tri.v[2]);
+            queries.push_back({shape, origin, dir});
+            repeated.push_back(t % 7 >= 3);
+            // The same ray through the renderer's findClosest and describeHit.
+            SpawnCase spawn;
+            spawn.shape = shape;
+            spawn.primaryOrigin = origin;
+            spawn.aim = target;
+            spawns.push_back(spawn);
         }
     }
     std::vector<Answer> answers = intersectOnGpu(queries);
-    int64_t hits = 0, nonFinite = 0;
+    std::vector<SpawnResult> described = spawnOnGpu(spawns);
+    std::array<int64_t, 2> hits{}, rays{}, rendererHits{}, nonFiniteHits{};
+    int64_t nonFinite = 0;
     for (size_t i = 0; i < queries.size(); ++i) {
         const Answer& a = answers[i];
+        const Query& q = queries[i];
+        ++rays[repeated[i]];
         if (!(a.rawFlag == 0.0f || a.rawFlag == 1.0f) || !std::isfinite(a.t)) ++nonFinite;
-        if (a.hit) {
-            const Query& q = queries[i];
-            if (hits++ < 10)
-                ADD_FAILURE() << "degenerate triangle hit at t " << a.t << ": " << str(q.shape.p[0]) << " "
-                              << str(q.shape.p[1]) << " " << str(q.shape.p[2]) << " origin " << str(q.origin) << " dir "
-                              << str(q.dir);
+        if (a.hit && hits[repeated[i]]++ < 5)
+            ADD_FAILURE() << (repeated[i] ? "repeated-vertex" : "collinear") << " triangle hit at t " << a.t << ": "
+                          << str(q.shape.p[0]) << " " << str(q.shape.p[1]) << " " << str(q.shape.p[2]) << " origin "
+                          << str(q.origin) << " dir " << str(q.dir);
+        const SpawnResult& r = described[i];
+        if (r.primaryHit) {
+            ++rendererHits[repeated[i]];
+            bool finiteHit = finite(r.position) && finite(r.origin) && finite(r.dir);
+            if (!finiteHit && nonFiniteHits[repeated[i]]++ < 3)
+                ADD_FAILURE() << "NaN from describeHit: " << describe(spawns[i], r);
         }
     }
-    EXPECT_EQ(hits, 0) << "of " << queries.size() << " rays";
+    for (int kind = 0; kind < 2; ++kind) {
+        std::string name = kind ? "RepeatedVertex" : "Collinear";
+        EXPECT_EQ(hits[kind], 0) << name << ": of " << rays[kind] << " rays";
+        EXPECT_EQ(rendererHits[kind], 0) << name << ": of " << rays[kind] << " rays (findClosest)";
+        EXPECT_EQ(nonFiniteHits[kind], 0) << name << ": non-finite hit point, normal or spawned ray";
+        report(name + "Rays", double(rays[kind]));
+        report(name + "Hits", double(hits[kind]));
+        report(name + "NonFiniteHits", double(nonFiniteHits[kind]));
+    }
     EXPECT_EQ(nonFinite, 0);
-    report("DegenerateTriangleRays", double(queries.size()));
-    report("DegenerateTriangleHits", double(hits));
 }
 
 // ---------------------------------------------------------------------------
@@ -966,7 +1302,8 @@ TEST_F(IntersectionProbeZeroComponents, TriangleAndPlaneWithAxisDirections)
                     queries.push_back({plane, glm::vec3(x, y, z), d});
                 }
     std::vector<Answer> answers = intersectOnGpu(queries);
-    int64_t wrong = 0, nonFinite = 0, badDistance = 0, hits = 0;
+    int64_t wrong = 0, nonFinite = 0, badDistance = 0, hits = 0, onPlaneTinyHits = 0;
+    double worstOnPlaneT = 0.0;
     for (size_t i = 0; i < queries.size(); ++i) {
         const Query& q = queries[i];
         const Answer& r = answers[i];
@@ -991,6 +1328,17 @@ TEST_F(IntersectionProbeZeroComponents, TriangleAndPlaneWithAxisDirections)
             if (nonFinite++ < 5) ADD_FAILURE() << "non-finite: " << what;
             continue;
         }
+        // From an origin exactly in the triangle's plane the exact distance is 0 and
+        // the float one is 0 give or take rounding: a miss or a hit at t ~ 0 (this is
+        // what offsetRayOrigin is for).
+        if (d.z != 0.0 && o.z == 2.0) {
+            if (r.hit) {
+                ++onPlaneTinyHits;
+                worstOnPlaneT = std::max(worstOnPlaneT, double(r.t));
+                if (!(r.t <= 1e-6)) ++wrong;
+            }
+            continue;
+        }
         if (r.hit != ref.hit) {
             if (wrong++ < 10) ADD_FAILURE() << what << ": GPU hit " << r.hit << " reference " << ref.hit;
             continue;
@@ -1007,6 +1355,8 @@ TEST_F(IntersectionProbeZeroComponents, TriangleAndPlaneWithAxisDirections)
     EXPECT_GT(hits, 1000);
     report("ZeroComponentTrianglePlaneRays", double(queries.size()));
     report("ZeroComponentTrianglePlaneWrong", double(wrong));
+    report("OriginInPlaneHitsAtTinyT", double(onPlaneTinyHits));
+    report("OriginInPlaneWorstT", worstOnPlaneT);
 }
 
 } // namespace

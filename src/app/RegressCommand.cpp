@@ -1,0 +1,38 @@
+// `vkrt regress`: the regression suite (src/regress/RegressionRun.cpp).
+#include "app/Commands.h"
+#include "regress/RegressionRun.h"
+#include "util/Error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <memory>
+
+namespace vkrt {
+
+CommandRunner addRegressCommand(CLI::App& app)
+{
+    auto o = std::make_shared<RegressOptions>();
+    auto defines = std::make_shared<std::vector<std::string>>();
+    o->suite = VKRT_DEFAULT_SUITE;
+    CLI::App* cmd = app.add_subcommand("regress", "Run the regression suite against its references");
+    cmd->add_option("--suite", o->suite, "Suite manifest (default: tests/regress/suite.toml)");
+    cmd->add_option("--filter", o->filter, "Only cases whose name contains this");
+    cmd->add_option("--driver", o->driver, "Vulkan ICD manifest (JSON) of the driver to test");
+    cmd->add_option("--device", o->device, "Vulkan device index or name");
+    cmd->add_option("--junit", o->junit, "Write JUnit XML here");
+    cmd->add_option("--report-dir", o->reportDir, "Write report.md and failure images here");
+    cmd->add_flag("--update", o->update, "Regenerate the vkrt-made references (never the Mitsuba ones)");
+    cmd->add_option("--seed-offset", o->seedOffset, "Added to the suite's seed (for repeated runs)");
+    cmd->add_flag("--fail-on-slowdown", o->failOnSlowdown, "Fail cases slower than baseline x max_slowdown");
+    cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");
+    return [o, defines] {
+        for (const std::string& d : *defines) {
+            auto eq = d.find('=');
+            if (eq == std::string::npos || eq == 0) throw InputError("--kernel-define " + d + ": expected NAME=VALUE");
+            o->kernelDefines.emplace_back(d.substr(0, eq), d.substr(eq + 1));
+        }
+        return runRegression(*o);
+    };
+}
+
+} // namespace vkrt
