@@ -17,6 +17,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/sampling.glsl"
 #include "lib/bsdf.glsl"
 #include "lib/environment.glsl"
+#include "lib/media.glsl"
 #include "lib/lights.glsl"
 #ifdef VKRT_INTEGRATOR_PATH
 #include "lib/path.glsl"

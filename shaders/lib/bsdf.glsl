@@ -104,19 +104,19 @@ BsdfSample sampleGlossy(Material m, vec3 n, vec3 wo, vec2 u)
 #ifdef VKRT_MATERIAL_DIELECTRIC
 // Reflects with probability F, else refracts (Snell's law); each branch
 // carries weight 1 because its probability equals its Fresnel factor.
-// frontFace: wo is on the outward side of the surface.
-BsdfSample sampleDielectric(Material m, vec3 n, vec3 wo, bool frontFace, float u)
+// eta = n_incident / n_transmitted for this crossing (lib/media.glsl).
+BsdfSample sampleDielectric(Material m, vec3 n, vec3 wo, float eta, float u)
 {
-    float eta = frontFace ? 1.0 / m.ior : m.ior;
-    float reflectance = dielectricReflectance(m.fresnel, dot(n, wo), eta, m.ior);
-    vec3 refracted = refract(-wo, n, eta);
-    if (u < reflectance || dot(refracted, refracted) == 0.0)
+    float reflectance = dielectricReflectance(m.fresnel, dot(n, wo), eta);
+    vec3 refracted = refractDirection(wo, n, eta);
+    if (u < reflectance || refracted == vec3(0.0))
         return BsdfSample(reflect(-wo, n), vec3(1.0), true, false);
-    return BsdfSample(normalize(refracted), vec3(1.0), true, true);
+    return BsdfSample(refracted, vec3(1.0), true, true);
 }
 #endif
 
-BsdfSample sampleBsdf(Material m, vec3 n, vec3 wo, bool frontFace, vec3 u)
+// eta: n_incident / n_transmitted, used by dielectrics only.
+BsdfSample sampleBsdf(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
 #ifdef VKRT_MATERIAL_LAMBERT
     if (m.type == MATERIAL_LAMBERT)
@@ -137,7 +137,7 @@ BsdfSample sampleBsdf(Material m, vec3 n, vec3 wo, bool frontFace, vec3 u)
 #endif
 #ifdef VKRT_MATERIAL_DIELECTRIC
     if (m.type == MATERIAL_DIELECTRIC)
-        return sampleDielectric(m, n, wo, frontFace, u.z);
+        return sampleDielectric(m, n, wo, eta, u.z);
 #endif
     return noScatter();
 }

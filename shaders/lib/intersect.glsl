@@ -8,7 +8,12 @@
 // with q = b + sign(b) sqrt(disc) avoid catastrophic cancellation (Haines et
 // al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems
 // ch. 7). The naive form misclassifies near-silhouette rays from afar.
-bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit)
+// `local` is the hit point relative to the centre, l -/+ sqrt(disc) d, which
+// keeps its accuracy when the sphere is small against its distance (the
+// point origin + t d would not). `front`: the ray starts outside, decided by
+// which root was taken rather than by the sign of dot(normal, d), which
+// rounding flips at grazing angles.
+bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit, out vec3 local, out bool front)
 {
     vec3 f = r.origin - s.center;
     float b = -dot(f, r.dir);
@@ -18,7 +23,8 @@ bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit)
     if (disc < 0.0)
         return false;
     float c = dot(f, f) - r2;
-    float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
+    float rootDisc = sqrt(disc);
+    float q = b + (b >= 0.0 ? rootDisc : -rootDisc);
     float tNear = c / q;
     float tFar = q;
     if (tNear > tFar) {
@@ -26,7 +32,9 @@ bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit)
         tNear = tFar;
         tFar = tmp;
     }
-    tHit = tNear > 0.0 ? tNear : tFar;
+    front = tNear > 0.0;
+    tHit = front ? tNear : tFar;
+    local = l + (front ? -rootDisc : rootDisc) * r.dir;
     return tHit > 0.0 && tHit < tMax;
 }
 
@@ -37,7 +45,7 @@ int argMin3(vec3 v) { return (v.x <= v.y && v.x <= v.z) ? 0 : (v.y <= v.z ? 1 : 
 // (0 * inf would be NaN): such an axis either rejects the ray or imposes no
 // limit. tFar is widened by 1 + 2*gamma(3) so that rounding cannot open a gap
 // at edges (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-bool intersectBox(Box b, Ray r, float tMax, out float tHit, out vec3 normal)
+bool intersectBox(Box b, Ray r, float tMax, out float tHit, out vec3 normal, out bool front)
 {
     bvec3 parallel = equal(r.dir, vec3(0.0));
     bvec3 outside = bvec3(uvec3(lessThan(r.origin, b.lower)) | uvec3(greaterThan(r.origin, b.upper)));
@@ -55,6 +63,7 @@ bool intersectBox(Box b, Ray r, float tMax, out float tHit, out vec3 normal)
     if (tNear > tFar)
         return false;
     bool entering = tNear > 0.0;
+    front = entering;
     tHit = entering ? tNear : tFar;
     if (!(tHit > 0.0 && tHit < tMax))
         return false;
@@ -88,9 +97,11 @@ TriangleRay triangleRaySetup(Ray r)
 
 // Watertight ray/triangle test (Woop, Benthin & Wald, JCGT 2013): edge
 // functions are evaluated in a ray-aligned frame so that a ray through a shared
-// edge hits at least one of the two triangles. Degenerate triangles have
-// det == 0 and are never hit. Both faces are hit.
-bool intersectTriangle(vec3 v0, vec3 v1, vec3 v2, Ray r, TriangleRay tr, float tMax, out float tHit)
+// edge hits at least one of the two triangles. Both faces are hit.
+// Degenerate triangles are never hit: det == 0 catches most, and a zero
+// cross product the rest (sheared edge functions of exactly collinear
+// vertices round to a tiny nonzero area). `bary` weighs v0, v1, v2.
+bool intersectTriangle(vec3 v0, vec3 v1, vec3 v2, Ray r, TriangleRay tr, float tMax, out float tHit, out vec3 bary)
 {
     vec3 A = v0 - r.origin;
     vec3 B = v1 - r.origin;
@@ -115,7 +126,10 @@ bool intersectTriangle(vec3 v0, vec3 v1, vec3 v2, Ray r, TriangleRay tr, float t
     float absDet = abs(det);
     if (signedT <= 0.0 || signedT >= tMax * absDet)
         return false;
+    if (all(equal(cross(v1 - v0, v2 - v0), vec3(0.0))))
+        return false;
     tHit = T / det;
+    bary = vec3(U, V, W) / det;
     return tHit > 0.0 && tHit < tMax;
 }
 

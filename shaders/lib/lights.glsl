@@ -4,14 +4,17 @@
 #define VKRT_LIGHTS_GLSL
 
 // Fraction of light that travels from `origin` along `dir` for distance
-// tMax. Each dielectric interface passes 1 - F, and the stretch inside a
-// dielectric is attenuated by Beer-Lambert; any other surface blocks.
-vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax)
+// tMax, starting in the media `media`. Each dielectric interface passes
+// 1 - F, and every stretch is attenuated by Beer-Lambert in the medium it
+// lies in; any other surface blocks.
+vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax, MediumStack media)
 {
     // The path integrator treats glass physically: a shadow ray cannot see a
     // light through it (light arrives through glass by BSDF sampling).
 #if !defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_INTEGRATOR_PATH)
-    return findClosest(Ray(origin, dir), tMax).shape == SHAPE_NONE ? vec3(1.0) : vec3(0.0);
+    if (findClosest(Ray(origin, dir), tMax).shape != SHAPE_NONE)
+        return vec3(0.0);
+    return beerLambert(mediumAbsorption(media), tMax);
 #else
     vec3 target = origin + dir * tMax;
     vec3 transmittance = vec3(1.0);
@@ -20,25 +23,25 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax)
         Ray ray = Ray(origin, dir);
         HitId id = findClosest(ray, tMax);
         if (id.shape == SHAPE_NONE)
-            return transmittance;
+            return transmittance * beerLambert(mediumAbsorption(media), tMax);
         if (id.shape == SHAPE_LIGHT)
             return vec3(0.0);
         SurfaceHit hit = describeHit(ray, id);
         Material m = materials[hit.material];
         if (m.type != MATERIAL_DIELECTRIC)
             return vec3(0.0);
-        bool exiting = dot(dir, hit.normal) > 0.0;
-        vec3 n = exiting ? -hit.normal : hit.normal; // faces the arriving ray
+        transmittance *= beerLambert(mediumAbsorption(media), hit.t);
         // A shadow ray is a straight line, so its angle with the surface is
-        // the one light has on the outside of this interface (for a slab, the
-        // refracted ray inside meets the far side at the matching angle).
-        // Fresnel reflectance is the same from either side at that pair of
-        // angles, so evaluate it as entering from outside: (1 - F(theta))^2
+        // the one light has on the less dense side of this interface (for a
+        // slab, the refracted ray inside meets the far side at the matching
+        // angle). Fresnel reflectance is the same from either side at that
+        // pair of angles, so evaluate it from the less dense side: (1 - F)^2
         // through a slab, and no spurious total internal reflection.
-        transmittance *= 1.0 - dielectricReflectance(m.fresnel, -dot(dir, n), 1.0 / m.ior, m.ior);
-        if (exiting)
-            transmittance *= beerLambert(m.absorption, hit.t);
-        origin = offsetRayOrigin(hit.position, -n);
+        float eta = interfaceEta(media, hit.material, hit.front);
+        transmittance *= 1.0 - dielectricReflectance(m.fresnel, abs(dot(dir, hit.normal)), min(eta, 1.0 / eta));
+        media = crossInterface(media, hit.material, hit.front);
+        vec3 towardsRay = hit.front ? hit.normal : -hit.normal;
+        origin = offsetRayOrigin(hit.position, hit.error, -towardsRay);
         tMax = dot(target - origin, dir);
         if (tMax <= 0.0)
             return transmittance;
@@ -47,12 +50,25 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax)
 #endif
 }
 
+// Transmittance from a spawned shadow-ray origin to a point. A point that
+// lies within the surface's error bound (at or behind the offset origin) has
+// nothing between it and the surface: fully visible, and no NaN direction.
+vec3 transmittanceTo(vec3 point, vec3 origin, vec3 n, MediumStack media)
+{
+    vec3 shadowDir = point - origin;
+    if (dot(shadowDir, n) <= 0.0)
+        return vec3(1.0);
+    float shadowDist = length(shadowDir);
+    return shadowTransmittance(origin, shadowDir / shadowDist, shadowDist, media);
+}
+
 // Point lights: f * I * cos / d^2 * transmittance.
-vec3 directFromPointLights(Material m, vec3 position, vec3 n, vec3 wo)
+vec3 directFromPointLights(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_POINT_LIGHTS
-    vec3 origin = offsetRayOrigin(position, n);
+    vec3 position = hit.position;
+    vec3 origin = offsetRayOrigin(position, hit.error, n);
     for (uint i = 0u; i < u.pointLightCount; ++i) {
         ++g_loopIterations;
         PointLight light = pointLights[i];
@@ -65,9 +81,7 @@ vec3 directFromPointLights(Material m, vec3 position, vec3 n, vec3 wo)
         if (cosTheta <= 0.0)
             continue;
         vec3 f = evalBsdf(m, n, wo, wi);
-        vec3 shadowDir = light.position - origin;
-        float shadowDist = length(shadowDir);
-        radiance += f * light.intensity * (cosTheta / distSq) * shadowTransmittance(origin, shadowDir / shadowDist, shadowDist);
+        radiance += f * light.intensity * (cosTheta / distSq) * transmittanceTo(light.position, origin, n, media);
     }
 #endif
     return radiance;
@@ -97,11 +111,12 @@ float triangleLightPdf(float area, float distSq, float cosLight) { return distSq
 // Triangle lights: one uniformly sampled point per light (pdf = 1 / area):
 // f * Le * cos_surface * cos_light / d^2 * area * transmittance; the path
 // integrator also weighs it against BSDF sampling (MIS).
-vec3 directFromTriangleLights(Material m, vec3 position, vec3 n, vec3 wo, inout Sampler rng)
+vec3 directFromTriangleLights(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
-    vec3 origin = offsetRayOrigin(position, n);
+    vec3 position = hit.position;
+    vec3 origin = offsetRayOrigin(position, hit.error, n);
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
         TriangleLight light = triangleLights[i];
@@ -115,15 +130,13 @@ vec3 directFromTriangleLights(Material m, vec3 position, vec3 n, vec3 wo, inout 
         if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0))
             continue;
         vec3 f = evalBsdf(m, n, wo, wi);
-        // Stop just short of the light so it does not shadow itself.
-        vec3 shadowDir = point - origin;
-        float shadowDist = length(shadowDir);
-        float tMax = shadowDist * (1.0 - 1.0 / 65536.0);
         vec3 contribution = f * le * (cosSurface * cosLight * light.area / distSq);
 #ifdef VKRT_INTEGRATOR_PATH
         contribution *= powerHeuristic(triangleLightPdf(light.area, distSq, cosLight), pdfBsdf(m, n, wo, wi));
 #endif
-        radiance += contribution * shadowTransmittance(origin, shadowDir / shadowDist, tMax);
+        // Aim just short of the light so it does not shadow itself.
+        vec3 target = mix(origin, point, 1.0 - 1.0 / 65536.0);
+        radiance += contribution * transmittanceTo(target, origin, n, media);
     }
 #endif
     return radiance;

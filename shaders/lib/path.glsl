@@ -13,7 +13,7 @@
 struct PathVertexState {
     vec3 radiance;
     vec3 throughput;
-    vec3 mediumAbsorption; // kappa of the dielectric the ray travels in (0 outside)
+    MediumStack media;     // the dielectrics the ray travels in
     bool specular;         // the last scattering was a delta event (or the camera)
     float bsdfPdf;         // solid-angle pdf of the last BSDF sample
 };
@@ -37,7 +37,7 @@ vec3 emissionOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
 
 // Next-event estimation of the cubemap environment, MIS-weighted against
 // BSDF sampling (which finds the same light when a ray escapes).
-vec3 directFromEnvironment(Material m, vec3 position, vec3 n, vec3 wo, inout Sampler rng)
+vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
 {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     float pdf;
@@ -49,7 +49,7 @@ vec3 directFromEnvironment(Material m, vec3 position, vec3 n, vec3 wo, inout Sam
     if (f == vec3(0.0))
         return vec3(0.0);
     float weight = powerHeuristic(pdf, pdfBsdf(m, n, wo, wi));
-    vec3 visible = shadowTransmittance(offsetRayOrigin(position, n), wi, FLT_MAX);
+    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
     return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
 #else
     return vec3(0.0);
@@ -83,12 +83,12 @@ bool survivesRoulette(inout PathVertexState path, uint depth, float u)
 
 vec3 tracePath(Ray ray, inout Sampler rng)
 {
-    PathVertexState path = PathVertexState(vec3(0.0), vec3(1.0), vec3(0.0), true, 0.0);
+    PathVertexState path = PathVertexState(vec3(0.0), vec3(1.0), cameraMedia(), true, 0.0);
     for (uint depth = 1u; depth <= u.maxDepth + 1u; ++depth) {
         ++g_loopIterations;
         SurfaceHit hit;
         bool missed = !traceClosest(ray, FLT_MAX, hit);
-        path.throughput *= beerLambert(path.mediumAbsorption, missed ? FLT_MAX : hit.t);
+        path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
         if (missed) {
             path.radiance += path.throughput * environmentOnEscape(path, ray.dir);
             break;
@@ -101,26 +101,26 @@ vec3 tracePath(Ray ray, inout Sampler rng)
             break; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
-        bool frontFace = dot(hit.normal, ray.dir) < 0.0;
-        vec3 n = frontFace ? hit.normal : -hit.normal;
+        vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
-            path.radiance += path.throughput * (directFromPointLights(m, hit.position, n, wo) +
-                                                directFromTriangleLights(m, hit.position, n, wo, rng) +
-                                                directFromEnvironment(m, hit.position, n, wo, rng));
+            path.radiance += path.throughput * (directFromPointLights(m, hit, n, wo, path.media) +
+                                                directFromTriangleLights(m, hit, n, wo, path.media, rng) +
+                                                directFromEnvironment(m, hit, n, wo, path.media, rng));
         }
         vec4 u4 = sampleNext4D(rng);
-        BsdfSample s = sampleBsdf(m, n, wo, frontFace, u4.xyz);
+        float eta = interfaceEta(path.media, hit.material, hit.front);
+        BsdfSample s = sampleBsdf(m, n, wo, eta, u4.xyz);
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;
         path.specular = s.specular;
         path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, n, wo, s.dir);
         if (s.transmitted)
-            path.mediumAbsorption = frontFace ? m.absorption : vec3(0.0);
+            path.media = crossInterface(path.media, hit.material, hit.front);
         if (!survivesRoulette(path, depth, u4.w))
             break;
-        ray = Ray(offsetRayOrigin(hit.position, s.transmitted ? -n : n), s.dir);
+        ray = Ray(offsetRayOrigin(hit.position, hit.error, s.transmitted ? -n : n), s.dir);
 #endif
     }
     return path.radiance;

@@ -15,23 +15,44 @@ struct Ray {
     vec3 dir; // unit length
 };
 
-// Moves a ray origin off the surface it was spawned on, along the geometric
-// normal n (pointing to the side the new ray travels into), by a few ulps of
-// the position's own magnitude: Wächter & Binder, "A Fast and Robust Method for
-// Avoiding Self-Intersection", Ray Tracing Gems ch. 6. A fixed epsilon would be
-// too small far from the origin and too large in tiny scenes.
-vec3 offsetRayOrigin(vec3 p, vec3 n)
+// gamma(n) = n u / (1 - n u), u = 2^-24: the bound on the relative error of n
+// chained float operations (Higham; pbrt-v4 section 6.8).
+float gammaBound(int n)
 {
-    const float originThreshold = 1.0 / 32.0;
-    const float floatScale = 1.0 / 65536.0;
-    const float intScale = 256.0;
-    ivec3 ofi = ivec3(intScale * n);
-    vec3 pi = vec3(intBitsToFloat(floatBitsToInt(p.x) + ((p.x < 0.0) ? -ofi.x : ofi.x)),
-                   intBitsToFloat(floatBitsToInt(p.y) + ((p.y < 0.0) ? -ofi.y : ofi.y)),
-                   intBitsToFloat(floatBitsToInt(p.z) + ((p.z < 0.0) ? -ofi.z : ofi.z)));
-    return vec3(abs(p.x) < originThreshold ? p.x + floatScale * n.x : pi.x,
-                abs(p.y) < originThreshold ? p.y + floatScale * n.y : pi.y,
-                abs(p.z) < originThreshold ? p.z + floatScale * n.z : pi.z);
+    const float unitRoundoff = 5.96046448e-8;
+    return float(n) * unitRoundoff / (1.0 - float(n) * unitRoundoff);
+}
+
+// The next float above x (below when `up` is false). Zero steps to the
+// smallest normal float, since lavapipe may flush denormals.
+float nextFloat(float x, bool up)
+{
+    if (x == 0.0)
+        return up ? 1.17549435e-38 : -1.17549435e-38;
+    int bits = floatBitsToInt(x);
+    bool awayFromZero = (x > 0.0) == up;
+    return intBitsToFloat(bits + (awayFromZero ? 1 : -1));
+}
+
+// One float step in the direction of the normal's component (none if it is 0).
+float stepAlongNormal(float x, float nComponent)
+{
+    return nComponent == 0.0 ? x : nextFloat(x, nComponent > 0.0);
+}
+
+// Moves a point spawned on a surface off it, to the side of the unit normal
+// n that the new ray travels into: by the point's error bound pError (per
+// coordinate, from the intersection routine) projected on n, then one more
+// float step per coordinate so rounding of the sum cannot pull it back
+// (Pharr, Jakob & Humphreys, pbrt-v4 section 6.8.6). The offset scales with
+// the scene by construction: no fixed epsilon, no scene-size constant.
+vec3 offsetRayOrigin(vec3 p, vec3 pError, vec3 n)
+{
+    float d = dot(abs(n), pError);
+    vec3 po = p + d * n;
+    // Written out per coordinate: a loop would count against lavapipe's
+    // per-invocation loop budget if the compiler kept it.
+    return vec3(stepAlongNormal(po.x, n.x), stepAlongNormal(po.y, n.y), stepAlongNormal(po.z, n.z));
 }
 
 #endif

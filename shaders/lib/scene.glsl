@@ -16,18 +16,24 @@ const int SHAPE_LIGHT = 4; // a triangle light: black, emitting, and opaque
 struct SurfaceHit {
     float t;
     vec3 position;
+    vec3 error;  // bound on |position - exact point| per coordinate (offsetRayOrigin)
     vec3 normal; // unit geometric normal; outward for spheres and boxes
+    bool front;  // the ray arrived on the side `normal` points to
     uint material;
     int shape;
     uint index;
 };
 
-// The closest primitive along the ray: its shape kind, index and distance.
+// The closest primitive along the ray: its shape kind, index and distance,
+// and what the test learnt on the way: a sphere's hit point relative to its
+// centre, a box's face normal, a triangle's barycentrics (`detail`), and for
+// spheres and boxes whether the ray started outside (`front`).
 struct HitId {
     int shape;
     uint index;
     float t;
-    vec3 boxNormal; // boxes report their face normal during the test
+    vec3 detail;
+    bool front;
 };
 
 void closestSpheres(Ray r, inout HitId best)
@@ -36,8 +42,10 @@ void closestSpheres(Ray r, inout HitId best)
     for (uint i = 0u; i < u.sphereCount; ++i) {
         ++g_loopIterations;
         float t;
-        if (intersectSphere(spheres[i], r, best.t, t))
-            best = HitId(SHAPE_SPHERE, i, t, vec3(0.0));
+        vec3 local;
+        bool front;
+        if (intersectSphere(spheres[i], r, best.t, t, local, front))
+            best = HitId(SHAPE_SPHERE, i, t, local, front);
     }
 #endif
 }
@@ -49,8 +57,9 @@ void closestBoxes(Ray r, inout HitId best)
         ++g_loopIterations;
         float t;
         vec3 n;
-        if (intersectBox(boxes[i], r, best.t, t, n))
-            best = HitId(SHAPE_BOX, i, t, n);
+        bool front;
+        if (intersectBox(boxes[i], r, best.t, t, n, front))
+            best = HitId(SHAPE_BOX, i, t, n, front);
     }
 #endif
 }
@@ -62,9 +71,10 @@ void closestTriangles(Ray r, inout HitId best)
     for (uint i = 0u; i < u.triangleCount; ++i) {
         ++g_loopIterations;
         float t;
+        vec3 bary;
         Triangle tri = triangles[i];
-        if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, best.t, t))
-            best = HitId(SHAPE_TRIANGLE, i, t, vec3(0.0));
+        if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, best.t, t, bary))
+            best = HitId(SHAPE_TRIANGLE, i, t, bary, true);
     }
 #endif
 }
@@ -76,7 +86,7 @@ void closestPlanes(Ray r, inout HitId best)
         ++g_loopIterations;
         float t;
         if (intersectPlane(planes[i], r, best.t, t))
-            best = HitId(SHAPE_PLANE, i, t, vec3(0.0));
+            best = HitId(SHAPE_PLANE, i, t, vec3(0.0), true);
     }
 #endif
 }
@@ -88,16 +98,17 @@ void closestLights(Ray r, inout HitId best)
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
         float t;
+        vec3 bary;
         TriangleLight light = triangleLights[i];
-        if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, best.t, t))
-            best = HitId(SHAPE_LIGHT, i, t, vec3(0.0));
+        if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, best.t, t, bary))
+            best = HitId(SHAPE_LIGHT, i, t, bary, true);
     }
 #endif
 }
 
 HitId findClosest(Ray r, float tMax)
 {
-    HitId best = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0));
+    HitId best = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true);
     closestSpheres(r, best);
     closestBoxes(r, best);
     closestTriangles(r, best);
@@ -111,48 +122,76 @@ HitId findClosest(Ray r, float tMax)
 vec3 triangleLightNormal(TriangleLight light) { return normalize(cross(light.v1 - light.v0, light.v2 - light.v0)); }
 #endif
 
-// Position, normal and material of the hit. Spheres and planes re-project the
-// point onto the surface, which removes the error of origin + t * dir.
+// Position (with its error bound), normal, side and material of the hit.
+// Each shape recomputes the point from what its test learnt, far more
+// accurately than origin + t * dir, whose error grows with |origin| and t.
 SurfaceHit describeHit(Ray r, HitId id)
 {
     SurfaceHit hit;
     hit.t = id.t;
     hit.position = r.origin + id.t * r.dir;
+    hit.error = gammaBound(3) * (abs(r.origin) + abs(id.t * r.dir));
+    hit.normal = -r.dir;
+    hit.front = id.front;
     hit.shape = id.shape;
     hit.index = id.index;
     hit.material = 0u;
 #ifdef VKRT_HAS_SPHERES
     if (id.shape == SHAPE_SPHERE) {
+        // Re-projected onto the sphere (pbrt-v4 section 6.8.5). A sphere far
+        // below its centre's float spacing can give local = 0: any normal
+        // facing the ray is then as good as another.
         Sphere s = spheres[id.index];
-        hit.normal = normalize(hit.position - s.center);
-        hit.position = s.center + s.radius * hit.normal;
+        float len = length(id.detail);
+        if (len > 0.0 && !isinf(len))
+            hit.normal = id.detail / len;
+        else
+            hit.normal = id.front ? -r.dir : r.dir;
+        vec3 local = s.radius * hit.normal;
+        hit.position = s.center + local;
+        hit.error = gammaBound(6) * (abs(s.center) + abs(local));
         hit.material = s.material;
     }
 #endif
 #ifdef VKRT_HAS_BOXES
     if (id.shape == SHAPE_BOX) {
-        hit.normal = id.boxNormal;
-        hit.material = boxes[id.index].material;
+        // The coordinate across the face is the face's own, exactly.
+        Box b = boxes[id.index];
+        hit.normal = id.detail;
+        int axis = id.detail.x != 0.0 ? 0 : (id.detail.y != 0.0 ? 1 : 2);
+        hit.position[axis] = id.detail[axis] > 0.0 ? b.upper[axis] : b.lower[axis];
+        hit.error[axis] = 0.0;
+        hit.material = b.material;
     }
 #endif
 #ifdef VKRT_HAS_TRIANGLES
     if (id.shape == SHAPE_TRIANGLE) {
+        // Barycentric interpolation: error gamma(7) sum |b_i v_i| (pbrt-v4 6.8.5).
         Triangle tri = triangles[id.index];
         hit.normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+        vec3 b0 = id.detail.x * tri.v0, b1 = id.detail.y * tri.v1, b2 = id.detail.z * tri.v2;
+        hit.position = b0 + b1 + b2;
+        hit.error = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2));
+        hit.front = dot(hit.normal, r.dir) < 0.0;
         hit.material = tri.material;
     }
 #endif
 #ifdef VKRT_HAS_PLANES
     if (id.shape == SHAPE_PLANE) {
+        // Projected onto the plane; what remains is the rounding of that step.
         Plane p = planes[id.index];
         hit.normal = p.normal;
         hit.position -= dot(hit.position - p.point, p.normal) * p.normal;
+        hit.error = gammaBound(6) * (abs(hit.position) + abs(p.point));
+        hit.front = dot(hit.normal, r.dir) < 0.0;
         hit.material = p.material;
     }
 #endif
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
-    if (id.shape == SHAPE_LIGHT)
+    if (id.shape == SHAPE_LIGHT) {
         hit.normal = triangleLightNormal(triangleLights[id.index]);
+        hit.front = dot(hit.normal, r.dir) < 0.0;
+    }
 #endif
     return hit;
 }

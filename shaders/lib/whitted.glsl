@@ -13,7 +13,7 @@
 struct PathState {
     vec3 radiance;
     vec3 throughput;
-    vec3 mediumAbsorption; // kappa of the dielectric the ray travels in (0 outside)
+    MediumStack media; // the dielectrics the ray travels in
     bool countEmission;
 };
 
@@ -32,36 +32,36 @@ void addEscapedRadiance(inout PathState path, Ray ray, SurfaceHit hit, bool miss
 
 vec3 traceWhitted(Ray ray, inout Sampler rng)
 {
-    PathState path = PathState(vec3(0.0), vec3(1.0), vec3(0.0), true);
+    PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true);
     for (uint depth = 1u; depth <= u.maxDepth; ++depth) {
         ++g_loopIterations;
         SurfaceHit hit;
         bool missed = !traceClosest(ray, FLT_MAX, hit);
         // Beer-Lambert over the segment just travelled inside a dielectric.
-        path.throughput *= beerLambert(path.mediumAbsorption, missed ? FLT_MAX : hit.t);
+        path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
         if (missed || hit.shape == SHAPE_LIGHT) {
             addEscapedRadiance(path, ray, hit, missed);
             break;
         }
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
-        bool frontFace = dot(hit.normal, ray.dir) < 0.0;
-        vec3 n = frontFace ? hit.normal : -hit.normal;
+        vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
-            path.radiance += path.throughput * (directFromPointLights(m, hit.position, n, wo) +
-                                                directFromTriangleLights(m, hit.position, n, wo, rng));
+            path.radiance += path.throughput * (directFromPointLights(m, hit, n, wo, path.media) +
+                                                directFromTriangleLights(m, hit, n, wo, path.media, rng));
         }
         if (depth == u.maxDepth)
             break;
-        BsdfSample s = sampleBsdf(m, n, wo, frontFace, sampleNext4D(rng).xyz);
+        float eta = interfaceEta(path.media, hit.material, hit.front);
+        BsdfSample s = sampleBsdf(m, n, wo, eta, sampleNext4D(rng).xyz);
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;
         path.countEmission = path.countEmission && s.specular;
         if (s.transmitted)
-            path.mediumAbsorption = frontFace ? m.absorption : vec3(0.0);
-        ray = Ray(offsetRayOrigin(hit.position, s.transmitted ? -n : n), s.dir);
+            path.media = crossInterface(path.media, hit.material, hit.front);
+        ray = Ray(offsetRayOrigin(hit.position, hit.error, s.transmitted ? -n : n), s.dir);
 #endif
     }
     return path.radiance;

@@ -36,6 +36,10 @@ VKRT_CONSTANT(uint, LOOP_BUDGET, 65535)
 // that would cross more is treated as blocked (documented in docs/whitted.md).
 VKRT_CONSTANT(uint, MAX_SHADOW_CROSSINGS, 16)
 
+// Dielectrics a ray can be inside at once (nested or overlapping glass); a
+// deeper nest is treated as this many levels (docs/robustness.md).
+VKRT_CONSTANT(uint, MEDIUM_STACK_DEPTH, 4)
+
 VKRT_END_NAMESPACE
 
 #endif

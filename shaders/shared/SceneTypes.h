@@ -94,6 +94,8 @@ struct SceneUniforms {
     uint tileCount;     // workgroup tiles in the image
     uint tileStride;    // coprime to tileCount: scatters tiles over the image
     uint environmentSize; // cubemap face width N (0 without a cubemap)
+    uint cameraMediumCount; // dielectrics containing the eye (lib/media.glsl)
+    uvec4 cameraMedia;      // their materials, innermost last
 };
 
 /// Per-dispatch values (push constants). Used only as hash inputs, never in

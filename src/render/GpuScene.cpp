@@ -2,7 +2,9 @@
 
 #include "shared/Bindings.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace vkrt {
@@ -88,6 +90,30 @@ uint32_t tileStrideFor(uint32_t tileCount)
     return 1;
 }
 
+/// The dielectric objects the eye is inside (spheres, boxes, the back side of
+/// planes), outermost first (by size: an enclosing object is larger), at most MEDIUM_STACK_DEPTH of the innermost.
+/// Decided in double on the world coordinates.
+std::vector<uint32_t> mediaAroundCamera(const Scene& scene)
+{
+    std::vector<std::pair<double, uint32_t>> around; // (size, material)
+    auto dielectric = [&](uint32_t m) { return scene.materials[m].type == MaterialType::Dielectric; };
+    const glm::dvec3 eye = scene.camera.eye;
+    for (const auto& s : scene.spheres)
+        if (dielectric(s.material) && glm::length(eye - s.center) < s.radius) around.push_back({s.radius, s.material});
+    for (const auto& b : scene.boxes)
+        if (dielectric(b.material) && glm::all(glm::greaterThan(eye, b.min)) && glm::all(glm::lessThan(eye, b.max)))
+            around.push_back({glm::length(b.max - b.min), b.material});
+    // A dielectric plane bounds a half-space of glass behind its normal.
+    for (const auto& p : scene.planes)
+        if (dielectric(p.material) && glm::dot(eye - p.point, p.normal) < 0.0)
+            around.push_back({std::numeric_limits<double>::infinity(), p.material});
+    std::stable_sort(around.begin(), around.end(), [](auto& a, auto& b) { return a.first > b.first; });
+    if (around.size() > gpu::MEDIUM_STACK_DEPTH) around.erase(around.begin(), around.end() - gpu::MEDIUM_STACK_DEPTH);
+    std::vector<uint32_t> materials;
+    for (const auto& entry : around) materials.push_back(entry.second);
+    return materials;
+}
+
 GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
 {
     GpuSceneData data;
@@ -118,6 +144,9 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
     u.triangleLightCount = uint32_t(data.triangleLights.size());
     u.tileCount = tileCountFor(u.width, u.height);
     u.tileStride = tileStrideFor(u.tileCount);
+    std::vector<uint32_t> media = mediaAroundCamera(scene);
+    u.cameraMediumCount = uint32_t(media.size());
+    for (size_t i = 0; i < media.size(); ++i) u.cameraMedia[int(i)] = media[i];
     return data;
 }
 

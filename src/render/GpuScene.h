@@ -26,6 +26,10 @@ struct FrameSettings {
 
 GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings);
 
+/// Materials of the dielectric spheres and boxes that contain the camera's
+/// eye, outermost first (the medium stack a camera ray starts with).
+std::vector<uint32_t> mediaAroundCamera(const Scene& scene);
+
 /// Triangle lights that can emit: zero-area (degenerate) ones are dropped.
 std::vector<TriangleLight> emittingTriangleLights(const Scene& scene);
 

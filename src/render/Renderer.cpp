@@ -208,8 +208,11 @@ Image Renderer::varianceOfMean() const
     for (size_t i = 0; i < image.pixelCount(); ++i) {
         double n = pixels[i].count;
         for (int c = 0; c < 3; ++c) {
-            double m2 = std::max(0.0, double(moments[i].m2[c]) - double(moments[i].m2Compensation[c]));
-            image.rgb[i * 3 + c] = n >= 2 ? float(m2 / (n - 1) / n) : std::numeric_limits<float>::infinity();
+            // An overflowed sum of squares (a radiance near float's limit) is an
+            // unknown, huge variance: report +inf, never a reassuring 0.
+            double m2 = double(moments[i].m2[c]) - double(moments[i].m2Compensation[c]);
+            bool known = n >= 2 && std::isfinite(m2);
+            image.rgb[i * 3 + c] = known ? float(std::max(0.0, m2) / (n - 1) / n) : std::numeric_limits<float>::infinity();
         }
     }
     return image;

@@ -59,7 +59,8 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, triangleCount), BLOCK_MEMBER(u, SceneUniforms, planeCount),
         BLOCK_MEMBER(u, SceneUniforms, pointLightCount), BLOCK_MEMBER(u, SceneUniforms, triangleLightCount),
         BLOCK_MEMBER(u, SceneUniforms, tileCount), BLOCK_MEMBER(u, SceneUniforms, tileStride),
-        BLOCK_MEMBER(u, SceneUniforms, environmentSize),
+        BLOCK_MEMBER(u, SceneUniforms, environmentSize), BLOCK_MEMBER(u, SceneUniforms, cameraMediumCount),
+        BLOCK_MEMBER(u, SceneUniforms, cameraMedia),
         BLOCK_MEMBER(frame, FrameConstants, frameIndex), BLOCK_MEMBER(frame, FrameConstants, seed),
     };
 }
@@ -86,7 +87,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
     EXPECT_EQ(offsets.at("materials[0].fresnel") + 4, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].radiance") + 12, int(sizeof(gpu::TriangleLight)));
-    EXPECT_EQ(offsets.at("u.environmentSize") + 4, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("u.cameraMedia") + 16, int(sizeof(gpu::SceneUniforms)));
 }
 
 } // namespace

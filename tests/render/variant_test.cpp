@@ -10,10 +10,10 @@ namespace fs = std::filesystem;
 namespace vkrt::test {
 namespace {
 
-constexpr uint32_t kOpExtInst = 12, kOpDecorate = 71, kDecorationBinding = 33, kGlslRefract = 72;
+constexpr uint32_t kOpName = 5, kOpDecorate = 71, kDecorationBinding = 33;
 
 struct SpirvSummary {
-    bool refract = false;
+    bool refract = false; ///< the kernel defines lib/fresnel.glsl's refractDirection
     std::set<uint32_t> bindings;
 };
 
@@ -24,7 +24,10 @@ SpirvSummary summarize(const std::vector<uint32_t>& spirv)
     for (size_t i = 5; i < spirv.size();) {
         uint32_t words = spirv[i] >> 16, opcode = spirv[i] & 0xffff;
         if (words == 0) break;
-        if (opcode == kOpExtInst && words >= 5 && spirv[i + 4] == kGlslRefract) summary.refract = true;
+        if (opcode == kOpName && words >= 3) {
+            std::string name(reinterpret_cast<const char*>(&spirv[i + 2]), (words - 2) * 4);
+            if (name.rfind("refractDirection(", 0) == 0) summary.refract = true;
+        }
         if (opcode == kOpDecorate && words >= 4 && spirv[i + 2] == kDecorationBinding) summary.bindings.insert(spirv[i + 3]);
         i += words;
     }

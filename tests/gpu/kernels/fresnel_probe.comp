@@ -15,8 +15,8 @@ void main()
     float cosI = inputs[3 * i], eta = inputs[3 * i + 1], ior = inputs[3 * i + 2];
     outputs[6 * i + 0] = fresnelSchlick(cosI, schlickR0(ior));
     outputs[6 * i + 1] = fresnelExact(cosI, eta);
-    outputs[6 * i + 2] = fresnelSchlickDielectric(cosI, eta, ior);
-    outputs[6 * i + 3] = dielectricReflectance(FRESNEL_EXACT, cosI, eta, ior);
-    outputs[6 * i + 4] = dielectricReflectance(FRESNEL_SCHLICK, cosI, eta, ior);
+    outputs[6 * i + 2] = fresnelSchlickDielectric(cosI, eta);
+    outputs[6 * i + 3] = dielectricReflectance(FRESNEL_EXACT, cosI, eta);
+    outputs[6 * i + 4] = dielectricReflectance(FRESNEL_SCHLICK, cosI, eta);
     outputs[6 * i + 5] = schlickR0(ior);
 }

@@ -25,12 +25,14 @@ void main()
     bool hit = false;
     float t = 0.0;
     vec3 normal = vec3(0.0);
+    vec3 detail;
+    bool front;
     if (kind == 0) {
-        hit = intersectSphere(Sphere(p0, p1.x, 0u), r, tMax, t);
+        hit = intersectSphere(Sphere(p0, p1.x, 0u), r, tMax, t, detail, front);
     } else if (kind == 1) {
-        hit = intersectBox(Box(p0, 0u, p1), r, tMax, t, normal);
+        hit = intersectBox(Box(p0, 0u, p1), r, tMax, t, normal, front);
     } else if (kind == 2) {
-        hit = intersectTriangle(p0, p1, p2, r, triangleRaySetup(r), tMax, t);
+        hit = intersectTriangle(p0, p1, p2, r, triangleRaySetup(r), tMax, t, detail);
     } else {
         hit = intersectPlane(Plane(p0, 0u, p1), r, tMax, t);
     }

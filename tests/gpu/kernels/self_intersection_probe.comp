@@ -61,19 +61,27 @@ void main()
     if (!traceClosest(primary, FLT_MAX, hit))
         return;
     // As the integrators do: n faces the side the primary ray came from.
-    bool frontFace = dot(hit.normal, primary.dir) < 0.0;
+    bool frontFace = hit.front;
     vec3 n = frontFace ? hit.normal : -hit.normal;
     vec3 side = mode == 1 ? -n : n;
     vec3 dir = normalize(fromLocal(local, side));
-    vec3 origin = offsetRayOrigin(hit.position, side);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, side);
     float tMax = FLT_MAX;
+    bool traced = true;
     if (mode == 2) {
+        // As lights.glsl's transmittanceTo: a light at or behind the offset
+        // origin lies within the surface's error bound and needs no shadow ray.
         vec3 light = hit.position + lightDistance * dir;
         vec3 shadowDir = light - origin;
-        tMax = length(shadowDir);
-        dir = shadowDir / tMax;
+        traced = dot(shadowDir, side) > 0.0;
+        if (traced) {
+            tMax = length(shadowDir);
+            dir = shadowDir / tMax;
+        }
     }
-    HitId second = findClosest(Ray(origin, dir), tMax);
+    HitId second = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true);
+    if (traced)
+        second = findClosest(Ray(origin, dir), tMax);
     outputs[o] = 1.0;
     outputs[o + 1u] = second.shape == SHAPE_NONE ? 0.0 : 1.0;
     outputs[o + 2u] = second.shape == SHAPE_NONE ? 0.0 : second.t;
