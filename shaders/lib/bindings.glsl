@@ -15,23 +15,33 @@ layout(push_constant, scalar) uniform PushBlock { FrameConstants frame; };
 layout(scalar, binding = BINDING_MOMENTS) buffer MomentBlock { MomentPixel moments[]; };
 #endif
 
+// Scene arrays: fixed-size uniform blocks in the uniform-scene variant,
+// runtime-sized storage buffers otherwise (shared/SceneTypes.h).
+#ifdef VKRT_UNIFORM_SCENE
+#define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity) \
+    layout(scalar, binding = binding_) uniform Block { Type name[capacity]; };
+#else
+#define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity) \
+    layout(scalar, binding = binding_) readonly buffer Block { Type name[]; };
+#endif
+
 #ifdef VKRT_HAS_MATERIALS
-layout(scalar, binding = BINDING_MATERIALS) readonly buffer MaterialBlock { Material materials[]; };
+VKRT_SCENE_ARRAY(BINDING_MATERIALS, MaterialBlock, Material, materials, UNIFORM_MATERIALS)
 #endif
 #ifdef VKRT_HAS_SPHERES
-layout(scalar, binding = BINDING_SPHERES) readonly buffer SphereBlock { Sphere spheres[]; };
+VKRT_SCENE_ARRAY(BINDING_SPHERES, SphereBlock, Sphere, spheres, UNIFORM_SPHERES)
 #endif
 #ifdef VKRT_HAS_BOXES
-layout(scalar, binding = BINDING_BOXES) readonly buffer BoxBlock { Box boxes[]; };
+VKRT_SCENE_ARRAY(BINDING_BOXES, BoxBlock, Box, boxes, UNIFORM_BOXES)
 #endif
 #ifdef VKRT_HAS_TRIANGLES
-layout(scalar, binding = BINDING_TRIANGLES) readonly buffer TriangleBlock { Triangle triangles[]; };
+VKRT_SCENE_ARRAY(BINDING_TRIANGLES, TriangleBlock, Triangle, triangles, UNIFORM_TRIANGLES)
 #endif
 #ifdef VKRT_HAS_PLANES
-layout(scalar, binding = BINDING_PLANES) readonly buffer PlaneBlock { Plane planes[]; };
+VKRT_SCENE_ARRAY(BINDING_PLANES, PlaneBlock, Plane, planes, UNIFORM_PLANES)
 #endif
 #ifdef VKRT_HAS_POINT_LIGHTS
-layout(scalar, binding = BINDING_POINT_LIGHTS) readonly buffer PointLightBlock { PointLight pointLights[]; };
+VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
 #endif
 #ifdef VKRT_HAS_CUBEMAP
 layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
@@ -40,7 +50,7 @@ layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
 layout(scalar, binding = BINDING_ENVIRONMENT_CDF) readonly buffer EnvironmentCdfBlock { float environmentCdf[]; };
 #endif
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
-layout(scalar, binding = BINDING_TRIANGLE_LIGHTS) readonly buffer TriangleLightBlock { TriangleLight triangleLights[]; };
+VKRT_SCENE_ARRAY(BINDING_TRIANGLE_LIGHTS, TriangleLightBlock, TriangleLight, triangleLights, UNIFORM_TRIANGLE_LIGHTS)
 #endif
 
 #endif

@@ -76,6 +76,19 @@ VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
 
 /// Per-render constants. Camera ray for pixel coordinate (x, y) in [0,w]x[0,h]:
 /// normalize(ndc.x * cameraRight + ndc.y * cameraUp + cameraForward).
+// Scene arrays live in uniform buffers when every one fits (lavapipe reads
+// uniform buffers markedly faster than storage buffers; shared/NUMERICS.md).
+// Each array then has this many records, 16 KiB being the smallest
+// maxUniformBufferRange Vulkan allows; src/gpu/SharedTypes.cpp checks the
+// sizes. Bigger scenes use the storage-buffer variant.
+VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 315)       // 16384 / 52
+VKRT_CONSTANT(uint, UNIFORM_SPHERES, 819)         // 16384 / 20
+VKRT_CONSTANT(uint, UNIFORM_BOXES, 585)           // 16384 / 28
+VKRT_CONSTANT(uint, UNIFORM_TRIANGLES, 409)       // 16384 / 40
+VKRT_CONSTANT(uint, UNIFORM_PLANES, 585)          // 16384 / 28
+VKRT_CONSTANT(uint, UNIFORM_POINT_LIGHTS, 682)    // 16384 / 24
+VKRT_CONSTANT(uint, UNIFORM_TRIANGLE_LIGHTS, 292) // 16384 / 56
+
 struct SceneUniforms {
     vec3 cameraRight;   // scaled by tan(fov/2) * aspect
     uint width;

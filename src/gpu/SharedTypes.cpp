@@ -19,6 +19,15 @@ static_assert(sizeof(Plane) == 28);
 static_assert(sizeof(PointLight) == 24);
 static_assert(sizeof(TriangleLight) == 56);
 static_assert(sizeof(SceneUniforms) == 120);
+// Each uniform scene array fills at most the 16 KiB every Vulkan device allows.
+constexpr uint32_t kUniformArrayBytes = 16384;
+static_assert(UNIFORM_MATERIALS * sizeof(Material) <= kUniformArrayBytes && (UNIFORM_MATERIALS + 1) * sizeof(Material) > kUniformArrayBytes);
+static_assert(UNIFORM_SPHERES * sizeof(Sphere) <= kUniformArrayBytes && (UNIFORM_SPHERES + 1) * sizeof(Sphere) > kUniformArrayBytes);
+static_assert(UNIFORM_BOXES * sizeof(Box) <= kUniformArrayBytes && (UNIFORM_BOXES + 1) * sizeof(Box) > kUniformArrayBytes);
+static_assert(UNIFORM_TRIANGLES * sizeof(Triangle) <= kUniformArrayBytes && (UNIFORM_TRIANGLES + 1) * sizeof(Triangle) > kUniformArrayBytes);
+static_assert(UNIFORM_PLANES * sizeof(Plane) <= kUniformArrayBytes && (UNIFORM_PLANES + 1) * sizeof(Plane) > kUniformArrayBytes);
+static_assert(UNIFORM_POINT_LIGHTS * sizeof(PointLight) <= kUniformArrayBytes && (UNIFORM_POINT_LIGHTS + 1) * sizeof(PointLight) > kUniformArrayBytes);
+static_assert(UNIFORM_TRIANGLE_LIGHTS * sizeof(TriangleLight) <= kUniformArrayBytes && (UNIFORM_TRIANGLE_LIGHTS + 1) * sizeof(TriangleLight) > kUniformArrayBytes);
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
 static_assert(sizeof(AccumPixel) == 28);

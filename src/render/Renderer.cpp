@@ -19,7 +19,29 @@ FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
     checkLoopBudget(scene); // before any compilation or allocation
     FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     features.variance = options.variance;
+    features.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
     return features;
+}
+
+/// The variant's bindings with their descriptor types (scene arrays are
+/// uniform buffers in the uniform-scene variant).
+std::vector<KernelBinding> kernelBindingsOf(const FeatureSet& features)
+{
+    std::vector<KernelBinding> bindings = renderKernelBindings(features.bindings());
+    for (KernelBinding& binding : bindings)
+        if (features.isUniformBinding(binding.index)) binding.type = vk::DescriptorType::eUniformBuffer;
+    return bindings;
+}
+
+/// A scene array's GPU buffer: padded to the block's fixed capacity when it
+/// is a uniform buffer, so the bound range covers the whole declared block.
+template <typename T>
+Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records, bool uniform, uint32_t capacity)
+{
+    if (!uniform) return makeBufferFrom(context, records, kStorage);
+    VKRT_CHECK(records.size() <= capacity);
+    records.resize(capacity);
+    return makeBufferFrom(context, records, vk::BufferUsageFlagBits::eUniformBuffer);
 }
 
 CompiledKernel compileVariant(const FeatureSet& features, const RenderOptions& options)
@@ -82,7 +104,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, renderKernelBindings(m_features.bindings()), sizeof(gpu::FrameConstants)),
+      m_kernel(context, m_compiled.spirv, kernelBindingsOf(m_features), sizeof(gpu::FrameConstants)),
       m_cubemap(scene.background.cubemap)
 {
     m_accumulation.clear(context);
@@ -119,22 +141,23 @@ void Renderer::bindEnvironment()
 
 void Renderer::uploadSceneBuffers()
 {
-    auto addBuffer = [&](uint32_t binding, auto&& records, vk::BufferUsageFlags usage) {
+    auto addBuffer = [&](uint32_t binding, auto&& records, uint32_t uniformCapacity) {
         if (!m_kernel.uses(binding)) return;
-        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, usage));
+        bool uniform = m_features.isUniformBinding(binding);
+        m_sceneBuffers.push_back(makeSceneArrayBuffer(m_context, records, uniform, uniformCapacity));
         m_kernel.bind(binding, m_sceneBuffers.back());
     };
     m_sceneBuffers.clear();
     m_sceneBuffers.reserve(gpu::BINDING_COUNT); // bind() keeps references: no reallocation
     m_data.uniforms.environmentSize = m_environmentSize;
-    addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, vk::BufferUsageFlagBits::eUniformBuffer);
-    addBuffer(gpu::BINDING_MATERIALS, m_data.materials, kStorage);
-    addBuffer(gpu::BINDING_SPHERES, m_data.spheres, kStorage);
-    addBuffer(gpu::BINDING_BOXES, m_data.boxes, kStorage);
-    addBuffer(gpu::BINDING_TRIANGLES, m_data.triangles, kStorage);
-    addBuffer(gpu::BINDING_PLANES, m_data.planes, kStorage);
-    addBuffer(gpu::BINDING_POINT_LIGHTS, m_data.pointLights, kStorage);
-    addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, kStorage);
+    addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
+    addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
+    addBuffer(gpu::BINDING_SPHERES, m_data.spheres, gpu::UNIFORM_SPHERES);
+    addBuffer(gpu::BINDING_BOXES, m_data.boxes, gpu::UNIFORM_BOXES);
+    addBuffer(gpu::BINDING_TRIANGLES, m_data.triangles, gpu::UNIFORM_TRIANGLES);
+    addBuffer(gpu::BINDING_PLANES, m_data.planes, gpu::UNIFORM_PLANES);
+    addBuffer(gpu::BINDING_POINT_LIGHTS, m_data.pointLights, gpu::UNIFORM_POINT_LIGHTS);
+    addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, gpu::UNIFORM_TRIANGLE_LIGHTS);
 }
 
 void Renderer::reset()

@@ -1,6 +1,7 @@
 #include "scene/FeatureSet.h"
 
 #include "shared/Bindings.h"
+#include "shared/SceneTypes.h"
 
 namespace vkrt {
 
@@ -75,12 +76,32 @@ FeatureSet featuresOf(const Scene& scene)
     set.cubemap = scene.background.cubemap.has_value();
     set.environmentSampling = set.cubemap && scene.render.integrator == Integrator::Path;
     set.integrator = scene.render.integrator;
+    set.uniformScene = sceneFitsUniformBuffers(scene);
     auto markUsed = [&](uint32_t material) { set.materialTypes[size_t(scene.materials[material].type)] = true; };
     for (const auto& s : scene.spheres) markUsed(s.material);
     for (const auto& b : scene.boxes) markUsed(b.material);
     for (const auto& t : scene.triangles) markUsed(t.material);
     for (const auto& p : scene.planes) markUsed(p.material);
     return set;
+}
+
+bool sceneFitsUniformBuffers(const Scene& scene)
+{
+    // Triangle lights count before zero-area ones are dropped: an upper bound.
+    return scene.materials.size() <= gpu::UNIFORM_MATERIALS && scene.spheres.size() <= gpu::UNIFORM_SPHERES &&
+           scene.boxes.size() <= gpu::UNIFORM_BOXES && scene.triangles.size() <= gpu::UNIFORM_TRIANGLES &&
+           scene.planes.size() <= gpu::UNIFORM_PLANES && scene.pointLights.size() <= gpu::UNIFORM_POINT_LIGHTS &&
+           scene.triangleLights.size() <= gpu::UNIFORM_TRIANGLE_LIGHTS;
+}
+
+bool FeatureSet::isUniformBinding(uint32_t binding) const
+{
+    if (binding == gpu::BINDING_UNIFORMS) return true;
+    bool sceneArray = binding == gpu::BINDING_MATERIALS || binding == gpu::BINDING_SPHERES ||
+                      binding == gpu::BINDING_BOXES || binding == gpu::BINDING_TRIANGLES ||
+                      binding == gpu::BINDING_PLANES || binding == gpu::BINDING_POINT_LIGHTS ||
+                      binding == gpu::BINDING_TRIANGLE_LIGHTS;
+    return uniformScene && sceneArray;
 }
 
 std::vector<std::pair<std::string, std::string>> FeatureSet::defines() const
@@ -92,6 +113,7 @@ std::vector<std::pair<std::string, std::string>> FeatureSet::defines() const
         if (this->*feature.flag) result.emplace_back(feature.define, "1");
     for (MaterialType type : kAllMaterialTypes)
         if (has(type)) result.emplace_back("VKRT_MATERIAL_" + upper(materialTypeName(type)), "1");
+    if (uniformScene) result.emplace_back("VKRT_UNIFORM_SCENE", "1");
     return result;
 }
 
@@ -112,6 +134,7 @@ std::string FeatureSet::describe() const
     text += ";";
     for (MaterialType type : kAllMaterialTypes)
         if (has(type)) text += " " + materialTypeName(type);
+    text += uniformScene ? "; uniform-scene" : "; storage-scene";
     return text;
 }
 

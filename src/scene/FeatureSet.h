@@ -21,6 +21,7 @@ struct FeatureSet {
     bool cubemap = false;
     bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
     bool variance = false; ///< per-pixel variance estimation (not a scene property: a render option)
+    bool uniformScene = false; ///< scene arrays in uniform buffers: every array fits (shared/SceneTypes.h)
     std::array<bool, 5> materialTypes{}; ///< indexed by MaterialType
     Integrator integrator = Integrator::Whitted;
 
@@ -34,6 +35,8 @@ struct FeatureSet {
     std::vector<std::pair<std::string, std::string>> defines() const;
     /// Descriptor binding indices (shaders/shared/Bindings.h) this variant declares.
     std::vector<uint32_t> bindings() const;
+    /// Whether this variant declares `binding` as a uniform buffer.
+    bool isUniformBinding(uint32_t binding) const;
     /// One line for people, e.g. "whitted; spheres planes; lambert; point-lights".
     std::string describe() const;
 
@@ -41,6 +44,9 @@ struct FeatureSet {
 };
 
 FeatureSet featuresOf(const Scene& scene);
+
+/// Whether every scene array of the scene fits the uniform-buffer capacities.
+bool sceneFitsUniformBuffers(const Scene& scene);
 
 std::string integratorName(Integrator integrator);
 std::string materialTypeName(MaterialType type);

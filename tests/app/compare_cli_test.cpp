@@ -116,7 +116,9 @@ TEST_F(StatsCli, TimeBudgetStopsWithinOneFrame)
     double spp = double(std::get<int64_t>(exr.metadata.at("spp")));
     double frame = seconds / spp;
     EXPECT_GE(seconds, 1.0);
-    EXPECT_LE(seconds, 1.0 + 2.0 * frame) << spp << " frames";
+    // One frame past the budget, plus the frame that was running when the
+    // check fired, plus 50 ms for the scheduler of a loaded 2-core machine.
+    EXPECT_LE(seconds, 1.0 + 2.0 * frame + 0.05) << spp << " frames";
 }
 
 TEST_F(StatsCli, ReportHasGeometricRowsAndTheLast)

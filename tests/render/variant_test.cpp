@@ -73,6 +73,49 @@ TEST_F(VariantTest, SpecializedAndUberKernelsGiveIdenticalImages)
     }
 }
 
+// Scene arrays in uniform buffers (the fast path on lavapipe) hold the same
+// records as storage buffers: the images must be bit-identical.
+TEST_F(VariantTest, UniformAndStorageSceneDataGiveIdenticalImages)
+{
+    for (const char* name : {"default.toml", "seed/baseline.toml"}) {
+        Scene scene = shippedScene(name);
+        RenderOptions storage = options(false);
+        storage.storageScene = true;
+        Renderer a(gpu(), scene, options(false)), b(gpu(), scene, storage);
+        EXPECT_TRUE(a.features().uniformScene) << name;
+        EXPECT_FALSE(b.features().uniformScene) << name;
+        a.renderFrames(2);
+        b.renderFrames(2);
+        EXPECT_EQ(a.mean().rgb, b.mean().rgb) << name;
+    }
+}
+
+// More spheres than a 16 KiB uniform block holds: the storage variant is
+// chosen, and the sphere past the uniform capacity is still rendered.
+TEST_F(VariantTest, SceneTooBigForUniformBuffersUsesStorageBuffers)
+{
+    Scene scene = shippedScene("seed/baseline.toml");
+    Sphere last = scene.spheres.front();
+    while (scene.spheres.size() <= gpu::UNIFORM_SPHERES) {
+        Sphere hidden = last;
+        hidden.center = glm::dvec3(0.0, -1e6, 0.0); // far below the floor, out of view
+        hidden.radius = 1.0;
+        scene.spheres.push_back(hidden);
+    }
+    scene.spheres.push_back(last); // the visible sphere again, as the very last record
+    scene.spheres.front().center.y -= 1e6;
+    EXPECT_FALSE(featuresOf(scene).uniformScene);
+    Scene small = shippedScene("seed/baseline.toml");
+    Renderer big(gpu(), scene, options(false)), reference(gpu(), small, options(false));
+    EXPECT_FALSE(big.features().uniformScene);
+    big.renderFrames(1);
+    reference.renderFrames(1);
+    Image a = big.mean(), b = reference.mean();
+    double sumA = 0, sumB = 0;
+    for (size_t i = 0; i < a.rgb.size(); ++i) sumA += a.rgb[i], sumB += b.rgb[i];
+    EXPECT_NEAR(sumA, sumB, 0.02 * sumB) << "the moved sphere must still be drawn from the last record";
+}
+
 TEST_F(VariantTest, SceneWithoutGlassHasNoRefractionCode)
 {
     Scene scene = shippedScene("seed/baseline.toml");
@@ -138,7 +181,10 @@ radiance = 1
     EXPECT_FALSE(f.spheres || f.boxes || f.planes || f.pointLights || f.cubemap);
     EXPECT_TRUE(f.has(MaterialType::Glossy));
     EXPECT_FALSE(f.has(MaterialType::Dielectric)) << "an unused material must not pull in its code";
-    EXPECT_EQ(f.describe(), "whitted; triangles triangle-lights; glossy");
+    EXPECT_EQ(f.describe(), "whitted; triangles triangle-lights; glossy; uniform-scene");
+    EXPECT_TRUE(f.uniformScene) << "a small scene's arrays fit uniform buffers";
+    EXPECT_TRUE(f.isUniformBinding(gpu::BINDING_TRIANGLES));
+    EXPECT_FALSE(f.isUniformBinding(gpu::BINDING_ACCUMULATION));
 }
 
 TEST(InfoCli, PrintsVariantAndCacheState)
