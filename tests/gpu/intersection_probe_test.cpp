@@ -377,21 +377,23 @@ class IntersectionProbeSelfIntersection : public GpuTest {};
 
 // For each shape, object offset (0, 1e3, 1e4 from the camera at the origin, half of
 // them along a coordinate axis) and scale (1e-3 ... 1e3): 1000 primary rays hit the
-// object and the renderer's describeHit gives the surface point (spheres and planes
-// re-projected, boxes and triangles origin + t dir); from there offsetRayOrigin and
+// object and the renderer's describeHit gives the surface point and its error bound
+// (spheres re-projected from the centre-relative root, boxes snapped onto the face,
+// triangles interpolated from barycentrics, planes projected); from there
+// offsetRayOrigin (the error bound projected on the normal, plus one float step) and
 //  - bounce: a random direction into the hemisphere the primary ray came from
 //    (a quarter of them grazing, cos theta from 1e-4 to 0.1),
 //  - transmit: the same into the other hemisphere,
 //  - shadow: towards a point light above, as directFromPointLights does.
 // A convex shape must not be hit again by a bounce or shadow ray; a plane or
 // triangle by none; a ray transmitted into a sphere or box must reach the far side.
-//
-// BUG (reported): this fails today, for three causes isolated in
-// ReproducersOfFoundFailures below: the side of grazing sphere hits is taken from
-// dot(normal, dir) and comes out wrong far from the origin; box and triangle hit
-// points (origin + t dir) carry an error that grows with |origin| and t, which
-// offsetRayOrigin's 256 ulps of the point's own coordinates do not cover; and a
-// sphere far smaller than its position's ulp gets a NaN normal.
+// The side each primary hit reports (front/back) must agree with the exact geometry,
+// and no surface point, origin or direction may be non-finite. Before 3ad6308 this
+// sweep found four causes of failure (ReproducersOfFoundFailures below keeps inputs
+// for each): the side of grazing sphere hits, taken from dot(normal, dir); box and
+// triangle hit points computed as origin + t dir, whose error grows with |origin|
+// and t; an offset of 256 n ulps truncated to nothing for small normal components;
+// and NaN normals of spheres far smaller than their position's ulp.
 TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
 {
     constexpr int kRays = 1000; // per shape, offset, scale and mode: 252,000 rays
@@ -479,8 +481,8 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
             std::cout << "[   STAT   ] failures " << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode] << " offset "
                       << c.offset << " scale " << c.scale << ": " << configFailures[k] << " of " << kRays << std::endl;
         }
-    // BUG (reported): the side of grazing sphere hits far from the origin comes out
-    // wrong (see ReproducersOfFoundFailures); every failure for spheres is one of these.
+    // The side comes from which sphere root was taken (box: entry or exit), not from
+    // the sign of dot(normal, dir), which rounding flips for grazing hits far away.
     for (int kind = 0; kind < 4; ++kind) {
         report(std::string("FlippedSide_") + kKindNames[kind], double(flips[kind]));
         EXPECT_EQ(flips[kind], 0) << "primary hits whose side disagrees with the geometry: " << kKindNames[kind];
@@ -494,8 +496,11 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     EXPECT_EQ(configsTooFewHits, 0);
 }
 
-// The smallest cases the sweep above found, one per cause, kept as fixed inputs
-// (float values printed with 9 significant digits, so they are exact).
+// Regression tests: the smallest cases the sweep above found before the bugs they
+// reproduce were fixed (3ad6308), one per cause, kept as fixed inputs (float values
+// printed with 9 significant digits, so they are exact). Each must report the exact
+// side, finite values, and no second hit of the surface it left (a ray transmitted
+// into a sphere must find the far side).
 TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
 {
     struct Reproducer {
@@ -513,19 +518,20 @@ TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
         return c;
     };
     const std::vector<Reproducer> cases = {
-        // BUG: describeHit/path.glsl take the side from dot(normal, ray.dir), whose sign
-        // is wrong for hits within ~1e-4 of grazing on a sphere 1000 units from the
-        // origin (the hit point's rounding, ~ulp(1000), tilts the normal). The ray is then
-        // spawned inside the sphere and the bounce or shadow ray hits it.
+        // Was: the side taken from dot(normal, ray.dir), whose sign is wrong for hits
+        // within ~1e-4 of grazing on a sphere 1000 units from the origin (the hit
+        // point's rounding, ~ulp(1000), tilts the normal), so the ray was spawned inside
+        // the sphere and hit it. Now: the side is the root taken (intersectSphere).
         {"sphere side flipped at grazing incidence (bounce)",
          make(sphereShape({0.0f, 0.0f, -1000.0f}, 1.0f), {0.0f, 0.0f, 0.0f}, {0.99981302f, 0.0193104576f, -999.998962f},
               {-0.682120204f, -0.731239319f, 0.00106611324f}, kBounce)},
         {"sphere side flipped at grazing incidence (bounce)",
          make(sphereShape({-1000.0f, 0.0f, 0.0f}, 1.0f), {0.0f, 0.0f, 0.0f}, {-999.999207f, 0.781252742f, -0.624214292f},
               {0.610685408f, 0.330188155f, 0.719749331f}, kBounce)},
-        // BUG: box hit points are origin + t * dir, whose error grows with |origin| and t,
-        // while offsetRayOrigin only moves by 256 ulps of the point's own coordinates: a
-        // face near a zero coordinate hit from 2500 units away stays inside the box.
+        // Was: box hit points origin + t * dir, whose error grows with |origin| and t,
+        // while offsetRayOrigin moved by 256 ulps of the point's own coordinates: a face
+        // near a zero coordinate hit from 2500 units away left the origin inside the box.
+        // Now: the coordinate across the face is the face's own, exactly (describeHit).
         {"box hit point error from a distant ray origin (bounce)",
          make(boxShape({-171.171021f, 43.5685921f, -2.6492908f}, {1033.87146f, 1387.94019f, 1101.07117f}),
               {567.65155f, -1833.38562f, -2530.28687f}, {-52.9118118f, 1228.44678f, 846.146606f},
@@ -534,23 +540,27 @@ TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
          make(boxShape({-931.560303f, -1988.18872f, -471.464661f}, {931.560303f, -11.8112402f, 471.464661f}),
               {-320.494263f, 2985.50073f, 114.316727f}, {-407.332581f, -1660.39868f, 319.405304f},
               {0.426078171f, -0.904663861f, 0.00637634844f}, kShadow, 18929.1699f)},
-        // BUG: the same for triangles (origin + t * dir from 40 units away, point near 0).
+        // Was: the same for triangles (origin + t * dir from 40 units away, point near 0).
+        // Now: barycentric interpolation with its error bound gamma(7) sum |b_i v_i|.
         {"triangle hit point error from a distant ray origin (transmit)",
          make(triangleShape({9.75412464f, 0.67492187f, 2.09798217f}, {-9.19676113f, -0.786071777f, 3.84729338f},
                             {-5.53187656f, -0.366248578f, -8.32251167f}),
               {11.7228088f, -38.2417374f, -0.381302506f}, {1.97903275f, 0.081382215f, 2.30971622f},
               {-0.259450257f, -0.570947707f, 0.778912246f}, kTransmit)},
-        // BUG: offsetRayOrigin truncates 256 * n per component, so a component with
-        // |n| < 1/256 gets no offset although its rounding error (ulp(1e4) here) still
+        // Was: offsetRayOrigin truncated 256 * n per component, so a component with
+        // |n| < 1/256 got no offset although its rounding error (ulp(1e4) here) still
         // reaches the normal direction: n = (0.61, -0.0036, -0.79) at y = -1e4 with x, z
-        // ~ 0.05 leaves the new origin 2.2e-7 behind the triangle.
+        // ~ 0.05 left the new origin 2.2e-7 behind the triangle. Now: the offset is the
+        // error bound projected on n, plus one float step per coordinate (pbrt-v4 6.8.6).
         {"offset too small when coordinates differ in magnitude (bounce)",
          make(triangleShape({-0.757167578f, -10000.4346f, -0.487904161f}, {-0.408449709f, -9999.11523f, -0.223367169f},
                             {0.662743568f, -10000.4297f, 0.613372207f}),
               {0.0f, 0.0f, 0.0f}, {-0.0614044517f, -10000.1641f, 0.0505194813f},
               {-0.302943379f, 0.292625517f, 0.906970561f}, kBounce)},
-        // BUG: a sphere of radius 1e-3 at ~1e4: the hit point rounds onto the centre and
-        // describeHit's normalize(position - centre) is NaN.
+        // Was: a sphere of radius 1e-3 at ~1e4: the hit point rounded onto the centre and
+        // describeHit's normalize(position - centre) was NaN. Now: the normal comes from
+        // the centre-relative root l -/+ sqrt(disc) d (a normal facing the ray if even
+        // that is 0).
         {"NaN normal when the hit point rounds onto the sphere's centre",
          make(sphereShape({-8358.68164f, 4315.56885f, -3392.39062f}, 0.001f), {0.0f, 0.0f, 0.0f},
               {-8358.68066f, 4315.56836f, -3392.39038f}, {0.706838071f, 0.686744034f, 0.169595301f}, kTransmit)},
@@ -1059,11 +1069,12 @@ class IntersectionProbeDegenerate : public GpuTest {};
 // anywhere including along the segment's line: intersectTriangle must never report
 // a hit, and findClosest + describeHit must produce no NaN.
 //
-// BUG (reported): repeated vertices are safe (two edge functions cancel exactly, so
-// det == 0), but for collinear vertices the sheared projection rounds the three
-// points off their common line and about 12 % of the rays aimed at the segment hit a
-// triangle of float area ~0; describeHit's normalize(cross(e1, e2)) is then
-// normalize(0) = NaN, and so are the spawned ray's origin and direction.
+// Repeated vertices give det == 0 exactly (two edge functions cancel). Collinear
+// distinct vertices need more: the sheared projection rounds the three points off
+// their common line, and before 3ad6308 about 12 % of the rays aimed at the segment
+// hit a triangle of float area ~0, whose normal normalize(cross(e1, e2)) =
+// normalize(0) was NaN (and so the spawned ray). intersectTriangle now also rejects
+// a triangle whose cross product is exactly zero.
 TEST_F(IntersectionProbeDegenerate, CollinearAndRepeatedVertexTrianglesAreNeverHit)
 {
     Random rng(31337u);
