@@ -16,7 +16,7 @@ CommandRunner addRegressCommand(CLI::App& app)
     o->suite = VKRT_DEFAULT_SUITE;
     CLI::App* cmd = app.add_subcommand("regress", "Run the regression suite against its references");
     cmd->add_option("--suite", o->suite, "Suite manifest (default: tests/regress/suite.toml)");
-    cmd->add_option("--filter", o->filter, "Only cases whose name contains this");
+    cmd->add_option("--filter", o->filters, "Only cases whose name contains this (repeatable: any of them)");
     cmd->add_option("--driver", o->driver, "Vulkan ICD manifest (JSON) of the driver to test");
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--junit", o->junit, "Write JUnit XML here");

@@ -10,12 +10,18 @@
 #include "scene/SceneParser.h"
 #include "util/Error.h"
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <memory>
+#include <optional>
+#include <set>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -25,40 +31,62 @@ namespace vkrt {
 namespace {
 
 constexpr uint32_t kReferenceSeed = 0x5eed5eed; // never a test seed
+constexpr uint32_t kFramesPerSubmit = 32;       // also the granularity of Ctrl-C
+
+// ---------------------------------------------------------------- Ctrl-C
 
 std::atomic<bool> g_stop{false};
 extern "C" void onRegressInterrupt(int) { g_stop.store(true); }
 
-struct CaseResult {
-    std::string name;
-    bool passed = false;
-    bool slow = false;
-    std::string error; ///< set when the case could not run
-    ReferenceTestResult test;
-    MeasuredError measured;
-    double seconds = 0.0;
-    double baseline = 0.0;
+/// While alive, SIGINT only sets g_stop; renders check it between submissions.
+class InterruptGuard {
+public:
+    InterruptGuard()
+    {
+        g_stop.store(false);
+        m_previous = std::signal(SIGINT, onRegressInterrupt);
+    }
+    ~InterruptGuard() { std::signal(SIGINT, m_previous); }
+    InterruptGuard(const InterruptGuard&) = delete;
+    InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+private:
+    void (*m_previous)(int) = SIG_DFL;
 };
+
+// ---------------------------------------------------------------- references
 
 struct Reference {
     Image mean, variance;
 };
 
-Reference loadReference(const RegressionCase& c, uint32_t width, uint32_t height)
+std::string makeHint(const RegressionCase& c)
 {
-    fs::path meanPath = c.referenceDir / "mean.exr", variancePath = c.referenceDir / "variance.exr";
-    for (const fs::path& p : {meanPath, variancePath})
-        if (!fs::exists(p))
-            throw InputError("case " + c.name + ": missing reference " + p.string() +
-                             (c.source == ReferenceSource::Vkrt ? " (make it with vkrt regress --update)"
-                                                                : " (make it with tools/make_reference.py)"));
-    Reference r{readExr(meanPath).image, readExr(variancePath).image};
-    for (const Image* image : {&r.mean, &r.variance})
-        if (image->width != width || image->height != height)
-            throw InputError("case " + c.name + ": reference is " + std::to_string(image->width) + "x" +
-                             std::to_string(image->height) + " but the case renders " + std::to_string(width) + "x" +
-                             std::to_string(height) + " (" + c.referenceDir.string() + ")");
-    return r;
+    if (c.source == ReferenceSource::Vkrt) return "make it with: vkrt regress --update --filter " + c.name;
+    return "make it with tools/make_reference.py (scenes/validation/README.md)";
+}
+
+/// One reference image, checked for size and for values a reference cannot have.
+Image readReferenceImage(const RegressionCase& c, const fs::path& path, uint32_t width, uint32_t height,
+                         bool isVariance)
+{
+    if (!fs::exists(path)) throw InputError("case " + c.name + ": missing reference " + path.string() + "; " + makeHint(c));
+    Image image;
+    try {
+        image = readExr(path).image;
+    } catch (const InputError& e) {
+        throw InputError("case " + c.name + ": " + e.what());
+    }
+    if (image.width != width || image.height != height)
+        throw InputError("case " + c.name + ": reference " + path.string() + " is " + std::to_string(image.width) + "x" +
+                         std::to_string(image.height) + " but the case renders " + std::to_string(width) + "x" +
+                         std::to_string(height) + " (match width/height in the manifest, or regenerate it)");
+    size_t invalid = std::count_if(image.rgb.begin(), image.rgb.end(),
+                                   [&](float v) { return !std::isfinite(v) || (isVariance && v < 0.0f); });
+    if (invalid)
+        throw InputError("case " + c.name + ": reference " + path.string() + " has " + std::to_string(invalid) +
+                         (isVariance ? " negative or non-finite values" : " non-finite values"));
+    return image;
 }
 
 Scene caseScene(const RegressionCase& c)
@@ -69,13 +97,45 @@ Scene caseScene(const RegressionCase& c)
     return scene;
 }
 
+/// A case with its scene parsed and its reference loaded and checked.
+struct PreparedCase {
+    RegressionCase spec;
+    Scene scene;
+    Reference reference;
+};
+
+/// Checks every selected case before anything renders; one InputError lists all problems.
+std::vector<PreparedCase> prepareCases(const std::vector<RegressionCase>& cases)
+{
+    std::vector<PreparedCase> prepared;
+    std::string problems;
+    for (const RegressionCase& c : cases) {
+        try {
+            Scene scene = caseScene(c);
+            uint32_t w = scene.camera.width, h = scene.camera.height;
+            Reference ref{readReferenceImage(c, c.referenceDir / "mean.exr", w, h, false),
+                          readReferenceImage(c, c.referenceDir / "variance.exr", w, h, true)};
+            prepared.push_back({c, std::move(scene), std::move(ref)});
+        } catch (const InputError& e) {
+            problems += std::string("\n  ") + e.what();
+        }
+    }
+    if (!problems.empty())
+        throw InputError(std::to_string(cases.size() - prepared.size()) + " case(s) cannot run:" + problems);
+    return prepared;
+}
+
+// ---------------------------------------------------------------- rendering
+
 struct Rendered {
     Image mean, variance;
     double seconds = 0.0;
+    uint64_t rejectedSamples = 0;
 };
 
-Rendered renderCase(const VulkanContext& context, const Scene& scene, uint32_t spp, uint32_t seed,
-                    const std::vector<Define>& defines)
+/// Renders `spp` frames after a warm-up frame; nullopt when Ctrl-C stopped it.
+std::optional<Rendered> renderCase(const VulkanContext& context, const Scene& scene, uint32_t spp, uint32_t seed,
+                                   const std::vector<Define>& defines)
 {
     RenderOptions options;
     options.seed = seed;
@@ -85,15 +145,81 @@ Rendered renderCase(const VulkanContext& context, const Scene& scene, uint32_t s
     renderer.warmUp();
     auto start = std::chrono::steady_clock::now();
     for (uint32_t done = 0; done < spp;) {
-        uint32_t batch = std::min(spp - done, 32u);
+        if (g_stop.load()) return std::nullopt;
+        uint32_t batch = std::min(spp - done, kFramesPerSubmit);
         renderer.renderFrames(batch);
         done += batch;
     }
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return {renderer.mean(), renderer.varianceOfMean(), seconds};
+    return Rendered{renderer.mean(), renderer.varianceOfMean(), seconds, renderer.counters().rejectedSamples};
 }
 
-// ---------------------------------------------------------------- reports
+/// The pooled test per channel: z_c = sum (x - r) / sqrt(sum sigma^2) over the
+/// pixels, with testAgainstReference's per-value sigma^2. The case's pooled z
+/// is the channel with the largest |z_c|; its limit is the two-sided quantile
+/// of pooledAlpha, Sidak-corrected over the 3 channels. (One sum over all
+/// values, as ErrorMetrics.cpp forms it, treats a pixel's channels as
+/// independent, but they come from the same paths: in a grey scene they are
+/// equal, and that sum's standard deviation is sqrt(3), not 1.)
+void poolByChannel(ReferenceTestResult& t, const Rendered& r, uint32_t spp, const Reference& ref, uint64_t refSpp,
+                   double pooledAlpha)
+{
+    double scale = double(refSpp) / double(std::max(spp, 1u));
+    std::array<double, 3> sumDiff{}, sumVariance{};
+    for (size_t i = 0; i < r.mean.rgb.size(); ++i) {
+        double x = r.mean.rgb[i], m = ref.mean.rgb[i], vr = ref.variance.rgb[i];
+        double vx = std::isfinite(r.variance.rgb[i]) ? double(r.variance.rgb[i]) : INFINITY;
+        double variance = std::max(vx, vr * scale) + vr + std::pow(1e-6 * m, 2);
+        if (!std::isfinite(x) || !std::isfinite(variance)) continue; // the per-value test fails x
+        sumDiff[i % 3] += x - m;
+        sumVariance[i % 3] += variance;
+    }
+    t.pooledZ = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        double z = sumVariance[c] > 0.0 ? sumDiff[c] / std::sqrt(sumVariance[c]) : (sumDiff[c] == 0.0 ? 0.0 : INFINITY);
+        if (std::abs(z) > std::abs(t.pooledZ)) t.pooledZ = z;
+    }
+    t.pooledThreshold = normalQuantileTwoSided(1.0 - std::pow(1.0 - pooledAlpha, 1.0 / 3.0));
+}
+
+/// testAgainstReference with two corrections (docs/regress.md): a value passes
+/// exactly when its p-value reaches the per-value level (ErrorMetrics.cpp
+/// computes z = 0/0 = NaN, a failure, where render, reference and both
+/// variances are 0, e.g. a black background; its p-value there is correctly
+/// 1), and the pooled test is per channel (poolByChannel).
+ReferenceTestResult testRender(const Rendered& r, uint32_t spp, const Reference& ref, uint64_t refSpp,
+                               const RegressionSuite& suite)
+{
+    ReferenceTestSettings settings{suite.alpha, suite.pooledAlpha, suite.minPass};
+    ReferenceTestResult t = testAgainstReference(r.mean, r.variance, spp, ref.mean, ref.variance, refSpp, settings);
+    float level = float(std::erfc(t.threshold / std::sqrt(2.0)));
+    t.passed = size_t(std::count_if(t.pValues.rgb.begin(), t.pValues.rgb.end(), [&](float p) { return p >= level; }));
+    poolByChannel(t, r, spp, ref, refSpp, suite.pooledAlpha);
+    return t;
+}
+
+// ---------------------------------------------------------------- results
+
+struct CaseResult {
+    std::string name;
+    bool passed = false;
+    bool slow = false;
+    std::string error; ///< set when the case could not run
+    int errorExit = 0; ///< the exit code that error calls for
+    ReferenceTestResult test;
+    MeasuredError measured;
+    double seconds = 0.0;
+    double baseline = 0.0;
+    uint64_t rejectedSamples = 0;
+    uint64_t maxRejected = 0;
+    std::string reference; ///< "mitsuba, 65536 spp"
+};
+
+std::string referenceLabel(const RegressionCase& c)
+{
+    return std::string(c.source == ReferenceSource::Mitsuba ? "mitsuba" : "vkrt") + ", " +
+           std::to_string(c.referenceSpp) + " spp";
+}
 
 Image differenceImage(const Image& a, const Image& b)
 {
@@ -130,38 +256,107 @@ void writeFailureImages(const fs::path& dir, const std::string& name, const Rend
     writePng(dir / (base + "-difference.png"), differenceImage(r.mean, ref.mean), 0.0f);
     writePng(dir / (base + "-significance.png"), significanceImage(t), 0.0f);
     writeExr(dir / (base + "-result.exr"), r.mean, {}, {{"variance", r.variance}});
+    writeExr(dir / (base + "-pvalues.exr"), t.pValues, {});
 }
 
-std::string markdownReport(const RegressionSuite& suite, const std::vector<CaseResult>& results,
+/// nullopt when Ctrl-C stopped the render.
+std::optional<CaseResult> runCase(const VulkanContext& context, const RegressionSuite& suite, const PreparedCase& pc,
+                                  const RegressOptions& options)
+{
+    const RegressionCase& c = pc.spec;
+    CaseResult result{c.name};
+    result.baseline = c.baselineSeconds;
+    result.reference = referenceLabel(c);
+    try {
+        std::optional<Rendered> r = renderCase(context, pc.scene, c.spp, suite.seed + options.seedOffset, options.kernelDefines);
+        if (!r) return std::nullopt;
+        result.test = testRender(*r, c.spp, pc.reference, c.referenceSpp, suite);
+        result.measured = measureError(r->mean, pc.reference.mean);
+        result.seconds = r->seconds;
+        result.rejectedSamples = r->rejectedSamples;
+        result.slow = c.baselineSeconds > 0 && r->seconds > c.baselineSeconds * suite.maxSlowdown;
+        result.maxRejected = c.maxRejected;
+        result.passed = result.test.passedRule(suite.minPass) && r->rejectedSamples <= c.maxRejected &&
+                        !(options.failOnSlowdown && result.slow);
+        if (!result.passed && !options.reportDir.empty())
+            writeFailureImages(options.reportDir, c.name, *r, pc.reference, result.test);
+    } catch (const InputError& e) {
+        result.error = e.what();
+        result.errorExit = kExitBadInput;
+    } catch (const std::exception& e) {
+        result.error = e.what();
+        result.errorExit = kExitFailure;
+    }
+    return result;
+}
+
+// ---------------------------------------------------------------- reports
+
+/// Where the run stands: "12 of 24 cases", plus "interrupted" when it ended early.
+struct RunStatus {
+    size_t total = 0;
+    bool interrupted = false;
+};
+
+std::string markdownHeader(const RegressionSuite& suite, const std::vector<CaseResult>& results, RunStatus status,
                            const VulkanContext& context, const RegressOptions& options)
 {
     std::ostringstream md;
-    size_t failed = std::count_if(results.begin(), results.end(), [](const CaseResult& r) { return !r.passed; });
+    size_t passed = std::count_if(results.begin(), results.end(), [](const CaseResult& r) { return r.passed; });
     md << "# vkrt regression report\n\n"
        << "- suite: `" << suite.path.string() << "`\n- device: " << context.deviceInfo().name << " ("
        << context.deviceInfo().driver << ")\n"
        << "- driver manifest: " << (options.driver.empty() ? "system default" : "`" + options.driver + "`") << "\n"
-       << "- seed: " << suite.seed + options.seedOffset << "\n- rule: at least " << 100.0 * suite.minPass
-       << " % of values pass a Sidak-corrected z-test at alpha " << suite.alpha << ", and |pooled z| within alpha "
-       << suite.pooledAlpha << " (docs/regress.md)\n- result: **" << results.size() - failed << " passed, " << failed
-       << " failed**\n\n| case | result | values passing | pooled z | smallest p | relMSE | seconds | baseline |\n"
-       << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
-    char line[512];
-    for (const CaseResult& r : results) {
-        if (!r.error.empty()) {
-            md << "| " << r.name << " | **error** | " << r.error << " | | | | | |\n";
-            continue;
-        }
-        std::snprintf(line, sizeof line, "| %s | %s%s | %.3f %% | %+.2f | %.3g | %.3g | %.2f | %s |\n", r.name.c_str(),
-                      r.passed ? "pass" : "**FAIL**", r.slow ? " (slow)" : "", 100.0 * r.test.fractionPassed(),
-                      r.test.pooledZ, r.test.minPValue, r.measured.relMse, r.seconds,
-                      r.baseline > 0 ? std::to_string(r.baseline).substr(0, 5).c_str() : "-");
-        md << line;
+       << "- seed: " << suite.seed + options.seedOffset << "\n";
+    for (const Define& d : options.kernelDefines) md << "- kernel define (test hook): `" << d.first << "=" << d.second << "`\n";
+    md << "- rule: at least " << 100.0 * suite.minPass << " % of values pass a Sidak-corrected z-test at alpha "
+       << suite.alpha << ", |pooled z| within alpha " << suite.pooledAlpha
+       << " (per channel, Sidak over 3), no more rejected (non-finite) samples than the case's max_rejected (default 0)"
+       << " (docs/regress.md); slow = more than " << suite.maxSlowdown
+       << " x baseline\n- result: **" << passed << " passed, " << results.size() - passed << " failed**";
+    if (results.size() < status.total)
+        md << " (" << results.size() << " of " << status.total << " cases"
+           << (status.interrupted ? ": **interrupted**" : " so far") << ")";
+    md << "\n\n";
+    return md.str();
+}
+
+std::string markdownRow(const CaseResult& r)
+{
+    if (!r.error.empty()) {
+        std::string message = r.error;
+        std::replace(message.begin(), message.end(), '\n', ' ');
+        std::replace(message.begin(), message.end(), '|', '/');
+        return "| " + r.name + " | **error** | " + message + " | | | | | | | | |\n";
     }
+    char line[640];
+    std::string baseline = r.baseline > 0 ? std::to_string(r.baseline).substr(0, 5) : "-";
+    std::string ratio = r.baseline > 0 ? std::to_string(r.seconds / r.baseline).substr(0, 4) : "-";
+    std::string rejected = std::to_string(r.rejectedSamples);
+    if (r.maxRejected) rejected += " (max " + std::to_string(r.maxRejected) + ")";
+    std::snprintf(line, sizeof line, "| %s | %s%s | %.3f %% | %+.2f | %.3g | %.3g | %s | %.2f | %s | %s | %s |\n",
+                  r.name.c_str(), r.passed ? "pass" : "**FAIL**", r.slow ? " (slow)" : "",
+                  100.0 * r.test.fractionPassed(), r.test.pooledZ, r.test.minPValue, r.measured.relMse,
+                  rejected.c_str(), r.seconds, baseline.c_str(), ratio.c_str(), r.reference.c_str());
+    return line;
+}
+
+std::string markdownReport(const RegressionSuite& suite, const std::vector<CaseResult>& results, RunStatus status,
+                           const VulkanContext& context, const RegressOptions& options)
+{
+    std::ostringstream md;
+    md << markdownHeader(suite, results, status, context, options)
+       << "| case | result | values passing | pooled z | smallest p | relMSE | rejected | seconds | baseline | ratio "
+          "| reference |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const CaseResult& r : results) md << markdownRow(r);
     for (const CaseResult& r : results) {
-        if (r.passed || !r.error.empty()) continue;
+        if (r.passed || !r.error.empty() || r.test.tested == 0) continue;
         std::string base = safeName(r.name);
-        md << "\n## " << r.name << "\n\n| reference | result | difference | significance |\n| --- | --- | --- | --- |\n"
+        md << "\n## " << r.name << "\n\n" << r.test.tested - r.test.passed << " of " << r.test.tested
+           << " values beyond |z| = " << r.test.threshold << "; pooled z " << r.test.pooledZ << " (limit "
+           << r.test.pooledThreshold << "); " << r.rejectedSamples << " rejected samples. Result with variance: `"
+           << base << "-result.exr`, p-values: `" << base << "-pvalues.exr`.\n\n"
+           << "| reference | result | difference | significance |\n| --- | --- | --- | --- |\n"
            << "| ![](" << base << "-reference.png) | ![](" << base << "-result.png) | ![](" << base
            << "-difference.png) | ![](" << base << "-significance.png) |\n";
     }
@@ -176,9 +371,18 @@ std::string xmlEscape(const std::string& text)
         else if (ch == '>') out += "&gt;";
         else if (ch == '&') out += "&amp;";
         else if (ch == '"') out += "&quot;";
+        else if (ch == '\n') out += "&#10;";
         else out += ch;
     }
     return out;
+}
+
+std::string failureMessage(const CaseResult& r)
+{
+    std::ostringstream m;
+    m << 100.0 * r.test.fractionPassed() << "% of values pass; pooled z " << r.test.pooledZ << "; smallest p "
+      << r.test.minPValue << "; " << r.rejectedSamples << " rejected samples" << (r.slow ? "; slower than baseline" : "");
+    return m.str();
 }
 
 std::string junitReport(const std::vector<CaseResult>& results)
@@ -197,9 +401,7 @@ std::string junitReport(const std::vector<CaseResult>& results)
         }
         xml << ">\n";
         if (!r.error.empty()) xml << "    <error message=\"" << xmlEscape(r.error) << "\"/>\n";
-        else
-            xml << "    <failure message=\"" << 100.0 * r.test.fractionPassed() << "% of values pass; pooled z "
-                << r.test.pooledZ << "\"/>\n";
+        else xml << "    <failure message=\"" << xmlEscape(failureMessage(r)) << "\"/>\n";
         xml << "  </testcase>\n";
     }
     xml << "</testsuite>\n";
@@ -215,126 +417,244 @@ void writeText(const fs::path& path, const std::string& text)
     });
 }
 
-// ---------------------------------------------------------------- cases
-
-CaseResult runCase(const VulkanContext& context, const RegressionSuite& suite, const RegressionCase& c,
-                   const RegressOptions& options)
+/// Rewritten after every case, so an interrupted run keeps what finished.
+void writeReports(const RegressionSuite& suite, const std::vector<CaseResult>& results, RunStatus status,
+                  const VulkanContext& context, const RegressOptions& options)
 {
-    CaseResult result{c.name};
-    result.baseline = c.baselineSeconds;
-    try {
-        Scene scene = caseScene(c);
-        Reference ref = loadReference(c, scene.camera.width, scene.camera.height);
-        Rendered r = renderCase(context, scene, c.spp, suite.seed + options.seedOffset, options.kernelDefines);
-        ReferenceTestSettings settings{suite.alpha, suite.pooledAlpha, suite.minPass};
-        result.test = testAgainstReference(r.mean, r.variance, c.spp, ref.mean, ref.variance, c.referenceSpp, settings);
-        result.measured = measureError(r.mean, ref.mean);
-        result.seconds = r.seconds;
-        result.slow = c.baselineSeconds > 0 && r.seconds > c.baselineSeconds * suite.maxSlowdown;
-        result.passed = result.test.passedRule(suite.minPass) && !(options.failOnSlowdown && result.slow);
-        if (!result.passed && !options.reportDir.empty()) writeFailureImages(options.reportDir, c.name, r, ref, result.test);
-    } catch (const std::exception& e) {
-        result.error = e.what();
+    if (!options.reportDir.empty())
+        writeText(options.reportDir / "report.md", markdownReport(suite, results, status, context, options));
+    if (!options.junit.empty()) writeText(options.junit, junitReport(results));
+}
+
+void printResult(const CaseResult& r)
+{
+    if (!r.error.empty()) std::printf("%-34s ERROR\n    %s\n", r.name.c_str(), r.error.c_str());
+    else
+        std::printf("%-34s %s  %.3f%% pass  pooled z %+.2f  %.2f s%s%s\n", r.name.c_str(), r.passed ? "pass" : "FAIL",
+                    100.0 * r.test.fractionPassed(), r.test.pooledZ, r.seconds,
+                    r.rejectedSamples ? ("  " + std::to_string(r.rejectedSamples) + " rejected samples").c_str() : "",
+                    r.slow ? "  (slower than baseline)" : "");
+    std::fflush(stdout);
+}
+
+/// 0, or the exit code of the first case that could not run, else 4 on a failure.
+int exitCode(const std::vector<CaseResult>& results)
+{
+    for (const CaseResult& r : results)
+        if (!r.error.empty()) return r.errorExit;
+    bool allPassed = std::all_of(results.begin(), results.end(), [](const CaseResult& r) { return r.passed; });
+    return allPassed ? kExitOk : kExitCompareFailed;
+}
+
+int runCases(const VulkanContext& context, const RegressionSuite& suite, const std::vector<PreparedCase>& cases,
+             const RegressOptions& options)
+{
+    std::vector<CaseResult> results;
+    RunStatus status{cases.size(), false};
+    for (const PreparedCase& c : cases) {
+        std::optional<CaseResult> r = g_stop.load() ? std::nullopt : runCase(context, suite, c, options);
+        if (!r) {
+            status.interrupted = true;
+            break;
+        }
+        results.push_back(std::move(*r));
+        printResult(results.back());
+        writeReports(suite, results, status, context, options);
     }
-    return result;
+    size_t passed = std::count_if(results.begin(), results.end(), [](const CaseResult& r) { return r.passed; });
+    std::printf("%zu passed, %zu failed", passed, results.size() - passed);
+    if (status.interrupted) {
+        writeReports(suite, results, status, context, options);
+        std::printf(" (interrupted after %zu of %zu cases)\n", results.size(), cases.size());
+        return kExitInterrupted;
+    }
+    std::printf("\n");
+    return exitCode(results);
 }
 
-std::string gitCommit(const fs::path& dir)
+// ---------------------------------------------------------------- --update
+
+/// First line of a git command's output in `dir`, or nullopt.
+std::optional<std::string> gitLine(const fs::path& dir, const std::string& arguments)
 {
-    std::string command = "git -C '" + dir.string() + "' rev-parse HEAD 2>/dev/null";
+    std::string command = "git -C '" + dir.string() + "' " + arguments + " 2>/dev/null";
     FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return "unknown";
-    char buffer[64] = {};
+    if (!pipe) return std::nullopt;
+    char buffer[4096] = {};
     size_t n = fread(buffer, 1, sizeof buffer - 1, pipe);
-    pclose(pipe);
-    std::string commit(buffer, n);
-    while (!commit.empty() && std::isspace(static_cast<unsigned char>(commit.back()))) commit.pop_back();
-    return commit.empty() ? "unknown" : commit;
+    int status = pclose(pipe);
+    std::string line(buffer, n);
+    line = line.substr(0, line.find('\n'));
+    if (status != 0 || line.empty()) return std::nullopt;
+    return line;
 }
 
-void updateReference(const VulkanContext& context, const RegressionCase& c)
+/// "commit abc… " plus a warning when shaders or sources differ from it.
+std::string commitDescription(const fs::path& dir)
 {
-    Scene scene = caseScene(c);
-    auto start = std::chrono::steady_clock::now();
-    Rendered r = renderCase(context, scene, uint32_t(c.referenceSpp), kReferenceSeed, {});
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fs::create_directories(c.referenceDir);
-    writeExr(c.referenceDir / "mean.exr", r.mean, {{"spp", int64_t(c.referenceSpp)}, {"seed", int64_t(kReferenceSeed)}});
-    writeExr(c.referenceDir / "variance.exr", r.variance, {{"spp", int64_t(c.referenceSpp)}});
+    std::optional<std::string> commit = gitLine(dir, "rev-parse HEAD");
+    if (!commit) return "commit unknown";
+    std::optional<std::string> dirty = gitLine(dir, "status --porcelain -- shaders src");
+    return "commit " + *commit + (dirty ? " with uncommitted changes in shaders/ or src/" : "");
+}
+
+/// The path relative to the git checkout holding it, else absolute.
+std::string repositoryPath(const fs::path& file)
+{
+    fs::path absolute = fs::weakly_canonical(file);
+    std::optional<std::string> top = gitLine(absolute.parent_path(), "rev-parse --show-toplevel");
+    fs::path relative = top ? absolute.lexically_relative(fs::path(*top)) : fs::path();
+    bool inside = !relative.empty() && *relative.begin() != "..";
+    return inside ? relative.string() : absolute.string();
+}
+
+void writeReferenceReadme(const VulkanContext& context, const RegressionSuite& suite, const RegressionCase& c,
+                          const Scene& scene, double seconds)
+{
     std::time_t now = std::time(nullptr);
     char date[64];
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
     std::ostringstream readme;
-    readme << "# vkrt reference: " << c.name << "\n\n- scene: `" << c.scene.string() << "`\n- made by: `vkrt regress --update`"
-           << " (vkrt " << VKRT_VERSION << ", commit " << gitCommit(c.scene.parent_path()) << ")\n- device: "
-           << context.deviceInfo().name << " (" << context.deviceInfo().driver << ")\n- spp: " << c.referenceSpp
-           << ", seed " << kReferenceSeed << ", " << scene.camera.width << "x" << scene.camera.height << "\n- date: "
-           << date << ", " << seconds << " s\n\n`mean.exr` is the per-pixel mean, `variance.exr` the variance of that mean.\n";
+    readme << "# vkrt reference: " << c.name << "\n\n| | |\n|---|---|\n| scene | `" << repositoryPath(c.scene)
+           << "` |\n| command | `vkrt regress --update --suite " << repositoryPath(suite.path) << " --filter " << c.name
+           << "` |\n| vkrt | " << VKRT_VERSION << ", " << commitDescription(c.scene.parent_path()) << " |\n| device | "
+           << context.deviceInfo().name << " (" << context.deviceInfo().driver << ") |\n| image | "
+           << scene.camera.width << " x " << scene.camera.height << " |\n| spp | " << c.referenceSpp << " (seed "
+           << kReferenceSeed << ") |\n| date | " << date << " |\n| render time | " << std::lround(seconds)
+           << " s |\n\n`mean.exr` is the per-pixel mean, `variance.exr` the variance of that mean (sample variance / spp).\n";
     writeText(c.referenceDir / "README.md", readme.str());
-    std::printf("updated %s (%llu spp, %.1f s)\n", c.referenceDir.c_str(), static_cast<unsigned long long>(c.referenceSpp),
-                seconds);
 }
 
-std::vector<RegressionCase> selectedCases(const RegressionSuite& suite, const std::string& filter)
+/// Renders one vkrt reference; false when Ctrl-C stopped it (nothing written).
+bool updateReference(const VulkanContext& context, const RegressionSuite& suite, const RegressionCase& c)
+{
+    std::printf("updating %s: %llu spp ...\n", c.name.c_str(), static_cast<unsigned long long>(c.referenceSpp));
+    std::fflush(stdout);
+    Scene scene = caseScene(c);
+    auto start = std::chrono::steady_clock::now();
+    std::optional<Rendered> r = renderCase(context, scene, uint32_t(c.referenceSpp), kReferenceSeed, {});
+    if (!r) return false;
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (r->rejectedSamples)
+        std::printf("warning: %s: %llu non-finite samples were rejected\n", c.name.c_str(),
+                    static_cast<unsigned long long>(r->rejectedSamples));
+    fs::create_directories(c.referenceDir);
+    writeExr(c.referenceDir / "mean.exr", r->mean, {{"spp", int64_t(c.referenceSpp)}, {"seed", int64_t(kReferenceSeed)}});
+    writeExr(c.referenceDir / "variance.exr", r->variance, {{"spp", int64_t(c.referenceSpp)}});
+    writeReferenceReadme(context, suite, c, scene, seconds);
+    std::printf("updated %s (%.1f s)\n", c.referenceDir.c_str(), seconds);
+    return true;
+}
+
+int updateReferences(const VulkanContext& context, const RegressionSuite& suite, const std::vector<RegressionCase>& cases)
+{
+    std::set<fs::path> updated;
+    for (const RegressionCase& c : cases) {
+        if (c.source == ReferenceSource::Mitsuba) {
+            std::printf("kept %s (made by Mitsuba 3: tools/make_reference.py)\n", c.name.c_str());
+            continue;
+        }
+        if (!updated.insert(c.referenceDir).second) {
+            std::printf("kept %s (its reference %s was just updated by another case)\n", c.name.c_str(),
+                        c.referenceDir.c_str());
+            continue;
+        }
+        if (g_stop.load() || !updateReference(context, suite, c)) {
+            std::printf("interrupted: %s and later references not updated\n", c.name.c_str());
+            return kExitInterrupted;
+        }
+    }
+    return kExitOk;
+}
+
+// ---------------------------------------------------------------- set-up
+
+std::vector<RegressionCase> selectedCases(const RegressionSuite& suite, const std::vector<std::string>& filters)
 {
     std::vector<RegressionCase> cases;
+    auto matches = [&](const std::string& name) {
+        return filters.empty() || std::any_of(filters.begin(), filters.end(), [&](const std::string& f) {
+                   return name.find(f) != std::string::npos;
+               });
+    };
     for (const auto& c : suite.cases)
-        if (filter.empty() || c.name.find(filter) != std::string::npos) cases.push_back(c);
-    if (cases.empty()) throw InputError("--filter " + filter + ": no case of " + suite.path.string() + " matches");
+        if (matches(c.name)) cases.push_back(c);
+    if (cases.empty()) {
+        std::string list;
+        for (const auto& f : filters) list += (list.empty() ? "" : ", ") + f;
+        throw InputError("--filter " + list + ": no case of " + suite.path.string() + " matches");
+    }
     return cases;
+}
+
+/// The value of the first "key": "value" pair in JSON text ("" if absent).
+std::string jsonString(const std::string& text, const std::string& key)
+{
+    size_t at = text.find("\"" + key + "\"");
+    if (at == std::string::npos) return "";
+    size_t colon = text.find(':', at), open = text.find('"', colon == std::string::npos ? at : colon);
+    size_t close = open == std::string::npos ? open : text.find('"', open + 1);
+    return close == std::string::npos ? "" : text.substr(open + 1, close - open - 1);
+}
+
+std::unique_ptr<VulkanContext> openContext(const RegressOptions& options)
+{
+    try {
+        return std::make_unique<VulkanContext>(ContextOptions{options.device, false, std::nullopt});
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::exception& e) {
+        if (options.driver.empty()) throw;
+        throw GpuError("--driver " + options.driver + ": the Vulkan loader could not use this driver (" + e.what() +
+                       "); is its library_path loadable, and does it list a device?");
+    }
+}
+
+void createReportDir(const fs::path& dir)
+{
+    std::error_code error;
+    fs::create_directories(dir, error);
+    if (error || !fs::is_directory(dir))
+        throw InputError("--report-dir " + dir.string() + ": cannot create it (" + (error ? error.message() : "not a directory") + ")");
 }
 
 } // namespace
 
 void selectVulkanDriver(const fs::path& icdManifest)
 {
-    std::ifstream in(icdManifest);
-    if (!in) throw InputError("--driver " + icdManifest.string() + ": no such file");
-    std::stringstream text;
-    text << in.rdbuf();
-    if (text.str().find("\"ICD\"") == std::string::npos)
-        throw InputError("--driver " + icdManifest.string() + ": not a Vulkan ICD manifest (no \"ICD\" object)");
-    setenv("VK_DRIVER_FILES", icdManifest.c_str(), 1);
-    setenv("VK_ICD_FILENAMES", icdManifest.c_str(), 1); // older loaders
+    std::string option = "--driver " + icdManifest.string();
+    fs::path path = fs::absolute(icdManifest);
+    if (!fs::is_regular_file(path)) throw InputError(option + ": no such file");
+    std::ifstream in(path);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) throw InputError(option + ": cannot read it");
+    if (text.find("\"ICD\"") == std::string::npos)
+        throw InputError(option + ": not a Vulkan ICD manifest (no \"ICD\" object)");
+    std::string library = jsonString(text, "library_path");
+    if (library.empty()) throw InputError(option + ": the ICD manifest has no \"library_path\"");
+    // A bare file name is looked up by the dynamic linker; a path is relative to the manifest.
+    fs::path libraryPath = (fs::path(library).is_absolute() ? fs::path(library) : path.parent_path() / library).lexically_normal();
+    if (library.find('/') != std::string::npos && !fs::exists(libraryPath))
+        throw InputError(option + ": its library_path " + libraryPath.string() + " does not exist");
+    setenv("VK_DRIVER_FILES", path.c_str(), 1);
+    setenv("VK_ICD_FILENAMES", path.c_str(), 1); // older loaders
 }
 
 int runRegression(const RegressOptions& options)
 {
     RegressionSuite suite = readRegressionSuite(options.suite);
-    std::vector<RegressionCase> cases = selectedCases(suite, options.filter);
+    if (options.update && !options.kernelDefines.empty())
+        throw InputError("--update cannot be combined with --kernel-define: references must come from unmodified kernels");
+    std::vector<RegressionCase> cases = selectedCases(suite, options.filters);
     if (!options.driver.empty()) selectVulkanDriver(options.driver);
-    if (!options.reportDir.empty()) fs::create_directories(options.reportDir);
-    VulkanContext context({options.device, false});
+    std::vector<PreparedCase> prepared;
+    if (!options.update) prepared = prepareCases(cases);
+    if (!options.reportDir.empty()) createReportDir(options.reportDir);
 
-    if (options.update) {
-        for (const auto& c : cases) {
-            if (c.source == ReferenceSource::Mitsuba) std::printf("kept %s (made by Mitsuba 3: tools/make_reference.py)\n", c.name.c_str());
-            else updateReference(context, c);
-        }
-        return kExitOk;
-    }
-
-    g_stop.store(false);
-    std::signal(SIGINT, onRegressInterrupt);
-    std::vector<CaseResult> results;
-    for (const auto& c : cases) {
-        if (g_stop.load()) break;
-        results.push_back(runCase(context, suite, c, options));
-        const CaseResult& r = results.back();
-        std::printf("%-34s %s  %.3f%% pass  pooled z %+.2f  %.2f s%s%s\n", r.name.c_str(),
-                    !r.error.empty() ? "ERROR" : r.passed ? "pass" : "FAIL", 100.0 * r.test.fractionPassed(),
-                    r.test.pooledZ, r.seconds, r.slow ? "  (slower than baseline)" : "",
-                    r.error.empty() ? "" : ("\n    " + r.error).c_str());
-        std::fflush(stdout);
-        // Written after every case: an interrupted run keeps what finished.
-        if (!options.reportDir.empty()) writeText(options.reportDir / "report.md", markdownReport(suite, results, context, options));
-        if (!options.junit.empty()) writeText(options.junit, junitReport(results));
-    }
-    std::signal(SIGINT, SIG_DFL);
-    size_t passed = std::count_if(results.begin(), results.end(), [](const CaseResult& r) { return r.passed; });
-    std::printf("%zu passed, %zu failed\n", passed, results.size() - passed);
-    if (g_stop.load()) return kExitInterrupted;
-    return passed == cases.size() ? kExitOk : kExitCompareFailed;
+    InterruptGuard interrupt;
+    std::unique_ptr<VulkanContext> context = openContext(options);
+    if (options.update) return updateReferences(*context, suite, cases);
+    return runCases(*context, suite, prepared, options);
 }
 
 } // namespace vkrt

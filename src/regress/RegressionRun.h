@@ -11,7 +11,7 @@ namespace vkrt {
 
 struct RegressOptions {
     std::filesystem::path suite;
-    std::string filter;                ///< run cases whose name contains this
+    std::vector<std::string> filters;  ///< run cases whose name contains any of these (all when empty)
     std::string driver;                ///< Vulkan ICD manifest (JSON) to load instead of the system's
     std::string device;
     std::filesystem::path junit;       ///< JUnit XML output (optional)
@@ -22,11 +22,15 @@ struct RegressOptions {
     std::vector<Define> kernelDefines; ///< test hooks: build every kernel with these
 };
 
-/// Runs the suite; returns the exit code (0 only when every case passes).
+/// Runs the suite; returns the exit code: 0 when every case passes, 4 when a
+/// case fails its test, 1 when a case could not render, 130 when interrupted
+/// (the finished cases are reported). Bad input (manifest, references,
+/// options) throws InputError before anything renders.
 int runRegression(const RegressOptions& options);
 
 /// Points the Vulkan loader at one ICD manifest; throws InputError naming the
-/// path if it is missing or not a JSON ICD manifest. Call before any instance exists.
+/// path if it is missing, not a JSON ICD manifest, or names a library file
+/// that does not exist. Call before any instance exists.
 void selectVulkanDriver(const std::filesystem::path& icdManifest);
 
 } // namespace vkrt

@@ -20,6 +20,7 @@ struct RegressionCase {
     uint32_t spp = 64;
     std::optional<uint32_t> width, height;
     double baselineSeconds = 0.0;       ///< 0: no timing check
+    uint64_t maxRejected = 0;           ///< non-finite samples tolerated (known bugs only)
 };
 
 struct RegressionSuite {

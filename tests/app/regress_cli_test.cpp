@@ -1,0 +1,382 @@
+// End-to-end tests of `vkrt regress` (docs/regress.md) as CI and a driver
+// developer run it: a deliberately biased kernel fails the right cases,
+// repeated seeds fail no more often than the suite's alpha allows, bad input
+// gives clear errors (never exit 4, never a crash), --update makes references
+// the suite then accepts, and Ctrl-C keeps the finished cases on disk.
+#include "io/ExrFile.h"
+#include "support/TestSupport.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace vkrt::test {
+namespace {
+
+const fs::path kSource = VKRT_TEST_SOURCE_DIR;
+
+/// One [[case]] of a test manifest; scene and reference are absolute paths.
+struct ManifestCase {
+    std::string name;
+    fs::path scene;
+    fs::path reference;
+    uint32_t referenceSpp = 4096;
+    uint32_t spp = 32;
+    std::string extra; ///< more TOML lines, e.g. "width = 64"
+    std::string source = "vkrt";
+};
+
+std::string manifestText(const std::vector<ManifestCase>& cases, const std::string& suiteLines = "")
+{
+    std::ostringstream toml;
+    toml << "[suite]\nseed = 1\n" << suiteLines << "\n";
+    for (const ManifestCase& c : cases)
+        toml << "[[case]]\nname = \"" << c.name << "\"\nscene = \"" << c.scene.string() << "\"\nreference = \""
+             << c.reference.string() << "\"\nreference_source = \"" << c.source << "\"\nreference_spp = "
+             << c.referenceSpp << "\nspp = " << c.spp << "\n" << c.extra << "\n";
+    return toml.str();
+}
+
+/// A case of the default suite's seed and extreme references.
+ManifestCase shipped(const std::string& name, uint32_t spp, const std::string& extra = "")
+{
+    std::string folder = name.substr(0, name.find('/')), file = name.substr(name.find('/') + 1);
+    return {name, kSource / "scenes" / folder / (file + ".toml"), kSource / "tests/references" / name, 4096, spp, extra};
+}
+
+std::string readFile(const fs::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// Outcome per case of a JUnit file: "pass", "failure" or "error".
+std::map<std::string, std::string> junitOutcomes(const fs::path& path)
+{
+    std::string xml = readFile(path);
+    std::map<std::string, std::string> outcomes;
+    std::regex testcase(R"re(<testcase [^>]*name="([^"]*)"[^>]*?(/?)>)re");
+    for (auto it = std::sregex_iterator(xml.begin(), xml.end(), testcase); it != std::sregex_iterator(); ++it) {
+        std::string name = (*it)[1], body;
+        if ((*it)[2] != "/") body = xml.substr(size_t(it->position() + it->length()));
+        body = body.substr(0, body.find("</testcase>"));
+        outcomes[name] = body.find("<failure") != std::string::npos ? "failure"
+                         : body.find("<error") != std::string::npos ? "error"
+                                                                     : "pass";
+    }
+    return outcomes;
+}
+
+/// Pooled z per case from the summary lines `vkrt regress` prints.
+std::map<std::string, double> pooledZ(const std::string& output)
+{
+    std::map<std::string, double> z;
+    std::regex line(R"((\S+)\s+(pass|FAIL)\s+\S+% pass\s+pooled z ([-+0-9.]+))");
+    for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it)
+        z[(*it)[1]] = std::stod((*it)[3]);
+    return z;
+}
+
+/// Smallest m with P(X > m) < tail for X ~ Binomial(n, p).
+int binomialUpperBound(int n, double p, double tail)
+{
+    double cumulative = 0.0;
+    for (int k = 0; k <= n; ++k) {
+        cumulative += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) +
+                               k * std::log(p) + (n - k) * std::log1p(-p));
+        if (1.0 - cumulative < tail) return k;
+    }
+    return n;
+}
+
+class RegressCli : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        m_dir = freshTempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+        setenv("VKRT_CACHE_DIR", testCacheDir().c_str(), 1);
+    }
+    fs::path m_dir;
+
+    static std::vector<std::string> deviceArgs()
+    {
+        const char* device = std::getenv("VKRT_TEST_DEVICE");
+        return device ? std::vector<std::string>{"--device", device} : std::vector<std::string>{};
+    }
+
+    ProcessResult regress(std::vector<std::string> args)
+    {
+        args.insert(args.begin(), "regress");
+        for (const std::string& a : deviceArgs()) args.push_back(a);
+        return runVkrt(args);
+    }
+
+    fs::path writeManifest(const std::vector<ManifestCase>& cases, const std::string& suiteLines = "")
+    {
+        fs::path path = m_dir / "suite.toml";
+        writeText(path, manifestText(cases, suiteLines));
+        return path;
+    }
+
+    /// A copy of a shipped reference folder that a test may damage.
+    fs::path copyReference(const std::string& name)
+    {
+        fs::path copy = m_dir / "references" / name;
+        fs::create_directories(copy);
+        for (const char* file : {"mean.exr", "variance.exr"})
+            fs::copy_file(kSource / "tests/references" / name / file, copy / file);
+        return copy;
+    }
+};
+
+/// Bad input: exit 2 (never 0, never 4 = "a case failed", never a signal),
+/// with every expected fragment in the message.
+void expectInputError(const ProcessResult& r, const std::vector<std::string>& fragments)
+{
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    for (const std::string& f : fragments) EXPECT_NE(r.output.find(f), std::string::npos) << f << "\n" << r.output;
+}
+
+// ------------------------------------------------------------ deliberate bias
+
+// VKRT_TEST_FRESNEL_SCALE=1.02 (shaders/lib/fresnel.glsl) makes every dielectric
+// reflect 2 % more. The cases whose image is dominated by a Fresnel term must
+// fail: kappa-halfspace shows only the Fresnel reflection of an opaque glass
+// half-space (green and blue are F itself), kappa-shadow lights a floor
+// through a slab with (1 - F)^2. The cases without a dielectric must pass:
+// they render the same kernels' other code bit for bit.
+TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
+{
+    fs::path junit = m_dir / "junit.xml", report = m_dir / "report";
+    ProcessResult r = regress({"--filter", "extreme/kappa-", "--filter", "seed/baseline", "--filter",
+                               "extreme/degenerate-lights", "--kernel-define", "VKRT_TEST_FRESNEL_SCALE=1.02",
+                               "--junit", junit.string(), "--report-dir", report.string()});
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    std::map<std::string, std::string> outcome = junitOutcomes(junit);
+    EXPECT_EQ(outcome.size(), 4u) << r.output;
+    EXPECT_EQ(outcome["extreme/kappa-halfspace"], "failure") << r.output;
+    EXPECT_EQ(outcome["extreme/kappa-shadow"], "failure") << r.output;
+    EXPECT_EQ(outcome["seed/baseline"], "pass") << r.output;
+    EXPECT_EQ(outcome["extreme/degenerate-lights"], "pass") << r.output;
+    // The report names the hook and shows the failures' images.
+    std::string md = readFile(report / "report.md");
+    EXPECT_NE(md.find("VKRT_TEST_FRESNEL_SCALE=1.02"), std::string::npos);
+    for (const char* suffix : {"reference.png", "result.png", "difference.png", "significance.png", "result.exr"})
+        EXPECT_TRUE(fs::exists(report / (std::string("extreme_kappa-halfspace-") + suffix))) << suffix;
+    EXPECT_FALSE(fs::exists(report / "seed_baseline-result.png"));
+}
+
+// ------------------------------------------------------------ seed consistency
+
+// Ten runs of a small suite with seed offsets 1..10. Each case of a correct
+// renderer fails with probability at most alpha = 0.01 (the pooled test's own
+// alpha is 0.001; the per-value rule almost never fails), so the failures over
+// all runs are at most Binomial(runs x cases, 0.01): allow the count that such
+// a variable exceeds with probability below 1e-3. The seed must really change
+// the noise: the pooled z of a case differs between runs.
+TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
+{
+    std::vector<ManifestCase> cases = {shipped("seed/baseline", 16, "width = 96\nheight = 72"),
+                                       shipped("extreme/kappa-shadow", 32), shipped("extreme/degenerate-lights", 32),
+                                       shipped("extreme/ior-huge", 32)};
+    fs::path suite = writeManifest(cases, "alpha = 0.01");
+    constexpr int kRuns = 10;
+    int failures = 0;
+    std::map<std::string, std::vector<double>> zs;
+    for (int offset = 1; offset <= kRuns; ++offset) {
+        fs::path junit = m_dir / ("run" + std::to_string(offset) + ".xml");
+        ProcessResult r = regress({"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--junit", junit.string()});
+        ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 4) << r.output;
+        std::map<std::string, std::string> outcome = junitOutcomes(junit);
+        ASSERT_EQ(outcome.size(), cases.size()) << r.output;
+        for (const auto& [name, result] : outcome) {
+            ASSERT_NE(result, "error") << r.output;
+            failures += result == "failure";
+        }
+        EXPECT_EQ(r.exitCode == 4, std::any_of(outcome.begin(), outcome.end(), [](auto& o) { return o.second == "failure"; }));
+        for (const auto& [name, z] : pooledZ(r.output)) zs[name].push_back(z);
+    }
+    int allowed = binomialUpperBound(kRuns * int(cases.size()), 0.01, 1e-3);
+    std::printf("[ measured ] %d failing cases in %d runs x %zu cases (allowed %d)\n", failures, kRuns, cases.size(), allowed);
+    EXPECT_LE(failures, allowed);
+    for (const auto& [name, values] : zs) {
+        ASSERT_EQ(values.size(), size_t(kRuns)) << name;
+        EXPECT_NE(*std::min_element(values.begin(), values.end()), *std::max_element(values.begin(), values.end()))
+            << name << ": the seed offset does not change the render";
+    }
+}
+
+// ------------------------------------------------------------ bad input
+
+TEST_F(RegressCli, MissingReferenceNamesTheFileAndHowToMakeIt)
+{
+    ManifestCase c = shipped("extreme/kappa-shadow", 8);
+    c.reference = m_dir / "no-such-reference";
+    fs::path suite = writeManifest({c});
+    ProcessResult r = regress({"--suite", suite.string(), "--junit", (m_dir / "j.xml").string()});
+    expectInputError(r, {"extreme/kappa-shadow", (c.reference / "mean.exr").string(),
+                         "vkrt regress --update --filter extreme/kappa-shadow"});
+    EXPECT_FALSE(fs::exists(m_dir / "j.xml")) << "nothing renders when a reference is missing";
+}
+
+TEST_F(RegressCli, CorruptReferenceNamesTheFile)
+{
+    ManifestCase c = shipped("extreme/kappa-shadow", 8);
+    c.reference = copyReference("extreme/kappa-shadow");
+    // EXR's magic number, then garbage: the header cannot be parsed.
+    writeText(c.reference / "variance.exr", "\x76\x2f\x31\x01 this is not an EXR file \xff\xfe");
+    ProcessResult r = regress({"--suite", writeManifest({c}).string()});
+    expectInputError(r, {(c.reference / "variance.exr").string(), "not a readable EXR"});
+    // A valid EXR holding impossible values is refused too.
+    Image negative(64, 48);
+    std::fill(negative.rgb.begin(), negative.rgb.end(), -1.0f);
+    writeExr(c.reference / "variance.exr", negative, {});
+    expectInputError(regress({"--suite", writeManifest({c}).string()}),
+                     {(c.reference / "variance.exr").string(), "negative or non-finite"});
+}
+
+TEST_F(RegressCli, MismatchedResolutionNamesBothSizes)
+{
+    fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8, "width = 32\nheight = 24")});
+    ProcessResult r = regress({"--suite", suite.string()});
+    expectInputError(r, {"extreme/kappa-shadow", "mean.exr", "is 64x48 but the case renders 32x24"});
+}
+
+TEST_F(RegressCli, UnusableDriverManifestIsNamed)
+{
+    fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8)});
+    expectInputError(regress({"--suite", suite.string(), "--driver", "/nonexistent.json"}),
+                     {"--driver /nonexistent.json", "no such file"});
+    writeText(m_dir / "not-icd.json", "{\"file_format_version\": \"1.0.0\"}\n");
+    expectInputError(regress({"--suite", suite.string(), "--driver", (m_dir / "not-icd.json").string()}),
+                     {"not-icd.json", "not a Vulkan ICD manifest"});
+    writeText(m_dir / "lost.json", "{\"file_format_version\": \"1.0.0\", \"ICD\": {\"library_path\": "
+                                   "\"./build/libvulkan_lvp.so\", \"api_version\": \"1.3.0\"}}\n");
+    expectInputError(regress({"--suite", suite.string(), "--driver", (m_dir / "lost.json").string()}),
+                     {"lost.json", (m_dir / "build/libvulkan_lvp.so").string(), "does not exist"});
+    // A bare library name is the dynamic linker's to find; when it cannot, the
+    // loader fails: a driver failure (exit 1) that still names the manifest.
+    writeText(m_dir / "bare.json", "{\"file_format_version\": \"1.0.0\", \"ICD\": {\"library_path\": "
+                                   "\"libvkrt_no_such_driver.so\", \"api_version\": \"1.3.0\"}}\n");
+    ProcessResult bare = regress({"--suite", suite.string(), "--driver", (m_dir / "bare.json").string()});
+    EXPECT_EQ(bare.exitCode, 1) << bare.output;
+    EXPECT_NE(bare.output.find("--driver " + (m_dir / "bare.json").string() + ": the Vulkan loader could not use"),
+              std::string::npos) << bare.output;
+}
+
+TEST_F(RegressCli, ManifestErrorsNameFileLineAndColumn)
+{
+    ManifestCase c = shipped("extreme/kappa-shadow", 8);
+    fs::path suite = m_dir / "suite.toml";
+    std::string good = manifestText({c});
+    // A misspelt key: reported where it stands, with the key it resembles.
+    writeText(suite, good + "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() + "\"\nreference = \"r\"\n"
+                                "reference_source = \"vkrt\"\nreference_spp = 16\nsp = 4\n");
+    int line = int(std::count(good.begin(), good.end(), '\n')) + 7;
+    expectInputError(regress({"--suite", suite.string()}),
+                     {suite.string() + ":" + std::to_string(line) + ":6", "unknown key 'sp'", "did you mean 'spp'"});
+    // A missing field: reported at its case's table.
+    writeText(suite, "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() + "\"\nreference_source = \"vkrt\"\n"
+                     "reference_spp = 16\nspp = 4\n");
+    expectInputError(regress({"--suite", suite.string()}), {suite.string() + ":", "missing required key 'reference'"});
+    // A value out of range, and a TOML syntax error.
+    writeManifest({c}, "alpha = 1.5");
+    expectInputError(regress({"--suite", suite.string()}), {suite.string() + ":3:9", "suite.alpha", "(0, 1)"});
+    writeText(suite, "[suite\n");
+    expectInputError(regress({"--suite", suite.string()}), {suite.string() + ":1:", "invalid TOML"});
+    expectInputError(regress({"--suite", (m_dir / "nope.toml").string()}), {"--suite", "nope.toml", "no such file"});
+    expectInputError(regress({"--suite", writeManifest({c}).string(), "--filter", "no-such-case"}),
+                     {"--filter no-such-case", "no case"});
+}
+
+// ------------------------------------------------------------ --update
+
+// --update renders the vkrt-made references (never a Mitsuba one, never with a
+// test hook), records how, and the suite then passes against them.
+TEST_F(RegressCli, UpdateMakesReferencesTheSuiteAccepts)
+{
+    ManifestCase made = shipped("extreme/kappa-shadow", 16, "width = 32\nheight = 24");
+    made.reference = m_dir / "made";
+    made.referenceSpp = 256;
+    ManifestCase mitsuba = shipped("extreme/degenerate-lights", 16);
+    mitsuba.reference = copyReference("extreme/degenerate-lights");
+    mitsuba.source = "mitsuba";
+    std::string before = readFile(mitsuba.reference / "mean.exr");
+    fs::path suite = writeManifest({made, mitsuba});
+
+    expectInputError(regress({"--suite", suite.string(), "--update", "--kernel-define", "VKRT_TEST_FRESNEL_SCALE=1.02"}),
+                     {"--update", "--kernel-define"});
+    EXPECT_FALSE(fs::exists(made.reference));
+
+    ProcessResult update = regress({"--suite", suite.string(), "--update"});
+    ASSERT_EQ(update.exitCode, 0) << update.output;
+    ExrContents mean = readExr(made.reference / "mean.exr");
+    EXPECT_EQ(mean.image.width, 32u);
+    EXPECT_EQ(std::get<int64_t>(mean.metadata.at("spp")), 256);
+    EXPECT_EQ(readExr(made.reference / "variance.exr").image.height, 24u);
+    std::string readme = readFile(made.reference / "README.md");
+    EXPECT_NE(readme.find("scenes/extreme/kappa-shadow.toml"), std::string::npos) << readme;
+    EXPECT_NE(readme.find("--filter extreme/kappa-shadow"), std::string::npos) << readme;
+    EXPECT_EQ(readFile(mitsuba.reference / "mean.exr"), before) << "a Mitsuba reference was overwritten";
+
+    ProcessResult run = regress({"--suite", suite.string()});
+    EXPECT_EQ(run.exitCode, 0) << run.output;
+}
+
+// ------------------------------------------------------------ Ctrl-C
+
+// SIGINT once the first case has finished (its JUnit file appears): the run
+// stops within a submission of the second case, exits 130, and the JUnit and
+// report files keep the first case's result.
+TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
+{
+    ManifestCase quick = shipped("extreme/kappa-shadow", 8);
+    ManifestCase endless = shipped("extreme/degenerate-lights", 1000000);
+    fs::path suite = writeManifest({quick, endless}), junit = m_dir / "junit.xml", report = m_dir / "report";
+    std::vector<std::string> args = {"vkrt", "regress", "--suite", suite.string(), "--junit", junit.string(),
+                                     "--report-dir", report.string()};
+    for (const std::string& a : deviceArgs()) args.push_back(a);
+    pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        std::vector<char*> argv;
+        for (std::string& a : args) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        execv(VKRT_BINARY, argv.data());
+        _exit(127);
+    }
+    auto start = std::chrono::steady_clock::now();
+    while (!fs::exists(junit) && std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    bool firstFinished = fs::exists(junit);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500)); // into the second case
+    auto interrupted = std::chrono::steady_clock::now();
+    kill(child, SIGINT);
+    int status = 0;
+    waitpid(child, &status, 0);
+    double stopSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - interrupted).count();
+    ASSERT_TRUE(firstFinished) << "the first case never finished";
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_LT(stopSeconds, 10.0) << "Ctrl-C must stop the case in progress";
+    std::map<std::string, std::string> outcome = junitOutcomes(junit);
+    EXPECT_EQ(outcome, (std::map<std::string, std::string>{{"extreme/kappa-shadow", "pass"}}));
+    std::string md = readFile(report / "report.md");
+    EXPECT_NE(md.find("extreme/kappa-shadow"), std::string::npos);
+    EXPECT_NE(md.find("1 of 2 cases: **interrupted**"), std::string::npos) << md;
+    EXPECT_EQ(md.find("extreme/degenerate-lights |"), std::string::npos) << md;
+}
+
+} // namespace
+} // namespace vkrt::test
