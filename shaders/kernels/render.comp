@@ -50,7 +50,8 @@ void main()
     if (pixel.x >= u.width || pixel.y >= u.height)
         return;
     uint pixelIndex = pixel.y * u.width + pixel.x;
-    Sampler rng = samplerCreate(pixelIndex, frame.frameIndex, frame.seed);
+    uint frameIndex = frame.firstFrame + gl_WorkGroupID.z; // shared/SceneTypes.h: FrameConstants
+    Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? sampleNext2D(rng) : vec2(0.5);
 #ifdef VKRT_INTEGRATOR_PATH
     vec3 radiance = tracePath(cameraRay(pixel, subpixel), rng);
@@ -59,13 +60,13 @@ void main()
 #endif
 #ifdef VKRT_TEST_ALTERNATING_SAMPLES
     // Test hook: samples alternate between OFFSET and OFFSET + 1 frame by frame.
-    radiance = vec3(VKRT_TEST_ALTERNATING_SAMPLES + float(frame.frameIndex & 1u));
+    radiance = vec3(VKRT_TEST_ALTERNATING_SAMPLES + float(frameIndex & 1u));
 #endif
 #ifdef VKRT_TEST_OUTLIER_SAMPLES
     // Test hook: the constant VKRT_TEST_OUTLIER_SAMPLES, except that one
     // (pixel, frame) in 10,000 carries an outlier a million times larger.
     radiance = vec3(VKRT_TEST_OUTLIER_SAMPLES);
-    if ((pixelIndex * 7919u + frame.frameIndex) % 10000u == 0u)
+    if ((pixelIndex * 7919u + frameIndex) % 10000u == 0u)
         radiance *= 1e6;
 #endif
 #ifdef VKRT_TEST_INJECT_NONFINITE

@@ -111,10 +111,13 @@ struct SceneUniforms {
     uvec4 cameraMedia;      // their materials, innermost last
 };
 
-/// Per-dispatch values (push constants). Used only as hash inputs, never in
-/// control flow, so lavapipe never specializes on them.
+/// Per-batch values (push constants), pushed once per submission: lavapipe
+/// re-specializes a kernel whenever push constants change (about 3 ms per
+/// dispatch), so each frame of a batch gets its index from the dispatch's
+/// base workgroup z instead: frame = firstFrame + gl_WorkGroupID.z. Used only
+/// as hash inputs, never in control flow.
 struct FrameConstants {
-    uint frameIndex;
+    uint firstFrame;
     uint seed;
 };
 

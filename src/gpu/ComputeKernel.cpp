@@ -44,7 +44,7 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
     m_pipelineLayout = vk::raii::PipelineLayout(device, layoutInfo);
 
     vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *m_module, "main");
-    m_pipeline = vk::raii::Pipeline(device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *m_pipelineLayout));
+    m_pipeline = vk::raii::Pipeline(device, nullptr, vk::ComputePipelineCreateInfo(vk::PipelineCreateFlagBits::eDispatchBase, stage, *m_pipelineLayout));
 
     m_pool = vk::raii::DescriptorPool(
         device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
@@ -85,8 +85,7 @@ void ComputeKernel::bindStorageImage(uint32_t binding, vk::ImageView view)
     m_context.device().updateDescriptorSets(write, nullptr);
 }
 
-void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants,
-                                   vk::Extent2D groups) const
+void ComputeKernel::recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants) const
 {
     VKRT_CHECK(pushConstants.size() == m_pushConstantSize);
     cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *m_pipeline);
@@ -94,7 +93,18 @@ void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::b
     if (!pushConstants.empty())
         cmd.pushConstants(*m_pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, uint32_t(pushConstants.size()),
                           pushConstants.data());
+}
+
+void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants,
+                                   vk::Extent2D groups) const
+{
+    recordBind(cmd, pushConstants);
     cmd.dispatch(groups.width, groups.height, 1);
+}
+
+void ComputeKernel::recordDispatchAt(vk::CommandBuffer cmd, uint32_t baseZ, vk::Extent2D groups) const
+{
+    cmd.dispatchBase(0, 0, baseZ, groups.width, groups.height, 1);
 }
 
 } // namespace vkrt

@@ -33,6 +33,12 @@ public:
     void bindStorageImage(uint32_t binding, vk::ImageView view);
     /// Records bind + push constants + dispatch of `groups`.
     void recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, vk::Extent2D groups) const;
+    /// Binds the pipeline, descriptor set and push constants once, for a run
+    /// of recordDispatchAt calls (lavapipe re-specializes the kernel each time
+    /// push constants or bindings change).
+    void recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants) const;
+    /// A dispatch whose workgroups see gl_WorkGroupID.z = baseZ.
+    void recordDispatchAt(vk::CommandBuffer cmd, uint32_t baseZ, vk::Extent2D groups) const;
     bool uses(uint32_t binding) const;
     vk::DescriptorType typeOf(uint32_t binding) const;
 

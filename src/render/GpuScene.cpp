@@ -91,22 +91,39 @@ uint32_t tileStrideFor(uint32_t tileCount)
 }
 
 /// The dielectric objects the eye is inside (spheres, boxes, the back side of
-/// planes), outermost first (by size: an enclosing object is larger), at most MEDIUM_STACK_DEPTH of the innermost.
-/// Decided in double on the world coordinates.
+/// planes), outermost first, at most MEDIUM_STACK_DEPTH of the innermost.
+/// Decided in double on the world coordinates. Nesting order comes from the
+/// distance between the eye and each boundary: for A inside B, the eye is
+/// never farther from A's boundary than from B's (the segment to B's nearest
+/// point crosses A's boundary). Of identical (coincident) objects only the
+/// first counts, as the kernel only ever meets the first of them.
 std::vector<uint32_t> mediaAroundCamera(const Scene& scene)
 {
-    std::vector<std::pair<double, uint32_t>> around; // (size, material)
+    std::vector<std::pair<double, uint32_t>> around; // (distance to the boundary, material)
     auto dielectric = [&](uint32_t m) { return scene.materials[m].type == MaterialType::Dielectric; };
     const glm::dvec3 eye = scene.camera.eye;
-    for (const auto& s : scene.spheres)
-        if (dielectric(s.material) && glm::length(eye - s.center) < s.radius) around.push_back({s.radius, s.material});
-    for (const auto& b : scene.boxes)
-        if (dielectric(b.material) && glm::all(glm::greaterThan(eye, b.min)) && glm::all(glm::lessThan(eye, b.max)))
-            around.push_back({glm::length(b.max - b.min), b.material});
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Sphere& s = scene.spheres[i];
+        double depth = s.radius - glm::length(eye - s.center);
+        bool repeated = std::any_of(scene.spheres.begin(), scene.spheres.begin() + long(i), [&](const Sphere& o) {
+            return dielectric(o.material) && o.center == s.center && o.radius == s.radius;
+        });
+        if (dielectric(s.material) && depth > 0.0 && !repeated) around.push_back({depth, s.material});
+    }
+    for (size_t i = 0; i < scene.boxes.size(); ++i) {
+        const Box& b = scene.boxes[i];
+        glm::dvec3 margin = glm::min(eye - b.min, b.max - eye);
+        double depth = std::min(margin.x, std::min(margin.y, margin.z));
+        bool repeated = std::any_of(scene.boxes.begin(), scene.boxes.begin() + long(i), [&](const Box& o) {
+            return dielectric(o.material) && o.min == b.min && o.max == b.max;
+        });
+        if (dielectric(b.material) && depth > 0.0 && !repeated) around.push_back({depth, b.material});
+    }
     // A dielectric plane bounds a half-space of glass behind its normal.
-    for (const auto& p : scene.planes)
-        if (dielectric(p.material) && glm::dot(eye - p.point, p.normal) < 0.0)
-            around.push_back({std::numeric_limits<double>::infinity(), p.material});
+    for (const auto& p : scene.planes) {
+        double depth = -glm::dot(eye - p.point, p.normal);
+        if (dielectric(p.material) && depth > 0.0) around.push_back({depth, p.material});
+    }
     std::stable_sort(around.begin(), around.end(), [](auto& a, auto& b) { return a.first > b.first; });
     if (around.size() > gpu::MEDIUM_STACK_DEPTH) around.erase(around.begin(), around.end() - gpu::MEDIUM_STACK_DEPTH);
     std::vector<uint32_t> materials;

@@ -177,24 +177,32 @@ void Renderer::moveCamera(const Camera& camera)
     reset();
 }
 
-void Renderer::recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const
+// One bind and push per run of frames; frame i of the run is the dispatch
+// with base workgroup z = i (shared/SceneTypes.h: FrameConstants).
+void Renderer::recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const
 {
-    gpu::FrameConstants constants{frameIndex, m_options.seed};
+    gpu::FrameConstants constants{firstFrame, m_options.seed};
     uint32_t tilesX = (width() + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
     uint32_t tilesY = (height() + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
-    m_kernel.recordDispatch(cmd, bytesOf(constants), vk::Extent2D(tilesX, tilesY));
-    // The next frame reads and writes the same accumulation pixels.
-    vk::MemoryBarrier barrier(vk::AccessFlagBits::eShaderWrite,
-                              vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
-    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
-                        barrier, nullptr, nullptr);
+    m_kernel.recordBind(cmd, bytesOf(constants));
+    for (uint32_t i = 0; i < count; ++i) {
+        m_kernel.recordDispatchAt(cmd, i, vk::Extent2D(tilesX, tilesY));
+        // The next frame reads and writes the same accumulation pixels.
+        vk::MemoryBarrier barrier(vk::AccessFlagBits::eShaderWrite,
+                                  vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+        cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
+                            barrier, nullptr, nullptr);
+    }
 }
 
 void Renderer::renderFrames(uint32_t frames)
 {
     if (frames == 0) return;
+    // Base z + 1 must stay within maxComputeWorkGroupCount[2] (>= 65535).
+    const uint32_t maxRun = std::min<uint32_t>(4096, m_context.physicalDevice().getProperties().limits.maxComputeWorkGroupCount[2]);
     m_context.submitAndWait([&](vk::CommandBuffer cmd) {
-        for (uint32_t i = 0; i < frames; ++i) recordFrame(cmd, m_frames + i);
+        for (uint32_t done = 0; done < frames; done += maxRun)
+            recordFrames(cmd, m_frames + done, std::min(maxRun, frames - done));
     });
     m_frames += frames;
 }
@@ -202,7 +210,11 @@ void Renderer::renderFrames(uint32_t frames)
 void Renderer::warmUp()
 {
     VKRT_CHECK(m_frames == 0);
-    renderFrames(1);
+    // One workgroup is enough to make lavapipe compile the kernel.
+    m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+        m_kernel.recordBind(cmd, bytesOf(gpu::FrameConstants{0, m_options.seed}));
+        m_kernel.recordDispatchAt(cmd, 0, vk::Extent2D(1, 1));
+    });
     reset();
 }
 

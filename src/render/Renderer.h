@@ -86,7 +86,7 @@ private:
 
     void bindEnvironment();
     void uploadSceneBuffers();
-    void recordFrame(vk::CommandBuffer cmd, uint32_t frameIndex) const;
+    void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
 };
 
 /// Worst-case loop iterations one invocation of the scene's kernel can run.

@@ -61,7 +61,7 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, tileCount), BLOCK_MEMBER(u, SceneUniforms, tileStride),
         BLOCK_MEMBER(u, SceneUniforms, environmentSize), BLOCK_MEMBER(u, SceneUniforms, cameraMediumCount),
         BLOCK_MEMBER(u, SceneUniforms, cameraMedia),
-        BLOCK_MEMBER(frame, FrameConstants, frameIndex), BLOCK_MEMBER(frame, FrameConstants, seed),
+        BLOCK_MEMBER(frame, FrameConstants, firstFrame), BLOCK_MEMBER(frame, FrameConstants, seed),
     };
 }
 
