@@ -21,6 +21,10 @@ uvec4 pcg4d(uvec4 v)
     return v;
 }
 
+#ifdef VKRT_SAMPLER_SOBOL
+// Owen-scrambled Sobol' points instead (`--sampler sobol`), same interface.
+#include "lib/sobol.glsl"
+#else
 struct Sampler {
     uint pixelIndex;
     uint frameIndex;
@@ -45,5 +49,7 @@ vec4 sampleNext4D(inout Sampler s)
 
 vec2 sampleNext2D(inout Sampler s) { return sampleNext4D(s).xy; }
 float sampleNext1D(inout Sampler s) { return sampleNext4D(s).x; }
+
+#endif // VKRT_SAMPLER_SOBOL
 
 #endif

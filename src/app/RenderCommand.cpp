@@ -46,9 +46,13 @@ struct RenderCommandOptions {
     std::string report;
     std::string reference;
     bool sppGiven = false;
+    std::string sampler = "auto";
 
     /// Variance is needed for the layer, the report and the target-error rule.
     bool needsVariance() const { return variance || targetError || !report.empty(); }
+    /// "auto": Sobol' (lower error) unless an error estimate is asked for,
+    /// which needs independent samples.
+    std::string resolvedSampler() const { return sampler != "auto" ? sampler : needsVariance() ? "independent" : "sobol"; }
     /// --spp caps the render; without it a time or error rule may run long.
     uint32_t maxSpp() const { return sppGiven || !(timeBudget || targetError) ? spp : (1u << 30); }
 };
@@ -94,6 +98,7 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
         {"sceneHash", "fnv1a64:" + toHex(scene.fileHash)},
         {"integrator", integratorName(scene.render.integrator)},
         {"kernelVariant", renderer.features().describe() + (options.uber ? " (uber)" : "")},
+        {"sampler", options.resolvedSampler()},
         {"rejectedSamples", int64_t(counters.rejectedSamples)},
     };
     if (estimated) {
@@ -161,6 +166,7 @@ int runRender(const RenderCommandOptions& options)
     renderOptions.jitter = !options.pixelCenters;
     renderOptions.uber = options.uber;
     renderOptions.variance = options.needsVariance();
+    renderOptions.sobol = options.resolvedSampler() == "sobol";
     std::optional<Image> reference = loadReference(options, scene);
     Renderer renderer(context, scene, renderOptions);
     renderer.warmUp();
@@ -251,7 +257,18 @@ CommandRunner addRenderCommand(CLI::App& app)
         ->needs(cmd->get_option("--report"));
     cmd->add_flag("--variance", options->variance,
                   "Also estimate per-pixel variance and write the variance of each pixel's mean as layer 'variance'");
-    return [options] { return runRender(*options); };
+    cmd->add_option("--sampler", options->sampler,
+                    "auto (default: sobol unless --variance, --report or --target-error), independent, or sobol "
+                    "(Owen-scrambled Sobol' points: lower error, no variance estimate)")
+        ->check(CLI::IsMember({"auto", "independent", "sobol"}));
+    return [options] {
+        // Per-pixel variance from frames assumes they are independent; under
+        // QMC it is wrong (docs/convergence.md), so refuse rather than mislead.
+        if (options->sampler == "sobol" && options->needsVariance())
+            throw InputError("--sampler sobol cannot be combined with --variance, --report or --target-error: "
+                             "their error estimate assumes independent samples (use --sampler independent)");
+        return runRender(*options);
+    };
 }
 
 } // namespace vkrt

@@ -19,6 +19,10 @@ FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
     checkLoopBudget(scene); // before any compilation or allocation
     FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     features.variance = options.variance;
+    // The per-frame variance estimate assumes independent frames; QMC frames
+    // are not (docs/convergence.md), so the two are never combined.
+    VKRT_CHECK(!(options.sobol && options.variance));
+    features.sobolSampler = options.sobol;
     features.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
     return features;
 }

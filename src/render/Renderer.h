@@ -20,6 +20,7 @@ struct RenderOptions {
     bool jitter = true;
     bool uber = false;                 ///< all-features kernel instead of the scene's variant
     bool variance = false;             ///< also estimate per-pixel variance (a kernel-variant flag)
+    bool sobol = false;                ///< Owen-scrambled Sobol' sampler (no per-pixel variance estimate)
     bool storageScene = false;         ///< scene arrays in storage buffers even when they fit uniform ones
     std::vector<Define> extraDefines;  ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();

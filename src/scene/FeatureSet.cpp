@@ -29,6 +29,7 @@ constexpr OptionalFeature kOptionalFeatures[] = {
     {&FeatureSet::environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
      "environment-sampling"},
     {&FeatureSet::variance, "VKRT_VARIANCE", int(gpu::BINDING_MOMENTS), "variance"},
+    {&FeatureSet::sobolSampler, "VKRT_SAMPLER_SOBOL", -1, "sobol"},
 };
 
 std::string upper(std::string text)
@@ -57,7 +58,8 @@ FeatureSet FeatureSet::everything(Integrator integrator)
 {
     FeatureSet all;
     for (const auto& feature : kOptionalFeatures) all.*feature.flag = true;
-    all.variance = false; // a render option, not scene content
+    all.variance = false; // render options, not scene content
+    all.sobolSampler = false;
     all.environmentSampling = integrator == Integrator::Path;
     all.materialTypes.fill(true);
     all.integrator = integrator;

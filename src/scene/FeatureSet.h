@@ -21,6 +21,7 @@ struct FeatureSet {
     bool cubemap = false;
     bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
     bool variance = false; ///< per-pixel variance estimation (not a scene property: a render option)
+    bool sobolSampler = false; ///< Owen-scrambled Sobol' points instead of independent ones (a render option)
     bool uniformScene = false; ///< scene arrays in uniform buffers: every array fits (shared/SceneTypes.h)
     std::array<bool, 5> materialTypes{}; ///< indexed by MaterialType
     Integrator integrator = Integrator::Whitted;

@@ -84,6 +84,25 @@ TEST_F(RenderCli, WritesExrWithMetadataAndPng)
     EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
 }
 
+// --sampler auto: Sobol' for a plain render, independent samples as soon as an
+// error estimate is needed; an explicit sobol with one is refused.
+TEST_F(RenderCli, SamplerAutoPicksSobolUnlessAnErrorEstimateIsNeeded)
+{
+    ASSERT_EQ(render("plain.exr", {"--spp", "2"}).exitCode, 0);
+    EXPECT_EQ(std::get<std::string>(readExr(m_dir / "plain.exr").metadata.at("sampler")), "sobol");
+    ASSERT_EQ(render("var.exr", {"--spp", "2", "--variance"}).exitCode, 0);
+    ExrContents withVariance = readExr(m_dir / "var.exr");
+    EXPECT_EQ(std::get<std::string>(withVariance.metadata.at("sampler")), "independent");
+    ProcessResult refused = render("no.exr", {"--spp", "2", "--sampler", "sobol", "--variance"});
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_NE(refused.output.find("--sampler sobol cannot be combined with --variance"), std::string::npos)
+        << refused.output;
+    EXPECT_FALSE(fs::exists(m_dir / "no.exr"));
+    ProcessResult unknown = render("no.exr", {"--sampler", "halton"});
+    EXPECT_EQ(unknown.exitCode, 2);
+    EXPECT_NE(unknown.output.find("--sampler"), std::string::npos) << unknown.output;
+}
+
 TEST_F(RenderCli, VarianceOptionWritesAVarianceLayer)
 {
     ASSERT_EQ(render("v.exr", {"--spp", "4", "--variance"}).exitCode, 0);
