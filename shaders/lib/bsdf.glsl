@@ -84,6 +84,8 @@ BsdfSample samplePhong(Material m, vec3 n, vec3 wo, vec3 u)
     if (cosI <= 0.0)
         return noScatter();
     float pdf = pd * cosI * INV_PI + (1.0 - pd) * phongLobePdf(dot(r, wi), m.exponent);
+    if (!(pdf > 0.0))
+        return noScatter(); // a lobe sample rounded onto the lobe's edge
     return BsdfSample(wi, evalBsdf(m, n, wo, wi) * cosI / pdf, false, false);
 }
 #endif

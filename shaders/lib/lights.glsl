@@ -98,10 +98,14 @@ vec3 emittedRadiance(TriangleLight light, vec3 towards)
 
 // Power-heuristic weight (Veach 1997, eq. 9.13) of a strategy with density
 // `pdf` against another with density `other`, one sample each.
+// Written as 1 / (1 + (other / pdf)^2): squaring a huge pdf (a light seen
+// almost edge-on) would overflow to inf / inf = NaN.
 float powerHeuristic(float pdf, float other)
 {
-    float a = pdf * pdf, b = other * other;
-    return a > 0.0 ? a / (a + b) : 0.0;
+    if (!(pdf > 0.0))
+        return 0.0;
+    float ratio = other / pdf;
+    return isinf(pdf) ? (isinf(other) ? 0.5 : 1.0) : 1.0 / (1.0 + ratio * ratio);
 }
 
 // Density in solid angle of sampling `light` uniformly by area, seen from a
