@@ -182,6 +182,7 @@ void Viewer::createRenderer()
     RenderOptions options;
     options.seed = m_options.seed;
     options.variance = m_options.variance;
+    options.sobol = !m_options.variance; // as `vkrt render --sampler auto`
     m_renderer = std::make_unique<Renderer>(m_context, m_scene, options);
     m_display = std::make_unique<DisplayPass>(m_context, m_renderer->accumulation(), m_renderer->width(),
                                               m_renderer->height());

@@ -55,8 +55,7 @@ TEST_F(ViewCli, ScreenshotMatchesRenderAfterToneMapping)
     ProcessResult view = runViewer({kScene, "--frames", "16", "--screenshot", (m_dir / "view.png").string(), "--width",
                                     "160", "--height", "120", "--seed", "4", "--validation"});
     ASSERT_EQ(view.exitCode, 0) << view.output;
-    ProcessResult render = runVkrt({"render", kScene, "--sampler", "independent", // the viewer's sampler
-                                    "--spp", "16", "--width", "160", "--height", "120", "--seed", "4",
+    ProcessResult render = runVkrt({"render", kScene, "--spp", "16", "--width", "160", "--height", "120", "--seed", "4",
                                     "-o", (m_dir / "r.exr").string(), "--png", (m_dir / "render.png").string()});
     ASSERT_EQ(render.exitCode, 0) << render.output;
     int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
