@@ -2,7 +2,8 @@
 """vkrt (Vulkan, here lavapipe) against Mitsuba 3 on the same scenes, side by side.
 
     tools/bench_vs_mitsuba.sh [--runs 3] [--spp 128] [--scenes A.toml B.toml ...] [--quick]
-                              [--variant llvm_ad_rgb|scalar_rgb] [--no-cold] [--markdown FILE] [--json FILE]
+                              [--variant llvm_ad_rgb|scalar_rgb] [--vkrt-sampler auto|sobol|independent]
+                              [--no-cold] [--markdown FILE] [--json FILE]
 
 Run it through tools/bench_vs_mitsuba.sh, which starts this file with the
 Python of .venv-mitsuba (made by tools/make_reference.py).
@@ -27,6 +28,12 @@ cache, Mesa's shader cache, Dr.Jit's kernel cache). Per run and renderer:
 * latency: 64 spp at 320x240, whole process;
 * first:   1 spp at 320x240, whole process (start-up to the first finished
            frame, written to disk), and vkrt's own `vkrt info` first-frame time.
+
+vkrt renders are plain `vkrt render` calls (no --variance/--report/
+--target-error), so vkrt's default sampler applies: with --sampler auto that
+is the Owen-scrambled Sobol' sampler. --vkrt-sampler independent|sobol passes
+--sampler to vkrt explicitly (independent: the throughput levers alone; auto
+passes nothing, so binaries older than --sampler still work).
 
 Efficiency = 1 / (median MSE x median whole-process seconds of `main`); its
 ratio vkrt/Mitsuba is Mitsuba's MSE x seconds over vkrt's (4 = half the RMSE in
@@ -332,6 +339,8 @@ class Runner:
     def vkrt_render(self, scene: Scene, size, spp, seed, out, env=None):
         cmd = [self.vkrt, "render", str(scene.vkrt_path), "-o", str(out), "--spp", str(spp),
                "--width", str(size[0]), "--height", str(size[1]), "--seed", str(seed)]
+        if self.args.vkrt_sampler != "auto":
+            cmd += ["--sampler", self.args.vkrt_sampler]
         whole, text = self._run(cmd, env, "vkrt render")
         m = SUMMARY.search(text)
         if not m:
@@ -459,6 +468,9 @@ def main(argv) -> int:
                     help="skip scenes Mitsuba cannot render instead of deriving a path-traced approximation")
     ap.add_argument("--vkrt", default=os.environ.get("VKRT", str(REPO / "build" / "vkrt")),
                     help="vkrt binary (default: $VKRT, else build/vkrt)")
+    ap.add_argument("--vkrt-sampler", default="auto", choices=["auto", "sobol", "independent"],
+                    help="vkrt's --sampler (default %(default)s: no flag, vkrt's own default, which is Sobol' "
+                         "for these plain renders; independent: without the Sobol' sampler)")
     ap.add_argument("--envmap-width", type=int, default=2048,
                     help="width of the equirectangular map Mitsuba gets for a cubemap (default %(default)s; "
                          "tools/to_mitsuba.py's own default, up to 8192, would make Mitsuba load a map of up "
@@ -605,10 +617,14 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
     device = subprocess.run([args.vkrt, "devices"], capture_output=True, text=True).stdout.splitlines()
     device = next((d.split(":", 1)[1].strip().split(" (CPU")[0] for d in device if d.startswith("*")), "?")
     command = "tools/bench_vs_mitsuba.sh " + " ".join(sys.argv[1:])
+    sampler = subprocess.run([args.vkrt, "render", "--help"], capture_output=True, text=True).stdout
+    sampler = (("--sampler " + args.vkrt_sampler) if args.vkrt_sampler != "auto" else
+               "vkrt's default (--sampler auto: Sobol' for plain renders)" if "--sampler" in sampler else
+               "independent (this vkrt has no --sampler option)")
     lines = [
         f"- date: {date}; {os.cpu_count()} cores ({cpu}); 1-minute load average {load_start[0]:.1f} at the start, "
         f"{os.getloadavg()[0]:.1f} at the end; timed part {elapsed / 60:.1f} min",
-        f"- vkrt: `{args.vkrt}` on {device}",
+        f"- vkrt: `{args.vkrt}` on {device}; sampler: {sampler}",
         f"- Mitsuba {mi.__version__} (Dr.Jit {drjit.__version__}), variant **{args.variant}**"
         + (f", DRJIT_LIBLLVM_PATH={args.libllvm}" if args.libllvm and args.variant.startswith("llvm") else ""),
         f"- command: `{command}`",
