@@ -6,20 +6,7 @@
 #ifndef VKRT_RANDOM_GLSL
 #define VKRT_RANDOM_GLSL
 
-uvec4 pcg4d(uvec4 v)
-{
-    v = v * 1664525u + 1013904223u;
-    v.x += v.y * v.w;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v.w += v.y * v.z;
-    v ^= v >> 16u;
-    v.x += v.y * v.w;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v.w += v.y * v.z;
-    return v;
-}
+#include "lib/pcg.glsl"
 
 #ifdef VKRT_SAMPLER_SOBOL
 // Owen-scrambled Sobol' points instead (`--sampler sobol`), same interface.

@@ -32,6 +32,8 @@
 #ifndef VKRT_SOBOL_GLSL
 #define VKRT_SOBOL_GLSL
 
+#include "lib/pcg.glsl"
+
 #ifndef VKRT_SOBOL_BATCHES
 #define VKRT_SOBOL_BATCHES 1
 #endif
@@ -118,23 +120,6 @@ uint sobolShuffle(uint index, uint seed)
     return bitfieldReverse(laineKarrasPermutation(uvec4(bitfieldReverse(index)), uvec4(seed)).x) & SOBOL_INDEX_MASK;
 }
 
-/// pcg4d (Jarzynski & Olano, JCGT 2020), as in lib/random.glsl; named apart so
-/// that both files can be included into one kernel.
-uvec4 sobolSeedHash(uvec4 v)
-{
-    v = v * 1664525u + 1013904223u;
-    v.x += v.y * v.w;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v.w += v.y * v.z;
-    v ^= v >> 16u;
-    v.x += v.y * v.w;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v.w += v.y * v.z;
-    return v;
-}
-
 /// lowbias32 (C. Wellons, "Hash function prospector", 2018): a bijective mixer.
 uint sobolMix(uint x)
 {
@@ -170,7 +155,7 @@ vec4 sampleNext4D(inout Sampler s)
 {
     uint batch = s.frameIndex % uint(VKRT_SOBOL_BATCHES);
     uint index = s.frameIndex / uint(VKRT_SOBOL_BATCHES);
-    uvec4 scrambleSeeds = sobolSeedHash(uvec4(s.pixelIndex, s.dimension, s.seed, batch));
+    uvec4 scrambleSeeds = pcg4d(uvec4(s.pixelIndex, s.dimension, s.seed, batch));
     // pcg4d is a bijection, so a fifth seed is a function of these four in any
     // case; mixing their xor gives one unrelated to each of them.
     uint shuffleSeed = sobolMix(scrambleSeeds.x ^ scrambleSeeds.y ^ scrambleSeeds.z ^ scrambleSeeds.w);

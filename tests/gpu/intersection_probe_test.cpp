@@ -39,14 +39,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Helpers
 
 /// Records a measured statistic in the test's XML properties and prints it.
-void report(const std::string& name, double value)
-{
-    std::ostringstream text;
-    text << std::setprecision(6) << value;
-    ::testing::Test::RecordProperty(name, text.str());
-    std::cout << "[   STAT   ] " << name << " = " << text.str() << std::endl;
-}
-
 std::string str(const glm::vec3& v)
 {
     std::ostringstream text;
@@ -468,9 +460,9 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     int64_t total = 0;
     for (int kind = 0; kind < 4; ++kind)
         for (int mode = 0; mode < 3; ++mode) {
-            report(std::string("Failures_") + kKindNames[kind] + "_" + kModeNames[mode], double(failures[kind][mode]));
-            report(std::string("Tested_") + kKindNames[kind] + "_" + kModeNames[mode], double(tested[kind][mode]));
-            report(std::string("FailuresWithFlippedSide_") + kKindNames[kind] + "_" + kModeNames[mode], double(failuresWithFlip[kind][mode]));
+            reportStat(std::string("Failures_") + kKindNames[kind] + "_" + kModeNames[mode], double(failures[kind][mode]));
+            reportStat(std::string("Tested_") + kKindNames[kind] + "_" + kModeNames[mode], double(tested[kind][mode]));
+            reportStat(std::string("FailuresWithFlippedSide_") + kKindNames[kind] + "_" + kModeNames[mode], double(failuresWithFlip[kind][mode]));
             EXPECT_EQ(failures[kind][mode], 0) << kKindNames[kind] << " " << kModeNames[mode];
             EXPECT_GT(tested[kind][mode], 84 * kRays / 4 / 2) << kKindNames[kind] << " " << kModeNames[mode];
             total += failures[kind][mode];
@@ -484,14 +476,14 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     // The side comes from which sphere root was taken (box: entry or exit), not from
     // the sign of dot(normal, dir), which rounding flips for grazing hits far away.
     for (int kind = 0; kind < 4; ++kind) {
-        report(std::string("FlippedSide_") + kKindNames[kind], double(flips[kind]));
+        reportStat(std::string("FlippedSide_") + kKindNames[kind], double(flips[kind]));
         EXPECT_EQ(flips[kind], 0) << "primary hits whose side disagrees with the geometry: " << kKindNames[kind];
     }
-    report("SelfIntersectionFailures", double(total));
-    report("NonFiniteSurfacePoints", double(nonFinite));
+    reportStat("SelfIntersectionFailures", double(total));
+    reportStat("NonFiniteSurfacePoints", double(nonFinite));
     EXPECT_EQ(nonFinite, 0);
-    report("PrimaryMisses", double(primaryMisses));
-    report("TransmitSkipped", double(transmitSkipped));
+    reportStat("PrimaryMisses", double(primaryMisses));
+    reportStat("TransmitSkipped", double(transmitSkipped));
     EXPECT_EQ(wrongHemisphere, 0);
     EXPECT_EQ(configsTooFewHits, 0);
 }
@@ -665,11 +657,11 @@ TEST_F(IntersectionProbeSilhouette, HitOrMissMatchesExactDistanceOutsideTinyBand
     EXPECT_EQ(outsideBand, 0) << "band " << kSilhouetteBand << " r";
     EXPECT_EQ(badDistance, 0) << "worst relative distance error " << worstDistanceError;
     EXPECT_GT(naiveOutsideBand, int64_t(queries.size()) / 10) << "the naive discriminant would pass";
-    report("SilhouetteNaiveFormMisclassifiedOutsideBand", double(naiveOutsideBand));
-    report("SilhouetteRays", double(queries.size()));
-    report("SilhouetteMisclassified", double(misclassified));
-    report("SilhouetteWorstBandOverR", worstBand);
-    report("SilhouetteWorstRelativeDistanceError", worstDistanceError);
+    reportStat("SilhouetteNaiveFormMisclassifiedOutsideBand", double(naiveOutsideBand));
+    reportStat("SilhouetteRays", double(queries.size()));
+    reportStat("SilhouetteMisclassified", double(misclassified));
+    reportStat("SilhouetteWorstBandOverR", worstBand);
+    reportStat("SilhouetteWorstRelativeDistanceError", worstDistanceError);
 }
 
 // ---------------------------------------------------------------------------
@@ -888,20 +880,20 @@ TEST_F(IntersectionProbeWatertight, SharedTriangleEdgeNeverLeaks)
     for (int kind = 0; kind < 2; ++kind) {
         std::string name = kind ? "Exact" : "FloatAimed";
         EXPECT_EQ(leaks[kind], 0) << name;
-        report("SharedEdge" + name + "MustHitRays", double(mustHit[kind]));
-        report("SharedEdge" + name + "Leaks", double(leaks[kind]));
-        report("SharedEdge" + name + "NearBoundaryRays", double(excluded[kind]));
-        report("SharedEdge" + name + "NearBoundaryMisses", double(excludedMisses[kind]));
+        reportStat("SharedEdge" + name + "MustHitRays", double(mustHit[kind]));
+        reportStat("SharedEdge" + name + "Leaks", double(leaks[kind]));
+        reportStat("SharedEdge" + name + "NearBoundaryRays", double(excluded[kind]));
+        reportStat("SharedEdge" + name + "NearBoundaryMisses", double(excludedMisses[kind]));
     }
     // The exclusion leaves most rays in: well over 20,000 of each kind must hit.
     EXPECT_GT(mustHit[0], 30000);
     EXPECT_GT(mustHit[1], 15000);
     EXPECT_EQ(badDistance, 0) << "worst error / tolerance " << worstDistance;
-    report("SharedEdgeHitBoth", double(both));
-    report("SharedEdgeMollerFloatLeaks", double(mollerLeaks));
+    reportStat("SharedEdgeHitBoth", double(both));
+    reportStat("SharedEdgeMollerFloatLeaks", double(mollerLeaks));
     // Control: the same rays leak through a plain float Moller-Trumbore pair.
     EXPECT_GT(mollerLeaks, 100);
-    report("SharedEdgeWorstDistanceErrorOverTolerance", worstDistance);
+    reportStat("SharedEdgeWorstDistanceErrorOverTolerance", worstDistance);
 }
 
 struct ExactBox {
@@ -982,12 +974,12 @@ TEST_F(IntersectionProbeWatertight, RaysThroughBoxEdgesAndCornersHit)
     EXPECT_EQ(misses[0], 0) << "of " << counts[0] << " edge rays";
     EXPECT_EQ(misses[1], 0) << "of " << counts[1] << " corner rays";
     EXPECT_EQ(badDistance, 0) << "worst relative distance error " << worstDistanceError;
-    report("BoxEdgeRays", double(counts[0]));
-    report("BoxEdgeMisses", double(misses[0]));
-    report("BoxCornerRays", double(counts[1]));
-    report("BoxCornerMisses", double(misses[1]));
-    report("BoxEdgeWorstRelativeDistanceError", worstDistanceError);
-    report("BoxEdgeMissesWithoutWidening", double(unwidenedMisses));
+    reportStat("BoxEdgeRays", double(counts[0]));
+    reportStat("BoxEdgeMisses", double(misses[0]));
+    reportStat("BoxCornerRays", double(counts[1]));
+    reportStat("BoxCornerMisses", double(misses[1]));
+    reportStat("BoxEdgeWorstRelativeDistanceError", worstDistanceError);
+    reportStat("BoxEdgeMissesWithoutWidening", double(unwidenedMisses));
     // Control: without the widening of tFar by 1 + 2 gamma(3) these rays do miss.
     EXPECT_GT(unwidenedMisses, 100);
 }
@@ -1054,9 +1046,9 @@ TEST_F(IntersectionProbeWatertight, EdgeBetweenBoxesSharingAFaceNeverLeaks)
     }
     EXPECT_EQ(leaks, 0);
     EXPECT_EQ(badDistance, 0) << "worst relative distance error " << worstDistanceError;
-    report("SharedBoxEdgeRays", double(expected.size()));
-    report("SharedBoxEdgeLeaks", double(leaks));
-    report("SharedBoxEdgeWorstRelativeDistanceError", worstDistanceError);
+    reportStat("SharedBoxEdgeRays", double(expected.size()));
+    reportStat("SharedBoxEdgeLeaks", double(leaks));
+    reportStat("SharedBoxEdgeWorstRelativeDistanceError", worstDistanceError);
 }
 
 // ---------------------------------------------------------------------------
@@ -1170,9 +1162,9 @@ TEST_F(IntersectionProbeDegenerate, CollinearAndRepeatedVertexTrianglesAreNeverH
         EXPECT_EQ(hits[kind], 0) << name << ": of " << rays[kind] << " rays";
         EXPECT_EQ(rendererHits[kind], 0) << name << ": of " << rays[kind] << " rays (findClosest)";
         EXPECT_EQ(nonFiniteHits[kind], 0) << name << ": non-finite hit point, normal or spawned ray";
-        report(name + "Rays", double(rays[kind]));
-        report(name + "Hits", double(hits[kind]));
-        report(name + "NonFiniteHits", double(nonFiniteHits[kind]));
+        reportStat(name + "Rays", double(rays[kind]));
+        reportStat(name + "Hits", double(hits[kind]));
+        reportStat(name + "NonFiniteHits", double(nonFiniteHits[kind]));
     }
     EXPECT_EQ(nonFinite, 0);
 }
@@ -1288,10 +1280,10 @@ TEST_F(IntersectionProbeZeroComponents, BoxHitMissAndDistanceMatchReference)
     EXPECT_GT(onBoundHits[1], 1000);
     EXPECT_GT(onBoundHits[2], 500);
     EXPECT_GT(onBoundHits[3], 100);
-    report("ZeroComponentBoxRays", double(queries.size()));
-    report("ZeroComponentBoxHits", double(hits));
-    report("ZeroComponentBoxWrong", double(wrong));
-    report("ZeroComponentBoxWorstRelativeDistanceError", worstDistanceError);
+    reportStat("ZeroComponentBoxRays", double(queries.size()));
+    reportStat("ZeroComponentBoxHits", double(hits));
+    reportStat("ZeroComponentBoxWrong", double(wrong));
+    reportStat("ZeroComponentBoxWorstRelativeDistanceError", worstDistanceError);
 }
 
 // The same directions against an axis-aligned triangle and plane: rays in their
@@ -1364,10 +1356,10 @@ TEST_F(IntersectionProbeZeroComponents, TriangleAndPlaneWithAxisDirections)
     EXPECT_EQ(wrong, 0);
     EXPECT_EQ(badDistance, 0);
     EXPECT_GT(hits, 1000);
-    report("ZeroComponentTrianglePlaneRays", double(queries.size()));
-    report("ZeroComponentTrianglePlaneWrong", double(wrong));
-    report("OriginInPlaneHitsAtTinyT", double(onPlaneTinyHits));
-    report("OriginInPlaneWorstT", worstOnPlaneT);
+    reportStat("ZeroComponentTrianglePlaneRays", double(queries.size()));
+    reportStat("ZeroComponentTrianglePlaneWrong", double(wrong));
+    reportStat("OriginInPlaneHitsAtTinyT", double(onPlaneTinyHits));
+    reportStat("OriginInPlaneWorstT", worstOnPlaneT);
 }
 
 } // namespace

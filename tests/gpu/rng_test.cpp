@@ -33,14 +33,6 @@
 namespace vkrt::test {
 namespace {
 
-void report(const std::string& name, double value)
-{
-    std::ostringstream text;
-    text << std::setprecision(6) << value;
-    ::testing::Test::RecordProperty(name, text.str());
-    std::cout << "[   STAT   ] " << name << " = " << text.str() << std::endl;
-}
-
 // ---------------------------------------------------------------------------
 // pcg4d and its inverse
 
@@ -60,21 +52,7 @@ constexpr uint32_t inverseOdd(uint32_t a)
 constexpr uint32_t kMultiplierInverse = inverseOdd(kMultiplier);
 static_assert(kMultiplier * kMultiplierInverse == 1u);
 
-/// lib/random.glsl's pcg4d, line by line.
-U4 pcg4d(U4 v)
-{
-    for (uint32_t& x : v) x = x * kMultiplier + kIncrement;
-    v[0] += v[1] * v[3];
-    v[1] += v[2] * v[0];
-    v[2] += v[0] * v[1];
-    v[3] += v[1] * v[2];
-    for (uint32_t& x : v) x ^= x >> 16u;
-    v[0] += v[1] * v[3];
-    v[1] += v[2] * v[0];
-    v[2] += v[0] * v[1];
-    v[3] += v[1] * v[2];
-    return v;
-}
+U4 pcg4d(U4 v) { return pcg4dReference(v); }
 
 /// Undoes the four lane updates: the last one first, each given the other lanes.
 void unmix(U4& v)
@@ -160,8 +138,8 @@ TEST_F(RngProbe, NoSeedCollisionsOverPixelsAndFrames)
         }
         EXPECT_EQ(mismatches, 0) << "dimension " << dimension;
         EXPECT_EQ(badChecksums, 0) << "dimension " << dimension;
-        report("PairsChecked_dimension" + std::to_string(dimension), double(kPixels) * kFrames);
-        report("Collisions_dimension" + std::to_string(dimension), double(mismatches));
+        reportStat("PairsChecked_dimension" + std::to_string(dimension), double(kPixels) * kFrames);
+        reportStat("Collisions_dimension" + std::to_string(dimension), double(mismatches));
     }
 }
 
@@ -212,7 +190,7 @@ TEST_F(RngProbe, GpuPcg4dMatchesCpu)
         if (gpu[i] != pcg4d(inputs[i]) && mismatches++ < 5)
             ADD_FAILURE() << "pcg4d" << hex(inputs[i]) << ": GPU " << hex(gpu[i]) << ", C++ " << hex(pcg4d(inputs[i]));
     EXPECT_EQ(mismatches, 0) << "of " << inputs.size();
-    report("Pcg4dInputsCompared", double(inputs.size()));
+    reportStat("Pcg4dInputsCompared", double(inputs.size()));
 }
 
 // ---------------------------------------------------------------------------
@@ -368,10 +346,10 @@ TEST_F(RngProbe, DrawsAreUncorrelatedAlongFramesAndAcrossPixels)
         EXPECT_GE(c.n, 1000000) << c.name;
     }
     failedCorrelations(gpu, true);
-    report("FrameLag1Correlation", all[0].r);
-    report("RightNeighbourCorrelation", all[1].r);
-    report("LowerNeighbourCorrelation", all[2].r);
-    report("CorrelationBound", all[0].bound());
+    reportStat("FrameLag1Correlation", all[0].r);
+    reportStat("RightNeighbourCorrelation", all[1].r);
+    reportStat("LowerNeighbourCorrelation", all[2].r);
+    reportStat("CorrelationBound", all[0].bound());
 }
 
 TEST_F(RngProbe, UniformDrawsHaveMeanOneHalfAndVarianceOneTwelfth)
@@ -398,11 +376,11 @@ TEST_F(RngProbe, UniformDrawsHaveMeanOneHalfAndVarianceOneTwelfth)
         EXPECT_LT(hi, 1.0) << what;
         EXPECT_GE(n, 1000000);
         if (lane < 0) {
-            report("Count", double(n));
-            report("MeanMinusHalf", mean - 0.5);
-            report("MeanStandardError", meanError);
-            report("VarianceMinusTwelfth", variance - 1.0 / 12.0);
-            report("VarianceStandardError", varianceError);
+            reportStat("Count", double(n));
+            reportStat("MeanMinusHalf", mean - 0.5);
+            reportStat("MeanStandardError", meanError);
+            reportStat("VarianceMinusTwelfth", variance - 1.0 / 12.0);
+            reportStat("VarianceStandardError", varianceError);
         }
     }
 }
@@ -428,9 +406,9 @@ TEST(RngProbeCpu, CorrelationChecksRejectBadSeeding)
     EXPECT_FALSE(a[0].ok()) << "frame lag-1 with the frame left out: r = " << a[0].r;
     EXPECT_FALSE(b[3].ok()) << "diagonal with pixel + frame seeding: r = " << b[3].r;
     EXPECT_FALSE(c[1].ok()) << "right neighbour with a plain LCG: r = " << c[1].r;
-    report("NoFrameLag1", a[0].r);
-    report("PixelPlusFrameDiagonal", b[3].r);
-    report("LcgRightNeighbour", c[1].r);
+    reportStat("NoFrameLag1", a[0].r);
+    reportStat("PixelPlusFrameDiagonal", b[3].r);
+    reportStat("LcgRightNeighbour", c[1].r);
 }
 
 } // namespace

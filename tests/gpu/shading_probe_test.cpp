@@ -40,14 +40,6 @@ namespace {
 double square(double x) { return x * x; }
 
 /// Records a measured statistic in the test's XML properties and prints it.
-void report(const std::string& name, double value)
-{
-    std::ostringstream text;
-    text << std::setprecision(4) << value;
-    ::testing::Test::RecordProperty(name, text.str());
-    std::cout << "[   STAT   ] " << name << " = " << text.str() << std::endl;
-}
-
 // ---------------------------------------------------------------------------
 // Fresnel references (double precision)
 
@@ -149,7 +141,7 @@ TEST_F(FresnelProbe, SchlickMatchesClosedFormAndR0)
             EXPECT_TRUE(closeTo(results[i].schlick, 1.0, 1e-6)) << describe(c);
         }
     }
-    report("SchlickMaxRelativeError", worst);
+    reportStat("SchlickMaxRelativeError", worst);
 }
 
 // Leaving the denser medium, Schlick takes the transmitted angle (the one on the less dense side).
@@ -201,7 +193,7 @@ TEST_F(FresnelProbe, ExactMatchesTextbookFormulaEnteringAndLeaving)
             EXPECT_EQ(results[i].exact, 1.0f) << describe(c);
         }
     }
-    report("ExactMaxRelativeError", worst);
+    reportStat("ExactMaxRelativeError", worst);
 }
 
 // An index-matched interface (IOR 1) is no interface: exactly 0 at every angle,
@@ -257,7 +249,7 @@ TEST_F(FresnelProbe, TotalInternalReflectionAtAndBeyondCriticalAngle)
     EXPECT_TRUE(std::isfinite(in.exact) && std::isfinite(in.schlickDielectric));
     // Close to the limit the value is ill-conditioned in float; only loosely compare.
     EXPECT_TRUE(closeTo(in.exact, fresnelExactRef(inside, eta, 1.0), 1e-3)) << describe(cases.back());
-    report("CriticalCosine", critical);
+    reportStat("CriticalCosine", critical);
 }
 
 // ---------------------------------------------------------------------------
@@ -379,12 +371,12 @@ TEST_F(SnellProbe, RefractionObeysSnellOrReflectsBeyondCriticalAngle)
     // Both branches must have been exercised.
     EXPECT_GT(refracted, 1000);
     EXPECT_GT(reflected, 1000);
-    report("Refracted", refracted);
-    report("Reflected", reflected);
-    report("WorstSnellResidual", worstSnell);
-    report("WorstPlaneResidual", worstPlane);
-    report("WorstLengthError", worstLength);
-    report("WorstMirrorError", worstMirror);
+    reportStat("Refracted", refracted);
+    reportStat("Reflected", reflected);
+    reportStat("WorstSnellResidual", worstSnell);
+    reportStat("WorstPlaneResidual", worstPlane);
+    reportStat("WorstLengthError", worstLength);
+    reportStat("WorstMirrorError", worstMirror);
 }
 
 // ---------------------------------------------------------------------------
@@ -585,10 +577,10 @@ TEST_F(TriangleSamplerProbe, PointsLieInTheTriangleAndAreUniform)
 
     UniformityResult chi = chiSquareUniformity(points, kGrid);
     EXPECT_GT(chi.pValue, kSignificance) << "chi-square " << chi.chiSquare << " with " << chi.dof << " dof";
-    report("ChiSquare", chi.chiSquare);
-    report("PValue", chi.pValue);
-    report("WorstPlaneDistance", worstPlane);
-    report("MostNegativeBarycentric", worstInside);
+    reportStat("ChiSquare", chi.chiSquare);
+    reportStat("PValue", chi.pValue);
+    reportStat("WorstPlaneDistance", worstPlane);
+    reportStat("MostNegativeBarycentric", worstInside);
 }
 
 TEST_F(TriangleSamplerProbe, VertexCoordinateFollowsItsMarginal)
@@ -596,7 +588,7 @@ TEST_F(TriangleSamplerProbe, VertexCoordinateFollowsItsMarginal)
     std::vector<Barycentric> points = barycentrics(floatTriangle(), gpuTrianglePoints());
     double ks = ksStatisticOfVertexCoordinate(points);
     EXPECT_LT(ks, kKsCritical);
-    report("KsStatistic", ks);
+    reportStat("KsStatistic", ks);
 }
 
 // The two tests above reject a sampler with the classic mistake, so they can fail.
@@ -608,9 +600,9 @@ TEST_F(TriangleSamplerProbe, TestsRejectSamplerWithoutSquareRoot)
     EXPECT_LT(chi.pValue, kSignificance) << "chi-square " << chi.chiSquare;
     double ks = ksStatisticOfVertexCoordinate(points);
     EXPECT_GT(ks, kKsCritical);
-    report("WrongChiSquare", chi.chiSquare);
-    report("WrongPValue", chi.pValue);
-    report("WrongKsStatistic", ks);
+    reportStat("WrongChiSquare", chi.chiSquare);
+    reportStat("WrongPValue", chi.pValue);
+    reportStat("WrongKsStatistic", ks);
 }
 
 } // namespace

@@ -28,14 +28,6 @@
 namespace vkrt::test {
 namespace {
 
-void report(const std::string& name, double value)
-{
-    std::ostringstream text;
-    text << std::setprecision(6) << value;
-    ::testing::Test::RecordProperty(name, text.str());
-    std::cout << "[   STAT   ] " << name << " = " << text.str() << std::endl;
-}
-
 // ---------------------------------------------------------------------------
 // C++ reference of lib/sobol.glsl
 
@@ -105,20 +97,7 @@ uint32_t nestedUniformScramble(uint32_t x, uint32_t seed)
     return reverseBits(laineKarrasPermutation(reverseBits(x), seed));
 }
 
-U4 pcg4d(U4 v)
-{
-    for (uint32_t& x : v) x = x * 1664525u + 1013904223u;
-    v[0] += v[1] * v[3];
-    v[1] += v[2] * v[0];
-    v[2] += v[0] * v[1];
-    v[3] += v[1] * v[2];
-    for (uint32_t& x : v) x ^= x >> 16u;
-    v[0] += v[1] * v[3];
-    v[1] += v[2] * v[0];
-    v[2] += v[0] * v[1];
-    v[3] += v[1] * v[2];
-    return v;
-}
+U4 pcg4d(U4 v) { return pcg4dReference(v); }
 
 /// lowbias32 (C. Wellons, "Hash function prospector", 2018).
 uint32_t mix32(uint32_t x)
@@ -163,7 +142,7 @@ std::vector<float> timedProbe(const std::string& what, const std::vector<float>&
 {
     auto start = std::chrono::steady_clock::now();
     std::vector<float> out = runProbe("sobol_probe", input, outputFloats, invocations, defines);
-    report("ProbeSeconds_" + what, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    reportStat("ProbeSeconds_" + what, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return out;
 }
 
@@ -369,7 +348,7 @@ TEST_F(SobolProbe, GpuDrawsMatchTheReferenceBitForBit)
             }
         }
         EXPECT_EQ(mismatches, 0) << "batches " << batches << ", of " << records.size() * 16;
-        report("ValuesCompared_batches" + std::to_string(batches), double(records.size() * 16));
+        reportStat("ValuesCompared_batches" + std::to_string(batches), double(records.size() * 16));
     }
 }
 
@@ -415,7 +394,7 @@ TEST_F(SobolProbe, EveryPowerOfTwoBlockOfAPixelIsANet)
             blocks += 2 * grid.frames - 1;
         }
     EXPECT_EQ(bad, 0) << "of " << blocks << " blocks";
-    report("NetBlocksChecked", double(blocks));
+    reportStat("NetBlocksChecked", double(blocks));
     // With batches, each batch (frames b, b + K, b + 2K, ...) is its own sequence.
     const Grid& batchedDraws = batchedGrid();
     int64_t badBatches = 0;
@@ -428,7 +407,7 @@ TEST_F(SobolProbe, EveryPowerOfTwoBlockOfAPixelIsANet)
     const Grid& pcg = pcgGrid();
     int64_t pcgBad = nonNets([&](uint32_t f) { return pcg.drawAt(0, f, 0); }, grid.frames);
     EXPECT_GT(pcgBad, 500);
-    report("PcgNonNetBlocks", double(pcgBad));
+    reportStat("PcgNonNetBlocks", double(pcgBad));
 }
 
 // ---------------------------------------------------------------------------
@@ -475,8 +454,8 @@ TEST_F(SobolProbe, ValuesAreUniformAcrossPixels)
             }
     EXPECT_GE(lo, 0.0);
     EXPECT_LT(hi, 1.0);
-    report("ChiSquareWorst", worst);
-    report("ChiSquareCritical", critical);
+    reportStat("ChiSquareWorst", worst);
+    reportStat("ChiSquareCritical", critical);
 }
 
 // ---------------------------------------------------------------------------
@@ -544,10 +523,10 @@ TEST_F(SobolProbe, SuccessiveDrawsAreUncorrelated)
             EXPECT_LT(perPixel, 2.5) << "dim " << dim << ", draw " << draw;
             worstPerPixel = std::max(worstPerPixel, perPixel);
         }
-    report("DrawLag1WorstPooledR", worstPooled);
-    report("DrawLag1Bound", bound);
-    report("DrawLag1PerPixelRSquaredTimesN_worst", worstPerPixel);
-    report("DrawLag1PerPixelRSquaredTimesN_pcg", perPixelSquaredCorrelation(gridValue(pcgGrid()), 256, grid.frames, 0, 0));
+    reportStat("DrawLag1WorstPooledR", worstPooled);
+    reportStat("DrawLag1Bound", bound);
+    reportStat("DrawLag1PerPixelRSquaredTimesN_worst", worstPerPixel);
+    reportStat("DrawLag1PerPixelRSquaredTimesN_pcg", perPixelSquaredCorrelation(gridValue(pcgGrid()), 256, grid.frames, 0, 0));
     // The per-pixel check can fail: without the index shuffle, successive draws
     // are scrambles of the same point, and correlate.
     Value unpadded = [](uint32_t p, uint32_t f, uint32_t draw, uint32_t d) {
@@ -555,14 +534,14 @@ TEST_F(SobolProbe, SuccessiveDrawsAreUncorrelated)
     };
     double unpaddedPerPixel = perPixelSquaredCorrelation(unpadded, 64, grid.frames, 0, 0);
     EXPECT_GT(unpaddedPerPixel, 20.0);
-    report("DrawLag1PerPixelRSquaredTimesN_unpadded", unpaddedPerPixel);
+    reportStat("DrawLag1PerPixelRSquaredTimesN_unpadded", unpaddedPerPixel);
     // Neighbouring pixels are independent randomizations too.
     Correlation neighbours = pearson([&](const auto& add) {
         for (uint32_t p = 0; p + 1 < grid.pixels; ++p)
             for (uint32_t f = 0; f < grid.frames; ++f) add(grid.at(p, f, 0, 0), grid.at(p + 1, f, 0, 0));
     });
     EXPECT_LT(std::abs(neighbours.r), 4.0 / std::sqrt(double(neighbours.n)));
-    report("NeighbourPixelR", neighbours.r);
+    reportStat("NeighbourPixelR", neighbours.r);
 }
 
 // ---------------------------------------------------------------------------
@@ -648,10 +627,10 @@ TEST_F(SobolProbe, IntegrationErrorFallsFasterThanMonteCarlo)
     for (const Integrand& integrand : integrands()) {
         double sobol = convergenceSlope(sobolGrid(), integrand), pcg = convergenceSlope(pcgGrid(), integrand);
         double batchedSlope = convergenceSlope(batchedGrid(), integrand);
-        report("Slope_sobol_" + integrand.name, sobol);
-        report("Slope_sobol_batches8_" + integrand.name, batchedSlope);
-        report("Slope_pcg_" + integrand.name, pcg);
-        report("MseRatio_pcg_over_sobol_1024spp_" + integrand.name,
+        reportStat("Slope_sobol_" + integrand.name, sobol);
+        reportStat("Slope_sobol_batches8_" + integrand.name, batchedSlope);
+        reportStat("Slope_pcg_" + integrand.name, pcg);
+        reportStat("MseRatio_pcg_over_sobol_1024spp_" + integrand.name,
                meanSquaredError(pcgGrid(), integrand, 1024) / meanSquaredError(sobolGrid(), integrand, 1024));
         EXPECT_NEAR(pcg, -1.0, 0.2) << integrand.name;
         if (integrand.name.rfind("smooth", 0) == 0) {
@@ -714,12 +693,12 @@ TEST_F(SobolProbe, BatchMeansGiveAnHonestVarianceEstimate)
             VarianceCheck batched = checkVariance(batchedGrid(), integrand, n, kBatches);
             VarianceCheck pcg = checkVariance(pcgGrid(), integrand, n, kBatches);
             std::string tag = integrand.name + "_" + std::to_string(n) + "spp";
-            report("WelfordOverTrue_sobol_" + tag, plain.welford / plain.trueMse);
-            report("WelfordOverTrue_pcg_" + tag, pcg.welford / pcg.trueMse);
-            report("BatchOverTrue_sobol_batches8_" + tag, batched.batchMeans / batched.trueMse);
-            report("ConsecutiveBlocksOverTrue_sobol_" + tag, plain.blockMeans / plain.trueMse);
-            report("TrueMse_batches8_over_batches1_" + tag, batched.trueMse / plain.trueMse);
-            report("TrueMse_pcg_over_batches8_" + tag, pcg.trueMse / batched.trueMse);
+            reportStat("WelfordOverTrue_sobol_" + tag, plain.welford / plain.trueMse);
+            reportStat("WelfordOverTrue_pcg_" + tag, pcg.welford / pcg.trueMse);
+            reportStat("BatchOverTrue_sobol_batches8_" + tag, batched.batchMeans / batched.trueMse);
+            reportStat("ConsecutiveBlocksOverTrue_sobol_" + tag, plain.blockMeans / plain.trueMse);
+            reportStat("TrueMse_batches8_over_batches1_" + tag, batched.trueMse / plain.trueMse);
+            reportStat("TrueMse_pcg_over_batches8_" + tag, pcg.trueMse / batched.trueMse);
             // Independent batches: the estimate matches the true error (1024 pixels:
             // the true MSE itself is known to about +-4.4 %, the estimate to +-1.7 %).
             EXPECT_GT(batched.batchMeans / batched.trueMse, 0.75) << tag;

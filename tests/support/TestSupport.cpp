@@ -2,8 +2,12 @@
 
 #include "scene/SceneParser.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <fstream>
+#include <iomanip>
+#include <iostream>
 #include <memory>
 #include <sstream>
 
@@ -91,6 +95,29 @@ void writeText(const fs::path& path, const std::string& text)
 {
     if (path.has_parent_path()) fs::create_directories(path.parent_path());
     std::ofstream(path) << text;
+}
+
+void reportStat(const std::string& name, double value)
+{
+    std::ostringstream text;
+    text << std::setprecision(6) << value;
+    ::testing::Test::RecordProperty(name, text.str());
+    std::cout << "[   STAT   ] " << name << " = " << text.str() << std::endl;
+}
+
+std::array<uint32_t, 4> pcg4dReference(std::array<uint32_t, 4> v)
+{
+    for (uint32_t& x : v) x = x * 1664525u + 1013904223u;
+    v[0] += v[1] * v[3];
+    v[1] += v[2] * v[0];
+    v[2] += v[0] * v[1];
+    v[3] += v[1] * v[2];
+    for (uint32_t& x : v) x ^= x >> 16u;
+    v[0] += v[1] * v[3];
+    v[1] += v[2] * v[0];
+    v[2] += v[0] * v[1];
+    v[3] += v[1] * v[2];
+    return v;
 }
 
 double channelMean(const Image& image, int channel)

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -57,5 +59,11 @@ void writeText(const std::filesystem::path& path, const std::string& text);
 
 /// Mean of one channel over all pixels.
 double channelMean(const Image& image, int channel);
+
+/// Records a measured figure as a test property and prints it as "[   STAT   ] name = value".
+void reportStat(const std::string& name, double value);
+
+/// lib/pcg.glsl's pcg4d on the CPU, line by line.
+std::array<uint32_t, 4> pcg4dReference(std::array<uint32_t, 4> v);
 
 } // namespace vkrt::test
