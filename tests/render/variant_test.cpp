@@ -110,10 +110,9 @@ TEST_F(VariantTest, SceneTooBigForUniformBuffersUsesStorageBuffers)
     EXPECT_FALSE(big.features().uniformScene);
     big.renderFrames(1);
     reference.renderFrames(1);
-    Image a = big.mean(), b = reference.mean();
-    double sumA = 0, sumB = 0;
-    for (size_t i = 0; i < a.rgb.size(); ++i) sumA += a.rgb[i], sumB += b.rgb[i];
-    EXPECT_NEAR(sumA, sumB, 0.02 * sumB) << "the moved sphere must still be drawn from the last record";
+    // The hidden spheres never win a closest hit and the same spheres are
+    // visible, so the same seed gives the same image bit for bit.
+    EXPECT_EQ(big.mean().rgb, reference.mean().rgb) << "the moved sphere must still be drawn from the last record";
 }
 
 TEST_F(VariantTest, SceneWithoutGlassHasNoRefractionCode)
