@@ -8,8 +8,10 @@ packages=(
   cmake ninja-build g++ pkg-config
   # Vulkan: loader and headers, lavapipe (software Vulkan), validation layers for tests
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
-  # run-time GLSL compiler, maths, window, images, scene files, options, tests
-  glslang-dev libglm-dev libglfw3-dev libopenexr-dev libtomlplusplus-dev libcli11-dev libstb-dev libgtest-dev
+  # run-time GLSL compiler, maths, window, images, scene files, options, tests;
+  # glslang-tools because glslang-dev's CMake package refers to glslangValidator
+  # and find_package fails without it (it is only a Recommends, not installed here)
+  glslang-dev glslang-tools libglm-dev libglfw3-dev libopenexr-dev libtomlplusplus-dev libcli11-dev libstb-dev libgtest-dev
   # a real X display for the viewer's tests
   xvfb xauth
 )
