@@ -62,26 +62,41 @@ vec3 transmittanceTo(vec3 point, vec3 origin, vec3 n, MediumStack media)
     return shadowTransmittance(origin, shadowDir / shadowDist, shadowDist, media);
 }
 
-// Point lights: f * I * cos / d^2 * transmittance.
+// A light's contribution to a surface point before visibility, and the point
+// a shadow ray must reach for it to count.
+struct LightSample {
+    vec3 unshadowed;
+    vec3 target;
+};
+
+#ifdef VKRT_HAS_POINT_LIGHTS
+// One point light: f * I * cos / d^2. Geometry from the surface point itself;
+// only the shadow ray starts at the offset origin (measuring from it would
+// bias 1/d^2 by the offset).
+LightSample samplePointLight(PointLight light, Material m, SurfaceHit hit, vec3 n, vec3 wo)
+{
+    vec3 toLight = light.position - hit.position;
+    float distSq = dot(toLight, toLight);
+    vec3 wi = toLight * inversesqrt(distSq);
+    float cosTheta = dot(n, wi);
+    if (cosTheta <= 0.0)
+        return LightSample(vec3(0.0), light.position);
+    vec3 f = evalBsdf(m, n, wo, wi);
+    return LightSample(f * light.intensity * (cosTheta / distSq), light.position);
+}
+#endif
+
+// Every point light (the Whitted integrator).
 vec3 directFromPointLights(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_POINT_LIGHTS
-    vec3 position = hit.position;
-    vec3 origin = offsetRayOrigin(position, hit.error, n);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     for (uint i = 0u; i < u.pointLightCount; ++i) {
         ++g_loopIterations;
-        PointLight light = pointLights[i];
-        // Geometry from the surface point itself; only the shadow ray starts
-        // at the offset origin (measuring from it would bias 1/d^2 by the offset).
-        vec3 toLight = light.position - position;
-        float distSq = dot(toLight, toLight);
-        vec3 wi = toLight * inversesqrt(distSq);
-        float cosTheta = dot(n, wi);
-        if (cosTheta <= 0.0)
-            continue;
-        vec3 f = evalBsdf(m, n, wo, wi);
-        radiance += f * light.intensity * (cosTheta / distSq) * transmittanceTo(light.position, origin, n, media);
+        LightSample s = samplePointLight(pointLights[i], m, hit, n, wo);
+        if (s.unshadowed != vec3(0.0))
+            radiance += s.unshadowed * transmittanceTo(s.target, origin, n, media);
     }
 #endif
     return radiance;
@@ -112,38 +127,100 @@ float powerHeuristic(float pdf, float other)
 // point at squared distance distSq along a direction with |cos| cosLight.
 float triangleLightPdf(float area, float distSq, float cosLight) { return distSq / (cosLight * area); }
 
-// Triangle lights: one uniformly sampled point per light (pdf = 1 / area):
-// f * Le * cos_surface * cos_light / d^2 * area * transmittance; the path
-// integrator also weighs it against BSDF sampling (MIS).
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+// One triangle light through a uniformly sampled point on it (pdf = 1 / area,
+// `u` its two coordinates): f * Le * cos_surface * cos_light / d^2 * area; the
+// path integrator weighs it against BSDF sampling (MIS).
+LightSample sampleTriangleLight(TriangleLight light, vec2 u, Material m, SurfaceHit hit, vec3 n, vec3 wo, vec3 origin)
+{
+    vec3 point = sampleTriangle(light.v0, light.v1, light.v2, u);
+    // Aim just short of the light so it does not shadow itself.
+    vec3 target = mix(origin, point, 1.0 - 1.0 / 65536.0);
+    vec3 toLight = point - hit.position;
+    float distSq = dot(toLight, toLight);
+    vec3 wi = toLight * inversesqrt(distSq);
+    float cosSurface = dot(n, wi);
+    float cosLight = abs(dot(triangleLightNormal(light), wi));
+    vec3 le = emittedRadiance(light, -wi);
+    if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0))
+        return LightSample(vec3(0.0), target);
+    vec3 f = evalBsdf(m, n, wo, wi);
+    vec3 contribution = f * le * (cosSurface * cosLight * light.area / distSq);
+#ifdef VKRT_INTEGRATOR_PATH
+    contribution *= powerHeuristic(triangleLightPdf(light.area, distSq, cosLight), pdfBsdf(m, n, wo, wi));
+#endif
+    return LightSample(contribution, target);
+}
+#endif
+
+// One sampled point on every triangle light (the Whitted integrator).
 vec3 directFromTriangleLights(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
-    vec3 position = hit.position;
-    vec3 origin = offsetRayOrigin(position, hit.error, n);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
-        TriangleLight light = triangleLights[i];
-        vec3 point = sampleTriangle(light.v0, light.v1, light.v2, sampleNext2D(rng));
-        vec3 toLight = point - position;
-        float distSq = dot(toLight, toLight);
-        vec3 wi = toLight * inversesqrt(distSq);
-        float cosSurface = dot(n, wi);
-        float cosLight = abs(dot(triangleLightNormal(light), wi));
-        vec3 le = emittedRadiance(light, -wi);
-        if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0))
-            continue;
-        vec3 f = evalBsdf(m, n, wo, wi);
-        vec3 contribution = f * le * (cosSurface * cosLight * light.area / distSq);
-#ifdef VKRT_INTEGRATOR_PATH
-        contribution *= powerHeuristic(triangleLightPdf(light.area, distSq, cosLight), pdfBsdf(m, n, wo, wi));
-#endif
-        // Aim just short of the light so it does not shadow itself.
-        vec3 target = mix(origin, point, 1.0 - 1.0 / 65536.0);
-        radiance += contribution * transmittanceTo(target, origin, n, media);
+        LightSample s = sampleTriangleLight(triangleLights[i], sampleNext2D(rng), m, hit, n, wo, origin);
+        if (s.unshadowed != vec3(0.0))
+            radiance += s.unshadowed * transmittanceTo(s.target, origin, n, media);
     }
 #endif
     return radiance;
+}
+
+// Picks one of a stream of light samples with probability proportional to its
+// weight (weighted reservoir sampling: candidate i replaces the kept one with
+// probability w_i / (w_1 + ... + w_i), decided by its own uniform number).
+struct LightReservoir {
+    LightSample kept;
+    float keptWeight;
+    float totalWeight;
+};
+
+void offerLightSample(inout LightReservoir r, LightSample s, float u)
+{
+    // The largest component: zero only for a sample that adds nothing, and
+    // finite whenever the sample is.
+    float w = max(s.unshadowed.r, max(s.unshadowed.g, s.unshadowed.b));
+    if (!(w > 0.0))
+        return;
+    r.totalWeight += w;
+    // The first sample is always kept (u * w < w could round to equality).
+    if (r.keptWeight == 0.0 || u * r.totalWeight < w) {
+        r.kept = s;
+        r.keptWeight = w;
+    }
+}
+
+// Next-event estimation from every point and triangle light with one shadow
+// ray (the path integrator). Each light gets its sample as in the Whitted
+// sums above, but only one is tested for visibility: sample i with
+// probability p_i = w_i / W, its unshadowed weight over their total, and
+// scaled by 1 / p_i. The expectation is the sum of every sample times its
+// visibility, so the estimate stays unbiased; where all lights are visible
+// it equals that sum up to the lights' colour differences, so it costs little
+// variance for a shadow ray per light saved.
+vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
+{
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
+#ifdef VKRT_HAS_POINT_LIGHTS
+    for (uint i = 0u; i < u.pointLightCount; ++i) {
+        ++g_loopIterations;
+        offerLightSample(r, samplePointLight(pointLights[i], m, hit, n, wo), sampleNext1D(rng));
+    }
+#endif
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    for (uint i = 0u; i < u.triangleLightCount; ++i) {
+        ++g_loopIterations;
+        vec3 u3 = sampleNext4D(rng).xyz;
+        offerLightSample(r, sampleTriangleLight(triangleLights[i], u3.xy, m, hit, n, wo, origin), u3.z);
+    }
+#endif
+    if (r.totalWeight == 0.0)
+        return vec3(0.0);
+    return r.kept.unshadowed * (r.totalWeight / r.keptWeight) * transmittanceTo(r.kept.target, origin, n, media);
 }
 
 #endif

@@ -1,7 +1,8 @@
 // Unbiased path tracing (`integrator = "path"`). At each non-specular vertex:
 // next-event estimation for every point light and one area-sampled point on
-// every triangle light, weighted against BSDF sampling with the power
-// heuristic; then one BSDF-sampled continuation. A continuation that hits a
+// every triangle light, with one shadow ray for all of them (chosen by
+// unshadowed contribution), and for the environment, weighted against BSDF
+// sampling with the power heuristic; then one BSDF-sampled continuation. A continuation that hits a
 // light adds its emission with the complementary MIS weight (full weight after
 // a specular bounce or from the camera); one that escapes adds the environment.
 // Russian roulette from the fourth vertex on keeps long paths unbiased.
@@ -104,8 +105,7 @@ vec3 tracePath(Ray ray, inout Sampler rng)
         vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
-            path.radiance += path.throughput * (directFromPointLights(m, hit, n, wo, path.media) +
-                                                directFromTriangleLights(m, hit, n, wo, path.media, rng) +
+            path.radiance += path.throughput * (directFromLightsOneShadowRay(m, hit, n, wo, path.media, rng) +
                                                 directFromEnvironment(m, hit, n, wo, path.media, rng));
         }
         vec4 u4 = sampleNext4D(rng);
