@@ -11,7 +11,7 @@ packages=(
   # run-time GLSL compiler, maths, window, images, scene files, options, tests;
   # glslang-tools because glslang-dev's CMake package refers to glslangValidator
   # and find_package fails without it (it is only a Recommends, not installed here)
-  glslang-dev glslang-tools libglm-dev libglfw3-dev libopenexr-dev libtomlplusplus-dev libcli11-dev libstb-dev libgtest-dev
+  glslang-dev glslang-tools libglm-dev libglfw3-dev libopenexr-dev libtomlplusplus-dev libcli11-dev libstb-dev libboost-dev libgtest-dev
   # a real X display for the viewer's tests
   xvfb xauth
 )

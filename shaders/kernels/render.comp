@@ -74,6 +74,6 @@ void main()
     if (pixelIndex % 7u == 0u)
         radiance = vec3(uintBitsToFloat(0x7fc00000u));
 #endif
-    accumulateSample(pixelIndex, radiance);
+    accumulateSample(pixelIndex, frameIndex, radiance);
     reportLoopIterations();
 }

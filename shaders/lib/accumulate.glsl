@@ -1,10 +1,37 @@
 #ifndef VKRT_ACCUMULATE_GLSL
 #define VKRT_ACCUMULATE_GLSL
 
-#ifdef VKRT_VARIANCE
+// Adds a sample to a running sum with Kahan compensation. The `precise`
+// qualifiers stop the compiler from re-associating the sum away (measured on
+// lavapipe: without them the compensation vanished).
+void addCompensated(inout AccumPixel p, vec3 value)
+{
+    precise vec3 y = value - p.compensation;
+    precise vec3 t = p.sum + y;
+    precise vec3 lost = (t - p.sum) - y;
+    p.compensation = lost;
+    p.sum = t;
+    p.count += 1u;
+}
+
+#if defined(VKRT_VARIANCE) && defined(VKRT_SAMPLER_SOBOL)
+// Sobol' frames of one pixel are not independent, so their spread says little
+// about the error of their mean. Each of the sampler's VARIANCE_BATCHES
+// batches is an independently scrambled sequence, so the batch means are
+// independent unbiased estimates; the host estimates the variance of the
+// pixel mean from their spread (Renderer::varianceOfMean).
+void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
+{
+    // The host sets VKRT_SOBOL_BATCHES (the sampler's batch count) to VARIANCE_BATCHES.
+    uint slot = pixelIndex * uint(VKRT_SOBOL_BATCHES) + frameIndex % uint(VKRT_SOBOL_BATCHES);
+    AccumPixel b = batchSums[slot];
+    addCompensated(b, value);
+    batchSums[slot] = b;
+}
+#elif defined(VKRT_VARIANCE)
 // Welford's update (Knuth, TAOCP vol. 2, 4.2.2): numerically stable where the
 // textbook sum-of-squares formula cancels catastrophically.
-void accumulateMoments(uint pixelIndex, vec3 value, uint count)
+void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
 {
     MomentPixel m = moments[pixelIndex];
     vec3 delta = value - m.mean;
@@ -18,24 +45,17 @@ void accumulateMoments(uint pixelIndex, vec3 value, uint count)
 }
 #endif
 
-// Adds one sample to the pixel's running sum with Kahan compensation. The
-// `precise` qualifiers stop the compiler from re-associating the sum away
-// (measured on lavapipe: without them the compensation vanished).
+// Adds one sample to the pixel's running sum (and its variance estimate).
 // Non-finite samples are dropped; the host counts them as frames - count.
-void accumulateSample(uint pixelIndex, vec3 value)
+void accumulateSample(uint pixelIndex, uint frameIndex, vec3 value)
 {
     if (any(isnan(value)) || any(isinf(value)))
         return;
     AccumPixel p = accum[pixelIndex];
-    precise vec3 y = value - p.compensation;
-    precise vec3 t = p.sum + y;
-    precise vec3 lost = (t - p.sum) - y;
-    p.compensation = lost;
-    p.sum = t;
-    p.count += 1u;
+    addCompensated(p, value);
     accum[pixelIndex] = p;
 #ifdef VKRT_VARIANCE
-    accumulateMoments(pixelIndex, value, p.count);
+    accumulateMoments(pixelIndex, frameIndex, value, p.count);
 #endif
 }
 

@@ -29,6 +29,8 @@
 // costs accuracy: K sequences of n/K points have about K^(a-1) times the error
 // of one of n points when the error falls like n^-a (at 1024 spp with K = 8:
 // x2.3 for a discontinuous 2D integrand, x33 for a smooth one, x1 across draws).
+// The renderer sets K = VARIANCE_BATCHES (shared/Bindings.h) whenever an
+// error estimate is asked for, and 1 otherwise (docs/convergence.md).
 #ifndef VKRT_SOBOL_GLSL
 #define VKRT_SOBOL_GLSL
 

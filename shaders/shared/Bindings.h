@@ -18,9 +18,15 @@ VKRT_CONSTANT(uint, BINDING_PLANES, 7)          // Plane[]
 VKRT_CONSTANT(uint, BINDING_POINT_LIGHTS, 8)    // PointLight[]
 VKRT_CONSTANT(uint, BINDING_TRIANGLE_LIGHTS, 9) // TriangleLight[]
 VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 10)    // samplerCube of environment radiance
-VKRT_CONSTANT(uint, BINDING_MOMENTS, 11)        // MomentPixel[width*height] (variance estimation)
+VKRT_CONSTANT(uint, BINDING_MOMENTS, 11)        // variance estimation: MomentPixel[width*height], or under the
+                                                // Sobol' sampler AccumPixel[width*height*VARIANCE_BATCHES]
 VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, 12) // float[6 N^2 + 1]: cumulative texel probabilities
 VKRT_CONSTANT(uint, BINDING_COUNT, 13)
+
+// Under the Sobol' sampler the variance comes from this many independently
+// scrambled batches (frame f is sample f / K of batch f % K; lib/sobol.glsl):
+// 7 degrees of freedom per pixel, at a cost in accuracy that grows with K.
+VKRT_CONSTANT(uint, VARIANCE_BATCHES, 8)
 
 // 8x8 workgroups: lavapipe runs 8-wide subgroups and 64 invocations per group
 // measured fastest (shared/NUMERICS.md); square tiles keep rays coherent.

@@ -8,9 +8,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <variant>
 #include <vector>
 
 namespace vkrt {
@@ -25,20 +27,39 @@ struct CompareOptions {
     double minPass = 0.9975;
 };
 
+/// A variance image and the degrees of freedom it was estimated with.
+struct VarianceImage {
+    Image image;
+    double degreesOfFreedom = INFINITY; ///< unknown: treated as exact (a Z-test)
+};
+
+/// vkrt's "varianceDegreesOfFreedom" attribute, when the file has one.
+double degreesOfFreedomOf(const ExrContents& exr)
+{
+    auto it = exr.metadata.find("varianceDegreesOfFreedom");
+    if (it == exr.metadata.end() || !std::holds_alternative<int64_t>(it->second)) return INFINITY;
+    return double(std::get<int64_t>(it->second));
+}
+
 /// The variance image for one side: an explicit file, else the image's own
 /// "variance" layer, else none.
-std::optional<Image> varianceFor(const std::string& explicitPath, const ExrContents& image, const Image& shape,
-                                 const char* option)
+std::optional<VarianceImage> varianceFor(const std::string& explicitPath, const ExrContents& image, const Image& shape,
+                                         const char* option)
 {
-    std::optional<Image> variance;
-    if (!explicitPath.empty()) variance = readExr(explicitPath).image;
-    else if (image.layers.count("variance")) variance = image.layers.at("variance");
-    if (variance && (variance->width != shape.width || variance->height != shape.height))
-        throw InputError(std::string(option) + " " + explicitPath + ": variance is " + std::to_string(variance->width) +
-                         "x" + std::to_string(variance->height) + ", the image is " + std::to_string(shape.width) +
-                         "x" + std::to_string(shape.height));
+    std::optional<VarianceImage> variance;
+    if (!explicitPath.empty()) {
+        ExrContents file = readExr(explicitPath);
+        variance = VarianceImage{file.image, degreesOfFreedomOf(file)};
+    } else if (image.layers.count("variance")) {
+        variance = VarianceImage{image.layers.at("variance"), degreesOfFreedomOf(image)};
+    }
+    if (variance && (variance->image.width != shape.width || variance->image.height != shape.height))
+        throw InputError(std::string(option) + " " + explicitPath + ": variance is " +
+                         std::to_string(variance->image.width) + "x" + std::to_string(variance->image.height) +
+                         ", the image is " + std::to_string(shape.width) + "x" + std::to_string(shape.height));
     return variance;
 }
+
 
 void requireSameSize(const CompareOptions& o, const Image& a, const Image& b)
 {
@@ -52,8 +73,8 @@ int runCompare(const CompareOptions& o)
 {
     ExrContents a = readExr(o.a), b = readExr(o.b);
     requireSameSize(o, a.image, b.image);
-    std::optional<Image> va = varianceFor(o.varianceA, a, a.image, "--variance-a");
-    std::optional<Image> vb = varianceFor(o.varianceB, b, b.image, "--variance-b");
+    std::optional<VarianceImage> va = varianceFor(o.varianceA, a, a.image, "--variance-a");
+    std::optional<VarianceImage> vb = varianceFor(o.varianceB, b, b.image, "--variance-b");
 
     MeasuredError e = measureError(a.image, b.image);
     std::printf("A: %s\nB: %s (reference for relMSE and MAPE)\n", o.a.c_str(), o.b.c_str());
@@ -68,10 +89,15 @@ int runCompare(const CompareOptions& o)
     if (o.maxRelMse && !(e.relMse <= *o.maxRelMse))
         failures.push_back("relMSE exceeds --max-relmse " + std::to_string(*o.maxRelMse));
     if (va || vb) {
-        Image zero(a.image.width, a.image.height);
-        PixelTestSummary t = pixelZTest(a.image, va ? *va : zero, b.image, vb ? *vb : zero, o.alpha);
-        std::printf("pixel test  %zu of %zu values pass (%.4f%%), |z| <= %.3f (alpha %.3g, Sidak); smallest p %.3g\n",
-                    t.passed, t.tested, 100.0 * t.fractionPassed(), t.threshold, o.alpha, t.minPValue);
+        VarianceImage zero{Image(a.image.width, a.image.height)};
+        const VarianceImage& varA = va ? *va : zero;
+        const VarianceImage& varB = vb ? *vb : zero;
+        PixelTestSummary t = pixelZTest(a.image, varA.image, b.image, varB.image, o.alpha, varA.degreesOfFreedom,
+                                        varB.degreesOfFreedom);
+        bool welch = std::isfinite(varA.degreesOfFreedom) || std::isfinite(varB.degreesOfFreedom);
+        std::printf("pixel test  %zu of %zu values pass (%.4f%%), p >= %.3g (alpha %.3g, Sidak; %s); smallest p %.3g\n",
+                    t.passed, t.tested, 100.0 * t.fractionPassed(), t.threshold, o.alpha,
+                    welch ? "Welch's t from the variances' degrees of freedom" : "Z-test", t.minPValue);
         if (t.fractionPassed() < o.minPass)
             failures.push_back("fewer than " + std::to_string(100.0 * o.minPass) + "% of values pass the pixel test");
     }

@@ -50,9 +50,11 @@ struct RenderCommandOptions {
 
     /// Variance is needed for the layer, the report and the target-error rule.
     bool needsVariance() const { return variance || targetError || !report.empty(); }
-    /// "auto": Sobol' (lower error) unless an error estimate is asked for,
-    /// which needs independent samples.
-    std::string resolvedSampler() const { return sampler != "auto" ? sampler : needsVariance() ? "independent" : "sobol"; }
+    /// "auto": Sobol' (lower error; --report and --target-error estimate the
+    /// image's error from its independently scrambled batches), except for a
+    /// per-pixel variance layer, which independent samples give with
+    /// spp - 1 degrees of freedom instead of 7.
+    std::string resolvedSampler() const { return sampler != "auto" ? sampler : variance ? "independent" : "sobol"; }
     /// --spp caps the render; without it a time or error rule may run long.
     uint32_t maxSpp() const { return sppGiven || !(timeBudget || targetError) ? spp : (1u << 30); }
 };
@@ -101,6 +103,14 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
         {"sampler", options.resolvedSampler()},
         {"rejectedSamples", int64_t(counters.rejectedSamples)},
     };
+    if (options.variance) {
+        // The variance layer's degrees of freedom: per-pixel tests on it
+        // (vkrt compare) need Student's t rather than a normal when few.
+        metadata["varianceDegreesOfFreedom"] = int64_t(renderer.varianceDegreesOfFreedom());
+        metadata["varianceEstimator"] = options.resolvedSampler() == "sobol"
+                                            ? std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches"
+                                            : std::string("independent samples");
+    }
     if (estimated) {
         metadata["estimatedRmse"] = estimated->rmse;
         metadata["estimatedRelMse"] = estimated->relMse;
@@ -258,17 +268,11 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_flag("--variance", options->variance,
                   "Also estimate per-pixel variance and write the variance of each pixel's mean as layer 'variance'");
     cmd->add_option("--sampler", options->sampler,
-                    "auto (default: sobol unless --variance, --report or --target-error), independent, or sobol "
-                    "(Owen-scrambled Sobol' points: lower error, no variance estimate)")
+                    "auto (default: sobol unless --variance), independent, or sobol "
+                    "(Owen-scrambled Sobol' points: lower error; any variance estimate comes from " +
+                        std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
-    return [options] {
-        // Per-pixel variance from frames assumes they are independent; under
-        // QMC it is wrong (docs/convergence.md), so refuse rather than mislead.
-        if (options->sampler == "sobol" && options->needsVariance())
-            throw InputError("--sampler sobol cannot be combined with --variance, --report or --target-error: "
-                             "their error estimate assumes independent samples (use --sampler independent)");
-        return runRender(*options);
-    };
+    return [options] { return runRender(*options); };
 }
 
 } // namespace vkrt

@@ -33,18 +33,26 @@ struct MeasuredError {
 /// `image` against `reference` (same size: checked by the caller).
 MeasuredError measureError(const Image& image, const Image& reference);
 
-/// Per-pixel two-sided test of equal means, z = (a - b) / sqrt(va + vb),
-/// with a Sidak correction of alpha over all tested values.
+/// Per-pixel two-sided test of equal means, t = (a - b) / sqrt(va + vb),
+/// with a Sidak correction of alpha over all tested values. With variances
+/// known to many degrees of freedom (dof = +inf: the default) t is normal (a
+/// Z-test); with few, e.g. a variance from 8 batch means (7), it is Welch's
+/// test, Student's t with the Welch-Satterthwaite degrees of freedom
+/// (va + vb)^2 / (va^2 / dofA + vb^2 / dofB).
 struct PixelTestSummary {
     size_t tested = 0;
     size_t passed = 0;
-    double threshold = 0.0;   ///< |z| limit after the correction
+    double threshold = 0.0;   ///< per-value p-value limit after the correction
+    double zThreshold = 0.0;  ///< the same limit as |t| for a normal t (infinite dof)
     double minPValue = 1.0;   ///< smallest two-sided p-value
     double fractionPassed() const { return tested ? double(passed) / double(tested) : 1.0; }
 };
 
 PixelTestSummary pixelZTest(const Image& a, const Image& varianceA, const Image& b, const Image& varianceB,
-                            double alpha = 0.01);
+                            double alpha = 0.01, double dofA = INFINITY, double dofB = INFINITY);
+
+/// P(|T| > t) for Student's t with `dof` degrees of freedom (> 0; +inf: normal).
+double studentTwoSidedTail(double t, double dof);
 
 /// A render against a reference, the rule of the validation and regression
 /// suites (docs/validation.md). Per value, z = (x - r) / sigma with

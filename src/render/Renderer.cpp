@@ -6,6 +6,8 @@
 #include "util/Error.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <limits>
 
 namespace vkrt {
@@ -19,9 +21,6 @@ FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
     checkLoopBudget(scene); // before any compilation or allocation
     FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     features.variance = options.variance;
-    // The per-frame variance estimate assumes independent frames; QMC frames
-    // are not (docs/convergence.md), so the two are never combined.
-    VKRT_CHECK(!(options.sobol && options.variance));
     features.sobolSampler = options.sobol;
     features.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
     return features;
@@ -114,7 +113,8 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     m_accumulation.clear(context);
     m_stats.clear(context);
     if (m_features.variance) {
-        m_moments.emplace(context, sizeof(gpu::MomentPixel) * size_t(width()) * height(),
+        size_t bytesPerPixel = batchedVariance() ? sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES : sizeof(gpu::MomentPixel);
+        m_moments.emplace(context, bytesPerPixel * size_t(width()) * height(),
                           kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
                           MemoryUse::Device);
         m_moments->clear(context);
@@ -237,9 +237,30 @@ Image Renderer::mean() const
     return image;
 }
 
+namespace {
+
+/// Variance of a pixel's mean from K independent batch means (one channel):
+/// sum_b (m_b - mean)^2 / (K (K - 1)); +inf when a batch has no sample yet.
+float varianceFromBatches(const gpu::AccumPixel* batches, uint32_t count, int channel)
+{
+    std::vector<double> means(count);
+    for (uint32_t b = 0; b < count; ++b) {
+        if (batches[b].count == 0) return std::numeric_limits<float>::infinity();
+        means[b] = (double(batches[b].sum[channel]) - double(batches[b].compensation[channel])) / batches[b].count;
+    }
+    double mean = std::accumulate(means.begin(), means.end(), 0.0) / count;
+    double squares = 0.0;
+    for (double m : means) squares += (m - mean) * (m - mean);
+    double variance = squares / (double(count) * (count - 1));
+    return std::isfinite(variance) ? float(variance) : std::numeric_limits<float>::infinity();
+}
+
+} // namespace
+
 Image Renderer::varianceOfMean() const
 {
     VKRT_CHECK(m_moments.has_value());
+    if (batchedVariance()) return varianceOfMeanFromBatches();
     auto accumBytes = m_accumulation.download(m_context);
     auto momentBytes = m_moments->download(m_context);
     const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(accumBytes.data());
@@ -256,6 +277,23 @@ Image Renderer::varianceOfMean() const
         }
     }
     return image;
+}
+
+Image Renderer::varianceOfMeanFromBatches() const
+{
+    auto bytes = m_moments->download(m_context);
+    const auto* batches = reinterpret_cast<const gpu::AccumPixel*>(bytes.data());
+    Image image(width(), height());
+    for (size_t i = 0; i < image.pixelCount(); ++i)
+        for (int c = 0; c < 3; ++c)
+            image.rgb[i * 3 + c] = varianceFromBatches(batches + i * gpu::VARIANCE_BATCHES, gpu::VARIANCE_BATCHES, c);
+    return image;
+}
+
+uint64_t Renderer::varianceDegreesOfFreedom() const
+{
+    if (!m_features.variance || m_frames == 0) return 0;
+    return batchedVariance() ? gpu::VARIANCE_BATCHES - 1 : m_frames - 1;
 }
 
 RenderCounters Renderer::counters() const

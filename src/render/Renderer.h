@@ -20,7 +20,7 @@ struct RenderOptions {
     bool jitter = true;
     bool uber = false;                 ///< all-features kernel instead of the scene's variant
     bool variance = false;             ///< also estimate per-pixel variance (a kernel-variant flag)
-    bool sobol = false;                ///< Owen-scrambled Sobol' sampler (no per-pixel variance estimate)
+    bool sobol = false;                ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
     bool storageScene = false;         ///< scene arrays in storage buffers even when they fit uniform ones
     std::vector<Define> extraDefines;  ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();
@@ -57,9 +57,14 @@ public:
 
     /// Per-pixel mean of the accepted samples, resolved in double precision.
     Image mean() const;
-    /// Per-pixel variance of that mean (sample variance / count); needs
-    /// RenderOptions::variance. Pixels with fewer than 2 samples get +inf.
+    /// Per-pixel variance of that mean; needs RenderOptions::variance. With
+    /// independent samples: sample variance / count (+inf below 2 samples).
+    /// With the Sobol' sampler: from the gpu::VARIANCE_BATCHES independently
+    /// scrambled batch means, VARIANCE_BATCHES - 1 degrees of freedom (+inf
+    /// until every batch has a sample).
     Image varianceOfMean() const;
+    /// Degrees of freedom of each pixel's variance estimate (0: none made).
+    uint64_t varianceDegreesOfFreedom() const;
     RenderCounters counters() const;
 
     const FeatureSet& features() const { return m_features; }
@@ -85,6 +90,8 @@ private:
     uint32_t m_environmentSize = 0;
     uint32_t m_frames = 0;
 
+    bool batchedVariance() const { return m_features.variance && m_features.sobolSampler; }
+    Image varianceOfMeanFromBatches() const;
     void bindEnvironment();
     void uploadSceneBuffers();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;

@@ -116,6 +116,8 @@ std::vector<std::pair<std::string, std::string>> FeatureSet::defines() const
     for (MaterialType type : kAllMaterialTypes)
         if (has(type)) result.emplace_back("VKRT_MATERIAL_" + upper(materialTypeName(type)), "1");
     if (uniformScene) result.emplace_back("VKRT_UNIFORM_SCENE", "1");
+    // Variance under the Sobol' sampler comes from independently scrambled batches.
+    if (variance && sobolSampler) result.emplace_back("VKRT_SOBOL_BATCHES", std::to_string(gpu::VARIANCE_BATCHES));
     return result;
 }
 

@@ -80,6 +80,24 @@ TEST_F(StatsCli, IndependentRendersPassThePixelTestAndABiasFailsIt)
     EXPECT_EQ(biased.exitCode, 4) << biased.output;
 }
 
+// Variances from the Sobol' sampler's 8 batches have 7 degrees of freedom;
+// compare reads that from the EXR and uses Welch's t: two seeds agree even
+// with every value required to pass, and a 25 % bias still fails.
+TEST_F(StatsCli, SobolBatchVariancesPassTheWelchTestAndABiasFailsIt)
+{
+    ASSERT_EQ(render("a.exr", {"--spp", "64", "--sampler", "sobol", "--variance", "--seed", "1"}).exitCode, 0);
+    ASSERT_EQ(render("b.exr", {"--spp", "64", "--sampler", "sobol", "--variance", "--seed", "2"}).exitCode, 0);
+    ProcessResult r = runVkrt({"compare", (m_dir / "a.exr").string(), (m_dir / "b.exr").string(), "--min-pass", "1"});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("Welch's t"), std::string::npos) << r.output;
+
+    ExrContents b = readExr(m_dir / "b.exr");
+    for (float& v : b.image.rgb) v *= 1.25f;
+    writeExr(m_dir / "biased.exr", b.image, b.metadata, b.layers);
+    ProcessResult biased = runVkrt({"compare", (m_dir / "a.exr").string(), (m_dir / "biased.exr").string()});
+    EXPECT_EQ(biased.exitCode, 4) << biased.output;
+}
+
 TEST_F(StatsCli, CompareRejectsMismatchedSizes)
 {
     writeExr(m_dir / "small.exr", Image(4, 4), {});

@@ -1,5 +1,6 @@
 // End-to-end tests of `vkrt render` and `vkrt devices` as a user runs them.
 #include "io/ExrFile.h"
+#include "shared/Bindings.h"
 #include "support/TestSupport.h"
 
 #include <chrono>
@@ -84,20 +85,28 @@ TEST_F(RenderCli, WritesExrWithMetadataAndPng)
     EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
 }
 
-// --sampler auto: Sobol' for a plain render, independent samples as soon as an
-// error estimate is needed; an explicit sobol with one is refused.
-TEST_F(RenderCli, SamplerAutoPicksSobolUnlessAnErrorEstimateIsNeeded)
+// --sampler auto: Sobol' unless a per-pixel variance layer is asked for; an
+// error estimate under Sobol' (--report, --target-error, or --variance with an
+// explicit sobol) comes from independently scrambled batches, and the EXR
+// says how many degrees of freedom the variance layer has.
+TEST_F(RenderCli, SamplerAutoPicksSobolUnlessAVarianceLayerIsAsked)
 {
     ASSERT_EQ(render("plain.exr", {"--spp", "2"}).exitCode, 0);
-    EXPECT_EQ(std::get<std::string>(readExr(m_dir / "plain.exr").metadata.at("sampler")), "sobol");
-    ASSERT_EQ(render("var.exr", {"--spp", "2", "--variance"}).exitCode, 0);
+    ExrContents plain = readExr(m_dir / "plain.exr");
+    EXPECT_EQ(std::get<std::string>(plain.metadata.at("sampler")), "sobol");
+    EXPECT_EQ(plain.metadata.count("varianceDegreesOfFreedom"), 0u);
+    ASSERT_EQ(render("var.exr", {"--spp", "3", "--variance"}).exitCode, 0);
     ExrContents withVariance = readExr(m_dir / "var.exr");
     EXPECT_EQ(std::get<std::string>(withVariance.metadata.at("sampler")), "independent");
-    ProcessResult refused = render("no.exr", {"--spp", "2", "--sampler", "sobol", "--variance"});
-    EXPECT_EQ(refused.exitCode, 2);
-    EXPECT_NE(refused.output.find("--sampler sobol cannot be combined with --variance"), std::string::npos)
-        << refused.output;
-    EXPECT_FALSE(fs::exists(m_dir / "no.exr"));
+    EXPECT_EQ(std::get<int64_t>(withVariance.metadata.at("varianceDegreesOfFreedom")), 2);
+    ASSERT_EQ(render("report.exr", {"--spp", "8", "--report", (m_dir / "r.csv").string()}).exitCode, 0);
+    EXPECT_EQ(std::get<std::string>(readExr(m_dir / "report.exr").metadata.at("sampler")), "sobol");
+    ASSERT_EQ(render("batched.exr", {"--spp", "16", "--sampler", "sobol", "--variance"}).exitCode, 0);
+    ExrContents batched = readExr(m_dir / "batched.exr");
+    EXPECT_EQ(std::get<std::string>(batched.metadata.at("sampler")), "sobol");
+    EXPECT_EQ(std::get<int64_t>(batched.metadata.at("varianceDegreesOfFreedom")), int64_t(gpu::VARIANCE_BATCHES) - 1);
+    ASSERT_TRUE(batched.layers.count("variance"));
+    for (float v : batched.layers.at("variance").rgb) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
     ProcessResult unknown = render("no.exr", {"--sampler", "halton"});
     EXPECT_EQ(unknown.exitCode, 2);
     EXPECT_NE(unknown.output.find("--sampler"), std::string::npos) << unknown.output;

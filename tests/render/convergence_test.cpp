@@ -77,33 +77,69 @@ Image exactImage(const Scene& scene)
     return image;
 }
 
-class ConvergenceTest : public GpuTest {};
+class ConvergenceTest : public GpuTest {
+protected:
+    struct ErrorAtSpp {
+        uint32_t spp;
+        double trueMse;
+        double estimatedMse;
+    };
+
+    /// True and estimated MSE of one progressive render at 1, 2, 4, ... 1024 spp.
+    std::vector<ErrorAtSpp> errorsBySpp(bool sobol)
+    {
+        Scene scene = lightOverFloor();
+        Image exact = exactImage(scene);
+        RenderOptions options;
+        options.variance = true;
+        options.sobol = sobol;
+        options.seed = 3;
+        options.cacheDirectory = testCacheDir();
+        Renderer renderer(gpu(), scene, options);
+        std::vector<ErrorAtSpp> errors;
+        for (uint32_t spp = 1; spp <= 1024; spp *= 2) {
+            renderer.renderFrames(spp - renderer.completedFrames());
+            Image mean = renderer.mean();
+            errors.push_back({spp, std::pow(measureError(mean, exact).rmse, 2),
+                              std::pow(estimateError(mean, renderer.varianceOfMean()).rmse, 2)});
+        }
+        return errors;
+    }
+};
 
 TEST_F(ConvergenceTest, EstimatedErrorTracksTrueErrorAndMseFallsAsOneOverSpp)
 {
-    Scene scene = lightOverFloor();
-    Image exact = exactImage(scene);
-    RenderOptions options;
-    options.variance = true;
-    options.seed = 3;
-    options.cacheDirectory = testCacheDir();
-    Renderer renderer(gpu(), scene, options);
     std::vector<double> logSpp, logMse;
-    for (uint32_t spp = 1; spp <= 1024; spp *= 2) {
-        renderer.renderFrames(spp - renderer.completedFrames());
-        Image mean = renderer.mean();
-        double trueMse = std::pow(measureError(mean, exact).rmse, 2);
-        double estimatedMse = std::pow(estimateError(mean, renderer.varianceOfMean()).rmse, 2);
-        if (spp >= 16) {
-            EXPECT_NEAR(estimatedMse / trueMse, 1.0, 0.25) << "spp " << spp;
+    for (const ErrorAtSpp& e : errorsBySpp(false)) {
+        if (e.spp >= 16) {
+            EXPECT_NEAR(e.estimatedMse / e.trueMse, 1.0, 0.25) << "spp " << e.spp;
         }
-        if (spp >= 4) logSpp.push_back(std::log(double(spp))), logMse.push_back(std::log(trueMse));
+        if (e.spp >= 4) logSpp.push_back(std::log(double(e.spp))), logMse.push_back(std::log(e.trueMse));
     }
     double n = double(logSpp.size()), sx = 0, sy = 0, sxx = 0, sxy = 0;
     for (size_t i = 0; i < logSpp.size(); ++i)
         sx += logSpp[i], sy += logMse[i], sxx += logSpp[i] * logSpp[i], sxy += logSpp[i] * logMse[i];
     double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
     EXPECT_NEAR(slope, -1.0, 0.1);
+}
+
+// Under the Sobol' sampler the frames of a pixel are correlated, so their
+// spread overstates the error of the mean (here by orders of magnitude); the
+// estimate from independently scrambled batches must track the true error
+// instead, while the image keeps a large part of the sampler's gain.
+TEST_F(ConvergenceTest, SobolBatchVarianceTracksTrueError)
+{
+    std::vector<ErrorAtSpp> sobol = errorsBySpp(true), independent = errorsBySpp(false);
+    for (const ErrorAtSpp& e : sobol) {
+        if (e.spp < gpu::VARIANCE_BATCHES) {
+            EXPECT_TRUE(std::isinf(e.estimatedMse)) << "spp " << e.spp << ": a batch without samples";
+        } else if (e.spp >= 2 * gpu::VARIANCE_BATCHES) {
+            EXPECT_NEAR(e.estimatedMse / e.trueMse, 1.0, 0.25) << "spp " << e.spp;
+        }
+    }
+    double gain = independent.back().trueMse / sobol.back().trueMse;
+    reportStat("sobol_batched_mse_gain_at_1024spp", gain);
+    EXPECT_GT(gain, 4.0) << "batched Sobol' at 1024 spp should still beat independent samples clearly";
 }
 
 TEST(ErrorMetrics, KnownValues)
@@ -121,6 +157,28 @@ TEST(ErrorMetrics, KnownValues)
     EXPECT_EQ(measureError(a, b).compared, 5u);
     EXPECT_NEAR(normalQuantileTwoSided(0.05), 1.959964, 1e-5);
     EXPECT_NEAR(normalQuantileTwoSided(0.01), 2.575829, 1e-5);
+}
+
+// Student's t against tabulated quantiles, and the Welch test's degrees of
+// freedom: two variances of 7 each, equal, give 14.
+TEST(ErrorMetrics, StudentTailAndWelchDegreesOfFreedom)
+{
+    EXPECT_NEAR(studentTwoSidedTail(2.364624, 7.0), 0.05, 1e-6);
+    EXPECT_NEAR(studentTwoSidedTail(-3.499483, 7.0), 0.01, 1e-6);
+    EXPECT_NEAR(studentTwoSidedTail(12.706205, 1.0), 0.05, 1e-6);
+    EXPECT_NEAR(studentTwoSidedTail(1.959964, INFINITY), 0.05, 1e-6);
+    EXPECT_EQ(studentTwoSidedTail(INFINITY, 7.0), 0.0);
+
+    // One value, difference t * sqrt(2) with unit variances: p is the t tail.
+    Image a(1, 1), b(1, 1), unit(1, 1);
+    unit.rgb = {1, 1, 1};
+    b.rgb = {0, 0, 0};
+    a.rgb = {float(2.144787 * std::sqrt(2.0)), 0, 0}; // t_{0.975} with 14 degrees of freedom
+    PixelTestSummary welch = pixelZTest(a, unit, b, unit, 0.01, 7.0, 7.0);
+    EXPECT_NEAR(welch.minPValue, 0.05, 1e-5);
+    PixelTestSummary z = pixelZTest(a, unit, b, unit, 0.01);
+    EXPECT_NEAR(z.minPValue, std::erfc(2.144787 / std::sqrt(2.0)), 1e-6); // the normal tail, smaller
+    EXPECT_EQ(welch.passed, 3u);
 }
 
 } // namespace

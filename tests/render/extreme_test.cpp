@@ -100,7 +100,7 @@ void expectSameImage(const Render& a, const Render& b, const std::string& what)
 {
     Comparison c = compareRenders(a, b);
     measured("%s: %zu/%zu values pass |z| < %.2f (%.4f), min p %.3g, pooled z %.2f", what.c_str(), c.pixels.passed,
-             c.pixels.tested, c.pixels.threshold, c.pixels.fractionPassed(), c.pixels.minPValue, c.pooledZ);
+             c.pixels.tested, c.pixels.zThreshold, c.pixels.fractionPassed(), c.pixels.minPValue, c.pooledZ);
     EXPECT_GE(c.pixels.fractionPassed(), 0.9975) << what;
     EXPECT_LT(std::abs(c.pooledZ), 4.0) << what;
 }
