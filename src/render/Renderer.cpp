@@ -6,6 +6,7 @@
 #include "util/Error.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <numeric>
 #include <limits>
@@ -63,6 +64,44 @@ Image constantFace(const glm::vec3& colour)
 
 template <typename T> std::span<const std::byte> bytesOf(const T& value) { return std::as_bytes(std::span(&value, 1)); }
 
+std::string gibibytes(double bytes)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f GiB", bytes / (1024.0 * 1024.0 * 1024.0));
+    return text;
+}
+
+/// A device-local storage buffer of `bytesPerPixel` per pixel of the scene's
+/// image. Memory the device cannot allocate is the user's image size, so say
+/// so rather than fail inside Vulkan. A buffer past the device's
+/// maxStorageBufferRange (128 MiB on lavapipe: 4.8 M pixels of accumulation)
+/// is outside what Vulkan guarantees; lavapipe does not bound storage
+/// accesses and renders it correctly (checked at 3840x2160), so it gets a
+/// warning, not a refusal (docs/robustness.md, L8).
+Buffer perPixelBuffer(const VulkanContext& context, const Scene& scene, size_t bytesPerPixel, const std::string& what,
+                      const std::string& hint = "")
+{
+    uint64_t bytes = uint64_t(bytesPerPixel) * scene.camera.width * scene.camera.height;
+    uint64_t range = context.physicalDevice().getProperties().limits.maxStorageBufferRange;
+    std::string size = std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height);
+    std::string advice = "render a smaller image (--width/--height)" + hint;
+    if (bytes > range)
+        std::fprintf(stderr,
+                     "vkrt: warning: a %s image needs %s for %s, more than the %s a storage buffer is guaranteed "
+                     "on %s (maxStorageBufferRange); it works on lavapipe, but Vulkan validation reports it\n",
+                     size.c_str(), gibibytes(double(bytes)).c_str(), what.c_str(), gibibytes(double(range)).c_str(),
+                     context.deviceInfo().name.c_str());
+    try {
+        return Buffer(context, bytes,
+                      kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
+                      MemoryUse::Device);
+    } catch (const vk::SystemError& error) {
+        throw InputError(scene.path + ": a " + size + " image needs " + gibibytes(double(bytes)) + " for " + what +
+                         ", which " + context.deviceInfo().name + " could not allocate (" + error.what() + "); " +
+                         advice);
+    }
+}
+
 } // namespace
 
 uint64_t worstCaseLoopIterations(const Scene& scene)
@@ -101,9 +140,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_features(chooseFeatures(scene, m_options)),
       m_data(convertScene(scene, FrameSettings{m_options.jitter})),
       m_compiled(compileVariant(m_features, m_options)),
-      m_accumulation(context, sizeof(gpu::AccumPixel) * size_t(scene.camera.width) * scene.camera.height,
-                     kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
-                     MemoryUse::Device),
+      m_accumulation(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel), "the accumulation buffer")),
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
@@ -113,10 +150,13 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     m_accumulation.clear(context);
     m_stats.clear(context);
     if (m_features.variance) {
-        size_t bytesPerPixel = batchedVariance() ? sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES : sizeof(gpu::MomentPixel);
-        m_moments.emplace(context, bytesPerPixel * size_t(width()) * height(),
-                          kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
-                          MemoryUse::Device);
+        if (batchedVariance())
+            m_moments.emplace(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES,
+                                             "the error estimate's " + std::to_string(gpu::VARIANCE_BATCHES) +
+                                                 " batch sums (Sobol' sampler)",
+                                             ", or estimate the error with --sampler independent (one sum per pixel)"));
+        else
+            m_moments.emplace(perPixelBuffer(context, scene, sizeof(gpu::MomentPixel), "the variance estimate"));
         m_moments->clear(context);
     }
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
