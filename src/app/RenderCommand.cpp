@@ -53,8 +53,17 @@ struct RenderCommandOptions {
     /// "auto": Sobol' (lower error; --report and --target-error estimate the
     /// image's error from its independently scrambled batches), except for a
     /// per-pixel variance layer, which independent samples give with
-    /// spp - 1 degrees of freedom instead of 7.
-    std::string resolvedSampler() const { return sampler != "auto" ? sampler : variance ? "independent" : "sobol"; }
+    /// spp - 1 degrees of freedom instead of 7, and except where the batch
+    /// sums (VARIANCE_BATCHES per pixel) would pass the storage-buffer range
+    /// the device guarantees (lavapipe: 0.6 M pixels), where independent
+    /// samples need one eighth of that.
+    std::string resolvedSampler(uint64_t pixels, uint64_t storageBufferRange) const
+    {
+        if (sampler != "auto") return sampler;
+        if (variance) return "independent";
+        bool batchesFit = pixels * sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES <= storageBufferRange;
+        return needsVariance() && !batchesFit ? "independent" : "sobol";
+    }
     /// --spp caps the render; without it a time or error rule may run long.
     uint32_t maxSpp() const { return sppGiven || !(timeBudget || targetError) ? spp : (1u << 30); }
 };
@@ -88,6 +97,7 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
                         const RenderCommandOptions& options, const LoopResult& loop, const RenderCounters& counters,
                         const std::optional<EstimatedError>& estimated)
 {
+    bool sobol = renderer.features().sobolSampler;
     Metadata metadata{
         {"vkrtVersion", std::string(VKRT_VERSION)},
         {"spp", int64_t(renderer.completedFrames())},
@@ -100,14 +110,14 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
         {"sceneHash", "fnv1a64:" + toHex(scene.fileHash)},
         {"integrator", integratorName(scene.render.integrator)},
         {"kernelVariant", renderer.features().describe() + (options.uber ? " (uber)" : "")},
-        {"sampler", options.resolvedSampler()},
+        {"sampler", std::string(sobol ? "sobol" : "independent")},
         {"rejectedSamples", int64_t(counters.rejectedSamples)},
     };
     if (options.variance) {
         // The variance layer's degrees of freedom: per-pixel tests on it
         // (vkrt compare) need Student's t rather than a normal when few.
         metadata["varianceDegreesOfFreedom"] = int64_t(renderer.varianceDegreesOfFreedom());
-        metadata["varianceEstimator"] = options.resolvedSampler() == "sobol"
+        metadata["varianceEstimator"] = sobol
                                             ? std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches"
                                             : std::string("independent samples");
     }
@@ -176,7 +186,9 @@ int runRender(const RenderCommandOptions& options)
     renderOptions.jitter = !options.pixelCenters;
     renderOptions.uber = options.uber;
     renderOptions.variance = options.needsVariance();
-    renderOptions.sobol = options.resolvedSampler() == "sobol";
+    uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
+    renderOptions.sobol =
+        options.resolvedSampler(pixels, context.physicalDevice().getProperties().limits.maxStorageBufferRange) == "sobol";
     std::optional<Image> reference = loadReference(options, scene);
     Renderer renderer(context, scene, renderOptions);
     renderer.warmUp();

@@ -101,6 +101,15 @@ TEST_F(RenderCli, SamplerAutoPicksSobolUnlessAVarianceLayerIsAsked)
     EXPECT_EQ(std::get<int64_t>(withVariance.metadata.at("varianceDegreesOfFreedom")), 2);
     ASSERT_EQ(render("report.exr", {"--spp", "8", "--report", (m_dir / "r.csv").string()}).exitCode, 0);
     EXPECT_EQ(std::get<std::string>(readExr(m_dir / "report.exr").metadata.at("sampler")), "sobol");
+    // Where 8 batch sums per pixel would pass the storage-buffer range the
+    // device guarantees (lavapipe: 128 MiB, 0.6 M pixels), auto estimates with
+    // independent samples instead: the run stays valid Vulkan (--validation
+    // would fail it with exit 3 otherwise).
+    ProcessResult wide = runVkrt({"render", kDefaultScene, "-o", (m_dir / "wide.exr").string(), "--width", "1024",
+                                  "--height", "768", "--spp", "1", "--report", (m_dir / "w.csv").string(),
+                                  "--validation"});
+    ASSERT_EQ(wide.exitCode, 0) << wide.output;
+    EXPECT_EQ(wide.output.find("warning"), std::string::npos) << wide.output;
     ASSERT_EQ(render("batched.exr", {"--spp", "16", "--sampler", "sobol", "--variance"}).exitCode, 0);
     ExrContents batched = readExr(m_dir / "batched.exr");
     EXPECT_EQ(std::get<std::string>(batched.metadata.at("sampler")), "sobol");
