@@ -22,8 +22,10 @@ void addCompensated(inout AccumPixel p, vec3 value)
 // pixel mean from their spread (Renderer::varianceOfMean).
 void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
 {
-    // The host sets VKRT_SOBOL_BATCHES (the sampler's batch count) to VARIANCE_BATCHES.
-    uint slot = pixelIndex * uint(VKRT_SOBOL_BATCHES) + frameIndex % uint(VKRT_SOBOL_BATCHES);
+    // The host sets the sampler's batch count VKRT_SOBOL_BATCHES to
+    // VARIANCE_BATCHES (and refuses to let a test define override it); the
+    // buffer is laid out for VARIANCE_BATCHES either way.
+    uint slot = pixelIndex * VARIANCE_BATCHES + frameIndex % VARIANCE_BATCHES;
     AccumPixel b = batchSums[slot];
     addCompensated(b, value);
     batchSums[slot] = b;

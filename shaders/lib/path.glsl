@@ -1,7 +1,8 @@
 // Unbiased path tracing (`integrator = "path"`). At each non-specular vertex:
 // next-event estimation for every point light and one area-sampled point on
 // every triangle light, with one shadow ray for all of them (chosen by
-// unshadowed contribution), and for the environment, weighted against BSDF
+// unshadowed contribution), and for the environment (a second shadow ray),
+// weighted against BSDF
 // sampling with the power heuristic; then one BSDF-sampled continuation. A continuation that hits a
 // light adds its emission with the complementary MIS weight (full weight after
 // a specular bounce or from the camera); one that escapes adds the environment.

@@ -33,25 +33,33 @@ struct VarianceImage {
     double degreesOfFreedom = INFINITY; ///< unknown: treated as exact (a Z-test)
 };
 
-/// vkrt's "varianceDegreesOfFreedom" attribute, when the file has one.
-double degreesOfFreedomOf(const ExrContents& exr)
+/// vkrt's "varianceDegreesOfFreedom" attribute, when the file has one; a
+/// value below 1 (no estimate was made) or of another type is an error, never
+/// a test that silently passes or silently becomes a Z-test.
+double degreesOfFreedomOf(const ExrContents& exr, const std::string& path)
 {
     auto it = exr.metadata.find("varianceDegreesOfFreedom");
-    if (it == exr.metadata.end() || !std::holds_alternative<int64_t>(it->second)) return INFINITY;
-    return double(std::get<int64_t>(it->second));
+    if (it == exr.metadata.end()) return INFINITY;
+    double dof = NAN;
+    if (std::holds_alternative<int64_t>(it->second)) dof = double(std::get<int64_t>(it->second));
+    else if (std::holds_alternative<double>(it->second)) dof = std::get<double>(it->second);
+    if (!(dof >= 1.0) || !std::isfinite(dof))
+        throw InputError(path + ": attribute varianceDegreesOfFreedom must be a number of at least 1" +
+                         (dof == 0.0 ? " (0: the render had too few samples for an error estimate)" : ""));
+    return dof;
 }
 
 /// The variance image for one side: an explicit file, else the image's own
 /// "variance" layer, else none.
-std::optional<VarianceImage> varianceFor(const std::string& explicitPath, const ExrContents& image, const Image& shape,
-                                         const char* option)
+std::optional<VarianceImage> varianceFor(const std::string& explicitPath, const ExrContents& image,
+                                         const std::string& imagePath, const Image& shape, const char* option)
 {
     std::optional<VarianceImage> variance;
     if (!explicitPath.empty()) {
         ExrContents file = readExr(explicitPath);
-        variance = VarianceImage{file.image, degreesOfFreedomOf(file)};
+        variance = VarianceImage{file.image, degreesOfFreedomOf(file, explicitPath)};
     } else if (image.layers.count("variance")) {
-        variance = VarianceImage{image.layers.at("variance"), degreesOfFreedomOf(image)};
+        variance = VarianceImage{image.layers.at("variance"), degreesOfFreedomOf(image, imagePath)};
     }
     if (variance && (variance->image.width != shape.width || variance->image.height != shape.height))
         throw InputError(std::string(option) + " " + explicitPath + ": variance is " +
@@ -73,8 +81,8 @@ int runCompare(const CompareOptions& o)
 {
     ExrContents a = readExr(o.a), b = readExr(o.b);
     requireSameSize(o, a.image, b.image);
-    std::optional<VarianceImage> va = varianceFor(o.varianceA, a, a.image, "--variance-a");
-    std::optional<VarianceImage> vb = varianceFor(o.varianceB, b, b.image, "--variance-b");
+    std::optional<VarianceImage> va = varianceFor(o.varianceA, a, o.a, a.image, "--variance-a");
+    std::optional<VarianceImage> vb = varianceFor(o.varianceB, b, o.b, b.image, "--variance-b");
 
     MeasuredError e = measureError(a.image, b.image);
     std::printf("A: %s\nB: %s (reference for relMSE and MAPE)\n", o.a.c_str(), o.b.c_str());

@@ -56,7 +56,7 @@ struct RenderCommandOptions {
     /// spp - 1 degrees of freedom instead of 7, and except where the batch
     /// sums (VARIANCE_BATCHES per pixel) would pass the storage-buffer range
     /// the device guarantees (lavapipe: 0.6 M pixels), where independent
-    /// samples need one eighth of that.
+    /// samples need about a sixth of that.
     std::string resolvedSampler(uint64_t pixels, uint64_t storageBufferRange) const
     {
         if (sampler != "auto") return sampler;
@@ -226,6 +226,11 @@ int runRender(const RenderCommandOptions& options)
     if (options.needsVariance()) {
         Image variance = renderer.varianceOfMean();
         estimated = estimateError(image, variance);
+        if (renderer.varianceDegreesOfFreedom() == 0)
+            std::fprintf(stderr,
+                         "vkrt: warning: %u spp are too few for an error estimate (it needs 2, or %u with the "
+                         "Sobol' sampler's batches): the estimate and any variance layer are +inf\n",
+                         renderer.completedFrames(), gpu::VARIANCE_BATCHES);
         if (report && lastCheckpoint != renderer.completedFrames())
             report->add(renderer.completedFrames(), loop.renderSeconds, image, variance); // the last row
         if (options.variance) layers["variance"] = std::move(variance);
@@ -280,7 +285,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_flag("--variance", options->variance,
                   "Also estimate per-pixel variance and write the variance of each pixel's mean as layer 'variance'");
     cmd->add_option("--sampler", options->sampler,
-                    "auto (default: sobol unless --variance), independent, or sobol "
+                    "auto (default: sobol, except independent for --variance and for error estimates too large "
+                    "for the Sobol' batch sums), independent, or sobol "
                     "(Owen-scrambled Sobol' points: lower error; any variance estimate comes from " +
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));

@@ -23,6 +23,13 @@ FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
     FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     features.variance = options.variance;
     features.sobolSampler = options.sobol;
+    // The batch sums are laid out for VARIANCE_BATCHES batches; a different
+    // sampler batch count would make the estimate describe other batches.
+    bool batchOverride = std::any_of(options.extraDefines.begin(), options.extraDefines.end(),
+                                     [](const Define& d) { return d.first == "VKRT_SOBOL_BATCHES"; });
+    if (options.variance && options.sobol && batchOverride)
+        throw InputError("VKRT_SOBOL_BATCHES cannot be overridden when the Sobol' sampler estimates variance "
+                         "(its batch count is VARIANCE_BATCHES)");
     features.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
     return features;
 }
@@ -265,6 +272,7 @@ void Renderer::warmUp()
 
 Image Renderer::mean() const
 {
+    if (batchedVariance()) return meanOfBatchMeans();
     auto bytes = m_accumulation.download(m_context);
     const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(bytes.data());
     Image image(width(), height());
@@ -279,6 +287,12 @@ Image Renderer::mean() const
 
 namespace {
 
+/// Mean of one batch's samples (one channel); the batch must have a sample.
+double batchMean(const gpu::AccumPixel& batch, int channel)
+{
+    return (double(batch.sum[channel]) - double(batch.compensation[channel])) / batch.count;
+}
+
 /// Variance of a pixel's mean from K independent batch means (one channel):
 /// sum_b (m_b - mean)^2 / (K (K - 1)); +inf when a batch has no sample yet.
 float varianceFromBatches(const gpu::AccumPixel* batches, uint32_t count, int channel)
@@ -286,7 +300,7 @@ float varianceFromBatches(const gpu::AccumPixel* batches, uint32_t count, int ch
     std::vector<double> means(count);
     for (uint32_t b = 0; b < count; ++b) {
         if (batches[b].count == 0) return std::numeric_limits<float>::infinity();
-        means[b] = (double(batches[b].sum[channel]) - double(batches[b].compensation[channel])) / batches[b].count;
+        means[b] = batchMean(batches[b], channel);
     }
     double mean = std::accumulate(means.begin(), means.end(), 0.0) / count;
     double squares = 0.0;
@@ -319,6 +333,38 @@ Image Renderer::varianceOfMean() const
     return image;
 }
 
+// The estimate whose variance varianceOfMeanFromBatches() gives: batch means
+// weighted equally. Frames that are not a multiple of the batch count, or
+// rejected (non-finite) samples, leave batches with unequal counts; a mean
+// weighted by count would then be a different estimator from the one the
+// variance describes. A pixel with an empty batch (fewer frames than
+// batches, or all of a batch's samples rejected) has no such estimate and
+// falls back to the mean of all its samples (its variance is +inf).
+Image Renderer::meanOfBatchMeans() const
+{
+    auto accumBytes = m_accumulation.download(m_context);
+    auto batchBytes = m_moments->download(m_context);
+    const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(accumBytes.data());
+    const auto* batches = reinterpret_cast<const gpu::AccumPixel*>(batchBytes.data());
+    Image image(width(), height());
+    for (size_t i = 0; i < image.pixelCount(); ++i) {
+        const gpu::AccumPixel* pixelBatches = batches + i * gpu::VARIANCE_BATCHES;
+        bool everyBatch = std::all_of(pixelBatches, pixelBatches + gpu::VARIANCE_BATCHES,
+                                      [](const gpu::AccumPixel& b) { return b.count > 0; });
+        for (int c = 0; c < 3; ++c) {
+            double value = 0.0;
+            if (everyBatch) {
+                for (uint32_t b = 0; b < gpu::VARIANCE_BATCHES; ++b) value += batchMean(pixelBatches[b], c);
+                value /= gpu::VARIANCE_BATCHES;
+            } else if (pixels[i].count > 0) {
+                value = (double(pixels[i].sum[c]) - double(pixels[i].compensation[c])) / pixels[i].count;
+            }
+            image.rgb[i * 3 + c] = float(value);
+        }
+    }
+    return image;
+}
+
 Image Renderer::varianceOfMeanFromBatches() const
 {
     auto bytes = m_moments->download(m_context);
@@ -333,7 +379,8 @@ Image Renderer::varianceOfMeanFromBatches() const
 uint64_t Renderer::varianceDegreesOfFreedom() const
 {
     if (!m_features.variance || m_frames == 0) return 0;
-    return batchedVariance() ? gpu::VARIANCE_BATCHES - 1 : m_frames - 1;
+    if (batchedVariance()) return m_frames >= gpu::VARIANCE_BATCHES ? gpu::VARIANCE_BATCHES - 1 : 0;
+    return m_frames - 1;
 }
 
 RenderCounters Renderer::counters() const

@@ -55,7 +55,8 @@ public:
     /// The accumulation buffer (AccumPixel per pixel), for display kernels.
     const Buffer& accumulation() const { return m_accumulation; }
 
-    /// Per-pixel mean of the accepted samples, resolved in double precision.
+    /// Per-pixel mean of the accepted samples, resolved in double precision
+    /// (with batched variance: the mean of the batch means, see Renderer.cpp).
     Image mean() const;
     /// Per-pixel variance of that mean; needs RenderOptions::variance. With
     /// independent samples: sample variance / count (+inf below 2 samples).
@@ -63,7 +64,7 @@ public:
     /// scrambled batch means, VARIANCE_BATCHES - 1 degrees of freedom (+inf
     /// until every batch has a sample).
     Image varianceOfMean() const;
-    /// Degrees of freedom of each pixel's variance estimate (0: none made).
+    /// Degrees of freedom of each pixel's variance estimate (0: none made yet).
     uint64_t varianceDegreesOfFreedom() const;
     RenderCounters counters() const;
 
@@ -92,6 +93,7 @@ private:
 
     bool batchedVariance() const { return m_features.variance && m_features.sobolSampler; }
     Image varianceOfMeanFromBatches() const;
+    Image meanOfBatchMeans() const;
     void bindEnvironment();
     void uploadSceneBuffers();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
