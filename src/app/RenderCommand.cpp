@@ -61,7 +61,7 @@ struct RenderCommandOptions {
     {
         if (sampler != "auto") return sampler;
         if (variance) return "independent";
-        bool batchesFit = pixels * sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES <= storageBufferRange;
+        bool batchesFit = pixels * varianceBytesPerPixel(true) <= storageBufferRange;
         return needsVariance() && !batchesFit ? "independent" : "sobol";
     }
     /// --spp caps the render; without it a time or error rule may run long.

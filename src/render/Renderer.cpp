@@ -71,6 +71,12 @@ Image constantFace(const glm::vec3& colour)
 
 template <typename T> std::span<const std::byte> bytesOf(const T& value) { return std::as_bytes(std::span(&value, 1)); }
 
+/// Mean of a compensated sum's samples (one channel); it must have a sample.
+double compensatedMean(const gpu::AccumPixel& p, int channel)
+{
+    return (double(p.sum[channel]) - double(p.compensation[channel])) / double(p.count);
+}
+
 std::string gibibytes(double bytes)
 {
     char text[32];
@@ -110,6 +116,11 @@ Buffer perPixelBuffer(const VulkanContext& context, const Scene& scene, size_t b
 }
 
 } // namespace
+
+size_t varianceBytesPerPixel(bool sobol)
+{
+    return sobol ? sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES : sizeof(gpu::MomentPixel);
+}
 
 uint64_t worstCaseLoopIterations(const Scene& scene)
 {
@@ -158,12 +169,12 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     m_stats.clear(context);
     if (m_features.variance) {
         if (batchedVariance())
-            m_moments.emplace(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES,
+            m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(true),
                                              "the error estimate's " + std::to_string(gpu::VARIANCE_BATCHES) +
                                                  " batch sums (Sobol' sampler)",
                                              ", or estimate the error with --sampler independent (one sum per pixel)"));
         else
-            m_moments.emplace(perPixelBuffer(context, scene, sizeof(gpu::MomentPixel), "the variance estimate"));
+            m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(false), "the variance estimate"));
         m_moments->clear(context);
     }
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
@@ -279,19 +290,12 @@ Image Renderer::mean() const
     for (size_t i = 0; i < image.pixelCount(); ++i) {
         const gpu::AccumPixel& p = pixels[i];
         if (p.count == 0) continue; // every sample was non-finite: black, and counted
-        for (int c = 0; c < 3; ++c)
-            image.rgb[i * 3 + c] = float((double(p.sum[c]) - double(p.compensation[c])) / double(p.count));
+        for (int c = 0; c < 3; ++c) image.rgb[i * 3 + c] = float(compensatedMean(p, c));
     }
     return image;
 }
 
 namespace {
-
-/// Mean of one batch's samples (one channel); the batch must have a sample.
-double batchMean(const gpu::AccumPixel& batch, int channel)
-{
-    return (double(batch.sum[channel]) - double(batch.compensation[channel])) / batch.count;
-}
 
 /// Variance of a pixel's mean from K independent batch means (one channel):
 /// sum_b (m_b - mean)^2 / (K (K - 1)); +inf when a batch has no sample yet.
@@ -300,7 +304,7 @@ float varianceFromBatches(const gpu::AccumPixel* batches, uint32_t count, int ch
     std::vector<double> means(count);
     for (uint32_t b = 0; b < count; ++b) {
         if (batches[b].count == 0) return std::numeric_limits<float>::infinity();
-        means[b] = batchMean(batches[b], channel);
+        means[b] = compensatedMean(batches[b], channel);
     }
     double mean = std::accumulate(means.begin(), means.end(), 0.0) / count;
     double squares = 0.0;
@@ -354,10 +358,10 @@ Image Renderer::meanOfBatchMeans() const
         for (int c = 0; c < 3; ++c) {
             double value = 0.0;
             if (everyBatch) {
-                for (uint32_t b = 0; b < gpu::VARIANCE_BATCHES; ++b) value += batchMean(pixelBatches[b], c);
+                for (uint32_t b = 0; b < gpu::VARIANCE_BATCHES; ++b) value += compensatedMean(pixelBatches[b], c);
                 value /= gpu::VARIANCE_BATCHES;
             } else if (pixels[i].count > 0) {
-                value = (double(pixels[i].sum[c]) - double(pixels[i].compensation[c])) / pixels[i].count;
+                value = compensatedMean(pixels[i], c);
             }
             image.rgb[i * 3 + c] = float(value);
         }

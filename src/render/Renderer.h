@@ -99,6 +99,10 @@ private:
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
 };
 
+/// Bytes per pixel of the variance estimate's buffer: Welford moments, or
+/// under the Sobol' sampler one compensated sum per batch.
+size_t varianceBytesPerPixel(bool sobol);
+
 /// Worst-case loop iterations one invocation of the scene's kernel can run.
 uint64_t worstCaseLoopIterations(const Scene& scene);
 
