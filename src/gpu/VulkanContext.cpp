@@ -157,10 +157,15 @@ void VulkanContext::createInstance(const std::optional<PresentationSupport>& pre
     if (!m_validation) return;
     using Severity = vk::DebugUtilsMessageSeverityFlagBitsEXT;
     using Type = vk::DebugUtilsMessageTypeFlagBitsEXT;
-    vk::DebugUtilsMessengerCreateInfoEXT info({}, Severity::eWarning | Severity::eError,
-                                              Type::eGeneral | Type::eValidation | Type::ePerformance,
-                                              &onValidationMessage, m_validationLog.get());
-    m_messenger = vk::raii::DebugUtilsMessengerEXT(m_instance, info);
+    // Built as the C struct and converted: Vulkan-Hpp 1.4 deprecates the
+    // constructor taking a C callback, and 1.3 has none taking a C++ one.
+    VkDebugUtilsMessengerCreateInfoEXT info{};
+    info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+    info.messageSeverity = VkDebugUtilsMessageSeverityFlagsEXT(Severity::eWarning | Severity::eError);
+    info.messageType = VkDebugUtilsMessageTypeFlagsEXT(Type::eGeneral | Type::eValidation | Type::ePerformance);
+    info.pfnUserCallback = &onValidationMessage;
+    info.pUserData = m_validationLog.get();
+    m_messenger = vk::raii::DebugUtilsMessengerEXT(m_instance, vk::DebugUtilsMessengerCreateInfoEXT(info));
 }
 
 void VulkanContext::chooseDevice(const std::string& selector)

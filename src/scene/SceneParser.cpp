@@ -572,7 +572,8 @@ const std::array<MaterialKind, 5> materialKinds{{
 
 Material readMaterial(std::string_view name, const TableField& table)
 {
-    const MaterialKind& kind = readChoice(table.require("type"), "material type", materialKinds);
+    // A copy: GCC 14 cannot tell that the reference would not dangle.
+    const MaterialKind kind = readChoice(table.require("type"), "material type", materialKinds);
     table.rejectUnknownKeys(kind.keys, allMaterialKeys, "material type " + quote(kind.name));
     Material material;
     material.name = name;
@@ -687,7 +688,7 @@ const std::array<ShapeKind, 4> shapeKinds{{
 
 void readObject(const TableField& table, const MaterialIndex& materials, Scene& scene)
 {
-    const ShapeKind& kind = readChoice(table.require("shape"), "shape", shapeKinds);
+    const ShapeKind kind = readChoice(table.require("shape"), "shape", shapeKinds);
     table.rejectUnknownKeys(kind.keys, allShapeKeys, "shape " + quote(kind.name));
     kind.read(table, materials.resolve(table.require("material")), scene);
 }
@@ -734,7 +735,7 @@ const std::array<LightKind, 2> lightKinds{{
 
 void readLight(const TableField& table, Scene& scene)
 {
-    const LightKind& kind = readChoice(table.require("type"), "light type", lightKinds);
+    const LightKind kind = readChoice(table.require("type"), "light type", lightKinds);
     table.rejectUnknownKeys(kind.keys, allLightKeys, "light type " + quote(kind.name));
     kind.read(table, scene);
 }
