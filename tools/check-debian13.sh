@@ -50,6 +50,9 @@ log() { printf 'check-debian13: %s\n' "$*"; }
 die() { printf 'check-debian13: error: %s\n' "$*" >&2; exit 1; }
 
 [[ $(id -u) -eq 0 ]] || die "debootstrap, mount and chroot need root: run it with sudo"
+# Under sudo the clone belongs to another user; git refuses such a repository
+# unless it is named safe.
+git() { command git -c safe.directory='*' "$@"; }
 repo=$(git -C "$(dirname "${BASH_SOURCE[0]}")" rev-parse --show-toplevel) \
   || die "this script must run from a git clone of the repository"
 head=$(git -C "$repo" rev-parse HEAD)
