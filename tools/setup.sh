@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One-command set-up on a fresh Debian 12 machine:
+# One-command set-up on a fresh Debian 12 or 13 machine:
 #   tools/setup.sh render   install what is missing, build, render scenes/default.toml
 #                           to default.exr and default.png in the repository root
 #   tools/setup.sh test     install what is missing, build, run the whole test suite on lavapipe

@@ -81,6 +81,7 @@ DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index
     info.name = props.deviceName.data();
     info.type = props.deviceType;
     info.driver = std::string(driver.driverName.data()) + ": " + driver.driverInfo.data();
+    info.driverId = driver.driverID;
     info.apiVersion = props.apiVersion;
     info.computeQueueFamily = findComputeQueueFamily(device, surface);
     info.unsuitableReason = unsuitableReason(device, info, surface);
@@ -166,6 +167,12 @@ void VulkanContext::createInstance(const std::optional<PresentationSupport>& pre
     info.pfnUserCallback = &onValidationMessage;
     info.pUserData = m_validationLog.get();
     m_messenger = vk::raii::DebugUtilsMessengerEXT(m_instance, vk::DebugUtilsMessengerCreateInfoEXT(info));
+}
+
+const LoopCap& VulkanContext::loopCap() const
+{
+    if (!m_loopCap) m_loopCap = detectLoopCap(*this);
+    return *m_loopCap;
 }
 
 void VulkanContext::chooseDevice(const std::string& selector)

@@ -2,6 +2,8 @@
 // The Vulkan instance, the chosen physical device, its logical device and a
 // compute queue. Members are declared in creation order, so RAII destroys
 // them in the reverse order Vulkan requires.
+#include "gpu/LoopCap.h"
+
 #include <vulkan/vulkan_raii.hpp>
 
 #include <functional>
@@ -19,6 +21,7 @@ struct DeviceInfo {
     std::string name;
     vk::PhysicalDeviceType type = vk::PhysicalDeviceType::eOther;
     std::string driver; ///< driver name and info, e.g. "llvmpipe: Mesa 22.3.6 (LLVM 15.0.6)"
+    vk::DriverId driverId{}; ///< e.g. eMesaLlvmpipe for lavapipe
     uint32_t apiVersion = 0;
     std::optional<uint32_t> computeQueueFamily;
     std::string unsuitableReason; ///< empty when vkrt can use the device
@@ -72,6 +75,10 @@ public:
     /// The window surface (viewer only; null otherwise).
     const vk::raii::SurfaceKHR& surface() const { return m_surface; }
 
+    /// Whether this device silently cuts long shader loops short (Mesa < 25
+    /// lavapipe); decided once, on first use, by detectLoopCap.
+    const LoopCap& loopCap() const;
+
     bool validationEnabled() const { return m_validation; }
     /// Messages the validation layer has emitted so far (empty when disabled).
     std::vector<std::string> validationMessages() const { return m_validationLog->messages(); }
@@ -104,6 +111,7 @@ private:
     vk::raii::Device m_device = nullptr;
     vk::raii::Queue m_queue = nullptr;
     vk::raii::CommandPool m_commandPool = nullptr;
+    mutable std::optional<LoopCap> m_loopCap;
 
     void createInstance(const std::optional<PresentationSupport>& presentation);
     void chooseDevice(const std::string& selector);

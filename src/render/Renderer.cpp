@@ -17,9 +17,9 @@ namespace {
 
 constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffer;
 
-FeatureSet chooseFeatures(const Scene& scene, const RenderOptions& options)
+FeatureSet chooseFeatures(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
-    checkLoopBudget(scene); // before any compilation or allocation
+    checkLoopBudget(scene, context.loopCap()); // before any compilation or allocation
     FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     features.variance = options.variance;
     features.sobolSampler = options.sobol;
@@ -142,20 +142,22 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
     return depth * (perDepth + environment) + 1 + hittables;
 }
 
-void checkLoopBudget(const Scene& scene)
+void checkLoopBudget(const Scene& scene, const LoopCap& cap)
 {
+    if (!cap.capped()) return; // the device runs every loop to completion
     uint64_t worst = worstCaseLoopIterations(scene);
-    if (worst >= gpu::LOOP_BUDGET)
-        throw InputError(scene.path + ": scene too large: one pixel sample may need " + std::to_string(worst) +
-                         " loop iterations, but lavapipe stops every shader invocation at " +
-                         std::to_string(gpu::LOOP_BUDGET) + " (reduce primitives or lights)");
+    if (worst >= *cap.budget)
+        throw InputError(scene.path + ": scene too large for this device: one pixel sample may need " +
+                         std::to_string(worst) + " loop iterations, but it silently stops every shader invocation at " +
+                         std::to_string(*cap.budget) + " (" + cap.evidence +
+                         "); reduce primitives or lights, or use Mesa 25's lavapipe, which has no such cap");
 }
 
 Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptions options)
     : m_context(context),
       m_scene(scene),
       m_options(std::move(options)),
-      m_features(chooseFeatures(scene, m_options)),
+      m_features(chooseFeatures(context, scene, m_options)),
       m_data(convertScene(scene, FrameSettings{m_options.jitter})),
       m_compiled(compileVariant(m_features, m_options)),
       m_accumulation(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel), "the accumulation buffer")),

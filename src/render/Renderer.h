@@ -106,7 +106,8 @@ size_t varianceBytesPerPixel(bool sobol);
 /// Worst-case loop iterations one invocation of the scene's kernel can run.
 uint64_t worstCaseLoopIterations(const Scene& scene);
 
-/// Throws InputError naming the scene if its kernel could hit lavapipe's loop budget.
-void checkLoopBudget(const Scene& scene);
+/// Throws InputError naming the scene if its kernel could be cut short by the
+/// device's loop cap (Mesa < 25 lavapipe); a device without a cap refuses nothing.
+void checkLoopBudget(const Scene& scene, const LoopCap& cap);
 
 } // namespace vkrt
