@@ -8,7 +8,9 @@
 #   tools/format.sh [--check] FILE...   only these files
 #
 # CLANG_FORMAT picks the binary (default: clang-format; Debian package
-# clang-format).
+# clang-format). Debian 12's clang-format 14 and Debian 13's 19 disagree on a
+# few constructs (a lambda that is not the last argument, `T C::* member`), so
+# a check must use the same major version as the one that formatted the tree.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
