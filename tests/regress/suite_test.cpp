@@ -147,7 +147,7 @@ TEST_F(SuiteFile, MissingThingsAreReportedAtTheirTable)
 {
     expectError(caseText() + "[[case]]\nname = \"b\"\n", 8, 1, "case[1]: missing required key 'scene'");
     expectError("[suite]\nseed = 2\n", 1, 1, "no [[case]] entries");
-    expectError("case = []\n", 1, 8, "no [[case]] entries");
+    expectError("case = []\n", 1, 8, "case: no [[case]] entries");
     expectError("[[case]]\nname = \"a\"\nscene = \"scenes/none.toml\"\n", 3, 9,
                 "case[0].scene: no such file " + (m_dir / "scenes/none.toml").string());
 }

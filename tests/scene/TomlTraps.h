@@ -3,6 +3,7 @@
 // assertions or reaches a __builtin_unreachable (fixed upstream after 3.3).
 // The compiled library vkrt links reports each as a parse error; the scene and
 // suite tests check that this stays so.
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,9 @@ struct TomlTrap {
     std::string name;
     std::string text; ///< one line, without its newline
 };
+
+/// gtest prints the name, not the (partly invalid) bytes.
+inline void PrintTo(const TomlTrap& trap, std::ostream* out) { *out << trap.name; }
 
 inline const std::vector<TomlTrap> kTomlTraps = {
     {"TableNameStartsWithDot", "[."},

@@ -609,6 +609,8 @@ const std::vector<BadScene> kBadScenes = {
     {"MaxDepthZero", "[render]\nmax_depth = 0\n" + kCamera, 2, 13, "render.max_depth: must be between 1 and 64, got 0"},
     {"MaxDepthTooLarge", "[render]\nmax_depth = 65\n" + kCamera, 2, 13,
      "render.max_depth: must be between 1 and 64, got 65"},
+    {"InvalidUtf8InComment", kCamera + "# caf\xE9\n", 5, 6, "invalid TOML: invalid UTF-8 (byte 0xE9)"},
+    {"InvalidUtf8InString", kCamera + "[materials.\"r\xC3\xA9" "d\xFF\"]\n", 5, 16, "invalid TOML: invalid UTF-8 (byte 0xFF)"},
     {"UnknownIntegrator", "[render]\nintegrator = \"pathh\"\n" + kCamera, 2, 14,
      "render.integrator: unknown integrator 'pathh'; did you mean 'path'?"},
 };

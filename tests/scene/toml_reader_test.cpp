@@ -130,6 +130,38 @@ TEST(TomlReaderValues, RangesAreWrittenAsIntervals)
               "t.toml:1:5: v: must be between 1 and 7, got -3");
 }
 
+/// The location and message of parsing `text`, or "parsed".
+std::string parseOutcome(const std::string& text)
+{
+    try {
+        parseToml(text, {"t.toml", "."});
+    } catch (const SceneError& error) {
+        return error.what();
+    }
+    return "parsed";
+}
+
+TEST(TomlReaderUtf8, WellFormedTextOfEveryLengthParses)
+{
+    // U+00E9, U+20AC, U+1F600 and U+10FFFF: two, three and four bytes.
+    EXPECT_EQ(parseOutcome("v = \"\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80 \xF4\x8F\xBF\xBF\"\n"), "parsed");
+    EXPECT_EQ(parseOutcome("\xEF\xBB\xBFv = 1\n"), "parsed"); // a byte-order mark
+}
+
+TEST(TomlReaderUtf8, InvalidBytesAreLocatedExactly)
+{
+    const std::string prefix = "a = 1\n# \xC3\xA9"; // line 2: '#', ' ', then one two-byte code point
+    const auto at4 = [](const std::string& hex) {
+        return "t.toml:2:4: invalid TOML: invalid UTF-8 (byte " + hex + "); TOML files must be UTF-8";
+    };
+    EXPECT_EQ(parseOutcome(prefix + "\xE9\n"), at4("0xE9"));         // Latin-1 'e acute'
+    EXPECT_EQ(parseOutcome(prefix + "\x80\n"), at4("0x80"));         // a lone continuation byte
+    EXPECT_EQ(parseOutcome(prefix + "\xC0\xAF\n"), at4("0xC0"));     // overlong '/'
+    EXPECT_EQ(parseOutcome(prefix + "\xED\xA0\x80\n"), at4("0xED")); // a UTF-16 surrogate
+    EXPECT_EQ(parseOutcome(prefix + "\xF4\x90\x80\x80\n"), at4("0xF4")); // above U+10FFFF
+    EXPECT_EQ(parseOutcome(prefix + "\xE2\x82"), at4("0xE2"));       // cut short by the end of the file
+}
+
 TEST(TomlReaderTables, UnknownKeysAreReportedInFileOrder)
 {
     const TomlSource source{"t.toml", "."};
