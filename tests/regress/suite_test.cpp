@@ -184,7 +184,7 @@ TEST_P(SuiteFileTomlTrap, IsALocatedSyntaxError)
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Inputs, SuiteFileTomlTrap, ::testing::ValuesIn(kTomlTraps),
+INSTANTIATE_TEST_SUITE_P(TomlTraps, SuiteFileTomlTrap, ::testing::ValuesIn(kTomlTraps),
                          [](const ::testing::TestParamInfo<TomlTrap>& info) { return info.param.name; });
 
 } // namespace

@@ -695,7 +695,7 @@ TEST_P(SceneParserTomlTrap, IsALocatedSyntaxError)
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Inputs, SceneParserTomlTrap, ::testing::ValuesIn(kTomlTraps),
+INSTANTIATE_TEST_SUITE_P(TomlTraps, SceneParserTomlTrap, ::testing::ValuesIn(kTomlTraps),
                          [](const ::testing::TestParamInfo<TomlTrap>& info) { return info.param.name; });
 
 // ---------------------------------------------------------- bad cubemap files
