@@ -92,8 +92,8 @@ private:
 std::vector<RegressionCase> readCases(const TableField& top)
 {
     const std::optional<Field> cases = top.find("case");
-    const bool empty = cases && cases->node().is_array() && cases->node().as_array()->empty();
-    if (!cases || empty) (cases ? *cases : top.field()).fail("no [[case]] entries");
+    if (!cases) top.field().fail("no [[case]] entries");
+    if (cases->node().is_array() && cases->node().as_array()->empty()) cases->fail("no [[case]] entries");
     std::vector<RegressionCase> out;
     CaseNames names;
     forEachTable(*cases, [&](const TableField& table) {

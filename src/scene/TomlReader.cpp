@@ -86,6 +86,56 @@ size_t fillBandRow(std::string_view a, std::string_view b, size_t i, size_t limi
     return smallest;
 }
 
+// ------------------------------------------------------------- documents
+
+/// Length of the well-formed UTF-8 sequence starting at `at` (Unicode table
+/// 3-7: no overlong forms, no surrogates, nothing above U+10FFFF), or 0.
+size_t utf8SequenceLength(std::string_view text, size_t at)
+{
+    const auto byte = [&](size_t i) { return at + i < text.size() ? static_cast<unsigned char>(text[at + i]) : 0u; };
+    const auto inRange = [](unsigned value, unsigned low, unsigned high) { return value >= low && value <= high; };
+    const unsigned lead = byte(0);
+    if (lead < 0x80) return 1;
+    const bool tail1 = inRange(byte(1), 0x80, 0xBF), tail2 = inRange(byte(2), 0x80, 0xBF);
+    const bool tail3 = inRange(byte(3), 0x80, 0xBF);
+    if (inRange(lead, 0xC2, 0xDF)) return tail1 ? 2 : 0;
+    if (lead == 0xE0) return inRange(byte(1), 0xA0, 0xBF) && tail2 ? 3 : 0;
+    if (lead == 0xED) return inRange(byte(1), 0x80, 0x9F) && tail2 ? 3 : 0;
+    if (inRange(lead, 0xE1, 0xEF)) return tail1 && tail2 ? 3 : 0;
+    if (lead == 0xF0) return inRange(byte(1), 0x90, 0xBF) && tail2 && tail3 ? 4 : 0;
+    if (lead == 0xF4) return inRange(byte(1), 0x80, 0x8F) && tail2 && tail3 ? 4 : 0;
+    if (inRange(lead, 0xF1, 0xF3)) return tail1 && tail2 && tail3 ? 4 : 0;
+    return 0;
+}
+
+/// TOML documents are UTF-8. toml++ 3.3 places an invalid byte's error at the
+/// end of the previous line, so vkrt finds the byte itself (columns count code
+/// points, as toml++'s do).
+void checkUtf8(std::string_view text, const TomlSource& source)
+{
+    int line = 1, column = 1;
+    for (size_t at = 0; at < text.size(); ++column) {
+        const size_t length = utf8SequenceLength(text, at);
+        if (length == 0) {
+            char hex[8];
+            std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned char>(text[at]));
+            throw SceneError({source.file, line, column},
+                             "invalid TOML: invalid UTF-8 (byte " + std::string(hex) + "); TOML files must be UTF-8");
+        }
+        if (text[at] == '\n') ++line, column = 0;
+        at += length;
+    }
+}
+
+struct FileCloser {
+    void operator()(std::FILE* file) const { std::fclose(file); }
+};
+
+[[noreturn]] void failToRead(std::string_view what, const std::string& path, int error)
+{
+    throw InputError("cannot read " + std::string(what) + " '" + path + "': " + std::strerror(error));
+}
+
 } // namespace
 
 // ------------------------------------------------------------------ wording
@@ -238,49 +288,6 @@ std::string TableField::unknownKeyMessage(const toml::key& key, KeyList allowed)
 
 // ------------------------------------------------------------------ documents
 
-namespace {
-
-/// Length of the well-formed UTF-8 sequence starting at `at` (Unicode table
-/// 3-7: no overlong forms, no surrogates, nothing above U+10FFFF), or 0.
-size_t utf8SequenceLength(std::string_view text, size_t at)
-{
-    const auto byte = [&](size_t i) { return at + i < text.size() ? static_cast<unsigned char>(text[at + i]) : 0u; };
-    const auto inRange = [](unsigned value, unsigned low, unsigned high) { return value >= low && value <= high; };
-    const unsigned lead = byte(0);
-    if (lead < 0x80) return 1;
-    const bool tail1 = inRange(byte(1), 0x80, 0xBF), tail2 = inRange(byte(2), 0x80, 0xBF);
-    const bool tail3 = inRange(byte(3), 0x80, 0xBF);
-    if (inRange(lead, 0xC2, 0xDF)) return tail1 ? 2 : 0;
-    if (lead == 0xE0) return inRange(byte(1), 0xA0, 0xBF) && tail2 ? 3 : 0;
-    if (lead == 0xED) return inRange(byte(1), 0x80, 0x9F) && tail2 ? 3 : 0;
-    if (inRange(lead, 0xE1, 0xEF)) return tail1 && tail2 ? 3 : 0;
-    if (lead == 0xF0) return inRange(byte(1), 0x90, 0xBF) && tail2 && tail3 ? 4 : 0;
-    if (lead == 0xF4) return inRange(byte(1), 0x80, 0x8F) && tail2 && tail3 ? 4 : 0;
-    if (inRange(lead, 0xF1, 0xF3)) return tail1 && tail2 && tail3 ? 4 : 0;
-    return 0;
-}
-
-/// TOML documents are UTF-8. toml++ 3.3 places an invalid byte's error at the
-/// end of the previous line, so vkrt finds the byte itself (columns count code
-/// points, as toml++'s do).
-void checkUtf8(std::string_view text, const TomlSource& source)
-{
-    int line = 1, column = 1;
-    for (size_t at = 0; at < text.size(); ++column) {
-        const size_t length = utf8SequenceLength(text, at);
-        if (length == 0) {
-            char hex[8];
-            std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned char>(text[at]));
-            throw SceneError({source.file, line, column},
-                             "invalid TOML: invalid UTF-8 (byte " + std::string(hex) + "); TOML files must be UTF-8");
-        }
-        if (text[at] == '\n') ++line, column = 0;
-        at += length;
-    }
-}
-
-} // namespace
-
 toml::table parseToml(std::string_view text, const TomlSource& source)
 {
     checkUtf8(text, source);
@@ -290,19 +297,6 @@ toml::table parseToml(std::string_view text, const TomlSource& source)
         throw SceneError(locate(source, error.source().begin), "invalid TOML: " + std::string(error.description()));
     }
 }
-
-namespace {
-
-struct FileCloser {
-    void operator()(std::FILE* file) const { std::fclose(file); }
-};
-
-[[noreturn]] void failToRead(std::string_view what, const std::string& path, int error)
-{
-    throw InputError("cannot read " + std::string(what) + " '" + path + "': " + std::strerror(error));
-}
-
-} // namespace
 
 /// Uses stdio rather than iostreams because only stdio reliably reports why (errno) a read failed.
 std::string readFileBytes(const std::string& path, std::string_view what)

@@ -20,8 +20,8 @@
 #include <vector>
 
 // toml++ 3.3 (Debian 12) trips its own debug assertions, and reaches one
-// __builtin_unreachable, on some invalid documents ("[.", "v=[}", a lone
-// non-ASCII byte, ...). The compiled library that distributions ship is built
+// __builtin_unreachable, on some invalid documents ("[.", "v=[}", a non-ASCII
+// letter outside a string, ...). The compiled library that distributions ship is built
 // with NDEBUG and reports those documents as parse errors; the header-only
 // build compiled here without NDEBUG would abort instead. So vkrt links the
 // compiled library (pkg-config's tomlplusplus sets TOML_HEADER_ONLY=0), and a
