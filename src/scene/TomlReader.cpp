@@ -36,8 +36,6 @@ bool isBefore(const toml::source_position& a, const toml::source_position& b)
     throw SceneError(where, path.empty() ? message : std::string(path) + ": " + message);
 }
 
-bool contains(KeyList keys, std::string_view key) { return std::find(keys.begin(), keys.end(), key) != keys.end(); }
-
 /// The unknown key that comes first in the file, so errors are reported in reading order.
 const toml::key* firstUnknownKey(const toml::table& table, KeyList allowed)
 {
@@ -158,6 +156,8 @@ std::string joinList(KeyList words)
     }
     return out;
 }
+
+bool contains(KeyList keys, std::string_view key) { return std::find(keys.begin(), keys.end(), key) != keys.end(); }
 
 std::string lowercase(std::string_view text)
 {

@@ -41,6 +41,7 @@ std::string formatNumber(double value);
 std::string quote(std::string_view text);
 std::string joinList(KeyList words);
 std::string lowercase(std::string_view text);
+bool contains(KeyList keys, std::string_view key);
 /// "a string", "an integer", ...: what a node is, for "expected X, got Y".
 std::string describeType(const toml::node& node);
 
