@@ -110,6 +110,17 @@ TEST(ViewNoDisplay, SuggestsRender)
     EXPECT_NE(r.output.find("vkrt render"), std::string::npos) << r.output;
 }
 
+// The size is checked with the scene parser's rules before any window opens,
+// so this needs no display.
+TEST(ViewNoDisplay, ResolutionOverridesAreValidatedLikeTheSceneFile)
+{
+    std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " +
+                          shellQuote(kScene) + " --width 0";
+    ProcessResult r = runShell(command);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--width: must be between 1 and 16384, got 0"), std::string::npos) << r.output;
+}
+
 TEST(ViewerScript, ParsesCommandsAndRejectsMistakes)
 {
     auto commands = parseViewerScript("frames 3 # comment\n\norbit 1.5 -2\nkey +\nsave out.exr\n", "s.txt");
