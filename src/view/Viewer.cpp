@@ -107,7 +107,7 @@ public:
 
 private:
     ViewOptions m_options;
-    Scene m_parsed; ///< as loaded, overrides applied; the session holds the live copy
+    Scene m_parsed; ///< as loaded (overrides applied) to size the window; then moved into the session
     GlfwSession m_glfw;
     Window m_window;
     VulkanContext m_context;
@@ -168,7 +168,7 @@ Viewer::Viewer(const ViewOptions& options)
       m_exposure(options.exposure),
       m_filmic(options.filmic)
 {
-    m_session = std::make_unique<RenderSession>(m_context, m_parsed, sessionConfig(options));
+    m_session = std::make_unique<RenderSession>(m_context, std::move(m_parsed), sessionConfig(options));
     createDisplay();
     recreateSwapchain();
     m_imageAvailable = vk::raii::Semaphore(m_context.device(), vk::SemaphoreCreateInfo());
