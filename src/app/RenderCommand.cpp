@@ -69,10 +69,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options)
     config.uber = options.uber;
     config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
     config.variance = options.varianceNeeds();
-    config.maxSpp = options.maxSpp();
-    config.timeBudgetSeconds = options.timeBudget;
-    config.targetRelMse = options.targetError;
-    config.interrupt = &interruptFlag();
+    config.stop = {options.maxSpp(), options.timeBudget, options.targetError, &interruptFlag()};
     return config;
 }
 
@@ -127,7 +124,7 @@ LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceR
 {
     InterruptGuard interrupt;
     const Camera& camera = session.scene().camera;
-    Progress progress(session.config().maxSpp, uint64_t(camera.width) * camera.height, isatty(STDERR_FILENO));
+    Progress progress(session.config().stop.maxSpp, uint64_t(camera.width) * camera.height, isatty(STDERR_FILENO));
     RunHooks hooks;
     hooks.onProgress = [&](uint32_t done) { progress.update(done); };
     if (report)

@@ -119,8 +119,7 @@ std::optional<Rendered> renderCase(const VulkanContext& context, const Scene& sc
     config.seed = seed;
     config.variance.layer = true;
     config.extraDefines = defines;
-    config.maxSpp = spp;
-    config.interrupt = &interruptFlag();
+    config.stop = {spp, std::nullopt, std::nullopt, &interruptFlag()};
     RenderSession session(context, scene, config);
     LoopResult loop = session.run();
     if (loop.reason == StopReason::Interrupted) return std::nullopt;

@@ -86,16 +86,16 @@ void RenderSession::startAfresh()
 
 bool RenderSession::atCheckpoint(const RunHooks& hooks, uint32_t spp, double seconds) const
 {
-    if (!hooks.onCheckpoint && !m_config.targetRelMse) return false; // no read-back needed
+    const std::optional<double>& target = m_config.stop.targetRelMse;
+    if (!hooks.onCheckpoint && !target) return false; // no read-back needed
     Film current = film();
     if (hooks.onCheckpoint) hooks.onCheckpoint(spp, seconds, current);
-    return m_config.targetRelMse && current.estimated && current.estimated->relMse < *m_config.targetRelMse;
+    return target && current.estimated && current.estimated->relMse < *target;
 }
 
 LoopResult RenderSession::run(const RunHooks& hooks)
 {
-    StopRules rules{m_config.maxSpp, m_config.timeBudgetSeconds, m_config.interrupt};
-    LoopResult loop = runRenderLoop(*m_renderer, rules, hooks.onProgress, [&](uint32_t spp, double seconds) {
+    LoopResult loop = runRenderLoop(*m_renderer, m_config.stop, hooks.onProgress, [&](uint32_t spp, double seconds) {
         return atCheckpoint(hooks, spp, seconds);
     });
     m_renderSeconds += loop.renderSeconds;
@@ -179,8 +179,8 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
         metadata["estimatedRmse"] = film.estimated->rmse;
         metadata["estimatedRelMse"] = film.estimated->relMse;
     }
-    if (m_config.timeBudgetSeconds) metadata["timeBudgetSeconds"] = *m_config.timeBudgetSeconds;
-    if (m_config.targetRelMse) metadata["targetRelMse"] = *m_config.targetRelMse;
+    if (m_config.stop.timeBudgetSeconds) metadata["timeBudgetSeconds"] = *m_config.stop.timeBudgetSeconds;
+    if (m_config.stop.targetRelMse) metadata["targetRelMse"] = *m_config.stop.targetRelMse;
     if (!savedBy.empty()) metadata["savedBy"] = savedBy;
     return metadata;
 }

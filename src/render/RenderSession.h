@@ -62,11 +62,7 @@ struct SessionConfig {
     VarianceNeeds variance;
     std::vector<Define> extraDefines; ///< test hooks
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
-    // Stop rules of run():
-    uint32_t maxSpp = 64;
-    std::optional<double> timeBudgetSeconds;      ///< of rendering, start-up excluded
-    std::optional<double> targetRelMse;           ///< estimated relMSE, checked at 1, 2, 4, ... spp
-    const std::atomic<bool>* interrupt = nullptr; ///< set asynchronously (InterruptGuard)
+    StopRules stop; ///< of run(); its interrupt is usually &interruptFlag() (InterruptGuard)
 };
 
 /// What the accumulation holds, read back to the host.

@@ -125,7 +125,7 @@ protected:
 TEST_F(RenderSessionTest, StopsWhenTheSppAreReached)
 {
     SessionConfig c = config();
-    c.maxSpp = 5;
+    c.stop.maxSpp = 5;
     RenderSession session(gpu(), smallScene(), c);
     LoopResult loop = session.run();
     EXPECT_EQ(loop.reason, StopReason::SppReached);
@@ -138,7 +138,7 @@ TEST_F(RenderSessionTest, AnInterruptBeforeTheFirstFrameRendersNothing)
 {
     std::atomic<bool> interrupt{true};
     SessionConfig c = config();
-    c.interrupt = &interrupt;
+    c.stop.interrupt = &interrupt;
     RenderSession session(gpu(), smallScene(), c);
     LoopResult loop = session.run();
     EXPECT_EQ(loop.reason, StopReason::Interrupted);
@@ -150,8 +150,8 @@ TEST_F(RenderSessionTest, AnInterruptBeforeTheFirstFrameRendersNothing)
 TEST_F(RenderSessionTest, StopsAtTheTimeBudget)
 {
     SessionConfig c = config();
-    c.maxSpp = 1u << 30;
-    c.timeBudgetSeconds = 0.3;
+    c.stop.maxSpp = 1u << 30;
+    c.stop.timeBudgetSeconds = 0.3;
     RenderSession session(gpu(), smallScene(), c);
     LoopResult loop = session.run();
     EXPECT_EQ(loop.reason, StopReason::TimeBudget);
@@ -163,8 +163,8 @@ TEST_F(RenderSessionTest, StopsAtTheTimeBudget)
 TEST_F(RenderSessionTest, StopsAtTheTargetErrorAtACheckpoint)
 {
     SessionConfig c = config();
-    c.maxSpp = 1u << 30;
-    c.targetRelMse = 1e9; // any finite estimate is below it
+    c.stop.maxSpp = 1u << 30;
+    c.stop.targetRelMse = 1e9; // any finite estimate is below it
     c.variance.errorEstimate = true;
     std::vector<uint32_t> checkpoints;
     RunHooks hooks;
@@ -190,8 +190,8 @@ std::set<std::string> keysOf(const Metadata& metadata)
 TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
 {
     SessionConfig c = config();
-    c.maxSpp = 8;
-    c.timeBudgetSeconds = 100.0;
+    c.stop.maxSpp = 8;
+    c.stop.timeBudgetSeconds = 100.0;
     c.variance.layer = true;
     RenderSession session(gpu(), smallScene(), c);
     session.run();
