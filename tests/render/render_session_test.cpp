@@ -7,6 +7,7 @@
 #include "view/CameraControl.h"
 
 #include <atomic>
+#include <csignal>
 #include <set>
 
 namespace vkrt::test {
@@ -102,6 +103,26 @@ TEST(SceneOverrides, CameraMovesThatCollapseTheViewAreRefused)
     EXPECT_EQ(cameraProblem(upAlongView), "up: must not be zero-length");
     EXPECT_EQ(errorOf([&] { checkCamera(zoom(c, 0.0), "zoom"); }),
               "zoom: fov: must be strictly between 0 and 180 degrees, got 0");
+}
+
+// ---------------------------------------------------------------- Ctrl-C
+
+std::atomic<int> g_previousHandlerCalls{0};
+extern "C" void countingHandler(int) { ++g_previousHandlerCalls; }
+
+TEST(InterruptGuard, CatchesSigintAndRestoresThePreviousHandler)
+{
+    auto before = std::signal(SIGINT, countingHandler);
+    {
+        InterruptGuard guard;
+        EXPECT_FALSE(interruptFlag().load()) << "a new guard starts clear";
+        std::raise(SIGINT);
+        EXPECT_TRUE(interruptFlag().load());
+        EXPECT_EQ(g_previousHandlerCalls.load(), 0);
+    }
+    std::raise(SIGINT);
+    EXPECT_EQ(g_previousHandlerCalls.load(), 1) << "the handler from before the guard is back";
+    std::signal(SIGINT, before);
 }
 
 // ---------------------------------------------------------------- session (GPU)
