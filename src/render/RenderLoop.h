@@ -29,6 +29,20 @@ struct LoopResult {
     double renderSeconds = 0.0; ///< wall time spent in frames (no compile, set-up or checkpoint work)
 };
 
+/// Sizes submissions so that each takes about `targetSeconds`, from the
+/// measured time of the last one: at most twice its frames, at most 64.
+/// The render loop paces with a quarter second, the viewer with a display refresh.
+class BatchPacer {
+public:
+    explicit BatchPacer(double targetSeconds) : m_targetSeconds(targetSeconds) {}
+    uint32_t nextFrames() const { return m_frames; }
+    void record(uint32_t frames, double seconds);
+
+private:
+    double m_targetSeconds;
+    uint32_t m_frames = 1;
+};
+
 /// Called at every checkpoint (spp a power of two, and the final spp) with
 /// the render time so far; returning true stops the render (target reached).
 using CheckpointHandler = std::function<bool(uint32_t spp, double renderSeconds)>;

@@ -122,7 +122,7 @@ private:
     bool m_filmic = false;
     bool m_paused = false;
     bool m_swapchainStale = false;
-    uint32_t m_framesPerRefresh = 1;
+    BatchPacer m_pacer{kFrameSeconds}; ///< one display refresh holds about kFrameSeconds of rendering
     std::deque<std::string> m_keys; ///< pressed keys not yet handled
     bool m_dragging = false;
     double m_lastX = 0, m_lastY = 0;
@@ -284,8 +284,7 @@ void Viewer::renderAndPresent(uint32_t frames)
     if (frames) m_session->renderFrames(frames);
     double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     m_rateSamples += uint64_t(frames) * renderer().width() * renderer().height();
-    if (frames && seconds > 0) // one display refresh holds about kFrameSeconds of rendering
-        m_framesPerRefresh = std::clamp(uint32_t(frames * kFrameSeconds / seconds), 1u, 64u);
+    if (frames) m_pacer.record(frames, seconds);
     present();
     updateTitle();
 }
@@ -375,7 +374,7 @@ void Viewer::runScript(const std::vector<ViewerCommand>& commands)
     for (const ViewerCommand& c : commands) {
         if (c.name == "frames") {
             for (uint32_t left = uint32_t(c.numbers[0]); left > 0;) {
-                uint32_t n = std::min(left, m_framesPerRefresh);
+                uint32_t n = std::min(left, m_pacer.nextFrames());
                 renderAndPresent(n);
                 left -= n;
                 glfwPollEvents();
@@ -405,7 +404,7 @@ void Viewer::runInteractive()
             m_keys.pop_front();
             if (!flying()) handleKey(key);
         }
-        renderAndPresent(m_paused ? 0 : m_framesPerRefresh);
+        renderAndPresent(m_paused ? 0 : m_pacer.nextFrames());
         if (m_paused) glfwWaitEventsTimeout(0.05);
     }
 }

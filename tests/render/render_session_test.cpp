@@ -105,6 +105,22 @@ TEST(SceneOverrides, CameraMovesThatCollapseTheViewAreRefused)
               "zoom: fov: must be strictly between 0 and 180 degrees, got 0");
 }
 
+// ---------------------------------------------------------------- frames
+
+TEST(BatchPacer, GrowsAtMostTwofoldTowardsTheTargetAndShrinksAtOnce)
+{
+    BatchPacer pacer(0.25);
+    EXPECT_EQ(pacer.nextFrames(), 1u);
+    pacer.record(1, 0.001); // far below the target: double, no more
+    EXPECT_EQ(pacer.nextFrames(), 2u);
+    pacer.record(40, 0.0);  // unmeasurably fast: double up to the cap
+    EXPECT_EQ(pacer.nextFrames(), 64u);
+    pacer.record(64, 1.0);  // four times too long: a quarter
+    EXPECT_EQ(pacer.nextFrames(), 16u);
+    pacer.record(1, 10.0);  // one slow frame: still at least one
+    EXPECT_EQ(pacer.nextFrames(), 1u);
+}
+
 // ---------------------------------------------------------------- Ctrl-C
 
 std::atomic<int> g_previousHandlerCalls{0};
