@@ -253,6 +253,14 @@ TEST_F(RegressCli, MismatchedResolutionNamesBothSizes)
     expectInputError(r, {"extreme/kappa-shadow", "mean.exr", "is 64x48 but the case renders 32x24"});
 }
 
+// A case's width/height pass the scene parser's checks, naming suite and case.
+TEST_F(RegressCli, CaseResolutionIsValidatedLikeTheSceneFile)
+{
+    fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8, "width = 99999\nheight = 24")});
+    ProcessResult r = regress({"--suite", suite.string()});
+    expectInputError(r, {suite.string() + ": case extreme/kappa-shadow: width: must be between 1 and 16384, got 99999"});
+}
+
 TEST_F(RegressCli, UnusableDriverManifestIsNamed)
 {
     fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8)});

@@ -213,6 +213,28 @@ TEST_F(RenderCli, BadOptionsNameTheOption)
     EXPECT_TRUE(filesInDir().empty());
 }
 
+// --width/--height go through the scene parser's checks (SceneOverrides.h):
+// same limits and wording as width/height in a scene file, naming the option.
+TEST_F(RenderCli, ResolutionOverridesAreValidatedLikeTheSceneFile)
+{
+    struct Case {
+        std::vector<std::string> args;
+        std::string expected;
+    } cases[] = {
+        {{"--width", "0"}, "--width: must be between 1 and 16384, got 0"},
+        {{"--width", "16384", "--height", "16384"},
+         "--height: width * height = 268435456 pixels exceeds the limit of 67108864"},
+    };
+    for (const auto& c : cases) {
+        std::vector<std::string> args = {"render", kDefaultScene, "-o", (m_dir / "x.exr").string()};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        ProcessResult r = runVkrt(args); // not render(): it gives --width and --height already
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
+    }
+    EXPECT_TRUE(filesInDir().empty());
+}
+
 TEST_F(RenderCli, SceneErrorsNameFileLineAndColumn)
 {
     fs::path scene = m_dir / "bad.toml";
