@@ -52,8 +52,10 @@ int runInfo(const InfoOptions& options)
     std::printf("spirv cache:    %s\n", renderOptions.cacheDirectory.c_str());
     std::printf("set-up:         %.3f s (parse excluded: compile or load, pipeline, buffers)\n", setupSeconds);
     std::printf("first frame:    %.3f s after set-up began (includes the driver's shader compile)\n", firstFrameSeconds);
-    std::printf("loop budget:    worst case %llu of %u iterations per invocation\n",
-                static_cast<unsigned long long>(worstCaseLoopIterations(scene)), gpu::LOOP_BUDGET);
+    std::printf("loop cap:       %s\n", context.loopCap().describe().c_str());
+    std::printf("loop passes:    worst case %llu per invocation%s\n",
+                static_cast<unsigned long long>(worstCaseLoopIterations(scene)),
+                context.loopCap().capped() ? (" of " + std::to_string(*context.loopCap().budget)).c_str() : "");
     std::printf("device:         %s\n", context.deviceInfo().name.c_str());
     return kExitOk;
 }

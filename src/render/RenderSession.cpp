@@ -165,7 +165,8 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
         {"sampler", samplerName(sampler())},
         {"rejectedSamples", int64_t(renderer.counters().rejectedSamples)},
     };
-    // Driver limits: a field describing the device's loop-iteration cap goes here, beside device and driver.
+    // Whether the device may have cut loops short (docs/platform.md).
+    metadata["loopCap"] = m_context.loopCap().describe();
     if (m_stoppedBy) metadata["stoppedBy"] = stopReasonName(*m_stoppedBy);
     if (renderer.features().variance) {
         // The variance's degrees of freedom: per-pixel tests on it (vkrt

@@ -293,7 +293,7 @@ TEST_F(RegressCli, ManifestErrorsNameFileLineAndColumn)
                                 "reference_source = \"vkrt\"\nreference_spp = 16\nsp = 4\n");
     int line = int(std::count(good.begin(), good.end(), '\n')) + 7;
     expectInputError(regress({"--suite", suite.string()}),
-                     {suite.string() + ":" + std::to_string(line) + ":6", "unknown key 'sp'", "did you mean 'spp'"});
+                     {suite.string() + ":" + std::to_string(line) + ":1", "unknown key 'sp'", "did you mean 'spp'"});
     // A missing field: reported at its case's table.
     writeText(suite, "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() + "\"\nreference_source = \"vkrt\"\n"
                      "reference_spp = 16\nspp = 4\n");

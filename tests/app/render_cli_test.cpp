@@ -74,6 +74,7 @@ TEST_F(RenderCli, WritesExrWithMetadataAndPng)
     EXPECT_EQ(intAttribute(exr.metadata, "seed"), 5);
     EXPECT_EQ(intAttribute(exr.metadata, "rejectedSamples"), 0);
     EXPECT_EQ(textAttribute(exr.metadata, "stoppedBy"), "spp");
+    EXPECT_EQ(textAttribute(exr.metadata, "loopCap"), gpu().loopCap().describe());
     EXPECT_EQ(textAttribute(exr.metadata, "vkrtVersion"), VKRT_VERSION);
     EXPECT_EQ(textAttribute(exr.metadata, "sceneHash").rfind("fnv1a64:", 0), 0u);
     EXPECT_FALSE(textAttribute(exr.metadata, "device").empty());

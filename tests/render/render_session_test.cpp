@@ -2,6 +2,7 @@
 // writes for every command, and the validation of overrides (resolution from
 // options or a suite, viewer camera moves) with the scene parser's rules.
 #include "render/RenderSession.h"
+#include "shared/Bindings.h"
 #include "scene/SceneOverrides.h"
 #include "support/TestSupport.h"
 #include "view/CameraControl.h"
@@ -235,7 +236,7 @@ TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
     Film film = session.film();
     Metadata m = session.metadata(film);
     for (const char* key : {"vkrtVersion", "spp", "seed", "renderSeconds", "stoppedBy", "device", "driver", "scene",
-                            "sceneHash", "integrator", "kernelVariant", "sampler", "rejectedSamples",
+                            "sceneHash", "integrator", "kernelVariant", "sampler", "rejectedSamples", "loopCap",
                             "varianceDegreesOfFreedom", "varianceEstimator", "estimatedRmse", "estimatedRelMse",
                             "timeBudgetSeconds"})
         EXPECT_EQ(m.count(key), 1u) << key;
@@ -246,6 +247,9 @@ TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
     EXPECT_EQ(std::get<std::string>(m.at("sampler")), "independent") << "a variance layer";
     EXPECT_EQ(std::get<int64_t>(m.at("varianceDegreesOfFreedom")), 7);
     EXPECT_EQ(std::get<std::string>(m.at("sceneHash")).rfind("fnv1a64:", 0), 0u);
+    EXPECT_EQ(std::get<std::string>(m.at("loopCap")), gpu().loopCap().describe());
+    std::string expectedStart = gpu().loopCap().capped() ? std::to_string(gpu::LOOP_BUDGET) : "none";
+    EXPECT_EQ(std::get<std::string>(m.at("loopCap")).rfind(expectedStart, 0), 0u) << std::get<std::string>(m.at("loopCap"));
 }
 
 TEST_F(RenderSessionTest, ViewerSaveMetadataAddsSavedByAndFollowsMovesAndResets)
@@ -259,7 +263,7 @@ TEST_F(RenderSessionTest, ViewerSaveMetadataAddsSavedByAndFollowsMovesAndResets)
     EXPECT_EQ(saved.count("estimatedRmse"), 0u) << "no variance estimated";
     std::set<std::string> expected = {"vkrtVersion", "spp",         "seed",          "renderSeconds", "device",
                                       "driver",      "scene",       "sceneHash",     "integrator",    "kernelVariant",
-                                      "sampler",     "rejectedSamples", "savedBy"};
+                                      "sampler",     "rejectedSamples", "loopCap",       "savedBy"};
     EXPECT_EQ(keysOf(saved), expected);
 
     Camera before = session.scene().camera;
