@@ -37,7 +37,7 @@ int runInfo(const InfoOptions& options)
     renderer.renderFrames(1);
     double firstFrameSeconds = secondsSince(start);
 
-    const FeatureSet& features = renderer.features();
+    const KernelVariant& features = renderer.variant();
     const CompiledKernel& kernel = renderer.kernel();
     std::printf("scene:          %s (%ux%u)\n", scene.path.c_str(), scene.camera.width, scene.camera.height);
     std::printf("features:       %s\n", features.describe().c_str());

@@ -97,7 +97,7 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
                         const RenderCommandOptions& options, const LoopResult& loop, const RenderCounters& counters,
                         const std::optional<EstimatedError>& estimated)
 {
-    bool sobol = renderer.features().sobolSampler;
+    bool sobol = renderer.variant().sobolSampler;
     Metadata metadata{
         {"vkrtVersion", std::string(VKRT_VERSION)},
         {"spp", int64_t(renderer.completedFrames())},
@@ -109,7 +109,7 @@ Metadata describeRender(const Scene& scene, const VulkanContext& context, const 
         {"scene", scene.path},
         {"sceneHash", "fnv1a64:" + toHex(scene.fileHash)},
         {"integrator", integratorName(scene.render.integrator)},
-        {"kernelVariant", renderer.features().describe() + (options.uber ? " (uber)" : "")},
+        {"kernelVariant", renderer.variant().describe() + (options.uber ? " (uber)" : "")},
         {"sampler", std::string(sobol ? "sobol" : "independent")},
         {"rejectedSamples", int64_t(counters.rejectedSamples)},
     };

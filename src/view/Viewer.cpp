@@ -365,7 +365,7 @@ void Viewer::save(const std::string& exrPath)
                       {"scene", m_scene.path},
                       {"sceneHash", "fnv1a64:" + toHex(m_scene.fileHash)},
                       {"integrator", integratorName(m_scene.render.integrator)},
-                      {"kernelVariant", m_renderer->features().describe()},
+                      {"kernelVariant", m_renderer->variant().describe()},
                       {"rejectedSamples", int64_t(m_renderer->counters().rejectedSamples)},
                       {"savedBy", std::string("vkrt view")}};
     std::map<std::string, Image> layers;
