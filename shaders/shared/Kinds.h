@@ -1,6 +1,6 @@
 // The registry of kinds: every material, shape and light kind vkrt knows,
 // listed once. C++ (the scene parser, FeatureSet, the kernel variant, the
-// upload) and GLSL (constants, the per-kind loops of lib/scene.glsl) expand
+// upload) and GLSL (constants, the dispatch of lib/scene.glsl and lib/bsdf.glsl) expand
 // these lists, so a new kind is one line here plus the code that only that
 // kind can have (its record, reader, intersection and shading functions).
 // docs/architecture.md lists every place a new kind touches.

@@ -1,7 +1,7 @@
 #pragma once
 // The validated, in-memory scene. Everything here is in double precision and in
 // world space; conversion to the GPU's float32, camera-relative form happens in
-// render/SceneUpload. A Scene is only ever produced by parseScene*, which has
+// render/GpuScene. A Scene is only ever produced by parseScene*, which has
 // already checked every value, so consumers need not re-validate.
 #include "shared/Kinds.h"
 #include "util/Error.h"

@@ -47,11 +47,13 @@ TEST(KindRegistry, GlslConstantsEqualTheCppOnes)
     KernelSource source{defaultShaderRoot(), "../tests/gpu/kernels/kind_registry_reflect.comp", {}};
     std::map<std::string, int> offsets;
     for (const auto& [name, offset] : reflectBlockMemberOffsets(source)) offsets[name] = offset;
+    std::string names;
+    for (const auto& [name, offset] : offsets) names += name + "@" + std::to_string(offset) + " ";
     int64_t expected = 0; // scalar layout: C + 1 words, then the marker
     for (const auto& [name, value] : cppConstants()) {
         expected += 4 * (value + 1);
-        auto marker = offsets.find("registry.end_" + name);
-        ASSERT_NE(marker, offsets.end()) << name << " not reflected";
+        auto marker = offsets.find("RegistryBlock.end_" + name);
+        ASSERT_NE(marker, offsets.end()) << name << " not reflected; glslang reported: " << names;
         EXPECT_EQ(marker->second, expected) << name << " differs between GLSL and C++ (" << value << " in C++)";
         expected += 4;
     }
