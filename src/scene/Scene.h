@@ -64,6 +64,8 @@ inline constexpr size_t kLightKindCount = gpu::LIGHT_KIND_COUNT;
 inline constexpr std::array<std::string_view, kMaterialKindCount> kMaterialNames{VKRT_MATERIAL_KINDS(VKRT_KIND_NAME)};
 inline constexpr std::array<std::string_view, kShapeKindCount> kShapeNames{VKRT_SHAPE_KINDS(VKRT_KIND_NAME)};
 inline constexpr std::array<std::string_view, kLightKindCount> kLightNames{VKRT_LIGHT_KINDS(VKRT_KIND_NAME)};
+#undef VKRT_KIND_ENUMERATOR
+#undef VKRT_KIND_NAME
 
 /// Every kind of a concept, in value order (for loops over the registry).
 template <class Kind, size_t N> constexpr std::array<Kind, N> allKinds()
