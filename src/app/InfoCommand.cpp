@@ -39,7 +39,7 @@ int runInfo(const InfoOptions& options)
     session.renderFrames(1);
     double firstFrameSeconds = secondsSince(start);
 
-    const FeatureSet& features = session.renderer().features();
+    const KernelVariant& features = session.renderer().variant();
     const CompiledKernel& kernel = session.renderer().kernel();
     const RenderOptions& renderOptions = session.renderOptions();
     std::printf("scene:          %s (%ux%u)\n", scene.path.c_str(), scene.camera.width, scene.camera.height);

@@ -135,13 +135,13 @@ void RenderSession::setIntegrator(Integrator integrator)
 
 Sampler RenderSession::sampler() const
 {
-    return m_renderer->features().sobolSampler ? Sampler::Sobol : Sampler::Independent;
+    return m_renderer->variant().sobolSampler ? Sampler::Sobol : Sampler::Independent;
 }
 
 Film RenderSession::film() const
 {
     Film film{m_renderer->mean(), std::nullopt, std::nullopt};
-    if (m_renderer->features().variance) {
+    if (m_renderer->variant().variance) {
         film.variance = m_renderer->varianceOfMean();
         film.estimated = estimateError(film.mean, *film.variance);
     }
@@ -161,14 +161,14 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
         {"scene", m_scene.path},
         {"sceneHash", "fnv1a64:" + toHex(m_scene.fileHash)},
         {"integrator", integratorName(m_scene.render.integrator)},
-        {"kernelVariant", renderer.features().describe() + (m_config.uber ? " (uber)" : "")},
+        {"kernelVariant", renderer.variant().describe() + (m_config.uber ? " (uber)" : "")},
         {"sampler", samplerName(sampler())},
         {"rejectedSamples", int64_t(renderer.counters().rejectedSamples)},
     };
     // Whether the device may have cut loops short (docs/platform.md).
     metadata["loopCap"] = m_context.loopCap().describe();
     if (m_stoppedBy) metadata["stoppedBy"] = stopReasonName(*m_stoppedBy);
-    if (renderer.features().variance) {
+    if (renderer.variant().variance) {
         // The variance's degrees of freedom: per-pixel tests on it (vkrt
         // compare) need Student's t rather than a normal when few.
         metadata["varianceDegreesOfFreedom"] = int64_t(renderer.varianceDegreesOfFreedom());

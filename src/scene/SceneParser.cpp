@@ -172,8 +172,6 @@ constexpr std::array<std::string_view, 4> phongKeys{"type", "diffuse", "specular
 constexpr std::array<std::string_view, 4> mirrorKeys{"type", "reflectance", "fresnel", "ior"};
 constexpr std::array<std::string_view, 5> glossyKeys{"type", "reflectance", "exponent", "fresnel", "ior"};
 constexpr std::array<std::string_view, 4> dielectricKeys{"type", "ior", "absorption", "fresnel"};
-constexpr std::array<std::string_view, 9> allMaterialKeys{"albedo",   "diffuse", "specular", "shininess", "reflectance",
-                                                          "exponent", "fresnel", "ior",      "absorption"};
 
 constexpr std::array<EnumName<FresnelMode>, 2> reflectorFresnelModes{
     {{"none", FresnelMode::None}, {"schlick", FresnelMode::Schlick}}};
@@ -236,13 +234,24 @@ struct MaterialKind {
     void (*read)(const TableField&, Material&);
 };
 
-const std::array<MaterialKind, 5> materialKinds{{
-    {"lambert", MaterialType::Lambert, lambertKeys, readLambert},
-    {"phong", MaterialType::Phong, phongKeys, readPhong},
-    {"mirror", MaterialType::Mirror, mirrorKeys, readMirror},
-    {"glossy", MaterialType::Glossy, glossyKeys, readGlossy},
-    {"dielectric", MaterialType::Dielectric, dielectricKeys, readDielectric},
-}};
+// The registry (shared/Kinds.h) names each kind's key list `nameKeys` and its reader `readType`.
+#define VKRT_MATERIAL_KIND_ENTRY(KIND, Type, name, value, delta) MaterialKind{#name, MaterialType::Type, name##Keys, read##Type},
+const std::array<MaterialKind, kMaterialKindCount> materialKinds{{VKRT_MATERIAL_KINDS(VKRT_MATERIAL_KIND_ENTRY)}};
+#undef VKRT_MATERIAL_KIND_ENTRY
+
+/// Every key some kind of the table accepts: a key of another kind gets a
+/// more precise message than "unknown".
+template <class Kind, size_t N>
+std::vector<std::string_view> keysOfEveryKind(const std::array<Kind, N>& kinds)
+{
+    std::vector<std::string_view> keys;
+    for (const Kind& kind : kinds)
+        for (std::string_view key : kind.keys)
+            if (!contains(keys, key)) keys.push_back(key);
+    return keys;
+}
+
+const std::vector<std::string_view> allMaterialKeys = keysOfEveryKind(materialKinds);
 
 Material readMaterial(std::string_view name, const TableField& table)
 {
@@ -305,7 +314,6 @@ constexpr std::array<std::string_view, 4> sphereKeys{"shape", "material", "cente
 constexpr std::array<std::string_view, 4> boxKeys{"shape", "material", "min", "max"};
 constexpr std::array<std::string_view, 3> triangleKeys{"shape", "material", "vertices"};
 constexpr std::array<std::string_view, 4> planeKeys{"shape", "material", "point", "normal"};
-constexpr std::array<std::string_view, 7> allShapeKeys{"center", "radius", "min", "max", "vertices", "point", "normal"};
 
 void readSphere(const TableField& table, uint32_t material, Scene& scene)
 {
@@ -347,22 +355,21 @@ void readPlane(const TableField& table, uint32_t material, Scene& scene)
     scene.planes.push_back({point, *normal, material});
 }
 
-struct ShapeKind {
+struct ShapeReader {
     std::string_view name;
     Keys keys;
     void (*read)(const TableField&, uint32_t, Scene&);
 };
 
-const std::array<ShapeKind, 4> shapeKinds{{
-    {"sphere", sphereKeys, readSphere},
-    {"box", boxKeys, readBox},
-    {"triangle", triangleKeys, readTriangle},
-    {"plane", planeKeys, readPlane},
-}};
+#define VKRT_SHAPE_KIND_ENTRY(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    ShapeReader{#name, field##Keys, read##Type},
+const std::array<ShapeReader, kShapeKindCount> shapeKinds{{VKRT_SHAPE_KINDS(VKRT_SHAPE_KIND_ENTRY)}};
+#undef VKRT_SHAPE_KIND_ENTRY
+const std::vector<std::string_view> allShapeKeys = keysOfEveryKind(shapeKinds);
 
 void readObject(const TableField& table, const MaterialIndex& materials, Scene& scene)
 {
-    const ShapeKind kind = readChoice(table.require("shape"), "shape", shapeKinds);
+    const ShapeReader kind = readChoice(table.require("shape"), "shape", shapeKinds);
     table.rejectUnknownKeys(kind.keys, allShapeKeys, "shape " + quote(kind.name));
     kind.read(table, materials.resolve(table.require("material")), scene);
 }
@@ -371,7 +378,6 @@ void readObject(const TableField& table, const MaterialIndex& materials, Scene& 
 
 constexpr std::array<std::string_view, 3> pointLightKeys{"type", "position", "intensity"};
 constexpr std::array<std::string_view, 4> triangleLightKeys{"type", "vertices", "radiance", "two_sided"};
-constexpr std::array<std::string_view, 5> allLightKeys{"position", "intensity", "vertices", "radiance", "two_sided"};
 
 void readPointLight(const TableField& table, Scene& scene)
 {
@@ -387,20 +393,21 @@ void readTriangleLight(const TableField& table, Scene& scene)
     scene.triangleLights.push_back(light);
 }
 
-struct LightKind {
+struct LightReader {
     std::string_view name;
     Keys keys;
     void (*read)(const TableField&, Scene&);
 };
 
-const std::array<LightKind, 2> lightKinds{{
-    {"point", pointLightKeys, readPointLight},
-    {"triangle", triangleLightKeys, readTriangleLight},
-}};
+#define VKRT_LIGHT_KIND_ENTRY(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    LightReader{#name, field##Keys, read##Type},
+const std::array<LightReader, kLightKindCount> lightKinds{{VKRT_LIGHT_KINDS(VKRT_LIGHT_KIND_ENTRY)}};
+#undef VKRT_LIGHT_KIND_ENTRY
+const std::vector<std::string_view> allLightKeys = keysOfEveryKind(lightKinds);
 
 void readLight(const TableField& table, Scene& scene)
 {
-    const LightKind kind = readChoice(table.require("type"), "light type", lightKinds);
+    const LightReader kind = readChoice(table.require("type"), "light type", lightKinds);
     table.rejectUnknownKeys(kind.keys, allLightKeys, "light type " + quote(kind.name));
     kind.read(table, scene);
 }
