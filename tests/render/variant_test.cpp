@@ -205,6 +205,7 @@ TEST(InfoCli, PrintsVariantAndCacheState)
     EXPECT_NE(cold.output.find("features:       whitted; spheres boxes triangles planes point-lights cubemap;"),
               std::string::npos) << cold.output;
     EXPECT_NE(cold.output.find("spirv bytes:"), std::string::npos);
+    EXPECT_NE(cold.output.find("loop cap:       " + gpu().loopCap().describe()), std::string::npos) << cold.output;
     EXPECT_EQ(cold.output.find("cache hit"), std::string::npos) << cold.output;
     EXPECT_NE(warm.output.find("cache hit"), std::string::npos) << warm.output;
 }
