@@ -1,5 +1,5 @@
 // Resource declarations of the render kernels. Each scene buffer exists only
-// in the variants whose FeatureSet needs it (src/scene/FeatureSet.cpp), and the
+// in the variants whose features need it (src/render/KernelVariant.cpp), and the
 // host builds the descriptor set layout from the same list.
 #ifndef VKRT_BINDINGS_GLSL
 #define VKRT_BINDINGS_GLSL

@@ -12,7 +12,7 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax, MediumStack media)
     // The path integrator treats glass physically: a shadow ray cannot see a
     // light through it (light arrives through glass by BSDF sampling).
 #if !defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_INTEGRATOR_PATH)
-    if (findClosest(Ray(origin, dir), tMax).shape != SHAPE_NONE)
+    if (traceAny(Ray(origin, dir), tMax))
         return vec3(0.0);
     return beerLambert(mediumAbsorption(media), tMax);
 #else
@@ -20,13 +20,11 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax, MediumStack media)
     vec3 transmittance = vec3(1.0);
     for (uint crossing = 0u; crossing < MAX_SHADOW_CROSSINGS; ++crossing) {
         ++g_loopIterations;
-        Ray ray = Ray(origin, dir);
-        HitId id = findClosest(ray, tMax);
-        if (id.shape == SHAPE_NONE)
+        SurfaceHit hit;
+        if (!traceClosest(Ray(origin, dir), tMax, hit))
             return transmittance * beerLambert(mediumAbsorption(media), tMax);
-        if (id.shape == SHAPE_LIGHT)
+        if (hitsLight(hit))
             return vec3(0.0);
-        SurfaceHit hit = describeHit(ray, id);
         Material m = materials[hit.material];
         if (m.type != MATERIAL_DIELECTRIC)
             return vec3(0.0);

@@ -95,7 +95,7 @@ vec3 tracePath(Ray ray, inout Sampler rng)
             path.radiance += path.throughput * environmentOnEscape(path, ray.dir);
             break;
         }
-        if (hit.shape == SHAPE_LIGHT) {
+        if (hitsLight(hit)) {
             path.radiance += path.throughput * emissionOnHit(path, ray, hit);
             break;
         }

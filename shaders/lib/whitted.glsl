@@ -39,7 +39,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         bool missed = !traceClosest(ray, FLT_MAX, hit);
         // Beer-Lambert over the segment just travelled inside a dielectric.
         path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
-        if (missed || hit.shape == SHAPE_LIGHT) {
+        if (missed || hitsLight(hit)) {
             addEscapedRadiance(path, ray, hit, missed);
             break;
         }

@@ -3,6 +3,7 @@
 #ifndef VKRT_SHARED_BINDINGS_H
 #define VKRT_SHARED_BINDINGS_H
 #include "Interop.h"
+#include "Kinds.h"
 
 VKRT_BEGIN_NAMESPACE
 
@@ -11,17 +12,20 @@ VKRT_CONSTANT(uint, BINDING_UNIFORMS, 0)        // SceneUniforms (uniform buffer
 VKRT_CONSTANT(uint, BINDING_ACCUMULATION, 1)    // AccumPixel[width*height]
 VKRT_CONSTANT(uint, BINDING_STATS, 2)           // RenderStats
 VKRT_CONSTANT(uint, BINDING_MATERIALS, 3)       // Material[]
-VKRT_CONSTANT(uint, BINDING_SPHERES, 4)         // Sphere[]
-VKRT_CONSTANT(uint, BINDING_BOXES, 5)           // Box[]
-VKRT_CONSTANT(uint, BINDING_TRIANGLES, 6)       // Triangle[]
-VKRT_CONSTANT(uint, BINDING_PLANES, 7)          // Plane[]
-VKRT_CONSTANT(uint, BINDING_POINT_LIGHTS, 8)    // PointLight[]
-VKRT_CONSTANT(uint, BINDING_TRIANGLE_LIGHTS, 9) // TriangleLight[]
-VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 10)    // samplerCube of environment radiance
-VKRT_CONSTANT(uint, BINDING_MOMENTS, 11)        // variance estimation: MomentPixel[width*height], or under the
-                                                // Sobol' sampler AccumPixel[width*height*VARIANCE_BATCHES]
-VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, 12) // float[6 N^2 + 1]: cumulative texel probabilities
-VKRT_CONSTANT(uint, BINDING_COUNT, 13)
+// Then one array per shape and light kind of the registry (shared/Kinds.h), in
+// its order: BINDING_SPHERES = 4 (Sphere[]), ..., BINDING_TRIANGLE_LIGHTS = 9.
+#define VKRT_SHAPE_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    VKRT_CONSTANT(uint, BINDING_##ARRAY, 4 + value)
+#define VKRT_LIGHT_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    VKRT_CONSTANT(uint, BINDING_##ARRAY, 4 + SHAPE_KIND_COUNT + value)
+VKRT_SHAPE_KINDS(VKRT_SHAPE_BINDING)
+VKRT_LIGHT_KINDS(VKRT_LIGHT_BINDING)
+VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 4 + SHAPE_KIND_COUNT + LIGHT_KIND_COUNT) // samplerCube of environment radiance
+// Variance estimation: MomentPixel[width*height], or under the Sobol' sampler
+// AccumPixel[width*height*VARIANCE_BATCHES].
+VKRT_CONSTANT(uint, BINDING_MOMENTS, BINDING_ENVIRONMENT + 1)
+VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, BINDING_ENVIRONMENT + 2) // float[6 N^2 + 1]: cumulative texel probabilities
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 3)
 
 // Under the Sobol' sampler the variance comes from this many independently
 // scrambled batches (frame f is sample f / K of batch f % K; lib/sobol.glsl):

@@ -7,15 +7,11 @@
 #ifndef VKRT_SHARED_SCENE_TYPES_H
 #define VKRT_SHARED_SCENE_TYPES_H
 #include "Interop.h"
+#include "Kinds.h"
 
 VKRT_BEGIN_NAMESPACE
 
-// Material::type
-VKRT_CONSTANT(uint, MATERIAL_LAMBERT, 0)
-VKRT_CONSTANT(uint, MATERIAL_PHONG, 1)
-VKRT_CONSTANT(uint, MATERIAL_MIRROR, 2)
-VKRT_CONSTANT(uint, MATERIAL_GLOSSY, 3)
-VKRT_CONSTANT(uint, MATERIAL_DIELECTRIC, 4)
+// Material::type is a MATERIAL_* kind of shared/Kinds.h.
 
 // Material::fresnel
 VKRT_CONSTANT(uint, FRESNEL_NONE, 0)
@@ -80,14 +76,13 @@ VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
 // uniform buffers markedly faster than storage buffers; shared/NUMERICS.md).
 // Each array then has this many records, 16 KiB being the smallest
 // maxUniformBufferRange Vulkan allows; src/gpu/SharedTypes.cpp checks the
-// sizes. Bigger scenes use the storage-buffer variant.
-VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 315)       // 16384 / 52
-VKRT_CONSTANT(uint, UNIFORM_SPHERES, 819)         // 16384 / 20
-VKRT_CONSTANT(uint, UNIFORM_BOXES, 585)           // 16384 / 28
-VKRT_CONSTANT(uint, UNIFORM_TRIANGLES, 409)       // 16384 / 40
-VKRT_CONSTANT(uint, UNIFORM_PLANES, 585)          // 16384 / 28
-VKRT_CONSTANT(uint, UNIFORM_POINT_LIGHTS, 682)    // 16384 / 24
-VKRT_CONSTANT(uint, UNIFORM_TRIANGLE_LIGHTS, 292) // 16384 / 56
+// sizes. Bigger scenes use the storage-buffer variant. The shape and light
+// arrays' capacities (UNIFORM_SPHERES, ...) are in the registry, shared/Kinds.h.
+VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 315) // 16384 / 52
+
+// One record count per shape and light array, in registry order:
+// sphereCount, boxCount, triangleCount, planeCount, pointLightCount, ...
+#define VKRT_COUNT_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) uint field##Count;
 
 struct SceneUniforms {
     vec3 cameraRight;   // scaled by tan(fov/2) * aspect
@@ -98,12 +93,8 @@ struct SceneUniforms {
     uint flags;
     vec3 backgroundColor;
     uint maxDepth;
-    uint sphereCount;
-    uint boxCount;
-    uint triangleCount;
-    uint planeCount;
-    uint pointLightCount;
-    uint triangleLightCount;
+    VKRT_SHAPE_KINDS(VKRT_COUNT_MEMBER)
+    VKRT_LIGHT_KINDS(VKRT_COUNT_MEMBER)
     uint tileCount;     // workgroup tiles in the image
     uint tileStride;    // coprime to tileCount: scatters tiles over the image
     uint environmentSize; // cubemap face width N (0 without a cubemap)

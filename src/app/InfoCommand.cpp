@@ -1,8 +1,7 @@
 // `vkrt info SCENE`: what the scene needs (its FeatureSet), the kernel
 // variant that was built for it, and how long it took to get a first frame.
 #include "app/Commands.h"
-#include "render/Renderer.h"
-#include "scene/SceneParser.h"
+#include "render/RenderSession.h"
 
 #include <CLI/CLI.hpp>
 
@@ -27,18 +26,22 @@ double secondsSince(std::chrono::steady_clock::time_point start)
 
 int runInfo(const InfoOptions& options)
 {
-    Scene scene = parseSceneFile(options.scenePath);
+    Scene scene = loadScene(options.scenePath);
     VulkanContext context({options.device, false});
-    RenderOptions renderOptions;
-    renderOptions.uber = options.uber;
+    SessionConfig config;
+    config.uber = options.uber;
+    config.warmUp = false; // the first frame's time is what info measures
+    // The variant info has always described: independent samples, no variance.
+    config.sampler = SamplerChoice::Independent;
     auto start = std::chrono::steady_clock::now();
-    Renderer renderer(context, scene, renderOptions);
+    RenderSession session(context, scene, config);
     double setupSeconds = secondsSince(start);
-    renderer.renderFrames(1);
+    session.renderFrames(1);
     double firstFrameSeconds = secondsSince(start);
 
-    const FeatureSet& features = renderer.features();
-    const CompiledKernel& kernel = renderer.kernel();
+    const KernelVariant& features = session.renderer().variant();
+    const CompiledKernel& kernel = session.renderer().kernel();
+    const RenderOptions& renderOptions = session.renderOptions();
     std::printf("scene:          %s (%ux%u)\n", scene.path.c_str(), scene.camera.width, scene.camera.height);
     std::printf("features:       %s\n", features.describe().c_str());
     std::printf("variant:        %s%s\n", kernel.cacheKey.c_str(), options.uber ? " (uber)" : "");
@@ -49,8 +52,10 @@ int runInfo(const InfoOptions& options)
     std::printf("spirv cache:    %s\n", renderOptions.cacheDirectory.c_str());
     std::printf("set-up:         %.3f s (parse excluded: compile or load, pipeline, buffers)\n", setupSeconds);
     std::printf("first frame:    %.3f s after set-up began (includes the driver's shader compile)\n", firstFrameSeconds);
-    std::printf("loop budget:    worst case %llu of %u iterations per invocation\n",
-                static_cast<unsigned long long>(worstCaseLoopIterations(scene)), gpu::LOOP_BUDGET);
+    std::printf("loop cap:       %s\n", context.loopCap().describe().c_str());
+    std::printf("loop passes:    worst case %llu per invocation%s\n",
+                static_cast<unsigned long long>(worstCaseLoopIterations(scene)),
+                context.loopCap().capped() ? (" of " + std::to_string(*context.loopCap().budget)).c_str() : "");
     std::printf("device:         %s\n", context.deviceInfo().name.c_str());
     return kExitOk;
 }

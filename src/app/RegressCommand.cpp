@@ -1,5 +1,6 @@
 // `vkrt regress`: the regression suite (src/regress/RegressionRun.cpp).
 #include "app/Commands.h"
+#include "app/ExitCodes.h"
 #include "regress/RegressionRun.h"
 #include "util/Error.h"
 
@@ -31,7 +32,7 @@ CommandRunner addRegressCommand(CLI::App& app)
             if (eq == std::string::npos || eq == 0) throw InputError("--kernel-define " + d + ": expected NAME=VALUE");
             o->kernelDefines.emplace_back(d.substr(0, eq), d.substr(eq + 1));
         }
-        return runRegression(*o);
+        return exitCodeFor(runRegression(*o));
     };
 }
 

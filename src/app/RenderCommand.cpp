@@ -2,21 +2,18 @@
 // optionally a PNG preview). Ctrl-C stops early and still writes what was
 // accumulated, with its true spp in the metadata.
 #include "app/Commands.h"
+#include "app/ExitCodes.h"
 #include "io/ExrFile.h"
 #include "io/PngFile.h"
 #include "render/ConvergenceReport.h"
 #include "render/Progress.h"
-#include "render/RenderLoop.h"
-#include "scene/SceneParser.h"
+#include "render/RenderSession.h"
 #include "util/Error.h"
-#include "util/Hash.h"
 
 #include <CLI/CLI.hpp>
 
-#include <atomic>
 #include <cmath>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -48,29 +45,10 @@ struct RenderCommandOptions {
     bool sppGiven = false;
     std::string sampler = "auto";
 
-    /// Variance is needed for the layer, the report and the target-error rule.
-    bool needsVariance() const { return variance || targetError || !report.empty(); }
-    /// "auto": Sobol' (lower error; --report and --target-error estimate the
-    /// image's error from its independently scrambled batches), except for a
-    /// per-pixel variance layer, which independent samples give with
-    /// spp - 1 degrees of freedom instead of 7, and except where the batch
-    /// sums (VARIANCE_BATCHES per pixel) would pass the storage-buffer range
-    /// the device guarantees (lavapipe: 0.6 M pixels), where independent
-    /// samples need about a sixth of that.
-    std::string resolvedSampler(uint64_t pixels, uint64_t storageBufferRange) const
-    {
-        if (sampler != "auto") return sampler;
-        if (variance) return "independent";
-        bool batchesFit = pixels * varianceBytesPerPixel(true) <= storageBufferRange;
-        return needsVariance() && !batchesFit ? "independent" : "sobol";
-    }
+    VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
     uint32_t maxSpp() const { return sppGiven || !(timeBudget || targetError) ? spp : (1u << 30); }
 };
-
-std::atomic<bool> g_interrupted{false};
-
-extern "C" void onInterrupt(int) { g_interrupted.store(true); }
 
 bool environmentFlag(const char* name)
 {
@@ -83,51 +61,16 @@ std::string defaultOutputFor(const std::string& scenePath)
     return std::filesystem::path(scenePath).stem().string() + ".exr";
 }
 
-void applyResolution(Scene& scene, const RenderCommandOptions& options)
+SessionConfig sessionConfig(const RenderCommandOptions& options)
 {
-    if (options.width) scene.camera.width = *options.width;
-    if (options.height) scene.camera.height = *options.height;
-    uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
-    if (pixels > SceneLimits::maxImagePixels)
-        throw InputError("--width/--height: " + std::to_string(pixels) + " pixels exceeds the limit of " +
-                         std::to_string(SceneLimits::maxImagePixels));
-}
-
-Metadata describeRender(const Scene& scene, const VulkanContext& context, const Renderer& renderer,
-                        const RenderCommandOptions& options, const LoopResult& loop, const RenderCounters& counters,
-                        const std::optional<EstimatedError>& estimated)
-{
-    bool sobol = renderer.features().sobolSampler;
-    Metadata metadata{
-        {"vkrtVersion", std::string(VKRT_VERSION)},
-        {"spp", int64_t(renderer.completedFrames())},
-        {"seed", int64_t(options.seed)},
-        {"renderSeconds", loop.renderSeconds},
-        {"stoppedBy", stopReasonName(loop.reason)},
-        {"device", context.deviceInfo().name},
-        {"driver", context.deviceInfo().driver},
-        {"scene", scene.path},
-        {"sceneHash", "fnv1a64:" + toHex(scene.fileHash)},
-        {"integrator", integratorName(scene.render.integrator)},
-        {"kernelVariant", renderer.features().describe() + (options.uber ? " (uber)" : "")},
-        {"sampler", std::string(sobol ? "sobol" : "independent")},
-        {"rejectedSamples", int64_t(counters.rejectedSamples)},
-    };
-    if (options.variance) {
-        // The variance layer's degrees of freedom: per-pixel tests on it
-        // (vkrt compare) need Student's t rather than a normal when few.
-        metadata["varianceDegreesOfFreedom"] = int64_t(renderer.varianceDegreesOfFreedom());
-        metadata["varianceEstimator"] = sobol
-                                            ? std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches"
-                                            : std::string("independent samples");
-    }
-    if (estimated) {
-        metadata["estimatedRmse"] = estimated->rmse;
-        metadata["estimatedRelMse"] = estimated->relMse;
-    }
-    if (options.timeBudget) metadata["timeBudgetSeconds"] = *options.timeBudget;
-    if (options.targetError) metadata["targetRelMse"] = *options.targetError;
-    return metadata;
+    SessionConfig config;
+    config.seed = options.seed;
+    config.jitter = !options.pixelCenters;
+    config.uber = options.uber;
+    config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
+    config.variance = options.varianceNeeds();
+    config.stop = {options.maxSpp(), options.timeBudget, options.targetError, &interruptFlag()};
+    return config;
 }
 
 /// The reference for --report, checked before any rendering starts.
@@ -161,85 +104,74 @@ void printSummary(const Renderer& renderer, const VulkanContext& context, const 
     if (counters.rejectedSamples)
         std::fprintf(stderr, "warning: %llu non-finite samples were rejected\n",
                      static_cast<unsigned long long>(counters.rejectedSamples));
-    if (counters.budgetExceeded)
-        std::fprintf(stderr, "warning: %u invocations reached lavapipe's loop budget; the image may be wrong\n",
+    // Only a device that cuts loops short makes a long loop a wrong image.
+    if (counters.budgetExceeded && context.loopCap().capped())
+        std::fprintf(stderr, "warning: %u invocations reached the device's loop cap; the image may be wrong\n",
                      counters.budgetExceeded);
 }
 
-int reportValidation(const VulkanContext& context)
+void warnIfTooFewForAnEstimate(const Renderer& renderer)
 {
-    auto messages = context.validationMessages();
-    for (const auto& m : messages) std::fprintf(stderr, "%s\n", m.c_str());
-    return messages.empty() ? kExitOk : kExitValidation;
+    if (renderer.varianceDegreesOfFreedom() != 0) return;
+    std::fprintf(stderr,
+                 "vkrt: warning: %u spp are too few for an error estimate (it needs 2, or %u with the "
+                 "Sobol' sampler's batches): the estimate and any variance layer are +inf\n",
+                 renderer.completedFrames(), gpu::VARIANCE_BATCHES);
 }
 
-int runRender(const RenderCommandOptions& options)
+/// Runs the session's stop rules with Ctrl-C caught, feeding --report at every checkpoint.
+LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceReport>& report,
+                              uint32_t& lastCheckpoint)
+{
+    InterruptGuard interrupt;
+    const Camera& camera = session.scene().camera;
+    Progress progress(session.config().stop.maxSpp, uint64_t(camera.width) * camera.height, isatty(STDERR_FILENO));
+    RunHooks hooks;
+    hooks.onProgress = [&](uint32_t done) { progress.update(done); };
+    if (report)
+        hooks.onCheckpoint = [&](uint32_t spp, double seconds, const Film& film) {
+            report->add(spp, seconds, film.mean, *film.variance);
+            lastCheckpoint = spp;
+        };
+    LoopResult loop = session.run(hooks);
+    progress.finish();
+    return loop;
+}
+
+Outcome runRender(const RenderCommandOptions& options)
 {
     auto start = std::chrono::steady_clock::now();
-    Scene scene = parseSceneFile(options.scenePath);
-    applyResolution(scene, options);
+    Scene scene = loadScene(options.scenePath, {options.width, options.height});
     std::string output = options.output.empty() ? defaultOutputFor(options.scenePath) : options.output;
 
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
-    RenderOptions renderOptions;
-    renderOptions.seed = options.seed;
-    renderOptions.jitter = !options.pixelCenters;
-    renderOptions.uber = options.uber;
-    renderOptions.variance = options.needsVariance();
-    uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
-    renderOptions.sobol =
-        options.resolvedSampler(pixels, context.physicalDevice().getProperties().limits.maxStorageBufferRange) == "sobol";
     std::optional<Image> reference = loadReference(options, scene);
-    Renderer renderer(context, scene, renderOptions);
-    renderer.warmUp();
+    RenderSession session(context, std::move(scene), sessionConfig(options));
     double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     std::optional<ConvergenceReport> report;
     if (!options.report.empty())
-        report.emplace(options.report, reportHeader(scene, context, startupSeconds), std::move(reference));
+        report.emplace(options.report, reportHeader(session.scene(), context, startupSeconds), std::move(reference));
     uint32_t lastCheckpoint = 0;
-    auto onCheckpoint = [&](uint32_t spp, double seconds) {
-        if (!report && !options.targetError) return false;
-        Image mean = renderer.mean(), variance = renderer.varianceOfMean();
-        if (report) report->add(spp, seconds, mean, variance);
-        lastCheckpoint = spp;
-        return options.targetError && estimateError(mean, variance).relMse < *options.targetError;
-    };
+    LoopResult loop = renderWithProgress(session, report, lastCheckpoint);
+    const Renderer& renderer = session.renderer();
+    if (renderer.completedFrames() == 0)
+        return Outcome::of(OutcomeKind::Interrupted, {"vkrt: interrupted before the first frame finished; nothing written"});
 
-    g_interrupted.store(false);
-    std::signal(SIGINT, onInterrupt);
-    StopRules rules{options.maxSpp(), options.timeBudget, &g_interrupted};
-    Progress progress(rules.maxSpp, uint64_t(scene.camera.width) * scene.camera.height, isatty(STDERR_FILENO));
-    LoopResult loop = runRenderLoop(
-        renderer, rules, [&](uint32_t done) { progress.update(done); }, onCheckpoint);
-    progress.finish();
-    std::signal(SIGINT, SIG_DFL);
-
-    if (renderer.completedFrames() == 0) {
-        std::fprintf(stderr, "vkrt: interrupted before the first frame finished; nothing written\n");
-        return kExitInterrupted;
+    Film film = session.film();
+    Metadata metadata = session.metadata(film);
+    std::map<std::string, Image> layers;
+    if (film.variance) {
+        warnIfTooFewForAnEstimate(renderer);
+        if (report && lastCheckpoint != renderer.completedFrames())
+            report->add(renderer.completedFrames(), loop.renderSeconds, film.mean, *film.variance); // the last row
+        if (options.variance) layers["variance"] = std::move(*film.variance);
     }
     RenderCounters counters = renderer.counters();
-    Image image = renderer.mean();
-    std::map<std::string, Image> layers;
-    std::optional<EstimatedError> estimated;
-    if (options.needsVariance()) {
-        Image variance = renderer.varianceOfMean();
-        estimated = estimateError(image, variance);
-        if (renderer.varianceDegreesOfFreedom() == 0)
-            std::fprintf(stderr,
-                         "vkrt: warning: %u spp are too few for an error estimate (it needs 2, or %u with the "
-                         "Sobol' sampler's batches): the estimate and any variance layer are +inf\n",
-                         renderer.completedFrames(), gpu::VARIANCE_BATCHES);
-        if (report && lastCheckpoint != renderer.completedFrames())
-            report->add(renderer.completedFrames(), loop.renderSeconds, image, variance); // the last row
-        if (options.variance) layers["variance"] = std::move(variance);
-    }
-    writeExr(output, image, describeRender(scene, context, renderer, options, loop, counters, estimated), layers);
-    if (!options.png.empty()) writePng(options.png, image, options.exposure);
+    writeExr(output, film.mean, metadata, layers);
+    if (!options.png.empty()) writePng(options.png, film.mean, options.exposure);
     printSummary(renderer, context, loop, counters, startupSeconds, output);
-    if (int status = reportValidation(context); status != kExitOk) return status;
-    return loop.reason == StopReason::Interrupted ? kExitInterrupted : kExitOk;
+    return withValidation(session.outcome(), context.validationMessages());
 }
 
 } // namespace
@@ -260,10 +192,9 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--spp", options->spp, "Samples per pixel (default 64; with --time-budget or --target-error: no limit)")
         ->check(CLI::Range(1u, 1u << 30))
         ->each([options](const std::string&) { options->sppGiven = true; });
-    cmd->add_option("--width", options->width, "Image width (overrides the scene)")
-        ->check(CLI::Range(1u, SceneLimits::maxImageSide));
-    cmd->add_option("--height", options->height, "Image height (overrides the scene)")
-        ->check(CLI::Range(1u, SceneLimits::maxImageSide));
+    // Checked with the scene parser's limits (SceneOverrides.h) once the scene is read.
+    cmd->add_option("--width", options->width, "Image width (overrides the scene)");
+    cmd->add_option("--height", options->height, "Image height (overrides the scene)");
     cmd->add_option("--seed", options->seed, "Random seed (same seed, same image)");
     cmd->add_option("--device", options->device, "Vulkan device index or name (see `vkrt devices`)");
     cmd->add_option("--png", options->png, "Also write a tone-mapped 8-bit sRGB PNG preview");
@@ -290,7 +221,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "(Owen-scrambled Sobol' points: lower error; any variance estimate comes from " +
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
-    return [options] { return runRender(*options); };
+    return [options] { return exitCodeFor(runRender(*options)); };
 }
 
 } // namespace vkrt

@@ -1,5 +1,6 @@
 // `vkrt view SCENE`: the progressive viewer (src/view/Viewer.cpp).
 #include "app/Commands.h"
+#include "app/ExitCodes.h"
 #include "util/Error.h"
 #include "view/Viewer.h"
 
@@ -17,8 +18,9 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_option("scene", o->scenePath, "Scene file")->required();
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--seed", o->seed, "Random seed");
-    cmd->add_option("--width", o->width, "Render width (default: the scene's)")->check(CLI::Range(1u, 8192u));
-    cmd->add_option("--height", o->height, "Render height (default: the scene's)")->check(CLI::Range(1u, 8192u));
+    // Checked with the scene parser's limits (SceneOverrides.h) once the scene is read.
+    cmd->add_option("--width", o->width, "Render width (default: the scene's)");
+    cmd->add_option("--height", o->height, "Render height (default: the scene's)");
     cmd->add_option("--frames", o->frames, "Render this many frames, then exit")->check(CLI::Range(0u, 1u << 24));
     cmd->add_option("--screenshot", o->screenshot, "With --frames: save the displayed image (PNG) before exiting")
         ->needs(cmd->get_option("--frames"));
@@ -30,7 +32,7 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_flag("--validation", o->validation, "Enable Vulkan validation; any message makes the exit status 3");
     return [o] {
         if (!std::isfinite(o->exposure)) throw InputError("--exposure: must be a finite number");
-        return runViewer(*o);
+        return exitCodeFor(runViewer(*o));
     };
 }
 

@@ -12,22 +12,41 @@ namespace vkrt::gpu {
 
 static_assert(alignof(vec3) == 4 && sizeof(vec3) == 12, "GLM vec3 must be three packed floats");
 static_assert(sizeof(Material) == 52);
-static_assert(sizeof(Sphere) == 20);
-static_assert(sizeof(Box) == 28);
-static_assert(sizeof(Triangle) == 40);
-static_assert(sizeof(Plane) == 28);
-static_assert(sizeof(PointLight) == 24);
-static_assert(sizeof(TriangleLight) == 56);
-static_assert(sizeof(SceneUniforms) == 120);
+// The shape and light records' sizes are pinned by their registry capacities
+// below: 16384 / (capacity + 1) < size <= 16384 / capacity admits one size.
 // Each uniform scene array fills at most the 16 KiB every Vulkan device allows.
 constexpr uint32_t kUniformArrayBytes = 16384;
 static_assert(UNIFORM_MATERIALS * sizeof(Material) <= kUniformArrayBytes && (UNIFORM_MATERIALS + 1) * sizeof(Material) > kUniformArrayBytes);
-static_assert(UNIFORM_SPHERES * sizeof(Sphere) <= kUniformArrayBytes && (UNIFORM_SPHERES + 1) * sizeof(Sphere) > kUniformArrayBytes);
-static_assert(UNIFORM_BOXES * sizeof(Box) <= kUniformArrayBytes && (UNIFORM_BOXES + 1) * sizeof(Box) > kUniformArrayBytes);
-static_assert(UNIFORM_TRIANGLES * sizeof(Triangle) <= kUniformArrayBytes && (UNIFORM_TRIANGLES + 1) * sizeof(Triangle) > kUniformArrayBytes);
-static_assert(UNIFORM_PLANES * sizeof(Plane) <= kUniformArrayBytes && (UNIFORM_PLANES + 1) * sizeof(Plane) > kUniformArrayBytes);
-static_assert(UNIFORM_POINT_LIGHTS * sizeof(PointLight) <= kUniformArrayBytes && (UNIFORM_POINT_LIGHTS + 1) * sizeof(PointLight) > kUniformArrayBytes);
-static_assert(UNIFORM_TRIANGLE_LIGHTS * sizeof(TriangleLight) <= kUniformArrayBytes && (UNIFORM_TRIANGLE_LIGHTS + 1) * sizeof(TriangleLight) > kUniformArrayBytes);
+// The registry's capacities (shared/Kinds.h) are exactly what 16 KiB holds.
+#define VKRT_CHECK_CAPACITY(KIND, Type, name, value, field, array, ARRAY, capacity)                      \
+    static_assert(capacity == UNIFORM_##ARRAY && UNIFORM_##ARRAY * sizeof(Type) <= kUniformArrayBytes && \
+                      (UNIFORM_##ARRAY + 1) * sizeof(Type) > kUniformArrayBytes,                        \
+                  "shared/Kinds.h: the capacity of " #array " must be 16384 / sizeof(" #Type ")");
+VKRT_SHAPE_KINDS(VKRT_CHECK_CAPACITY)
+VKRT_LIGHT_KINDS(VKRT_CHECK_CAPACITY)
+#undef VKRT_CHECK_CAPACITY
+
+// Every scene array has a binding of its own, distinct from the fixed ones.
+#define VKRT_BINDING_OF(KIND, Type, name, value, field, array, ARRAY, capacity) BINDING_##ARRAY,
+constexpr uint kSceneArrayBindings[] = {BINDING_MATERIALS, VKRT_SHAPE_KINDS(VKRT_BINDING_OF)
+                                            VKRT_LIGHT_KINDS(VKRT_BINDING_OF)};
+#undef VKRT_BINDING_OF
+constexpr bool bindingsDistinct()
+{
+    constexpr uint fixed[] = {BINDING_UNIFORMS, BINDING_ACCUMULATION, BINDING_STATS,
+                              BINDING_ENVIRONMENT, BINDING_MOMENTS, BINDING_ENVIRONMENT_CDF};
+    for (uint a : kSceneArrayBindings) {
+        if (a >= BINDING_COUNT) return false;
+        for (uint f : fixed) if (a == f) return false;
+        int seen = 0;
+        for (uint b : kSceneArrayBindings) seen += a == b;
+        if (seen != 1) return false;
+    }
+    return true;
+}
+static_assert(bindingsDistinct(), "shared/Bindings.h: every scene array needs its own binding below BINDING_COUNT");
+static_assert(sizeof(SceneUniforms) == 96 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
+              "SceneUniforms holds one count per shape and light kind");
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
 static_assert(sizeof(AccumPixel) == 28);

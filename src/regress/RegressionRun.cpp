@@ -1,21 +1,17 @@
 #include "regress/RegressionRun.h"
 
-#include "app/Commands.h"
 #include "io/AtomicFile.h"
 #include "io/ExrFile.h"
 #include "io/PngFile.h"
 #include "regress/Suite.h"
 #include "render/ErrorMetrics.h"
-#include "render/Renderer.h"
-#include "scene/SceneParser.h"
+#include "render/RenderSession.h"
 #include "util/Error.h"
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -31,28 +27,9 @@ namespace vkrt {
 namespace {
 
 constexpr uint32_t kReferenceSeed = 0x5eed5eed; // never a test seed
-constexpr uint32_t kFramesPerSubmit = 32;       // also the granularity of Ctrl-C
 
-// ---------------------------------------------------------------- Ctrl-C
-
-std::atomic<bool> g_stop{false};
-extern "C" void onRegressInterrupt(int) { g_stop.store(true); }
-
-/// While alive, SIGINT only sets g_stop; renders check it between submissions.
-class InterruptGuard {
-public:
-    InterruptGuard()
-    {
-        g_stop.store(false);
-        m_previous = std::signal(SIGINT, onRegressInterrupt);
-    }
-    ~InterruptGuard() { std::signal(SIGINT, m_previous); }
-    InterruptGuard(const InterruptGuard&) = delete;
-    InterruptGuard& operator=(const InterruptGuard&) = delete;
-
-private:
-    void (*m_previous)(int) = SIG_DFL;
-};
+/// Ctrl-C (runRegression holds an InterruptGuard): renders stop between submissions.
+bool interrupted() { return interruptFlag().load(); }
 
 // ---------------------------------------------------------------- references
 
@@ -89,12 +66,11 @@ Image readReferenceImage(const RegressionCase& c, const fs::path& path, uint32_t
     return image;
 }
 
-Scene caseScene(const RegressionCase& c)
+/// The case's scene at the case's size, checked with the scene parser's limits.
+Scene caseScene(const RegressionSuite& suite, const RegressionCase& c)
 {
-    Scene scene = parseSceneFile(c.scene.string());
-    if (c.width) scene.camera.width = *c.width;
-    if (c.height) scene.camera.height = *c.height;
-    return scene;
+    std::string where = suite.path.string() + ": case " + c.name + ": ";
+    return loadScene(c.scene.string(), {c.width, c.height, where + "width", where + "height"});
 }
 
 /// A case with its scene parsed and its reference loaded and checked.
@@ -105,13 +81,13 @@ struct PreparedCase {
 };
 
 /// Checks every selected case before anything renders; one InputError lists all problems.
-std::vector<PreparedCase> prepareCases(const std::vector<RegressionCase>& cases)
+std::vector<PreparedCase> prepareCases(const RegressionSuite& suite, const std::vector<RegressionCase>& cases)
 {
     std::vector<PreparedCase> prepared;
     std::string problems;
     for (const RegressionCase& c : cases) {
         try {
-            Scene scene = caseScene(c);
+            Scene scene = caseScene(suite, c);
             uint32_t w = scene.camera.width, h = scene.camera.height;
             Reference ref{readReferenceImage(c, c.referenceDir / "mean.exr", w, h, false),
                           readReferenceImage(c, c.referenceDir / "variance.exr", w, h, true)};
@@ -131,27 +107,26 @@ struct Rendered {
     Image mean, variance;
     double seconds = 0.0;
     uint64_t rejectedSamples = 0;
+    Metadata metadata; ///< the session's, for the images written from it
 };
 
-/// Renders `spp` frames after a warm-up frame; nullopt when Ctrl-C stopped it.
+/// Renders `spp` frames after a warm-up frame, with a per-pixel variance (the
+/// per-value test needs it); nullopt when Ctrl-C stopped it.
 std::optional<Rendered> renderCase(const VulkanContext& context, const Scene& scene, uint32_t spp, uint32_t seed,
                                    const std::vector<Define>& defines)
 {
-    RenderOptions options;
-    options.seed = seed;
-    options.variance = true;
-    options.extraDefines = defines;
-    Renderer renderer(context, scene, options);
-    renderer.warmUp();
-    auto start = std::chrono::steady_clock::now();
-    for (uint32_t done = 0; done < spp;) {
-        if (g_stop.load()) return std::nullopt;
-        uint32_t batch = std::min(spp - done, kFramesPerSubmit);
-        renderer.renderFrames(batch);
-        done += batch;
-    }
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return Rendered{renderer.mean(), renderer.varianceOfMean(), seconds, renderer.counters().rejectedSamples};
+    SessionConfig config;
+    config.seed = seed;
+    config.variance.layer = true;
+    config.extraDefines = defines;
+    config.stop = {spp, std::nullopt, std::nullopt, &interruptFlag()};
+    RenderSession session(context, scene, config);
+    LoopResult loop = session.run();
+    if (loop.reason == StopReason::Interrupted) return std::nullopt;
+    Film film = session.film();
+    Metadata metadata = session.metadata(film);
+    return Rendered{std::move(film.mean), std::move(*film.variance), loop.renderSeconds,
+                    session.renderer().counters().rejectedSamples, std::move(metadata)};
 }
 
 /// The pooled test per channel: z_c = sum (x - r) / sqrt(sum sigma^2) over the
@@ -205,7 +180,7 @@ struct CaseResult {
     bool passed = false;
     bool slow = false;
     std::string error; ///< set when the case could not run
-    int errorExit = 0; ///< the exit code that error calls for
+    OutcomeKind errorKind = OutcomeKind::Passed; ///< what that error was
     ReferenceTestResult test;
     MeasuredError measured;
     double seconds = 0.0;
@@ -255,7 +230,7 @@ void writeFailureImages(const fs::path& dir, const std::string& name, const Rend
     writePng(dir / (base + "-result.png"), r.mean, 0.0f);
     writePng(dir / (base + "-difference.png"), differenceImage(r.mean, ref.mean), 0.0f);
     writePng(dir / (base + "-significance.png"), significanceImage(t), 0.0f);
-    writeExr(dir / (base + "-result.exr"), r.mean, {}, {{"variance", r.variance}});
+    writeExr(dir / (base + "-result.exr"), r.mean, r.metadata, {{"variance", r.variance}});
     writeExr(dir / (base + "-pvalues.exr"), t.pValues, {});
 }
 
@@ -282,10 +257,10 @@ std::optional<CaseResult> runCase(const VulkanContext& context, const Regression
             writeFailureImages(options.reportDir, c.name, *r, pc.reference, result.test);
     } catch (const InputError& e) {
         result.error = e.what();
-        result.errorExit = kExitBadInput;
+        result.errorKind = OutcomeKind::BadInput;
     } catch (const std::exception& e) {
         result.error = e.what();
-        result.errorExit = kExitFailure;
+        result.errorKind = OutcomeKind::DeviceFailure;
     }
     return result;
 }
@@ -437,22 +412,22 @@ void printResult(const CaseResult& r)
     std::fflush(stdout);
 }
 
-/// 0, or the exit code of the first case that could not run, else 4 on a failure.
-int exitCode(const std::vector<CaseResult>& results)
+/// Passed, or the kind of the first case that could not run, else Failed on a failure.
+Outcome outcomeOf(const std::vector<CaseResult>& results)
 {
     for (const CaseResult& r : results)
-        if (!r.error.empty()) return r.errorExit;
+        if (!r.error.empty()) return Outcome::of(r.errorKind);
     bool allPassed = std::all_of(results.begin(), results.end(), [](const CaseResult& r) { return r.passed; });
-    return allPassed ? kExitOk : kExitCompareFailed;
+    return allPassed ? Outcome::passed() : Outcome::of(OutcomeKind::Failed);
 }
 
-int runCases(const VulkanContext& context, const RegressionSuite& suite, const std::vector<PreparedCase>& cases,
+Outcome runCases(const VulkanContext& context, const RegressionSuite& suite, const std::vector<PreparedCase>& cases,
              const RegressOptions& options)
 {
     std::vector<CaseResult> results;
     RunStatus status{cases.size(), false};
     for (const PreparedCase& c : cases) {
-        std::optional<CaseResult> r = g_stop.load() ? std::nullopt : runCase(context, suite, c, options);
+        std::optional<CaseResult> r = interrupted() ? std::nullopt : runCase(context, suite, c, options);
         if (!r) {
             status.interrupted = true;
             break;
@@ -466,10 +441,10 @@ int runCases(const VulkanContext& context, const RegressionSuite& suite, const s
     if (status.interrupted) {
         writeReports(suite, results, status, context, options);
         std::printf(" (interrupted after %zu of %zu cases)\n", results.size(), cases.size());
-        return kExitInterrupted;
+        return Outcome::of(OutcomeKind::Interrupted);
     }
     std::printf("\n");
-    return exitCode(results);
+    return outcomeOf(results);
 }
 
 // ---------------------------------------------------------------- --update
@@ -530,7 +505,7 @@ bool updateReference(const VulkanContext& context, const RegressionSuite& suite,
 {
     std::printf("updating %s: %llu spp ...\n", c.name.c_str(), static_cast<unsigned long long>(c.referenceSpp));
     std::fflush(stdout);
-    Scene scene = caseScene(c);
+    Scene scene = caseScene(suite, c);
     auto start = std::chrono::steady_clock::now();
     std::optional<Rendered> r = renderCase(context, scene, uint32_t(c.referenceSpp), kReferenceSeed, {});
     if (!r) return false;
@@ -539,14 +514,14 @@ bool updateReference(const VulkanContext& context, const RegressionSuite& suite,
         std::printf("warning: %s: %llu non-finite samples were rejected\n", c.name.c_str(),
                     static_cast<unsigned long long>(r->rejectedSamples));
     fs::create_directories(c.referenceDir);
-    writeExr(c.referenceDir / "mean.exr", r->mean, {{"spp", int64_t(c.referenceSpp)}, {"seed", int64_t(kReferenceSeed)}});
-    writeExr(c.referenceDir / "variance.exr", r->variance, {{"spp", int64_t(c.referenceSpp)}});
+    writeExr(c.referenceDir / "mean.exr", r->mean, r->metadata);
+    writeExr(c.referenceDir / "variance.exr", r->variance, r->metadata);
     writeReferenceReadme(context, suite, c, scene, seconds);
     std::printf("updated %s (%.1f s)\n", c.referenceDir.c_str(), seconds);
     return true;
 }
 
-int updateReferences(const VulkanContext& context, const RegressionSuite& suite, const std::vector<RegressionCase>& cases)
+Outcome updateReferences(const VulkanContext& context, const RegressionSuite& suite, const std::vector<RegressionCase>& cases)
 {
     std::set<fs::path> updated;
     for (const RegressionCase& c : cases) {
@@ -559,12 +534,12 @@ int updateReferences(const VulkanContext& context, const RegressionSuite& suite,
                         c.referenceDir.c_str());
             continue;
         }
-        if (g_stop.load() || !updateReference(context, suite, c)) {
+        if (interrupted() || !updateReference(context, suite, c)) {
             std::printf("interrupted: %s and later references not updated\n", c.name.c_str());
-            return kExitInterrupted;
+            return Outcome::of(OutcomeKind::Interrupted);
         }
     }
-    return kExitOk;
+    return Outcome::passed();
 }
 
 // ---------------------------------------------------------------- set-up
@@ -640,7 +615,7 @@ void selectVulkanDriver(const fs::path& icdManifest)
     setenv("VK_ICD_FILENAMES", path.c_str(), 1); // older loaders
 }
 
-int runRegression(const RegressOptions& options)
+Outcome runRegression(const RegressOptions& options)
 {
     RegressionSuite suite = readRegressionSuite(options.suite);
     if (options.update && !options.kernelDefines.empty())
@@ -648,7 +623,7 @@ int runRegression(const RegressOptions& options)
     std::vector<RegressionCase> cases = selectedCases(suite, options.filters);
     if (!options.driver.empty()) selectVulkanDriver(options.driver);
     std::vector<PreparedCase> prepared;
-    if (!options.update) prepared = prepareCases(cases);
+    if (!options.update) prepared = prepareCases(suite, cases);
     if (!options.reportDir.empty()) createReportDir(options.reportDir);
 
     InterruptGuard interrupt;

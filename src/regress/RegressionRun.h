@@ -2,6 +2,7 @@
 // `vkrt regress`: renders every case of a suite, tests it against its
 // reference, and writes a Markdown report, failure images and JUnit XML.
 #include "gpu/ShaderCompiler.h"
+#include "render/Outcome.h"
 
 #include <filesystem>
 #include <string>
@@ -22,11 +23,11 @@ struct RegressOptions {
     std::vector<Define> kernelDefines; ///< test hooks: build every kernel with these
 };
 
-/// Runs the suite; returns the exit code: 0 when every case passes, 4 when a
-/// case fails its test, 1 when a case could not render, 130 when interrupted
-/// (the finished cases are reported). Bad input (manifest, references,
-/// options) throws InputError before anything renders.
-int runRegression(const RegressOptions& options);
+/// Runs the suite: Passed when every case passes, Failed when a case fails its
+/// test, DeviceFailure (or BadInput) when a case could not render,
+/// Interrupted on Ctrl-C (the finished cases are reported). Bad input
+/// (manifest, references, options) throws InputError before anything renders.
+Outcome runRegression(const RegressOptions& options);
 
 /// Points the Vulkan loader at one ICD manifest; throws InputError naming the
 /// path if it is missing, not a JSON ICD manifest, or names a library file

@@ -1,14 +1,16 @@
+// Regression-suite manifest reader. Manifests are written by hand like scene
+// files, so they are read with the same located, typed checks
+// (scene/TomlReader.h): every error names file:line:column and the dotted path.
 #include "regress/Suite.h"
 
+#include "scene/TomlReader.h"
 #include "util/Error.h"
 
-#include <toml++/toml.h>
-
-#include <algorithm>
-#include <cmath>
+#include <array>
 #include <cstdint>
-#include <set>
-#include <vector>
+#include <map>
+#include <string_view>
+#include <utility>
 
 namespace fs = std::filesystem;
 
@@ -16,122 +18,89 @@ namespace vkrt {
 
 namespace {
 
-SourceLocation locate(const fs::path& file, const toml::node& node)
+constexpr std::array<std::string_view, 2> topLevelKeys{"suite", "case"};
+constexpr std::array<std::string_view, 5> suiteKeys{"alpha", "pooled_alpha", "min_pass", "max_slowdown", "seed"};
+constexpr std::array<std::string_view, 10> caseKeys{"name",          "scene", "reference", "reference_source",
+                                                    "reference_spp", "spp",   "width",     "height",
+                                                    "baseline_seconds", "max_rejected"};
+
+constexpr std::array<EnumName<ReferenceSource>, 2> referenceSources{
+    {{"mitsuba", ReferenceSource::Mitsuba}, {"vkrt", ReferenceSource::Vkrt}}};
+
+/// A significance level: 0 and 1 would make the test meaningless.
+double readAlpha(const Field& field) { return readNumberIn(field, {0, 1, true, true}); }
+/// A fraction of passing values: 1 (all must pass) is allowed.
+double readPassFraction(const Field& field) { return readNumberIn(field, {0, 1, true, false}); }
+
+uint32_t readUint32(const Field& field, int64_t min) { return static_cast<uint32_t>(readInteger(field, min, UINT32_MAX)); }
+uint32_t readCount(const Field& field) { return readUint32(field, 1); }
+uint32_t readSeed(const Field& field) { return readUint32(field, 0); }
+uint64_t readTolerance(const Field& field) { return readUint32(field, 0); }
+std::optional<uint32_t> readSide(const Field& field) { return readCount(field); }
+
+fs::path readScenePath(const Field& field)
 {
-    return {file.string(), int(node.source().begin.line), int(node.source().begin.column)};
+    const fs::path scene = readPath(field).lexically_normal();
+    if (!fs::exists(scene)) field.fail("no such file " + scene.string());
+    return scene;
 }
 
-/// Levenshtein distance, for "did you mean".
-size_t editDistance(const std::string& a, const std::string& b)
+fs::path readFolder(const Field& field) { return readPath(field).lexically_normal(); }
+
+void readSuiteSettings(const TableField& table, RegressionSuite& suite)
 {
-    std::vector<size_t> row(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-        size_t diagonal = row[0];
-        row[0] = i;
-        for (size_t j = 1; j <= b.size(); ++j) {
-            size_t above = row[j];
-            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-            diagonal = above;
-        }
-    }
-    return row[b.size()];
+    table.rejectUnknownKeys(suiteKeys);
+    suite.alpha = readOr(table, "alpha", suite.alpha, readAlpha);
+    suite.pooledAlpha = readOr(table, "pooled_alpha", suite.pooledAlpha, readAlpha);
+    suite.minPass = readOr(table, "min_pass", suite.minPass, readPassFraction);
+    suite.maxSlowdown = readOr(table, "max_slowdown", suite.maxSlowdown, readPositive);
+    suite.seed = readOr(table, "seed", suite.seed, readSeed);
 }
 
-std::string didYouMean(const std::string& key, const std::set<std::string>& allowed)
+RegressionCase readCase(const TableField& table)
 {
-    std::string best;
-    size_t bestDistance = 3; // offer only keys within two edits
-    for (const std::string& candidate : allowed) {
-        size_t d = editDistance(key, candidate);
-        if (d < bestDistance && d < std::max(key.size(), candidate.size())) best = candidate, bestDistance = d;
-    }
-    return best.empty() ? "" : "; did you mean '" + best + "'?";
-}
-
-void rejectUnknownKeys(const fs::path& file, const toml::table& table, const std::set<std::string>& allowed,
-                       const std::string& where)
-{
-    for (const auto& [key, value] : table) {
-        std::string name(key.str());
-        if (!allowed.count(name))
-            throw SceneError(locate(file, value), where + ": unknown key '" + name + "'" + didYouMean(name, allowed));
-    }
-}
-
-template <typename T> T require(const fs::path& file, const toml::table& table, const char* key, const std::string& where)
-{
-    const toml::node* node = table.get(key);
-    if (!node) throw SceneError(locate(file, table), where + ": missing required key '" + key + "'");
-    if constexpr (std::is_same_v<T, std::string>) {
-        if (auto v = node->value<std::string>()) return *v;
-        throw SceneError(locate(file, *node), where + "." + key + ": expected a string");
-    } else {
-        if (auto v = node->value<T>()) return *v;
-        throw SceneError(locate(file, *node), where + "." + key + ": expected a number");
-    }
-}
-
-template <typename T>
-std::optional<T> optional(const fs::path& file, const toml::table& table, const char* key, const std::string& where)
-{
-    if (!table.get(key)) return std::nullopt;
-    return require<T>(file, table, key, where);
-}
-
-double positive(const fs::path& file, const toml::table& table, const char* key, const std::string& where, double value)
-{
-    if (!(value > 0.0) || !std::isfinite(value))
-        throw SceneError(locate(file, *table.get(key)), where + "." + key + ": must be a positive number");
-    return value;
-}
-
-/// A probability: in (0, 1), or (0, 1] when `closed`.
-double probability(const fs::path& file, const toml::table& table, const char* key, const std::string& where,
-                   double value, bool closed)
-{
-    if (!(value > 0.0) || value > 1.0 || (!closed && value == 1.0))
-        throw SceneError(locate(file, *table.get(key)),
-                         where + "." + key + ": must be in (0, 1" + (closed ? "]" : ")") + ", got " + std::to_string(value));
-    return value;
-}
-
-/// An integer in [minimum, 2^32 - 1].
-uint32_t count32(const fs::path& file, const toml::table& table, const char* key, const std::string& where, int64_t value,
-                 int64_t minimum = 1)
-{
-    if (value < minimum || value > int64_t(UINT32_MAX))
-        throw SceneError(locate(file, *table.get(key)),
-                         where + "." + key + ": must be an integer in [" + std::to_string(minimum) + ", 4294967295]");
-    return uint32_t(value);
-}
-
-RegressionCase readCase(const fs::path& file, const toml::table& t, size_t index)
-{
-    std::string where = "case[" + std::to_string(index) + "]";
-    rejectUnknownKeys(file, t,
-                      {"name", "scene", "reference", "reference_source", "reference_spp", "spp", "width", "height",
-                       "baseline_seconds", "max_rejected"},
-                      where);
+    table.rejectUnknownKeys(caseKeys);
     RegressionCase c;
-    fs::path dir = file.parent_path();
-    c.name = require<std::string>(file, t, "name", where);
-    c.scene = (dir / require<std::string>(file, t, "scene", where)).lexically_normal();
-    c.referenceDir = (dir / require<std::string>(file, t, "reference", where)).lexically_normal();
-    std::string source = require<std::string>(file, t, "reference_source", where);
-    if (source != "mitsuba" && source != "vkrt")
-        throw SceneError(locate(file, *t.get("reference_source")),
-                         where + ".reference_source: expected \"mitsuba\" or \"vkrt\", got \"" + source + "\"");
-    c.source = source == "mitsuba" ? ReferenceSource::Mitsuba : ReferenceSource::Vkrt;
-    c.referenceSpp = count32(file, t, "reference_spp", where, require<int64_t>(file, t, "reference_spp", where));
-    c.spp = count32(file, t, "spp", where, require<int64_t>(file, t, "spp", where));
-    if (auto w = optional<int64_t>(file, t, "width", where)) c.width = count32(file, t, "width", where, *w);
-    if (auto h = optional<int64_t>(file, t, "height", where)) c.height = count32(file, t, "height", where, *h);
-    if (auto b = optional<double>(file, t, "baseline_seconds", where)) c.baselineSeconds = positive(file, t, "baseline_seconds", where, *b);
-    if (auto m = optional<int64_t>(file, t, "max_rejected", where)) c.maxRejected = count32(file, t, "max_rejected", where, *m, 0);
-    if (!fs::exists(c.scene))
-        throw SceneError(locate(file, *t.get("scene")), where + ".scene: no such file " + c.scene.string());
+    c.name = readString(table.require("name"));
+    c.scene = readScenePath(table.require("scene"));
+    c.referenceDir = readFolder(table.require("reference"));
+    c.source = readChoice(table.require("reference_source"), "reference source", referenceSources).value;
+    c.referenceSpp = readCount(table.require("reference_spp"));
+    c.spp = readCount(table.require("spp"));
+    c.width = readOr(table, "width", c.width, readSide);
+    c.height = readOr(table, "height", c.height, readSide);
+    c.baselineSeconds = readOr(table, "baseline_seconds", c.baselineSeconds, readPositive);
+    c.maxRejected = readOr(table, "max_rejected", c.maxRejected, readTolerance);
     return c;
+}
+
+/// Case names are what --filter and the report use, so two cases may not share one.
+class CaseNames {
+public:
+    void add(const TableField& table, const std::string& name)
+    {
+        const Field field = table.require("name");
+        const auto [first, inserted] = m_seen.emplace(name, field.location().line);
+        if (!inserted) field.fail("duplicate case name " + quote(name) + " (first used on line " +
+                                  std::to_string(first->second) + ")");
+    }
+
+private:
+    std::map<std::string, int> m_seen;
+};
+
+std::vector<RegressionCase> readCases(const TableField& top)
+{
+    const std::optional<Field> cases = top.find("case");
+    if (!cases) top.field().fail("no [[case]] entries");
+    if (cases->node().is_array() && cases->node().as_array()->empty()) cases->fail("no [[case]] entries");
+    std::vector<RegressionCase> out;
+    CaseNames names;
+    forEachTable(*cases, [&](const TableField& table) {
+        out.push_back(readCase(table));
+        names.add(table, out.back().name);
+    });
+    return out;
 }
 
 } // namespace
@@ -139,37 +108,14 @@ RegressionCase readCase(const fs::path& file, const toml::table& t, size_t index
 RegressionSuite readRegressionSuite(const fs::path& path)
 {
     if (!fs::exists(path)) throw InputError("--suite " + path.string() + ": no such file");
-    toml::table root;
-    try {
-        root = toml::parse_file(path.string());
-    } catch (const toml::parse_error& e) {
-        throw SceneError({path.string(), int(e.source().begin.line), int(e.source().begin.column)},
-                         std::string("invalid TOML: ") + std::string(e.description()));
-    }
-    rejectUnknownKeys(path, root, {"suite", "case"}, "suite file");
+    const TomlSource source{path.string(), path.parent_path()};
+    const toml::table root = parseToml(readFileBytes(source.file, "suite file"), source);
+    const TableField top(Field(source, root, ""));
+    top.rejectUnknownKeys(topLevelKeys);
     RegressionSuite suite;
     suite.path = path;
-    if (const toml::table* s = root["suite"].as_table()) {
-        rejectUnknownKeys(path, *s, {"alpha", "pooled_alpha", "min_pass", "max_slowdown", "seed"}, "suite");
-        if (auto v = optional<double>(path, *s, "alpha", "suite")) suite.alpha = probability(path, *s, "alpha", "suite", *v, false);
-        if (auto v = optional<double>(path, *s, "pooled_alpha", "suite"))
-            suite.pooledAlpha = probability(path, *s, "pooled_alpha", "suite", *v, false);
-        if (auto v = optional<double>(path, *s, "min_pass", "suite")) suite.minPass = probability(path, *s, "min_pass", "suite", *v, true);
-        if (auto v = optional<double>(path, *s, "max_slowdown", "suite"))
-            suite.maxSlowdown = positive(path, *s, "max_slowdown", "suite", *v);
-        if (auto v = optional<int64_t>(path, *s, "seed", "suite")) suite.seed = count32(path, *s, "seed", "suite", *v, 0);
-    }
-    const toml::array* cases = root["case"].as_array();
-    if (!cases || cases->empty()) throw SceneError({path.string(), 1, 1}, "suite file: no [[case]] entries");
-    std::set<std::string> names;
-    for (size_t i = 0; i < cases->size(); ++i) {
-        const toml::table* t = (*cases)[i].as_table();
-        if (!t) throw SceneError(locate(path, (*cases)[i]), "case[" + std::to_string(i) + "]: expected a table");
-        RegressionCase c = readCase(path, *t, i);
-        if (!names.insert(c.name).second)
-            throw SceneError(locate(path, *t->get("name")), "case[" + std::to_string(i) + "].name: duplicate '" + c.name + "'");
-        suite.cases.push_back(std::move(c));
-    }
+    if (const auto settings = top.find("suite")) readSuiteSettings(TableField(*settings), suite);
+    suite.cases = readCases(top);
     return suite;
 }
 

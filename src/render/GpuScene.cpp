@@ -41,6 +41,33 @@ gpu::Material convertMaterial(const Material& m, Integrator integrator)
     return g;
 }
 
+// One conversion per shape and light kind (shared/Kinds.h), found by overload.
+gpu::Sphere toGpu(const Sphere& s, const Relativizer& rel) { return {rel(s.center), float(s.radius), s.material}; }
+gpu::Box toGpu(const Box& b, const Relativizer& rel) { return {rel(b.min), b.material, rel(b.max)}; }
+gpu::Triangle toGpu(const Triangle& t, const Relativizer& rel)
+{
+    return {rel(t.vertices[0]), t.material, rel(t.vertices[1]), rel(t.vertices[2])};
+}
+gpu::Plane toGpu(const Plane& p, const Relativizer& rel) { return {rel(p.point), p.material, toFloat(p.normal)}; }
+gpu::PointLight toGpu(const PointLight& l, const Relativizer& rel) { return {rel(l.position), toFloat(l.intensity)}; }
+gpu::TriangleLight toGpu(const TriangleLight& l, const Relativizer& rel)
+{
+    double area = triangleArea(l.vertices);
+    return {rel(l.vertices[0]), float(area), rel(l.vertices[1]), l.twoSided ? 1u : 0u, rel(l.vertices[2]),
+            toFloat(l.radiance)};
+}
+
+/// The records of a kind that reach the GPU: all of them, except that
+/// triangle lights that cannot emit are dropped.
+template <class Record> const std::vector<Record>& recordsToUpload(const Scene&, const std::vector<Record>& all)
+{
+    return all;
+}
+std::vector<TriangleLight> recordsToUpload(const Scene& scene, const std::vector<TriangleLight>&)
+{
+    return emittingTriangleLights(scene);
+}
+
 void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
 {
     glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
@@ -136,29 +163,22 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
     GpuSceneData data;
     Relativizer rel{scene.camera.eye};
     for (const auto& m : scene.materials) data.materials.push_back(convertMaterial(m, scene.render.integrator));
-    for (const auto& s : scene.spheres) data.spheres.push_back({rel(s.center), float(s.radius), s.material});
-    for (const auto& b : scene.boxes) data.boxes.push_back({rel(b.min), b.material, rel(b.max)});
-    for (const auto& t : scene.triangles)
-        data.triangles.push_back({rel(t.vertices[0]), t.material, rel(t.vertices[1]), rel(t.vertices[2])});
-    for (const auto& p : scene.planes) data.planes.push_back({rel(p.point), p.material, toFloat(p.normal)});
-    for (const auto& l : scene.pointLights) data.pointLights.push_back({rel(l.position), toFloat(l.intensity)});
-    for (const auto& l : emittingTriangleLights(scene)) {
-        double area = triangleArea(l.vertices);
-        data.triangleLights.push_back({rel(l.vertices[0]), float(area), rel(l.vertices[1]), l.twoSided ? 1u : 0u,
-                                       rel(l.vertices[2]), toFloat(l.radiance)});
-    }
+#define VKRT_CONVERT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    for (const auto& record : recordsToUpload(scene, scene.array)) data.array.push_back(toGpu(record, rel));
+    VKRT_SHAPE_KINDS(VKRT_CONVERT_RECORDS)
+    VKRT_LIGHT_KINDS(VKRT_CONVERT_RECORDS)
+#undef VKRT_CONVERT_RECORDS
 
     gpu::SceneUniforms& u = data.uniforms;
     convertCamera(scene.camera, u);
     u.flags = settings.jitter ? gpu::RENDER_FLAG_JITTER : 0u;
     u.backgroundColor = toFloat(scene.background.color);
     u.maxDepth = uint32_t(scene.render.maxDepth);
-    u.sphereCount = uint32_t(data.spheres.size());
-    u.boxCount = uint32_t(data.boxes.size());
-    u.triangleCount = uint32_t(data.triangles.size());
-    u.planeCount = uint32_t(data.planes.size());
-    u.pointLightCount = uint32_t(data.pointLights.size());
-    u.triangleLightCount = uint32_t(data.triangleLights.size());
+#define VKRT_COUNT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    u.field##Count = uint32_t(data.array.size());
+    VKRT_SHAPE_KINDS(VKRT_COUNT_RECORDS)
+    VKRT_LIGHT_KINDS(VKRT_COUNT_RECORDS)
+#undef VKRT_COUNT_RECORDS
     u.tileCount = tileCountFor(u.width, u.height);
     u.tileStride = tileStrideFor(u.tileCount);
     std::vector<uint32_t> media = mediaAroundCamera(scene);

@@ -12,12 +12,11 @@ namespace vkrt {
 struct GpuSceneData {
     gpu::SceneUniforms uniforms{};
     std::vector<gpu::Material> materials;
-    std::vector<gpu::Sphere> spheres;
-    std::vector<gpu::Box> boxes;
-    std::vector<gpu::Triangle> triangles;
-    std::vector<gpu::Plane> planes;
-    std::vector<gpu::PointLight> pointLights;
-    std::vector<gpu::TriangleLight> triangleLights;
+    // One array per shape and light kind (shared/Kinds.h), named as in Scene.
+#define VKRT_GPU_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) std::vector<gpu::Type> array;
+    VKRT_SHAPE_KINDS(VKRT_GPU_ARRAY_MEMBER)
+    VKRT_LIGHT_KINDS(VKRT_GPU_ARRAY_MEMBER)
+#undef VKRT_GPU_ARRAY_MEMBER
 };
 
 struct FrameSettings {

@@ -31,14 +31,13 @@ uint32_t framesForNextBatch(uint32_t batch, uint32_t done, const StopRules& rule
     return std::max(frames, 1u);
 }
 
-uint32_t grownBatch(uint32_t frames, double seconds)
-{
-    if (seconds <= 0.0) return std::min(frames * 2, kMaxFramesPerSubmit);
-    double scaled = double(frames) * kTargetSubmitSeconds / seconds;
-    return uint32_t(std::clamp(scaled, 1.0, double(std::min(frames * 2, kMaxFramesPerSubmit))));
-}
-
 } // namespace
+
+void BatchPacer::record(uint32_t frames, double seconds)
+{
+    uint32_t most = std::min(frames * 2, kMaxFramesPerSubmit);
+    m_frames = seconds <= 0.0 ? most : uint32_t(std::clamp(double(frames) * m_targetSeconds / seconds, 1.0, double(most)));
+}
 
 uint32_t nextCheckpoint(uint32_t spp)
 {
@@ -62,7 +61,7 @@ LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules, const std::
                          const CheckpointHandler& onCheckpoint)
 {
     LoopResult result;
-    uint32_t batch = 1;
+    BatchPacer pacer(kTargetSubmitSeconds);
     double secondsPerFrame = 0.0;
     while (true) {
         uint32_t done = renderer.completedFrames();
@@ -75,13 +74,13 @@ LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules, const std::
             result.reason = StopReason::TimeBudget;
             break;
         }
-        uint32_t frames = framesForNextBatch(batch, done, rules, result.renderSeconds, secondsPerFrame);
+        uint32_t frames = framesForNextBatch(pacer.nextFrames(), done, rules, result.renderSeconds, secondsPerFrame);
         auto start = Clock::now();
         renderer.renderFrames(frames);
         double seconds = std::chrono::duration<double>(Clock::now() - start).count();
         result.renderSeconds += seconds;
         secondsPerFrame = seconds / frames;
-        batch = grownBatch(frames, seconds);
+        pacer.record(frames, seconds);
         done = renderer.completedFrames();
         if (onProgress) onProgress(done);
         bool atCheckpoint = (done & (done - 1)) == 0 || done == rules.maxSpp;

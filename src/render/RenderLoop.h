@@ -13,9 +13,11 @@
 
 namespace vkrt {
 
+/// When a render stops: whichever rule fires first.
 struct StopRules {
     uint32_t maxSpp = 64;
     std::optional<double> timeBudgetSeconds;       ///< of rendering, start-up excluded
+    std::optional<double> targetRelMse;            ///< estimated relMSE; the checkpoint handler tests it (it needs the film)
     const std::atomic<bool>* interrupt = nullptr; ///< set asynchronously (SIGINT)
 };
 
@@ -25,6 +27,20 @@ std::string stopReasonName(StopReason reason);
 struct LoopResult {
     StopReason reason = StopReason::SppReached;
     double renderSeconds = 0.0; ///< wall time spent in frames (no compile, set-up or checkpoint work)
+};
+
+/// Sizes submissions so that each takes about `targetSeconds`, from the
+/// measured time of the last one: at most twice its frames, at most 64.
+/// The render loop paces with a quarter second, the viewer with a display refresh.
+class BatchPacer {
+public:
+    explicit BatchPacer(double targetSeconds) : m_targetSeconds(targetSeconds) {}
+    uint32_t nextFrames() const { return m_frames; }
+    void record(uint32_t frames, double seconds);
+
+private:
+    double m_targetSeconds;
+    uint32_t m_frames = 1;
 };
 
 /// Called at every checkpoint (spp a power of two, and the final spp) with

@@ -17,12 +17,13 @@ namespace {
 
 constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffer;
 
-FeatureSet chooseFeatures(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
+KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
     checkLoopBudget(scene, context.loopCap()); // before any compilation or allocation
-    FeatureSet features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
-    features.variance = options.variance;
-    features.sobolSampler = options.sobol;
+    KernelVariant variant;
+    variant.features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
+    variant.variance = options.variance;
+    variant.sobolSampler = options.sobol;
     // The batch sums are laid out for VARIANCE_BATCHES batches; a different
     // sampler batch count would make the estimate describe other batches.
     bool batchOverride = std::any_of(options.extraDefines.begin(), options.extraDefines.end(),
@@ -30,17 +31,17 @@ FeatureSet chooseFeatures(const VulkanContext& context, const Scene& scene, cons
     if (options.variance && options.sobol && batchOverride)
         throw InputError("VKRT_SOBOL_BATCHES cannot be overridden when the Sobol' sampler estimates variance "
                          "(its batch count is VARIANCE_BATCHES)");
-    features.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
-    return features;
+    variant.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
+    return variant;
 }
 
 /// The variant's bindings with their descriptor types (scene arrays are
 /// uniform buffers in the uniform-scene variant).
-std::vector<KernelBinding> kernelBindingsOf(const FeatureSet& features)
+std::vector<KernelBinding> kernelBindingsOf(const KernelVariant& variant)
 {
-    std::vector<KernelBinding> bindings = renderKernelBindings(features.bindings());
+    std::vector<KernelBinding> bindings = renderKernelBindings(variant.bindings());
     for (KernelBinding& binding : bindings)
-        if (features.isUniformBinding(binding.index)) binding.type = vk::DescriptorType::eUniformBuffer;
+        if (variant.isUniformBinding(binding.index)) binding.type = vk::DescriptorType::eUniformBuffer;
     return bindings;
 }
 
@@ -55,9 +56,9 @@ Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records
     return makeBufferFrom(context, records, vk::BufferUsageFlagBits::eUniformBuffer);
 }
 
-CompiledKernel compileVariant(const FeatureSet& features, const RenderOptions& options)
+CompiledKernel compileVariant(const KernelVariant& variant, const RenderOptions& options)
 {
-    KernelSource source{options.shaderRoot, "kernels/render.comp", features.defines()};
+    KernelSource source{options.shaderRoot, "kernels/render.comp", variant.defines()};
     source.defines.insert(source.defines.end(), options.extraDefines.begin(), options.extraDefines.end());
     return compileKernelCached(source, SpirvCache(options.cacheDirectory));
 }
@@ -157,19 +158,19 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     : m_context(context),
       m_scene(scene),
       m_options(std::move(options)),
-      m_features(chooseFeatures(context, scene, m_options)),
+      m_variant(chooseVariant(context, scene, m_options)),
       m_data(convertScene(scene, FrameSettings{m_options.jitter})),
-      m_compiled(compileVariant(m_features, m_options)),
+      m_compiled(compileVariant(m_variant, m_options)),
       m_accumulation(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel), "the accumulation buffer")),
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, kernelBindingsOf(m_features), sizeof(gpu::FrameConstants)),
+      m_kernel(context, m_compiled.spirv, kernelBindingsOf(m_variant), sizeof(gpu::FrameConstants)),
       m_cubemap(scene.background.cubemap)
 {
     m_accumulation.clear(context);
     m_stats.clear(context);
-    if (m_features.variance) {
+    if (m_variant.variance) {
         if (batchedVariance())
             m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(true),
                                              "the error estimate's " + std::to_string(gpu::VARIANCE_BATCHES) +
@@ -207,7 +208,7 @@ void Renderer::uploadSceneBuffers()
 {
     auto addBuffer = [&](uint32_t binding, auto&& records, uint32_t uniformCapacity) {
         if (!m_kernel.uses(binding)) return;
-        bool uniform = m_features.isUniformBinding(binding);
+        bool uniform = m_variant.isUniformBinding(binding);
         m_sceneBuffers.push_back(makeSceneArrayBuffer(m_context, records, uniform, uniformCapacity));
         m_kernel.bind(binding, m_sceneBuffers.back());
     };
@@ -216,12 +217,11 @@ void Renderer::uploadSceneBuffers()
     m_data.uniforms.environmentSize = m_environmentSize;
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
-    addBuffer(gpu::BINDING_SPHERES, m_data.spheres, gpu::UNIFORM_SPHERES);
-    addBuffer(gpu::BINDING_BOXES, m_data.boxes, gpu::UNIFORM_BOXES);
-    addBuffer(gpu::BINDING_TRIANGLES, m_data.triangles, gpu::UNIFORM_TRIANGLES);
-    addBuffer(gpu::BINDING_PLANES, m_data.planes, gpu::UNIFORM_PLANES);
-    addBuffer(gpu::BINDING_POINT_LIGHTS, m_data.pointLights, gpu::UNIFORM_POINT_LIGHTS);
-    addBuffer(gpu::BINDING_TRIANGLE_LIGHTS, m_data.triangleLights, gpu::UNIFORM_TRIANGLE_LIGHTS);
+#define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    addBuffer(gpu::BINDING_##ARRAY, m_data.array, gpu::UNIFORM_##ARRAY);
+    VKRT_SHAPE_KINDS(VKRT_UPLOAD_ARRAY)
+    VKRT_LIGHT_KINDS(VKRT_UPLOAD_ARRAY)
+#undef VKRT_UPLOAD_ARRAY
 }
 
 void Renderer::reset()
@@ -384,7 +384,7 @@ Image Renderer::varianceOfMeanFromBatches() const
 
 uint64_t Renderer::varianceDegreesOfFreedom() const
 {
-    if (!m_features.variance || m_frames == 0) return 0;
+    if (!m_variant.variance || m_frames == 0) return 0;
     if (batchedVariance()) return m_frames >= gpu::VARIANCE_BATCHES ? gpu::VARIANCE_BATCHES - 1 : 0;
     return m_frames - 1;
 }

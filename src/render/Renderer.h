@@ -7,8 +7,8 @@
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
 #include "render/GpuScene.h"
+#include "render/KernelVariant.h"
 #include "shared/Bindings.h"
-#include "scene/FeatureSet.h"
 
 #include <filesystem>
 #include <optional>
@@ -68,7 +68,7 @@ public:
     uint64_t varianceDegreesOfFreedom() const;
     RenderCounters counters() const;
 
-    const FeatureSet& features() const { return m_features; }
+    const KernelVariant& variant() const { return m_variant; }
     const CompiledKernel& kernel() const { return m_compiled; }
     uint32_t width() const { return m_data.uniforms.width; }
     uint32_t height() const { return m_data.uniforms.height; }
@@ -77,7 +77,7 @@ private:
     const VulkanContext& m_context;
     Scene m_scene;
     RenderOptions m_options;
-    FeatureSet m_features;
+    KernelVariant m_variant;
     GpuSceneData m_data;
     CompiledKernel m_compiled;
     std::vector<Buffer> m_sceneBuffers;
@@ -91,7 +91,7 @@ private:
     uint32_t m_environmentSize = 0;
     uint32_t m_frames = 0;
 
-    bool batchedVariance() const { return m_features.variance && m_features.sobolSampler; }
+    bool batchedVariance() const { return m_variant.variance && m_variant.sobolSampler; }
     Image varianceOfMeanFromBatches() const;
     Image meanOfBatchMeans() const;
     void bindEnvironment();

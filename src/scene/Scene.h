@@ -1,8 +1,9 @@
 #pragma once
 // The validated, in-memory scene. Everything here is in double precision and in
 // world space; conversion to the GPU's float32, camera-relative form happens in
-// render/SceneUpload. A Scene is only ever produced by parseScene*, which has
+// render/GpuScene. A Scene is only ever produced by parseScene*, which has
 // already checked every value, so consumers need not re-validate.
+#include "shared/Kinds.h"
 #include "util/Error.h"
 
 #include <glm/glm.hpp>
@@ -11,6 +12,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vkrt {
@@ -42,7 +44,78 @@ struct Camera {
     uint32_t height = 480;
 };
 
-enum class MaterialType { Lambert, Phong, Mirror, Glossy, Dielectric };
+// ------------------------------------------------ kinds (shared/Kinds.h)
+
+#define VKRT_KIND_ENUMERATOR(KIND, Type, name, value, ...) Type = value,
+#define VKRT_KIND_NAME(KIND, Type, name, value, ...) #name,
+
+/// A material kind; the values are the GPU's MATERIAL_* constants.
+enum class MaterialType : uint32_t { VKRT_MATERIAL_KINDS(VKRT_KIND_ENUMERATOR) };
+/// A shape kind; the values are the GPU's SHAPE_* constants.
+enum class ShapeKind : uint32_t { VKRT_SHAPE_KINDS(VKRT_KIND_ENUMERATOR) };
+/// A light kind; the values are the GPU's LIGHT_* constants.
+enum class LightKind : uint32_t { VKRT_LIGHT_KINDS(VKRT_KIND_ENUMERATOR) };
+
+inline constexpr size_t kMaterialKindCount = gpu::MATERIAL_KIND_COUNT;
+inline constexpr size_t kShapeKindCount = gpu::SHAPE_KIND_COUNT;
+inline constexpr size_t kLightKindCount = gpu::LIGHT_KIND_COUNT;
+
+/// The scene file's names of each kind, indexed by the kind's value.
+inline constexpr std::array<std::string_view, kMaterialKindCount> kMaterialNames{VKRT_MATERIAL_KINDS(VKRT_KIND_NAME)};
+inline constexpr std::array<std::string_view, kShapeKindCount> kShapeNames{VKRT_SHAPE_KINDS(VKRT_KIND_NAME)};
+inline constexpr std::array<std::string_view, kLightKindCount> kLightNames{VKRT_LIGHT_KINDS(VKRT_KIND_NAME)};
+#undef VKRT_KIND_ENUMERATOR
+#undef VKRT_KIND_NAME
+
+/// Every kind of a concept, in value order (for loops over the registry).
+template <class Kind, size_t N> constexpr std::array<Kind, N> allKinds()
+{
+    std::array<Kind, N> kinds{};
+    for (size_t i = 0; i < N; ++i) kinds[i] = Kind(i);
+    return kinds;
+}
+inline constexpr auto kAllMaterialTypes = allKinds<MaterialType, kMaterialKindCount>();
+inline constexpr auto kAllShapeKinds = allKinds<ShapeKind, kShapeKindCount>();
+inline constexpr auto kAllLightKinds = allKinds<LightKind, kLightKindCount>();
+
+constexpr std::string_view kindName(MaterialType type) { return kMaterialNames[size_t(type)]; }
+constexpr std::string_view kindName(ShapeKind kind) { return kShapeNames[size_t(kind)]; }
+constexpr std::string_view kindName(LightKind kind) { return kLightNames[size_t(kind)]; }
+
+namespace kinds_check {
+/// The registry lists each kind with value = its position, so value-indexed tables line up.
+#define VKRT_KIND_IN_ORDER(KIND, Type, name, value, ...) && (value == position++)
+constexpr bool materialsInOrder() { int position = 0; return true VKRT_MATERIAL_KINDS(VKRT_KIND_IN_ORDER); }
+constexpr bool shapesInOrder() { int position = 0; return true VKRT_SHAPE_KINDS(VKRT_KIND_IN_ORDER); }
+constexpr bool lightsInOrder() { int position = 0; return true VKRT_LIGHT_KINDS(VKRT_KIND_IN_ORDER); }
+#undef VKRT_KIND_IN_ORDER
+
+template <size_t N> constexpr bool namesUnique(const std::array<std::string_view, N>& names)
+{
+    for (size_t i = 0; i < N; ++i)
+        for (size_t j = i + 1; j < N; ++j)
+            if (names[i] == names[j]) return false;
+    return true;
+}
+} // namespace kinds_check
+
+static_assert(kinds_check::materialsInOrder() && kinds_check::shapesInOrder() && kinds_check::lightsInOrder(),
+              "shared/Kinds.h: list each kind with value 0, 1, 2, ... in order");
+static_assert(kinds_check::namesUnique(kMaterialNames), "shared/Kinds.h: two materials share a name");
+static_assert(kinds_check::namesUnique(kShapeNames), "shared/Kinds.h: two shapes share a name");
+static_assert(kinds_check::namesUnique(kLightNames), "shared/Kinds.h: two lights share a name");
+#define VKRT_CHECK_MATERIAL_VALUE(KIND, Type, name, value, ...) \
+    static_assert(uint32_t(MaterialType::Type) == gpu::MATERIAL_##KIND);
+#define VKRT_CHECK_SHAPE_VALUE(KIND, Type, name, value, ...) \
+    static_assert(int(ShapeKind::Type) == gpu::SHAPE_##KIND);
+#define VKRT_CHECK_LIGHT_VALUE(KIND, Type, name, value, ...) \
+    static_assert(int(LightKind::Type) == gpu::LIGHT_##KIND);
+VKRT_MATERIAL_KINDS(VKRT_CHECK_MATERIAL_VALUE)
+VKRT_SHAPE_KINDS(VKRT_CHECK_SHAPE_VALUE)
+VKRT_LIGHT_KINDS(VKRT_CHECK_LIGHT_VALUE)
+#undef VKRT_CHECK_MATERIAL_VALUE
+#undef VKRT_CHECK_SHAPE_VALUE
+#undef VKRT_CHECK_LIGHT_VALUE
 
 /// How reflection strength depends on angle. Default lets the integrator pick
 /// (Whitted: Schlick for dielectrics, none otherwise; path: exact for dielectrics).
@@ -117,15 +190,38 @@ struct Scene {
     RenderSettings render;
     Camera camera;
     std::vector<Material> materials;
-    std::vector<Sphere> spheres;
-    std::vector<Box> boxes;
-    std::vector<Triangle> triangles;
-    std::vector<Plane> planes;
-    std::vector<PointLight> pointLights;
-    std::vector<TriangleLight> triangleLights;
+    // One array per shape and light kind: spheres, boxes, ..., pointLights, triangleLights.
+#define VKRT_SCENE_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) std::vector<Type> array;
+    VKRT_SHAPE_KINDS(VKRT_SCENE_ARRAY_MEMBER)
+    VKRT_LIGHT_KINDS(VKRT_SCENE_ARRAY_MEMBER)
+#undef VKRT_SCENE_ARRAY_MEMBER
     Background background;
 
-    size_t primitiveCount() const { return spheres.size() + boxes.size() + triangles.size() + planes.size(); }
+    size_t primitiveCount() const;
+    /// Records of one kind (triangle lights: before zero-area ones are dropped).
+    size_t count(ShapeKind kind) const;
+    size_t count(LightKind kind) const;
 };
+
+#define VKRT_SCENE_COUNT_CASE(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    case decltype(kind)::Type: return array.size();
+inline size_t Scene::count(ShapeKind kind) const
+{
+    switch (kind) { VKRT_SHAPE_KINDS(VKRT_SCENE_COUNT_CASE) }
+    return 0;
+}
+inline size_t Scene::count(LightKind kind) const
+{
+    switch (kind) { VKRT_LIGHT_KINDS(VKRT_SCENE_COUNT_CASE) }
+    return 0;
+}
+#undef VKRT_SCENE_COUNT_CASE
+
+inline size_t Scene::primitiveCount() const
+{
+    size_t total = 0;
+    for (ShapeKind kind : kAllShapeKinds) total += count(kind);
+    return total;
+}
 
 } // namespace vkrt

@@ -3,25 +3,19 @@
 // Every check reports the exact position of the offending value (or of the
 // enclosing table when something is missing) together with the value's full
 // dotted path, because scene files are written by hand and an error that only
-// says "bad radius" is useless in a file with a hundred spheres.
+// says "bad radius" is useless in a file with a hundred spheres. The located
+// reading itself is scene/TomlReader.h; this file knows what a scene holds.
 #include "scene/SceneParser.h"
 
+#include "scene/TomlReader.h"
 #include "util/Hash.h"
-
-#include <toml++/toml.h>
 
 #include <algorithm>
 #include <array>
-#include <cctype>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <map>
-#include <memory>
 #include <optional>
 #include <span>
 #include <utility>
@@ -31,261 +25,9 @@ namespace vkrt {
 namespace {
 
 namespace fs = std::filesystem;
-using Keys = std::span<const std::string_view>;
-
-// ----------------------------------------------------------------- wording
-
-/// Shortest text that reads back as the same double, so messages echo what the user wrote.
-std::string formatNumber(double value)
-{
-    char text[64];
-    const auto result = std::to_chars(text, text + sizeof text, value);
-    return std::string(text, result.ptr);
-}
-
-std::string quote(std::string_view text) { return "'" + std::string(text) + "'"; }
-
-std::string joinList(Keys words)
-{
-    std::string out;
-    for (std::string_view word : words) {
-        if (!out.empty()) out += ", ";
-        out += word;
-    }
-    return out;
-}
-
-bool isBareKey(std::string_view key)
-{
-    const auto bare = [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; };
-    return !key.empty() && std::all_of(key.begin(), key.end(), bare);
-}
-
-/// Keys that TOML needs quoted (material names may contain anything) are
-/// quoted here too, so the printed path stays unambiguous.
-std::string childPath(std::string_view parent, std::string_view key)
-{
-    const std::string name = isBareKey(key) ? std::string(key) : "\"" + std::string(key) + "\"";
-    return parent.empty() ? name : std::string(parent) + "." + name;
-}
-
-std::string elementPath(std::string_view parent, size_t index)
-{
-    return std::string(parent) + "[" + std::to_string(index) + "]";
-}
-
-std::string describeType(const toml::node& node)
-{
-    switch (node.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    case toml::node_type::none: break;
-    }
-    return "nothing";
-}
-
-// ------------------------------------------------------------- suggestions
-
-std::string lowercase(std::string_view text)
-{
-    std::string out(text);
-    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return out;
-}
-
-/// Optimal-string-alignment distance: Levenshtein plus adjacent transposition,
-/// because swapped letters ("lambret") are the most common typo in names.
-size_t editDistance(std::string_view a, std::string_view b)
-{
-    std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
-    for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-    for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-        for (size_t j = 1; j <= b.size(); ++j) {
-            const size_t substitution = d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
-            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, substitution});
-            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
-                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-        }
-    }
-    return d[a.size()][b.size()];
-}
-
-/// The closest candidate within edit distance 2 (or equal ignoring case). A
-/// candidate reachable only by rewriting every character ('x' -> 'up') is not
-/// offered: for short keys that would be noise, not a hint.
-std::optional<std::string_view> closestMatch(std::string_view word, Keys candidates)
-{
-    constexpr size_t maxDistance = 2;
-    std::optional<std::string_view> best;
-    size_t bestDistance = maxDistance + 1;
-    for (std::string_view candidate : candidates) {
-        const size_t distance = lowercase(candidate) == lowercase(word) ? 0 : editDistance(word, candidate);
-        if (distance >= std::max(word.size(), candidate.size())) continue;
-        if (distance < bestDistance) {
-            best = candidate;
-            bestDistance = distance;
-        }
-    }
-    return best;
-}
-
-std::string didYouMean(std::string_view word, Keys candidates)
-{
-    const auto match = closestMatch(word, candidates);
-    return match ? "; did you mean " + quote(*match) + "?" : "";
-}
-
-// --------------------------------------------------------- located values
-
-struct Context {
-    std::string file; ///< as given by the caller, for messages
-    fs::path baseDir; ///< relative asset paths are resolved against it
-};
-
-SourceLocation locate(const Context& context, const toml::source_position& position)
-{
-    return {context.file, static_cast<int>(position.line), static_cast<int>(position.column)};
-}
-
-bool isBefore(const toml::source_position& a, const toml::source_position& b)
-{
-    return std::pair(a.line, a.column) < std::pair(b.line, b.column);
-}
-
-[[noreturn]] void failAt(const SourceLocation& where, std::string_view path, const std::string& message)
-{
-    throw SceneError(where, path.empty() ? message : std::string(path) + ": " + message);
-}
-
-/// A TOML value together with what is needed to complain about it.
-class Field {
-public:
-    Field(const Context& context, const toml::node& node, std::string path)
-        : m_context(&context), m_node(&node), m_path(std::move(path))
-    {
-    }
-    const Context& context() const { return *m_context; }
-    const toml::node& node() const { return *m_node; }
-    const std::string& path() const { return m_path; }
-    SourceLocation location() const { return locate(*m_context, m_node->source().begin); }
-    [[noreturn]] void fail(const std::string& message) const { failAt(location(), m_path, message); }
-    Field element(size_t index, const toml::node& node) const { return {*m_context, node, elementPath(m_path, index)}; }
-
-private:
-    const Context* m_context;
-    const toml::node* m_node;
-    std::string m_path;
-};
-
-const toml::table& asTable(const Field& field)
-{
-    if (!field.node().is_table()) field.fail("expected a table, got " + describeType(field.node()));
-    return *field.node().as_table();
-}
-
-bool contains(Keys keys, std::string_view key) { return std::find(keys.begin(), keys.end(), key) != keys.end(); }
-
-/// The unknown key that comes first in the file, so errors are reported in reading order.
-const toml::key* firstUnknownKey(const toml::table& table, Keys allowed)
-{
-    const toml::key* first = nullptr;
-    for (auto&& [key, value] : table) {
-        if (contains(allowed, key.str())) continue;
-        if (!first || isBefore(key.source().begin, first->source().begin)) first = &key;
-    }
-    return first;
-}
-
-/// A Field known to be a table, with key-level checks.
-class TableField {
-public:
-    explicit TableField(const Field& field) : m_field(field), m_table(&asTable(field)) {}
-
-    const Field& field() const { return m_field; }
-
-    std::optional<Field> find(std::string_view key) const
-    {
-        const toml::node* node = m_table->get(key);
-        if (!node) return std::nullopt;
-        return Field(m_field.context(), *node, childPath(m_field.path(), key));
-    }
-
-    Field require(std::string_view key) const
-    {
-        if (auto field = find(key)) return *field;
-        if (m_field.path().empty()) m_field.fail("missing required table [" + std::string(key) + "]");
-        m_field.fail("missing required key " + quote(key));
-    }
-
-    /// Rejects keys outside `allowed`. Keys in `otherKindsKeys` are valid for a
-    /// different `type`/`shape`, which deserves a more precise message than "unknown".
-    void rejectUnknownKeys(Keys allowed, Keys otherKindsKeys = {}, std::string_view kind = {}) const
-    {
-        const toml::key* key = firstUnknownKey(*m_table, allowed);
-        if (!key) return;
-        const std::string message = contains(otherKindsKeys, key->str())
-                                        ? "key " + quote(key->str()) + " is not used by " + std::string(kind)
-                                        : unknownKeyMessage(*key, allowed);
-        failAt(locate(m_field.context(), key->source().begin), m_field.path(), message);
-    }
-
-    /// Entries in the order they appear in the file (toml::table sorts by name).
-    std::vector<std::pair<std::string_view, Field>> entriesInFileOrder() const
-    {
-        std::vector<std::pair<std::string_view, Field>> entries;
-        for (auto&& [key, value] : *m_table) entries.emplace_back(key.str(), *find(key.str()));
-        std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-            return isBefore(a.second.node().source().begin, b.second.node().source().begin);
-        });
-        return entries;
-    }
-
-private:
-    std::string unknownKeyMessage(const toml::key& key, Keys allowed) const
-    {
-        std::string noun = "key";
-        if (m_field.path().empty()) noun = (*m_table)[key.str()].is_table() ? "top-level table" : "top-level key";
-        return "unknown " + noun + " " + quote(key.str()) + didYouMean(key.str(), allowed);
-    }
-
-    Field m_field;
-    const toml::table* m_table;
-};
+using Keys = KeyList;
 
 // ------------------------------------------------------------ scalar values
-
-double readNumber(const Field& field)
-{
-    const toml::node& node = field.node();
-    if (!node.is_number()) field.fail("expected a number, got " + describeType(node));
-    const double value =
-        node.is_integer() ? static_cast<double>(node.as_integer()->get()) : node.as_floating_point()->get();
-    // TOML allows nan and inf literals; nothing in a scene can use them.
-    if (!std::isfinite(value)) field.fail("must be finite, got " + formatNumber(value));
-    return value;
-}
-
-double readPositive(const Field& field)
-{
-    const double value = readNumber(field);
-    if (!(value > 0)) field.fail("must be > 0, got " + formatNumber(value));
-    return value;
-}
-
-double readNonNegative(const Field& field)
-{
-    const double value = readNumber(field);
-    if (value < 0) field.fail("must be >= 0, got " + formatNumber(value));
-    return value;
-}
 
 double readIor(const Field& field)
 {
@@ -303,75 +45,7 @@ double readFov(const Field& field)
     return value;
 }
 
-int64_t readInteger(const Field& field, int64_t min, int64_t max)
-{
-    if (!field.node().is_integer()) field.fail("expected an integer, got " + describeType(field.node()));
-    const int64_t value = field.node().as_integer()->get();
-    if (value < min || value > max)
-        field.fail("must be between " + std::to_string(min) + " and " + std::to_string(max) + ", got " +
-                   std::to_string(value));
-    return value;
-}
-
-std::string readString(const Field& field)
-{
-    if (!field.node().is_string()) field.fail("expected a string, got " + describeType(field.node()));
-    return field.node().as_string()->get();
-}
-
-bool readBool(const Field& field)
-{
-    if (!field.node().is_boolean()) field.fail("expected a boolean (true or false), got " + describeType(field.node()));
-    return field.node().as_boolean()->get();
-}
-
-/// Looks a string up among `choices` (anything with a `name`), suggesting the closest one on failure.
-template <class Choice, size_t N>
-const Choice& readChoice(const Field& field, std::string_view noun, const std::array<Choice, N>& choices)
-{
-    const std::string text = readString(field);
-    std::array<std::string_view, N> names;
-    for (size_t i = 0; i < N; ++i) {
-        if (choices[i].name == text) return choices[i];
-        names[i] = choices[i].name;
-    }
-    field.fail("unknown " + std::string(noun) + " " + quote(text) + didYouMean(text, names) +
-               " (expected one of: " + joinList(names) + ")");
-}
-
-template <class E>
-struct EnumName {
-    std::string_view name;
-    E value;
-};
-
-template <class T, class Read>
-T readOr(const TableField& table, std::string_view key, T fallback, Read read)
-{
-    const std::optional<Field> field = table.find(key);
-    return field ? static_cast<T>(read(*field)) : fallback;
-}
-
 // ---------------------------------------------------------- vectors, colours
-
-/// Reads an array of exactly three elements with `read`.
-template <class Read>
-auto readTriple(const Field& field, std::string_view what, Read read)
-{
-    const toml::array* array = field.node().as_array();
-    const std::string expected = "expected an array of 3 " + std::string(what) + ", got ";
-    if (!array) field.fail(expected + describeType(field.node()));
-    if (array->size() != 3) field.fail(expected + std::to_string(array->size()) + " element(s)");
-    std::array<decltype(read(field)), 3> out;
-    for (size_t i = 0; i < 3; ++i) out[i] = read(field.element(i, *array->get(i)));
-    return out;
-}
-
-glm::dvec3 readVector(const Field& field)
-{
-    const auto c = readTriple(field, "numbers", readNumber);
-    return {c[0], c[1], c[2]};
-}
 
 std::array<glm::dvec3, 3> readVertices(const Field& field) { return readTriple(field, "points", readVector); }
 
@@ -498,8 +172,6 @@ constexpr std::array<std::string_view, 4> phongKeys{"type", "diffuse", "specular
 constexpr std::array<std::string_view, 4> mirrorKeys{"type", "reflectance", "fresnel", "ior"};
 constexpr std::array<std::string_view, 5> glossyKeys{"type", "reflectance", "exponent", "fresnel", "ior"};
 constexpr std::array<std::string_view, 4> dielectricKeys{"type", "ior", "absorption", "fresnel"};
-constexpr std::array<std::string_view, 9> allMaterialKeys{"albedo",   "diffuse", "specular", "shininess", "reflectance",
-                                                          "exponent", "fresnel", "ior",      "absorption"};
 
 constexpr std::array<EnumName<FresnelMode>, 2> reflectorFresnelModes{
     {{"none", FresnelMode::None}, {"schlick", FresnelMode::Schlick}}};
@@ -562,13 +234,24 @@ struct MaterialKind {
     void (*read)(const TableField&, Material&);
 };
 
-const std::array<MaterialKind, 5> materialKinds{{
-    {"lambert", MaterialType::Lambert, lambertKeys, readLambert},
-    {"phong", MaterialType::Phong, phongKeys, readPhong},
-    {"mirror", MaterialType::Mirror, mirrorKeys, readMirror},
-    {"glossy", MaterialType::Glossy, glossyKeys, readGlossy},
-    {"dielectric", MaterialType::Dielectric, dielectricKeys, readDielectric},
-}};
+// The registry (shared/Kinds.h) names each kind's key list `nameKeys` and its reader `readType`.
+#define VKRT_MATERIAL_KIND_ENTRY(KIND, Type, name, value, delta) MaterialKind{#name, MaterialType::Type, name##Keys, read##Type},
+const std::array<MaterialKind, kMaterialKindCount> materialKinds{{VKRT_MATERIAL_KINDS(VKRT_MATERIAL_KIND_ENTRY)}};
+#undef VKRT_MATERIAL_KIND_ENTRY
+
+/// Every key some kind of the table accepts: a key of another kind gets a
+/// more precise message than "unknown".
+template <class Kind, size_t N>
+std::vector<std::string_view> keysOfEveryKind(const std::array<Kind, N>& kinds)
+{
+    std::vector<std::string_view> keys;
+    for (const Kind& kind : kinds)
+        for (std::string_view key : kind.keys)
+            if (!contains(keys, key)) keys.push_back(key);
+    return keys;
+}
+
+const std::vector<std::string_view> allMaterialKeys = keysOfEveryKind(materialKinds);
 
 Material readMaterial(std::string_view name, const TableField& table)
 {
@@ -631,7 +314,6 @@ constexpr std::array<std::string_view, 4> sphereKeys{"shape", "material", "cente
 constexpr std::array<std::string_view, 4> boxKeys{"shape", "material", "min", "max"};
 constexpr std::array<std::string_view, 3> triangleKeys{"shape", "material", "vertices"};
 constexpr std::array<std::string_view, 4> planeKeys{"shape", "material", "point", "normal"};
-constexpr std::array<std::string_view, 7> allShapeKeys{"center", "radius", "min", "max", "vertices", "point", "normal"};
 
 void readSphere(const TableField& table, uint32_t material, Scene& scene)
 {
@@ -673,40 +355,29 @@ void readPlane(const TableField& table, uint32_t material, Scene& scene)
     scene.planes.push_back({point, *normal, material});
 }
 
-struct ShapeKind {
+struct ShapeReader {
     std::string_view name;
     Keys keys;
     void (*read)(const TableField&, uint32_t, Scene&);
 };
 
-const std::array<ShapeKind, 4> shapeKinds{{
-    {"sphere", sphereKeys, readSphere},
-    {"box", boxKeys, readBox},
-    {"triangle", triangleKeys, readTriangle},
-    {"plane", planeKeys, readPlane},
-}};
+#define VKRT_SHAPE_KIND_ENTRY(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    ShapeReader{#name, field##Keys, read##Type},
+const std::array<ShapeReader, kShapeKindCount> shapeKinds{{VKRT_SHAPE_KINDS(VKRT_SHAPE_KIND_ENTRY)}};
+#undef VKRT_SHAPE_KIND_ENTRY
+const std::vector<std::string_view> allShapeKeys = keysOfEveryKind(shapeKinds);
 
 void readObject(const TableField& table, const MaterialIndex& materials, Scene& scene)
 {
-    const ShapeKind kind = readChoice(table.require("shape"), "shape", shapeKinds);
+    const ShapeReader kind = readChoice(table.require("shape"), "shape", shapeKinds);
     table.rejectUnknownKeys(kind.keys, allShapeKeys, "shape " + quote(kind.name));
     kind.read(table, materials.resolve(table.require("material")), scene);
-}
-
-/// Calls `read` for every table of a [[name]] array.
-template <class Read>
-void forEachTable(const Field& field, Read read)
-{
-    const toml::array* array = field.node().as_array();
-    if (!array) field.fail("expected an array of tables ([[" + field.path() + "]]), got " + describeType(field.node()));
-    for (size_t i = 0; i < array->size(); ++i) read(TableField(field.element(i, *array->get(i))));
 }
 
 // -------------------------------------------------------------------- lights
 
 constexpr std::array<std::string_view, 3> pointLightKeys{"type", "position", "intensity"};
 constexpr std::array<std::string_view, 4> triangleLightKeys{"type", "vertices", "radiance", "two_sided"};
-constexpr std::array<std::string_view, 5> allLightKeys{"position", "intensity", "vertices", "radiance", "two_sided"};
 
 void readPointLight(const TableField& table, Scene& scene)
 {
@@ -722,20 +393,21 @@ void readTriangleLight(const TableField& table, Scene& scene)
     scene.triangleLights.push_back(light);
 }
 
-struct LightKind {
+struct LightReader {
     std::string_view name;
     Keys keys;
     void (*read)(const TableField&, Scene&);
 };
 
-const std::array<LightKind, 2> lightKinds{{
-    {"point", pointLightKeys, readPointLight},
-    {"triangle", triangleLightKeys, readTriangleLight},
-}};
+#define VKRT_LIGHT_KIND_ENTRY(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    LightReader{#name, field##Keys, read##Type},
+const std::array<LightReader, kLightKindCount> lightKinds{{VKRT_LIGHT_KINDS(VKRT_LIGHT_KIND_ENTRY)}};
+#undef VKRT_LIGHT_KIND_ENTRY
+const std::vector<std::string_view> allLightKeys = keysOfEveryKind(lightKinds);
 
 void readLight(const TableField& table, Scene& scene)
 {
-    const LightKind kind = readChoice(table.require("type"), "light type", lightKinds);
+    const LightReader kind = readChoice(table.require("type"), "light type", lightKinds);
     table.rejectUnknownKeys(kind.keys, allLightKeys, "light type " + quote(kind.name));
     kind.read(table, scene);
 }
@@ -763,8 +435,7 @@ void checkRegularFile(const Field& field, const fs::path& path)
 
 std::string readFacePath(const Field& field)
 {
-    const fs::path given = readString(field);
-    const fs::path path = given.is_absolute() ? given : field.context().baseDir / given;
+    const fs::path path = readPath(field);
     checkImageExtension(field, path);
     checkRegularFile(field, path);
     return path.string();
@@ -813,50 +484,18 @@ Scene readScene(const TableField& top)
     return scene;
 }
 
-toml::table parseToml(std::string_view text, const Context& context)
-{
-    try {
-        return toml::parse(text, std::string_view(context.file));
-    } catch (const toml::parse_error& error) {
-        throw SceneError(locate(context, error.source().begin), "invalid TOML: " + std::string(error.description()));
-    }
-}
-
-struct FileCloser {
-    void operator()(std::FILE* file) const { std::fclose(file); }
-};
-
-[[noreturn]] void failToRead(const std::string& path, int error)
-{
-    throw InputError("cannot read scene file '" + path + "': " + std::strerror(error));
-}
-
-/// Uses stdio rather than iostreams because only stdio reliably reports why (errno) a read failed.
-std::string readFileBytes(const std::string& path)
-{
-    errno = 0;
-    const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-    if (!file) failToRead(path, errno);
-    std::string bytes;
-    char buffer[1 << 16];
-    size_t count = 0;
-    while ((count = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) bytes.append(buffer, count);
-    if (std::ferror(file.get())) failToRead(path, errno);
-    return bytes;
-}
-
 } // namespace
 
 Scene parseSceneString(std::string_view text, const std::string& path)
 {
-    const Context context{path, fs::path(path).parent_path()};
-    const toml::table root = parseToml(text, context);
-    Scene scene = readScene(TableField(Field(context, root, "")));
+    const TomlSource source{path, fs::path(path).parent_path()};
+    const toml::table root = parseToml(text, source);
+    Scene scene = readScene(TableField(Field(source, root, "")));
     scene.path = path;
     scene.fileHash = fnv1a64(text);
     return scene;
 }
 
-Scene parseSceneFile(const std::string& path) { return parseSceneString(readFileBytes(path), path); }
+Scene parseSceneFile(const std::string& path) { return parseSceneString(readFileBytes(path, "scene file"), path); }
 
 } // namespace vkrt

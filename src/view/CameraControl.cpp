@@ -44,7 +44,9 @@ Camera fly(const Camera& camera, double right, double up, double forward)
 Camera zoom(const Camera& camera, double factor)
 {
     Camera zoomed = camera;
-    zoomed.fovY = std::clamp(camera.fovY * factor, 1.0, 170.0);
+    // A factor that is not > 0 has no field of view to clamp to: keep the
+    // product (0, negative or NaN), which checkCamera/cameraProblem refuse.
+    zoomed.fovY = factor > 0 ? std::clamp(camera.fovY * factor, 1.0, 170.0) : camera.fovY * factor;
     return zoomed;
 }
 

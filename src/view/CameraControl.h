@@ -14,7 +14,9 @@ Camera orbit(const Camera& camera, double yawDegrees, double pitchDegrees);
 /// units of the eye-target distance.
 Camera fly(const Camera& camera, double right, double up, double forward);
 
-/// Multiplies the vertical field of view by `factor`, kept inside [1, 170] degrees.
+/// Multiplies the vertical field of view by `factor` > 0, kept inside [1, 170]
+/// degrees. Any other factor collapses the view: the result is an invalid
+/// camera (fov <= 0 or NaN) that the viewer refuses (SceneOverrides.h).
 Camera zoom(const Camera& camera, double factor);
 
 } // namespace vkrt

@@ -1,14 +1,11 @@
 #include "view/Viewer.h"
 
-#include "app/Commands.h"
 #include "io/ExrFile.h"
 #include "io/PngFile.h"
 #include "render/ErrorMetrics.h"
 #include "render/Progress.h"
-#include "render/Renderer.h"
-#include "scene/SceneParser.h"
+#include "render/RenderSession.h"
 #include "util/Error.h"
-#include "util/Hash.h"
 #include "view/CameraControl.h"
 #include "view/DisplayPass.h"
 #include "view/Swapchain.h"
@@ -105,16 +102,16 @@ class Viewer {
 public:
     explicit Viewer(const ViewOptions& options);
     /// Runs `script` if it has commands, else the interactive loop.
-    int run(const std::vector<ViewerCommand>& script);
+    void run(const std::vector<ViewerCommand>& script);
     std::vector<std::string> validationMessages() const { return m_context.validationMessages(); }
 
 private:
     ViewOptions m_options;
-    Scene m_scene;
+    Scene m_parsed; ///< as loaded (overrides applied) to size the window; then moved into the session
     GlfwSession m_glfw;
     Window m_window;
     VulkanContext m_context;
-    std::unique_ptr<Renderer> m_renderer;
+    std::unique_ptr<RenderSession> m_session;
     std::unique_ptr<DisplayPass> m_display;
     std::unique_ptr<Swapchain> m_swapchain;
     vk::raii::Semaphore m_imageAvailable = nullptr;
@@ -125,7 +122,7 @@ private:
     bool m_filmic = false;
     bool m_paused = false;
     bool m_swapchainStale = false;
-    uint32_t m_framesPerRefresh = 1;
+    BatchPacer m_pacer{kFrameSeconds}; ///< one display refresh holds about kFrameSeconds of rendering
     std::deque<std::string> m_keys; ///< pressed keys not yet handled
     bool m_dragging = false;
     double m_lastX = 0, m_lastY = 0;
@@ -136,7 +133,9 @@ private:
     Clock::time_point m_lastTitle{};
     int m_saveCount = 0;
 
-    void createRenderer();
+    const Scene& scene() const { return m_session->scene(); }
+    const Renderer& renderer() const { return m_session->renderer(); }
+    void createDisplay();
     void recreateSwapchain();
     void installCallbacks();
     void renderAndPresent(uint32_t frames);
@@ -144,31 +143,33 @@ private:
     bool handleKey(const std::string& key);
     bool flying() const { return glfwGetMouseButton(m_window.get(), GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS; }
     void applyCameraInput(double dt);
-    void setCamera(const Camera& camera);
+    void setCamera(const Camera& camera, const char* move);
     void updateTitle(bool force = false);
     void save(const std::string& exrPath);
     void screenshot(const std::string& pngPath);
-    int runScript(const std::vector<ViewerCommand>& commands);
-    int runInteractive();
+    void runScript(const std::vector<ViewerCommand>& commands);
+    void runInteractive();
 };
 
-Scene sceneForViewer(const ViewOptions& options)
+SessionConfig sessionConfig(const ViewOptions& options)
 {
-    Scene scene = parseSceneFile(options.scenePath);
-    if (options.width) scene.camera.width = *options.width;
-    if (options.height) scene.camera.height = *options.height;
-    return scene;
+    SessionConfig config;
+    config.seed = options.seed;
+    config.variance.layer = options.variance;
+    config.warmUp = false; // the first frames show at once
+    return config;
 }
 
 Viewer::Viewer(const ViewOptions& options)
     : m_options(options),
-      m_scene(sceneForViewer(options)),
-      m_window(m_scene.camera.width, m_scene.camera.height, "vkrt view - " + options.scenePath),
+      m_parsed(loadScene(options.scenePath, {options.width, options.height})),
+      m_window(m_parsed.camera.width, m_parsed.camera.height, "vkrt view - " + options.scenePath),
       m_context(ContextOptions{options.device, options.validation, presentationFor(m_window.get())}),
       m_exposure(options.exposure),
       m_filmic(options.filmic)
 {
-    createRenderer();
+    m_session = std::make_unique<RenderSession>(m_context, std::move(m_parsed), sessionConfig(options));
+    createDisplay();
     recreateSwapchain();
     m_imageAvailable = vk::raii::Semaphore(m_context.device(), vk::SemaphoreCreateInfo());
     m_renderFinished = vk::raii::Semaphore(m_context.device(), vk::SemaphoreCreateInfo());
@@ -176,16 +177,10 @@ Viewer::Viewer(const ViewOptions& options)
     installCallbacks();
 }
 
-void Viewer::createRenderer()
+void Viewer::createDisplay()
 {
-    m_display.reset(); // it reads the old renderer's accumulation buffer
-    RenderOptions options;
-    options.seed = m_options.seed;
-    options.variance = m_options.variance;
-    options.sobol = !m_options.variance; // as `vkrt render --sampler auto`
-    m_renderer = std::make_unique<Renderer>(m_context, m_scene, options);
-    m_display = std::make_unique<DisplayPass>(m_context, m_renderer->accumulation(), m_renderer->width(),
-                                              m_renderer->height());
+    m_display = std::make_unique<DisplayPass>(m_context, renderer().accumulation(), renderer().width(),
+                                              renderer().height());
 }
 
 void Viewer::recreateSwapchain()
@@ -231,11 +226,13 @@ void Viewer::installCallbacks()
     });
 }
 
-void Viewer::setCamera(const Camera& camera)
+/// A move the scene parser would refuse (a camera at its target, a field of
+/// view of 0) is ignored with a message: the view stays as it was.
+void Viewer::setCamera(const Camera& camera, const char* move)
 {
     m_context.device().waitIdle();
-    m_renderer->moveCamera(camera);
-    m_scene.camera = camera;
+    if (auto problem = m_session->moveCamera(camera))
+        std::fprintf(stderr, "vkrt view: %s ignored: the camera would be invalid (%s)\n", move, problem->c_str());
 }
 
 void Viewer::applyCameraInput(double dt)
@@ -247,31 +244,32 @@ void Viewer::applyCameraInput(double dt)
     double right = (held(GLFW_KEY_D) - held(GLFW_KEY_A)) * speed;
     double up = (held(GLFW_KEY_E) - held(GLFW_KEY_Q)) * speed;
     double forward = (held(GLFW_KEY_W) - held(GLFW_KEY_S)) * speed;
-    Camera camera = m_scene.camera;
+    Camera camera = scene().camera;
     bool changed = false;
     if (right != 0 || up != 0 || forward != 0) camera = fly(camera, right, up, forward), changed = true;
     if (m_pendingYaw != 0 || m_pendingPitch != 0) camera = orbit(camera, m_pendingYaw, m_pendingPitch), changed = true;
     if (m_pendingZoom != 1) camera = zoom(camera, m_pendingZoom), changed = true;
     m_pendingYaw = m_pendingPitch = 0, m_pendingZoom = 1;
-    if (changed) setCamera(camera);
+    if (changed) setCamera(camera, "camera move");
 }
 
 bool Viewer::handleKey(const std::string& key)
 {
     if (key == "H") std::fputs(viewerHelp(), stdout), std::fflush(stdout);
-    else if (key == "R") m_context.device().waitIdle(), m_renderer->reset();
+    else if (key == "R") m_context.device().waitIdle(), m_session->reset();
     else if (key == "P") m_paused = !m_paused;
     else if (key == "+" || key == "=") m_exposure += 0.5f;
     else if (key == "-") m_exposure -= 0.5f;
     else if (key == "F") m_filmic = !m_filmic;
     else if (key == "I") {
         m_context.device().waitIdle();
-        bool path = m_scene.render.integrator == Integrator::Path;
-        m_scene.render.integrator = path ? Integrator::Whitted : Integrator::Path;
-        createRenderer();
+        bool path = scene().render.integrator == Integrator::Path;
+        m_display.reset(); // it reads the old renderer's accumulation buffer
+        m_session->setIntegrator(path ? Integrator::Whitted : Integrator::Path);
+        createDisplay();
     } else if (key == "S") {
         ++m_saveCount;
-        std::string stem = std::filesystem::path(m_scene.path).stem().string();
+        std::string stem = std::filesystem::path(scene().path).stem().string();
         save(stem + "-view-" + std::to_string(m_saveCount) + ".exr");
     } else {
         return false;
@@ -283,11 +281,10 @@ bool Viewer::handleKey(const std::string& key)
 void Viewer::renderAndPresent(uint32_t frames)
 {
     auto start = Clock::now();
-    if (frames) m_renderer->renderFrames(frames);
+    if (frames) m_session->renderFrames(frames);
     double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    m_rateSamples += uint64_t(frames) * m_renderer->width() * m_renderer->height();
-    if (frames && seconds > 0) // one display refresh holds about kFrameSeconds of rendering
-        m_framesPerRefresh = std::clamp(uint32_t(frames * kFrameSeconds / seconds), 1u, 64u);
+    m_rateSamples += uint64_t(frames) * renderer().width() * renderer().height();
+    if (frames) m_pacer.record(frames, seconds);
     present();
     updateTitle();
 }
@@ -308,7 +305,7 @@ void Viewer::present()
     }
     m_context.device().resetFences(*m_presented);
     vk::raii::CommandBuffer cmd = m_context.beginOneShot();
-    gpu::DisplayConstants constants{std::exp2(m_exposure), m_renderer->width(), m_renderer->height(),
+    gpu::DisplayConstants constants{std::exp2(m_exposure), renderer().width(), renderer().height(),
                                     m_filmic ? gpu::TONE_MAP_FILMIC : gpu::TONE_MAP_CLAMP};
     m_display->recordToneMap(*cmd, constants);
     m_display->recordBlit(*cmd, m_swapchain->image(index), m_swapchain->extent());
@@ -339,16 +336,15 @@ void Viewer::updateTitle(bool force)
     if (!force && std::chrono::duration<double>(now - m_lastTitle).count() < 0.25) return;
     m_lastTitle = now;
     std::string error;
-    if (m_options.variance && m_renderer->completedFrames() >= 2) {
+    if (m_options.variance && renderer().completedFrames() >= 2) {
         char text[64];
-        std::snprintf(text, sizeof text, "  rel.MSE %.3g",
-                      estimateError(m_renderer->mean(), m_renderer->varianceOfMean()).relMse);
+        std::snprintf(text, sizeof text, "  rel.MSE %.3g", m_session->film().estimated->relMse);
         error = text;
     }
     char title[512];
     std::snprintf(title, sizeof title, "vkrt view - %s - %s - %u spp - %ssamples/s%s - %s%s",
-                  std::filesystem::path(m_scene.path).filename().c_str(),
-                  integratorName(m_scene.render.integrator).c_str(), m_renderer->completedFrames(),
+                  std::filesystem::path(scene().path).filename().c_str(),
+                  integratorName(scene().render.integrator).c_str(), renderer().completedFrames(),
                   humanCount(m_samplesPerSecond).c_str(), error.c_str(), m_context.deviceInfo().name.c_str(),
                   m_paused ? " [paused]" : "");
     glfwSetWindowTitle(m_window.get(), title);
@@ -357,54 +353,43 @@ void Viewer::updateTitle(bool force)
 void Viewer::save(const std::string& exrPath)
 {
     m_context.device().waitIdle();
-    Metadata metadata{{"vkrtVersion", std::string(VKRT_VERSION)},
-                      {"spp", int64_t(m_renderer->completedFrames())},
-                      {"seed", int64_t(m_options.seed)},
-                      {"device", m_context.deviceInfo().name},
-                      {"driver", m_context.deviceInfo().driver},
-                      {"scene", m_scene.path},
-                      {"sceneHash", "fnv1a64:" + toHex(m_scene.fileHash)},
-                      {"integrator", integratorName(m_scene.render.integrator)},
-                      {"kernelVariant", m_renderer->features().describe()},
-                      {"rejectedSamples", int64_t(m_renderer->counters().rejectedSamples)},
-                      {"savedBy", std::string("vkrt view")}};
+    Film film = m_session->film();
     std::map<std::string, Image> layers;
-    if (m_options.variance) layers["variance"] = m_renderer->varianceOfMean();
-    writeExr(exrPath, m_renderer->mean(), metadata, layers);
+    if (film.variance) layers["variance"] = *film.variance;
+    writeExr(exrPath, film.mean, m_session->metadata(film, "vkrt view"), layers);
     std::filesystem::path png = std::filesystem::path(exrPath).replace_extension(".png");
     screenshot(png.string());
-    std::printf("saved %s (%u spp) and %s\n", exrPath.c_str(), m_renderer->completedFrames(), png.c_str());
+    std::printf("saved %s (%u spp) and %s\n", exrPath.c_str(), renderer().completedFrames(), png.c_str());
     std::fflush(stdout);
 }
 
 void Viewer::screenshot(const std::string& pngPath)
 {
     m_context.device().waitIdle();
-    writePngPixels(pngPath, m_renderer->width(), m_renderer->height(), m_display->readPixels());
+    writePngPixels(pngPath, renderer().width(), renderer().height(), m_display->readPixels());
 }
 
-int Viewer::runScript(const std::vector<ViewerCommand>& commands)
+void Viewer::runScript(const std::vector<ViewerCommand>& commands)
 {
     for (const ViewerCommand& c : commands) {
         if (c.name == "frames") {
             for (uint32_t left = uint32_t(c.numbers[0]); left > 0;) {
-                uint32_t n = std::min(left, m_framesPerRefresh);
+                uint32_t n = std::min(left, m_pacer.nextFrames());
                 renderAndPresent(n);
                 left -= n;
                 glfwPollEvents();
             }
-        } else if (c.name == "orbit") setCamera(orbit(m_scene.camera, c.numbers[0], c.numbers[1]));
-        else if (c.name == "fly") setCamera(fly(m_scene.camera, c.numbers[0], c.numbers[1], c.numbers[2]));
-        else if (c.name == "zoom") setCamera(zoom(m_scene.camera, c.numbers[0]));
+        } else if (c.name == "orbit") setCamera(orbit(scene().camera, c.numbers[0], c.numbers[1]), "orbit");
+        else if (c.name == "fly") setCamera(fly(scene().camera, c.numbers[0], c.numbers[1], c.numbers[2]), "fly");
+        else if (c.name == "zoom") setCamera(zoom(scene().camera, c.numbers[0]), "zoom");
         else if (c.name == "exposure") m_exposure = float(c.numbers[0]);
         else if (c.name == "key") handleKey(c.text);
         else if (c.name == "save") save(c.text);
         else if (c.name == "screenshot") present(), screenshot(c.text);
     }
-    return kExitOk;
 }
 
-int Viewer::runInteractive()
+void Viewer::runInteractive()
 {
     std::fputs(viewerHelp(), stdout);
     auto last = Clock::now();
@@ -419,15 +404,15 @@ int Viewer::runInteractive()
             m_keys.pop_front();
             if (!flying()) handleKey(key);
         }
-        renderAndPresent(m_paused ? 0 : m_framesPerRefresh);
+        renderAndPresent(m_paused ? 0 : m_pacer.nextFrames());
         if (m_paused) glfwWaitEventsTimeout(0.05);
     }
-    return kExitOk;
 }
 
-int Viewer::run(const std::vector<ViewerCommand>& script)
+void Viewer::run(const std::vector<ViewerCommand>& script)
 {
-    return script.empty() ? runInteractive() : runScript(script);
+    if (script.empty()) runInteractive();
+    else runScript(script);
 }
 
 /// The scripted part of a session: --script, or --frames [--screenshot].
@@ -442,14 +427,12 @@ std::vector<ViewerCommand> scriptFor(const ViewOptions& options)
     return commands;
 }
 
-int runViewer(const ViewOptions& options)
+Outcome runViewer(const ViewOptions& options)
 {
     std::vector<ViewerCommand> script = scriptFor(options); // mistakes surface before any window opens
     Viewer viewer(options);
-    int status = viewer.run(script);
-    auto messages = viewer.validationMessages();
-    for (const auto& m : messages) std::fprintf(stderr, "%s\n", m.c_str());
-    return messages.empty() ? status : int(kExitValidation);
+    viewer.run(script);
+    return withValidation(Outcome::passed(), viewer.validationMessages());
 }
 
 } // namespace vkrt

@@ -1,6 +1,8 @@
 #pragma once
 // `vkrt view`: a GLFW window showing the progressive render as it converges,
 // with camera controls, and scripted sessions for tests.
+#include "render/Outcome.h"
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -22,8 +24,9 @@ struct ViewOptions {
     bool validation = false;
 };
 
-/// Runs the viewer; returns the process exit code.
-int runViewer(const ViewOptions& options);
+/// Runs the viewer; Passed, or ValidationMessages with them. Bad input (scene,
+/// --width/--height, script) throws InputError before any window opens.
+Outcome runViewer(const ViewOptions& options);
 
 /// The key list printed by `H`.
 const char* viewerHelp();

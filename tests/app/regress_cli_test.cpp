@@ -253,6 +253,14 @@ TEST_F(RegressCli, MismatchedResolutionNamesBothSizes)
     expectInputError(r, {"extreme/kappa-shadow", "mean.exr", "is 64x48 but the case renders 32x24"});
 }
 
+// A case's width/height pass the scene parser's checks, naming suite and case.
+TEST_F(RegressCli, CaseResolutionIsValidatedLikeTheSceneFile)
+{
+    fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8, "width = 99999\nheight = 24")});
+    ProcessResult r = regress({"--suite", suite.string()});
+    expectInputError(r, {suite.string() + ": case extreme/kappa-shadow: width: must be between 1 and 16384, got 99999"});
+}
+
 TEST_F(RegressCli, UnusableDriverManifestIsNamed)
 {
     fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8)});
@@ -285,7 +293,7 @@ TEST_F(RegressCli, ManifestErrorsNameFileLineAndColumn)
                                 "reference_source = \"vkrt\"\nreference_spp = 16\nsp = 4\n");
     int line = int(std::count(good.begin(), good.end(), '\n')) + 7;
     expectInputError(regress({"--suite", suite.string()}),
-                     {suite.string() + ":" + std::to_string(line) + ":6", "unknown key 'sp'", "did you mean 'spp'"});
+                     {suite.string() + ":" + std::to_string(line) + ":1", "unknown key 'sp'", "did you mean 'spp'"});
     // A missing field: reported at its case's table.
     writeText(suite, "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() + "\"\nreference_source = \"vkrt\"\n"
                      "reference_spp = 16\nspp = 4\n");

@@ -74,6 +74,7 @@ TEST_F(RenderCli, WritesExrWithMetadataAndPng)
     EXPECT_EQ(intAttribute(exr.metadata, "seed"), 5);
     EXPECT_EQ(intAttribute(exr.metadata, "rejectedSamples"), 0);
     EXPECT_EQ(textAttribute(exr.metadata, "stoppedBy"), "spp");
+    EXPECT_EQ(textAttribute(exr.metadata, "loopCap"), gpu().loopCap().describe());
     EXPECT_EQ(textAttribute(exr.metadata, "vkrtVersion"), VKRT_VERSION);
     EXPECT_EQ(textAttribute(exr.metadata, "sceneHash").rfind("fnv1a64:", 0), 0u);
     EXPECT_FALSE(textAttribute(exr.metadata, "device").empty());
@@ -208,6 +209,28 @@ TEST_F(RenderCli, BadOptionsNameTheOption)
     for (const auto& c : cases) {
         ProcessResult r = render("x.exr", c.args);
         EXPECT_EQ(r.exitCode, 2) << c.args[0] << ": " << r.output;
+        EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
+    }
+    EXPECT_TRUE(filesInDir().empty());
+}
+
+// --width/--height go through the scene parser's checks (SceneOverrides.h):
+// same limits and wording as width/height in a scene file, naming the option.
+TEST_F(RenderCli, ResolutionOverridesAreValidatedLikeTheSceneFile)
+{
+    struct Case {
+        std::vector<std::string> args;
+        std::string expected;
+    } cases[] = {
+        {{"--width", "0"}, "--width: must be between 1 and 16384, got 0"},
+        {{"--width", "16384", "--height", "16384"},
+         "--height: width * height = 268435456 pixels exceeds the limit of 67108864"},
+    };
+    for (const auto& c : cases) {
+        std::vector<std::string> args = {"render", kDefaultScene, "-o", (m_dir / "x.exr").string()};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        ProcessResult r = runVkrt(args); // not render(): it gives --width and --height already
+        EXPECT_EQ(r.exitCode, 2) << r.output;
         EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
     }
     EXPECT_TRUE(filesInDir().empty());

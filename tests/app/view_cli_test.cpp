@@ -93,6 +93,20 @@ TEST_F(ViewCli, CameraMoveResetsAccumulationAndSaveRecordsTrueSpp)
     EXPECT_NE(readExr(m_dir / "before.exr").image.rgb, readExr(m_dir / "after.exr").image.rgb);
 }
 
+// A move to a camera the scene file could not hold (here: flown to infinity)
+// is ignored with a message; the accumulation and the camera stay.
+TEST_F(ViewCli, InvalidCameraMoveIsIgnoredWithAMessage)
+{
+    fs::path script = m_dir / "session.txt";
+    writeText(script, "frames 3\nfly 0 0 1e308\nframes 2\nsave " + (m_dir / "kept.exr").string() + "\n");
+    ProcessResult r = runViewer({kScene, "--script", script.string(), "--width", "48", "--height", "36", "--validation"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("fly ignored: the camera would be invalid (eye: must be finite)"), std::string::npos)
+        << r.output;
+    EXPECT_EQ(std::get<int64_t>(readExr(m_dir / "kept.exr").metadata.at("spp")), 5) << "no reset for a refused move";
+    EXPECT_EQ(std::get<std::string>(readExr(m_dir / "kept.exr").metadata.at("savedBy")), "vkrt view");
+}
+
 TEST_F(ViewCli, BadScriptNamesFileLineAndColumn)
 {
     fs::path script = m_dir / "bad.txt";
@@ -108,6 +122,17 @@ TEST(ViewNoDisplay, SuggestsRender)
     ProcessResult r = runShell(command);
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.output.find("vkrt render"), std::string::npos) << r.output;
+}
+
+// The size is checked with the scene parser's rules before any window opens,
+// so this needs no display.
+TEST(ViewNoDisplay, ResolutionOverridesAreValidatedLikeTheSceneFile)
+{
+    std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " +
+                          shellQuote(kScene) + " --width 0";
+    ProcessResult r = runShell(command);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--width: must be between 1 and 16384, got 0"), std::string::npos) << r.output;
 }
 
 TEST(ViewerScript, ParsesCommandsAndRejectsMistakes)

@@ -204,6 +204,7 @@ struct SpawnResult {
     glm::vec3 origin{0.0f}, dir{0.0f}, position{0.0f};
     float cosSide = 0.0f;
     bool frontFace = false;
+    bool anyHit = false; ///< traceAny on the second ray
 };
 
 std::vector<SpawnResult> spawnOnGpu(const std::vector<SpawnCase>& cases)
@@ -215,10 +216,10 @@ std::vector<SpawnResult> spawnOnGpu(const std::vector<SpawnCase>& cases)
         input.insert(input.end(), {c.primaryOrigin.x, c.primaryOrigin.y, c.primaryOrigin.z, c.aim.x, c.aim.y, c.aim.z,
                                    c.local.x, c.local.y, c.local.z, float(c.mode), c.lightDistance});
     }
-    std::vector<float> out = runProbe("self_intersection_probe", input, 14 * cases.size(), uint32_t(cases.size()));
+    std::vector<float> out = runProbe("self_intersection_probe", input, 15 * cases.size(), uint32_t(cases.size()));
     std::vector<SpawnResult> results(cases.size());
     for (size_t i = 0; i < cases.size(); ++i) {
-        const float* r = &out[14 * i];
+        const float* r = &out[15 * i];
         SpawnResult& s = results[i];
         s.primaryHit = r[0] == 1.0f;
         s.secondHit = r[1] == 1.0f;
@@ -228,6 +229,7 @@ std::vector<SpawnResult> spawnOnGpu(const std::vector<SpawnCase>& cases)
         s.cosSide = r[9];
         s.position = glm::vec3(r[10], r[11], r[12]);
         s.frontFace = r[13] == 1.0f;
+        s.anyHit = r[14] == 1.0f;
     }
     return results;
 }
@@ -398,6 +400,7 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     std::array<std::array<int64_t, 3>, 4> failures{}, tested{}, failuresWithFlip{};
     std::array<int64_t, 4> flips{};
     int64_t primaryMisses = 0, wrongHemisphere = 0, transmitSkipped = 0, configsTooFewHits = 0, nonFinite = 0;
+    int64_t anyHitDisagreements = 0, secondHits = 0; // traceAny against the closest-hit query
     std::vector<int64_t> configFailures(cases.size() / kRays, 0);
     for (size_t first = 0; first < cases.size(); first += kRays) {
         int64_t hits = 0;
@@ -409,6 +412,10 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
                 continue;
             }
             ++hits;
+            secondHits += r.secondHit;
+            if (r.anyHit != r.secondHit && anyHitDisagreements++ < 3)
+                ADD_FAILURE() << "traceAny says " << r.anyHit << ", the closest hit " << r.secondHit << ": "
+                              << describe(c, r);
             int kind = int(c.shape.kind);
             if (!(finite(r.origin) && finite(r.dir) && finite(r.position))) {
                 if (nonFinite++ < 3) ADD_FAILURE() << "non-finite surface point: " << describe(c, r);
@@ -457,6 +464,9 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
                           << cases[first].scale;
         }
     }
+    EXPECT_EQ(anyHitDisagreements, 0) << "traceAny must find a blocker exactly when the closest-hit query does";
+    EXPECT_GT(secondHits, 1000) << "too few second hits to compare traceAny with";
+    reportStat("SecondHits", double(secondHits));
     int64_t total = 0;
     for (int kind = 0; kind < 4; ++kind)
         for (int mode = 0; mode < 3; ++mode) {

@@ -1,6 +1,6 @@
 // Run-time GLSL compilation: readable errors, and the on-disk SPIR-V cache.
 #include "gpu/ShaderCompiler.h"
-#include "scene/FeatureSet.h"
+#include "render/KernelVariant.h"
 #include "support/TestSupport.h"
 
 #include <fstream>
@@ -46,7 +46,7 @@ TEST(ShaderCompiler, ErrorsNameIncludedFileLineAndDefines)
 
 TEST(ShaderCompiler, ProducesSpirv)
 {
-    auto spirv = compileGlsl(renderKernel(defaultShaderRoot(), FeatureSet::everything(Integrator::Whitted).defines()));
+    auto spirv = compileGlsl(renderKernel(defaultShaderRoot(), KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()));
     ASSERT_GT(spirv.size(), 5u);
     EXPECT_EQ(spirv[0], 0x07230203u);
 }
@@ -55,7 +55,7 @@ TEST(SpirvCache, HitSkipsGlslangAndChangesMiss)
 {
     fs::path root = copyShaderTree("cache-keys");
     SpirvCache cache(freshTempDir("cache-keys-store"));
-    auto defines = FeatureSet::everything(Integrator::Whitted).defines();
+    auto defines = KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines();
 
     uint64_t before = glslangInvocationCount();
     CompiledKernel first = compileKernelCached(renderKernel(root, defines), cache);

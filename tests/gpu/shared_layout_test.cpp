@@ -2,7 +2,7 @@
 // glslang gives the same struct in the real kernels: compare every member
 // offset with glslang's reflection of the all-features kernel.
 #include "gpu/ShaderCompiler.h"
-#include "scene/FeatureSet.h"
+#include "render/KernelVariant.h"
 #include "shared/Bindings.h"
 #include "shared/SceneTypes.h"
 
@@ -16,7 +16,7 @@ namespace {
 
 std::map<std::string, int> reflectedOffsets()
 {
-    KernelSource source{defaultShaderRoot(), "kernels/render.comp", FeatureSet::everything(Integrator::Whitted).defines()};
+    KernelSource source{defaultShaderRoot(), "kernels/render.comp", KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()};
     std::map<std::string, int> offsets;
     for (const auto& [name, offset] : reflectBlockMemberOffsets(source)) offsets[name] = offset;
     return offsets;

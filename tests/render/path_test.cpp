@@ -364,7 +364,7 @@ TEST_F(PathTest, SobolSamplerIsUnbiasedAndLowersTheError)
                     name, mseSobol, mseIndependent, mseIndependent / mseSobol, 100 * biasSobol, 100 * biasIndependent);
         EXPECT_LT(mseSobol, 0.5 * mseIndependent) << name;
         EXPECT_LT(std::abs(biasSobol), 0.005) << name << ": the image mean must match Mitsuba's";
-        EXPECT_TRUE(a.features().sobolSampler && !b.features().sobolSampler);
+        EXPECT_TRUE(a.variant().sobolSampler && !b.variant().sobolSampler);
     }
 }
 

@@ -83,8 +83,8 @@ TEST_F(VariantTest, UniformAndStorageSceneDataGiveIdenticalImages)
         RenderOptions storage = options(false);
         storage.storageScene = true;
         Renderer a(gpu(), scene, options(false)), b(gpu(), scene, storage);
-        EXPECT_TRUE(a.features().uniformScene) << name;
-        EXPECT_FALSE(b.features().uniformScene) << name;
+        EXPECT_TRUE(a.variant().uniformScene) << name;
+        EXPECT_FALSE(b.variant().uniformScene) << name;
         a.renderFrames(2);
         b.renderFrames(2);
         EXPECT_EQ(a.mean().rgb, b.mean().rgb) << name;
@@ -105,10 +105,10 @@ TEST_F(VariantTest, SceneTooBigForUniformBuffersUsesStorageBuffers)
     }
     scene.spheres.push_back(last); // the visible sphere again, as the very last record
     scene.spheres.front().center.y -= 1e6;
-    EXPECT_FALSE(featuresOf(scene).uniformScene);
+    EXPECT_FALSE(sceneFitsUniformBuffers(scene));
     Scene small = shippedScene("seed/baseline.toml");
     Renderer big(gpu(), scene, options(false)), reference(gpu(), small, options(false));
-    EXPECT_FALSE(big.features().uniformScene);
+    EXPECT_FALSE(big.variant().uniformScene);
     big.renderFrames(1);
     reference.renderFrames(1);
     // The hidden spheres never win a closest hit and the same spheres are
@@ -120,7 +120,7 @@ TEST_F(VariantTest, SceneWithoutGlassHasNoRefractionCode)
 {
     Scene scene = shippedScene("seed/baseline.toml");
     Renderer specialized(gpu(), scene, options(false)), uber(gpu(), scene, options(true));
-    auto defines = describeDefines(specialized.features().defines());
+    auto defines = describeDefines(specialized.variant().defines());
     EXPECT_EQ(defines.find("VKRT_MATERIAL_DIELECTRIC"), std::string::npos) << defines;
     EXPECT_FALSE(summarize(specialized.kernel().spirv).refract);
     EXPECT_TRUE(summarize(uber.kernel().spirv).refract);
@@ -146,7 +146,7 @@ TEST_F(VariantTest, UnusedLightsAndCubemapHaveNoBindings)
     EXPECT_TRUE(all.count(gpu::BINDING_TRIANGLE_LIGHTS));
     EXPECT_TRUE(all.count(gpu::BINDING_ENVIRONMENT));
     // The descriptor set layout holds exactly what the module declares.
-    auto layout = specialized.features().bindings();
+    auto layout = specialized.variant().bindings();
     EXPECT_EQ(std::set<uint32_t>(layout.begin(), layout.end()), used);
 
     Renderer area(gpu(), shippedScene("seed/area-light.toml"), options(false));
@@ -177,14 +177,20 @@ vertices = [[0, 2, 0], [1, 2, 0], [0, 2, 1]]
 radiance = 1
 )");
     FeatureSet f = featuresOf(scene);
-    EXPECT_TRUE(f.triangles && f.triangleLights);
-    EXPECT_FALSE(f.spheres || f.boxes || f.planes || f.pointLights || f.cubemap);
+    EXPECT_TRUE(f.has(ShapeKind::Triangle) && f.has(LightKind::TriangleLight));
+    EXPECT_FALSE(f.has(ShapeKind::Sphere) || f.has(ShapeKind::Box) || f.has(ShapeKind::Plane) ||
+                 f.has(LightKind::PointLight) || f.cubemap);
     EXPECT_TRUE(f.has(MaterialType::Glossy));
     EXPECT_FALSE(f.has(MaterialType::Dielectric)) << "an unused material must not pull in its code";
-    EXPECT_EQ(f.describe(), "whitted; triangles triangle-lights; glossy; uniform-scene");
-    EXPECT_TRUE(f.uniformScene) << "a small scene's arrays fit uniform buffers";
-    EXPECT_TRUE(f.isUniformBinding(gpu::BINDING_TRIANGLES));
-    EXPECT_FALSE(f.isUniformBinding(gpu::BINDING_ACCUMULATION));
+    KernelVariant v{f};
+    v.uniformScene = sceneFitsUniformBuffers(scene);
+    EXPECT_EQ(v.describe(), "whitted; triangles triangle-lights; glossy; uniform-scene");
+    EXPECT_TRUE(v.uniformScene) << "a small scene's arrays fit uniform buffers";
+    EXPECT_TRUE(v.isUniformBinding(gpu::BINDING_TRIANGLES));
+    EXPECT_TRUE(v.isUniformBinding(gpu::BINDING_MATERIALS));
+    EXPECT_FALSE(v.isUniformBinding(gpu::BINDING_ACCUMULATION));
+    v.uniformScene = false;
+    EXPECT_FALSE(v.isUniformBinding(gpu::BINDING_TRIANGLES));
 }
 
 TEST(InfoCli, PrintsVariantAndCacheState)
@@ -200,6 +206,7 @@ TEST(InfoCli, PrintsVariantAndCacheState)
     EXPECT_NE(cold.output.find("features:       whitted; spheres boxes triangles planes point-lights cubemap;"),
               std::string::npos) << cold.output;
     EXPECT_NE(cold.output.find("spirv bytes:"), std::string::npos);
+    EXPECT_NE(cold.output.find("loop cap:       " + gpu().loopCap().describe()), std::string::npos) << cold.output;
     EXPECT_EQ(cold.output.find("cache hit"), std::string::npos) << cold.output;
     EXPECT_NE(warm.output.find("cache hit"), std::string::npos) << warm.output;
 }

@@ -2,10 +2,12 @@
 // every kind of bad input produces a SceneError at the exact offending position.
 #include "scene/SceneParser.h"
 
+#include "scene/TomlTraps.h"
 #include "util/Hash.h"
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -607,6 +609,8 @@ const std::vector<BadScene> kBadScenes = {
     {"MaxDepthZero", "[render]\nmax_depth = 0\n" + kCamera, 2, 13, "render.max_depth: must be between 1 and 64, got 0"},
     {"MaxDepthTooLarge", "[render]\nmax_depth = 65\n" + kCamera, 2, 13,
      "render.max_depth: must be between 1 and 64, got 65"},
+    {"InvalidUtf8InComment", kCamera + "# caf\xE9\n", 5, 6, "invalid TOML: invalid UTF-8 (byte 0xE9)"},
+    {"InvalidUtf8InString", kCamera + "[materials.\"r\xC3\xA9" "d\xFF\"]\n", 5, 16, "invalid TOML: invalid UTF-8 (byte 0xFF)"},
     {"UnknownIntegrator", "[render]\nintegrator = \"pathh\"\n" + kCamera, 2, 14,
      "render.integrator: unknown integrator 'pathh'; did you mean 'path'?"},
 };
@@ -629,6 +633,70 @@ TEST(SceneParserSuggestions, UnknownMaterialListsDefinedNamesWhenNoneIsClose)
                                        "[[objects]]\nshape = \"sphere\"\nmaterial = \"xyzzy\"\n";
     EXPECT_EQ(parseError(text).message(), "objects[0].material: unknown material 'xyzzy' (defined: a, b)");
 }
+
+TEST(SceneParserSuggestions, SwappedLettersCountAsOneEdit)
+{
+    // Two swaps: two edits with transpositions, four without (no suggestion then).
+    EXPECT_EQ(parseError(kCamera + "hiegth = 45\n").message(), "camera: unknown key 'hiegth'; did you mean 'height'?");
+    EXPECT_EQ(parseError(kCamera + "atrgte = 1\n").message(), "camera: unknown key 'atrgte'; did you mean 'target'?");
+}
+
+// A scene with one very long material name and an object that names a slightly
+// different one: the did-you-mean once filled a |a| x |b| table (2 GB and 20 s
+// at 16,000 characters, 12.6 GB at 40,000). Names that long get no suggestion.
+SceneError longNameError(size_t length)
+{
+    const std::string defined(length, 'a');
+    const std::string used = std::string(length - 1, 'a') + "b";
+    return parseError(kCamera + "[materials." + defined + "]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
+                                "material = \"" + used + "\"\ncenter = [0, 0, 0]\nradius = 1\n");
+}
+
+TEST(SceneParserSuggestions, VeryLongUnknownNameIsLocatedQuicklyWithoutSuggestion)
+{
+    for (const size_t length : {size_t{16000}, size_t{40000}}) {
+        const auto start = std::chrono::steady_clock::now();
+        const SceneError error = longNameError(length);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        EXPECT_EQ(error.where().line, 9);
+        EXPECT_EQ(error.where().column, 12);
+        EXPECT_EQ(error.message().rfind("objects[0].material: unknown material 'aaa", 0), 0u);
+        EXPECT_EQ(error.message().find("did you mean"), std::string::npos);
+        // Milliseconds now; the bound is loose for sanitizer builds on a busy machine.
+        EXPECT_LT(seconds, 2.0) << length << " characters";
+    }
+}
+
+TEST(SceneParserSuggestions, LongButPlausibleNameIsStillSuggested)
+{
+    const std::string name = "wall_left_" + std::string(50, 'x') + "_painted_red";
+    const std::string typo = "wall_left_" + std::string(50, 'x') + "_painted_rde";
+    const std::string text = kCamera + "[materials." + name + "]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
+                                       "material = \"" + typo + "\"\ncenter = [0, 0, 0]\nradius = 1\n";
+    EXPECT_EQ(parseError(text).message(),
+              "objects[0].material: unknown material '" + typo + "'; did you mean '" + name + "'?");
+}
+
+// ------------------------------------------------ inputs that crash toml++ 3.3
+
+class SceneParserTomlTrap : public ::testing::TestWithParam<TomlTrap> {};
+
+TEST_P(SceneParserTomlTrap, IsALocatedSyntaxError)
+{
+    const std::string& line = GetParam().text;
+    for (const std::string& before : {std::string(), kCamera}) {
+        const SceneError error = parseError(before + line + "\n");
+        const int expectedLine = before.empty() ? 1 : 5;
+        EXPECT_EQ(error.where().file, "scene.toml");
+        EXPECT_EQ(error.where().line, expectedLine) << error.what();
+        EXPECT_GE(error.where().column, 1) << error.what();
+        EXPECT_LE(error.where().column, int(line.size()) + 1) << error.what();
+        EXPECT_EQ(error.message().rfind("invalid TOML: ", 0), 0u) << error.what();
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(TomlTraps, SceneParserTomlTrap, ::testing::ValuesIn(kTomlTraps),
+                         [](const ::testing::TestParamInfo<TomlTrap>& info) { return info.param.name; });
 
 // ---------------------------------------------------------- bad cubemap files
 

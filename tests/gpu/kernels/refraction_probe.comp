@@ -24,7 +24,7 @@ void main()
     m.type = MATERIAL_DIELECTRIC;
     bool frontFace = dot(wo, outward) > 0.0;
     vec3 n = frontFace ? outward : -outward;
-    BsdfSample s = sampleDielectric(m, n, wo, frontFace ? 1.0 / m.ior : m.ior, 1.0);
+    BsdfSample s = sampleDielectric(m, n, wo, frontFace ? 1.0 / m.ior : m.ior, vec3(1.0));
     outputs[4 * i + 0] = s.dir.x;
     outputs[4 * i + 1] = s.dir.y;
     outputs[4 * i + 2] = s.dir.z;

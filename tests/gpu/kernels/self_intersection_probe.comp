@@ -8,9 +8,10 @@
 // the primary ray came from, 1: transmission to the other side, 2: shadow ray
 // towards a point light at hit + distance * direction, as
 // directFromPointLights does), light distance.
-// outputs[14i ..] = primary hit flag, second hit flag, second t, new ray
+// outputs[15i ..] = primary hit flag, second hit flag, second t, new ray
 // origin, new ray direction, dot(direction, side normal), surface point,
-// front-face flag.
+// front-face flag, traceAny's answer for the second ray (it must agree
+// with the second hit flag of the closest-hit query).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "probe.glsl"
@@ -53,8 +54,8 @@ void main()
     triangles[0] = Triangle(p0, 0u, p1, p2);
     planes[0] = Plane(p0, 0u, p1);
 
-    uint o = 14u * i;
-    for (uint k = 0u; k < 14u; ++k)
+    uint o = 15u * i;
+    for (uint k = 0u; k < 15u; ++k)
         outputs[o + k] = 0.0;
     Ray primary = Ray(primaryOrigin, normalize(aim - primaryOrigin));
     SurfaceHit hit;
@@ -80,8 +81,11 @@ void main()
         }
     }
     HitId second = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true);
-    if (traced)
+    bool anyHit = false;
+    if (traced) {
         second = findClosest(Ray(origin, dir), tMax);
+        anyHit = traceAny(Ray(origin, dir), tMax);
+    }
     outputs[o] = 1.0;
     outputs[o + 1u] = second.shape == SHAPE_NONE ? 0.0 : 1.0;
     outputs[o + 2u] = second.shape == SHAPE_NONE ? 0.0 : second.t;
@@ -96,4 +100,5 @@ void main()
     outputs[o + 11u] = hit.position.y;
     outputs[o + 12u] = hit.position.z;
     outputs[o + 13u] = frontFace ? 1.0 : 0.0;
+    outputs[o + 14u] = anyHit ? 1.0 : 0.0;
 }

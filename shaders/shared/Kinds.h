@@ -1,0 +1,77 @@
+// The registry of kinds: every material, shape and light kind vkrt knows,
+// listed once. C++ (the scene parser, FeatureSet, the kernel variant, the
+// upload) and GLSL (constants, the dispatch of lib/scene.glsl and lib/bsdf.glsl) expand
+// these lists, so a new kind is one line here plus the code that only that
+// kind can have (its record, reader, intersection and shading functions).
+// docs/architecture.md lists every place a new kind touches.
+//
+// Each list calls X once per kind, in the order of its value (0, 1, ...):
+//   VKRT_MATERIAL_KINDS: X(KIND, Type, name, value, delta)
+//   VKRT_SHAPE_KINDS, VKRT_LIGHT_KINDS:
+//       X(KIND, Type, name, value, field, array, ARRAY, capacity)
+// KIND: constant suffix (MATERIAL_KIND, SHAPE_KIND, LIGHT_KIND) and the
+//       VKRT_MATERIAL_KIND define of the variants that use the material;
+// Type: the C++ enumerator, the GPU record (shared/SceneTypes.h) and the
+//       suffix of per-kind functions (readType, closestType, ...);
+// delta: 1 for a material that scatters into single directions (mirror,
+//        glass): lights cannot be sampled for it;
+// name: the scene file's spelling (`type = "name"`, `shape = "name"`);
+// field: SceneUniforms::fieldCount holds the number of records;
+// array: the member of Scene and GpuSceneData and the GLSL array;
+// ARRAY: VKRT_HAS_ARRAY define, BINDING_ARRAY (shared/Bindings.h) and
+//        UNIFORM_ARRAY, the records a 16 KiB uniform block holds (capacity:
+//        16384 / sizeof(Type), checked in src/gpu/SharedTypes.cpp).
+// GLSL's preprocessor has no stringizing: names stay bare words.
+#ifndef VKRT_SHARED_KINDS_H
+#define VKRT_SHARED_KINDS_H
+#include "Interop.h"
+
+#define VKRT_MATERIAL_KINDS(X)                 \
+    X(LAMBERT, Lambert, lambert, 0, 0)         \
+    X(PHONG, Phong, phong, 1, 0)               \
+    X(MIRROR, Mirror, mirror, 2, 1)            \
+    X(GLOSSY, Glossy, glossy, 3, 0)            \
+    X(DIELECTRIC, Dielectric, dielectric, 4, 1)
+
+#define VKRT_SHAPE_KINDS(X)                                                   \
+    X(SPHERE, Sphere, sphere, 0, sphere, spheres, SPHERES, 819)               \
+    X(BOX, Box, box, 1, box, boxes, BOXES, 585)                               \
+    X(TRIANGLE, Triangle, triangle, 2, triangle, triangles, TRIANGLES, 409)   \
+    X(PLANE, Plane, plane, 3, plane, planes, PLANES, 585)
+
+#define VKRT_LIGHT_KINDS(X)                                                                    \
+    X(POINT, PointLight, point, 0, pointLight, pointLights, POINT_LIGHTS, 682)                 \
+    X(TRIANGLE, TriangleLight, triangle, 1, triangleLight, triangleLights, TRIANGLE_LIGHTS, 292)
+
+// ------------------------------------------------------ derived constants
+
+#define VKRT_PLUS_ONE_MATERIAL(KIND, Type, name, value, delta) +1
+#define VKRT_PLUS_ONE_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity) +1
+#define VKRT_MATERIAL_CONSTANT(KIND, Type, name, value, delta) VKRT_CONSTANT(uint, MATERIAL_##KIND, value)
+#define VKRT_SHAPE_CONSTANT(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    VKRT_CONSTANT(int, SHAPE_##KIND, value)
+#define VKRT_LIGHT_CONSTANT(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    VKRT_CONSTANT(int, LIGHT_##KIND, value)
+#define VKRT_CAPACITY_CONSTANT(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    VKRT_CONSTANT(uint, UNIFORM_##ARRAY, capacity)
+
+VKRT_BEGIN_NAMESPACE
+
+// Material::type
+VKRT_MATERIAL_KINDS(VKRT_MATERIAL_CONSTANT)
+VKRT_CONSTANT(uint, MATERIAL_KIND_COUNT, 0 VKRT_MATERIAL_KINDS(VKRT_PLUS_ONE_MATERIAL))
+
+// Shape kinds, as lib/scene.glsl's HitId::shape.
+VKRT_SHAPE_KINDS(VKRT_SHAPE_CONSTANT)
+VKRT_CONSTANT(int, SHAPE_KIND_COUNT, 0 VKRT_SHAPE_KINDS(VKRT_PLUS_ONE_ARRAY))
+
+VKRT_LIGHT_KINDS(VKRT_LIGHT_CONSTANT)
+VKRT_CONSTANT(int, LIGHT_KIND_COUNT, 0 VKRT_LIGHT_KINDS(VKRT_PLUS_ONE_ARRAY))
+
+// Uniform-block capacities of the shape and light arrays (UNIFORM_SPHERES, ...).
+VKRT_SHAPE_KINDS(VKRT_CAPACITY_CONSTANT)
+VKRT_LIGHT_KINDS(VKRT_CAPACITY_CONSTANT)
+
+VKRT_END_NAMESPACE
+
+#endif

@@ -1,0 +1,118 @@
+#include "render/KernelVariant.h"
+
+#include "shared/Bindings.h"
+#include "shared/SceneTypes.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace vkrt {
+
+namespace {
+
+/// A feature of the variant that is on or off: its define, its binding, its name.
+struct OptionalFeature {
+    bool on;
+    std::string define;
+    int binding; // -1: no buffer of its own
+    std::string name;
+};
+
+/// Every optional feature in the stable order of defines, bindings and descriptions:
+/// the shape and light arrays (from the registry), the environment, then render options.
+std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
+{
+    const FeatureSet& f = v.features;
+    std::vector<OptionalFeature> list;
+#define VKRT_SHAPE_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    list.push_back({f.has(ShapeKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(ShapeKind::Type)});
+#define VKRT_LIGHT_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    list.push_back({f.has(LightKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(LightKind::Type)});
+    VKRT_SHAPE_KINDS(VKRT_SHAPE_FEATURE)
+    VKRT_LIGHT_KINDS(VKRT_LIGHT_FEATURE)
+#undef VKRT_SHAPE_FEATURE
+#undef VKRT_LIGHT_FEATURE
+    list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});
+    list.push_back({f.environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
+                    "environment-sampling"});
+    list.push_back({v.variance, "VKRT_VARIANCE", int(gpu::BINDING_MOMENTS), "variance"});
+    list.push_back({v.sobolSampler, "VKRT_SAMPLER_SOBOL", -1, "sobol"});
+    return list;
+}
+
+std::string upper(std::string text)
+{
+    for (char& c : text) c = char(std::toupper(static_cast<unsigned char>(c)));
+    return text;
+}
+
+} // namespace
+
+const std::vector<SceneArrayBinding>& sceneArrayBindings()
+{
+#define VKRT_ARRAY_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    SceneArrayBinding{gpu::BINDING_##ARRAY, gpu::UNIFORM_##ARRAY},
+    static const std::vector<SceneArrayBinding> bindings{
+        SceneArrayBinding{gpu::BINDING_MATERIALS, gpu::UNIFORM_MATERIALS},
+        VKRT_SHAPE_KINDS(VKRT_ARRAY_BINDING) VKRT_LIGHT_KINDS(VKRT_ARRAY_BINDING)};
+#undef VKRT_ARRAY_BINDING
+    return bindings;
+}
+
+bool sceneFitsUniformBuffers(const Scene& scene)
+{
+    // Triangle lights count before zero-area ones are dropped: an upper bound.
+    bool fits = scene.materials.size() <= gpu::UNIFORM_MATERIALS;
+#define VKRT_ARRAY_FITS(KIND, Type, name, value, field, array, ARRAY, capacity) \
+    fits = fits && scene.array.size() <= gpu::UNIFORM_##ARRAY;
+    VKRT_SHAPE_KINDS(VKRT_ARRAY_FITS)
+    VKRT_LIGHT_KINDS(VKRT_ARRAY_FITS)
+#undef VKRT_ARRAY_FITS
+    return fits;
+}
+
+bool KernelVariant::isUniformBinding(uint32_t binding) const
+{
+    if (binding == gpu::BINDING_UNIFORMS) return true;
+    const auto& arrays = sceneArrayBindings();
+    bool sceneArray = std::any_of(arrays.begin(), arrays.end(), [&](const auto& a) { return a.binding == binding; });
+    return uniformScene && sceneArray;
+}
+
+std::vector<std::pair<std::string, std::string>> KernelVariant::defines() const
+{
+    std::vector<std::pair<std::string, std::string>> result;
+    result.emplace_back("VKRT_INTEGRATOR_" + upper(integratorName(features.integrator)), "1");
+    if (features.anyPrimitive()) result.emplace_back("VKRT_HAS_MATERIALS", "1");
+    for (const auto& feature : optionalFeatures(*this))
+        if (feature.on) result.emplace_back(feature.define, "1");
+    for (MaterialType type : kAllMaterialTypes)
+        if (features.has(type)) result.emplace_back("VKRT_MATERIAL_" + upper(materialTypeName(type)), "1");
+    if (uniformScene) result.emplace_back("VKRT_UNIFORM_SCENE", "1");
+    // Variance under the Sobol' sampler comes from independently scrambled batches.
+    if (variance && sobolSampler) result.emplace_back("VKRT_SOBOL_BATCHES", std::to_string(gpu::VARIANCE_BATCHES));
+    return result;
+}
+
+std::vector<uint32_t> KernelVariant::bindings() const
+{
+    std::vector<uint32_t> result = {gpu::BINDING_UNIFORMS, gpu::BINDING_ACCUMULATION, gpu::BINDING_STATS};
+    if (features.anyPrimitive()) result.push_back(gpu::BINDING_MATERIALS);
+    for (const auto& feature : optionalFeatures(*this))
+        if (feature.on && feature.binding >= 0) result.push_back(uint32_t(feature.binding));
+    return result;
+}
+
+std::string KernelVariant::describe() const
+{
+    std::string text = integratorName(features.integrator) + ";";
+    for (const auto& feature : optionalFeatures(*this))
+        if (feature.on) text += " " + feature.name;
+    text += ";";
+    for (MaterialType type : kAllMaterialTypes)
+        if (features.has(type)) text += " " + materialTypeName(type);
+    text += uniformScene ? "; uniform-scene" : "; storage-scene";
+    return text;
+}
+
+} // namespace vkrt

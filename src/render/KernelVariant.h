@@ -1,0 +1,48 @@
+#pragma once
+// The render kernel variant: a scene's FeatureSet plus the render options that
+// change the kernel (variance estimation, the sampler, where scene arrays
+// live), turned into preprocessor defines and descriptor bindings.
+// Data flow: Scene -> FeatureSet -> KernelVariant -> defines -> SPIR-V (cached)
+// -> pipeline. The shape and light arrays' defines, bindings and uniform
+// capacities all come from the registry (shared/Kinds.h).
+#include "scene/FeatureSet.h"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace vkrt {
+
+/// One scene array of the GPU scene: its binding and its uniform-block capacity.
+struct SceneArrayBinding {
+    uint32_t binding;
+    uint32_t uniformCapacity;
+};
+
+/// The materials array, then every shape and light array in registry order.
+const std::vector<SceneArrayBinding>& sceneArrayBindings();
+
+struct KernelVariant {
+    explicit KernelVariant(const FeatureSet& sceneFeatures = {}) : features(sceneFeatures) {}
+
+    FeatureSet features;
+    bool variance = false;     ///< per-pixel variance estimation (a render option)
+    bool sobolSampler = false; ///< Owen-scrambled Sobol' points instead of independent ones (a render option)
+    bool uniformScene = false; ///< scene arrays in uniform buffers: every array fits (shared/SceneTypes.h)
+
+    /// Preprocessor defines selecting this variant, in a stable order.
+    std::vector<std::pair<std::string, std::string>> defines() const;
+    /// Descriptor binding indices (shaders/shared/Bindings.h) this variant declares.
+    std::vector<uint32_t> bindings() const;
+    /// Whether this variant declares `binding` as a uniform buffer.
+    bool isUniformBinding(uint32_t binding) const;
+    /// One line for people, e.g. "whitted; spheres planes point-lights; lambert; uniform-scene".
+    std::string describe() const;
+
+    bool operator==(const KernelVariant&) const = default;
+};
+
+/// Whether every scene array of the scene fits the uniform-buffer capacities.
+bool sceneFitsUniformBuffers(const Scene& scene);
+
+} // namespace vkrt

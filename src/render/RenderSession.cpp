@@ -1,0 +1,215 @@
+#include "render/RenderSession.h"
+
+#include "scene/SceneParser.h"
+#include "util/Hash.h"
+
+#include <chrono>
+#include <csignal>
+
+namespace vkrt {
+
+// ---------------------------------------------------------------- sampler
+
+std::optional<SamplerChoice> samplerChoiceNamed(const std::string& name)
+{
+    if (name == "auto") return SamplerChoice::Auto;
+    if (name == "independent") return SamplerChoice::Independent;
+    if (name == "sobol") return SamplerChoice::Sobol;
+    return std::nullopt;
+}
+
+std::string samplerName(Sampler sampler) { return sampler == Sampler::Sobol ? "sobol" : "independent"; }
+
+Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixels, uint64_t storageBufferRange)
+{
+    if (choice == SamplerChoice::Independent) return Sampler::Independent;
+    if (choice == SamplerChoice::Sobol) return Sampler::Sobol;
+    if (needs.layer) return Sampler::Independent;
+    bool batchesFit = pixels * varianceBytesPerPixel(true) <= storageBufferRange;
+    return needs.errorEstimate && !batchesFit ? Sampler::Independent : Sampler::Sobol;
+}
+
+// ---------------------------------------------------------------- scene
+
+Scene loadScene(const std::string& path, const ResolutionOverride& resolution)
+{
+    Scene scene = parseSceneFile(path);
+    applyResolution(scene.camera, resolution);
+    return scene;
+}
+
+// ---------------------------------------------------------------- session
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene, const SessionConfig& config)
+{
+    RenderOptions options;
+    options.seed = config.seed;
+    options.jitter = config.jitter;
+    options.uber = config.uber;
+    options.variance = config.variance.any();
+    options.extraDefines = config.extraDefines;
+    options.cacheDirectory = config.cacheDirectory;
+    uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
+    uint64_t range = context.physicalDevice().getProperties().limits.maxStorageBufferRange;
+    options.sobol = resolveSampler(config.sampler, config.variance, pixels, range) == Sampler::Sobol;
+    return options;
+}
+
+} // namespace
+
+RenderSession::RenderSession(const VulkanContext& context, Scene scene, SessionConfig config)
+    : m_context(context),
+      m_scene(std::move(scene)),
+      m_config(std::move(config)),
+      m_renderOptions(renderOptionsFor(context, m_scene, m_config))
+{
+    createRenderer();
+    if (m_config.warmUp) m_renderer->warmUp();
+}
+
+void RenderSession::createRenderer()
+{
+    m_renderer.reset(); // its buffers go before the new ones are made
+    m_renderer = std::make_unique<Renderer>(m_context, m_scene, m_renderOptions);
+    startAfresh();
+}
+
+void RenderSession::startAfresh()
+{
+    m_renderSeconds = 0.0;
+    m_stoppedBy.reset();
+}
+
+bool RenderSession::atCheckpoint(const RunHooks& hooks, uint32_t spp, double seconds) const
+{
+    const std::optional<double>& target = m_config.stop.targetRelMse;
+    if (!hooks.onCheckpoint && !target) return false; // no read-back needed
+    Film current = film();
+    if (hooks.onCheckpoint) hooks.onCheckpoint(spp, seconds, current);
+    return target && current.estimated && current.estimated->relMse < *target;
+}
+
+LoopResult RenderSession::run(const RunHooks& hooks)
+{
+    LoopResult loop = runRenderLoop(*m_renderer, m_config.stop, hooks.onProgress, [&](uint32_t spp, double seconds) {
+        return atCheckpoint(hooks, spp, seconds);
+    });
+    m_renderSeconds += loop.renderSeconds;
+    m_stoppedBy = loop.reason;
+    return loop;
+}
+
+void RenderSession::renderFrames(uint32_t frames)
+{
+    auto start = Clock::now();
+    m_renderer->renderFrames(frames);
+    m_renderSeconds += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void RenderSession::reset()
+{
+    m_renderer->reset();
+    startAfresh();
+}
+
+std::optional<std::string> RenderSession::moveCamera(const Camera& camera)
+{
+    if (auto problem = cameraProblem(camera)) return problem;
+    if (camera.width != m_scene.camera.width || camera.height != m_scene.camera.height)
+        return std::string("a camera move cannot change the image size");
+    m_renderer->moveCamera(camera);
+    m_scene.camera = camera;
+    startAfresh();
+    return std::nullopt;
+}
+
+void RenderSession::setIntegrator(Integrator integrator)
+{
+    m_scene.render.integrator = integrator;
+    createRenderer();
+}
+
+Sampler RenderSession::sampler() const
+{
+    return m_renderer->variant().sobolSampler ? Sampler::Sobol : Sampler::Independent;
+}
+
+Film RenderSession::film() const
+{
+    Film film{m_renderer->mean(), std::nullopt, std::nullopt};
+    if (m_renderer->variant().variance) {
+        film.variance = m_renderer->varianceOfMean();
+        film.estimated = estimateError(film.mean, *film.variance);
+    }
+    return film;
+}
+
+Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) const
+{
+    const Renderer& renderer = *m_renderer;
+    Metadata metadata{
+        {"vkrtVersion", std::string(VKRT_VERSION)},
+        {"spp", int64_t(renderer.completedFrames())},
+        {"seed", int64_t(m_config.seed)},
+        {"renderSeconds", m_renderSeconds},
+        {"device", m_context.deviceInfo().name},
+        {"driver", m_context.deviceInfo().driver},
+        {"scene", m_scene.path},
+        {"sceneHash", "fnv1a64:" + toHex(m_scene.fileHash)},
+        {"integrator", integratorName(m_scene.render.integrator)},
+        {"kernelVariant", renderer.variant().describe() + (m_config.uber ? " (uber)" : "")},
+        {"sampler", samplerName(sampler())},
+        {"rejectedSamples", int64_t(renderer.counters().rejectedSamples)},
+    };
+    // Whether the device may have cut loops short (docs/platform.md).
+    metadata["loopCap"] = m_context.loopCap().describe();
+    if (m_stoppedBy) metadata["stoppedBy"] = stopReasonName(*m_stoppedBy);
+    if (renderer.variant().variance) {
+        // The variance's degrees of freedom: per-pixel tests on it (vkrt
+        // compare) need Student's t rather than a normal when few.
+        metadata["varianceDegreesOfFreedom"] = int64_t(renderer.varianceDegreesOfFreedom());
+        metadata["varianceEstimator"] = sampler() == Sampler::Sobol ? std::to_string(gpu::VARIANCE_BATCHES) +
+                                                                          " independently scrambled batches"
+                                                                    : std::string("independent samples");
+    }
+    if (film.estimated) {
+        metadata["estimatedRmse"] = film.estimated->rmse;
+        metadata["estimatedRelMse"] = film.estimated->relMse;
+    }
+    if (m_config.stop.timeBudgetSeconds) metadata["timeBudgetSeconds"] = *m_config.stop.timeBudgetSeconds;
+    if (m_config.stop.targetRelMse) metadata["targetRelMse"] = *m_config.stop.targetRelMse;
+    if (!savedBy.empty()) metadata["savedBy"] = savedBy;
+    return metadata;
+}
+
+Outcome RenderSession::outcome() const
+{
+    if (m_stoppedBy == StopReason::Interrupted) return Outcome::of(OutcomeKind::Interrupted);
+    return Outcome::passed();
+}
+
+// ---------------------------------------------------------------- Ctrl-C
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+
+extern "C" void onInterrupt(int) { g_interrupted.store(true); }
+
+} // namespace
+
+InterruptGuard::InterruptGuard()
+{
+    g_interrupted.store(false);
+    m_previous = std::signal(SIGINT, onInterrupt);
+}
+
+InterruptGuard::~InterruptGuard() { std::signal(SIGINT, m_previous == SIG_ERR ? SIG_DFL : m_previous); }
+
+const std::atomic<bool>& interruptFlag() { return g_interrupted; }
+
+} // namespace vkrt

@@ -1,0 +1,102 @@
+#include "scene/SceneOverrides.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace vkrt {
+
+namespace {
+
+// The parser's constant (SceneParser.cpp, camera section): sin of the smallest
+// accepted angle between up and the view direction.
+constexpr double kParallelTolerance = 1e-6;
+
+bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// As the parser's `normalized`: scaled by the largest component first, so
+/// that legal extreme vectors normalize; nullopt for the zero vector.
+std::optional<glm::dvec3> normalized(const glm::dvec3& v)
+{
+    double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    if (largest == 0) return std::nullopt;
+    return glm::normalize(v / largest);
+}
+
+/// to - from, halved when the full difference of two finite points overflows.
+glm::dvec3 difference(const glm::dvec3& from, const glm::dvec3& to)
+{
+    glm::dvec3 d = to - from;
+    return isFinite(d) ? d : to * 0.5 - from * 0.5;
+}
+
+/// Shortest round-trip text of a number, as the parser prints them.
+std::string formatNumber(double value)
+{
+    char text[64];
+    auto result = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, result.ptr);
+}
+
+std::optional<std::string> sideProblem(uint32_t side)
+{
+    if (side >= 1 && side <= SceneLimits::maxImageSide) return std::nullopt;
+    return "must be between 1 and " + std::to_string(SceneLimits::maxImageSide) + ", got " + std::to_string(side);
+}
+
+std::optional<std::string> pixelCountProblem(uint32_t width, uint32_t height)
+{
+    uint64_t pixels = uint64_t{width} * height;
+    if (pixels <= SceneLimits::maxImagePixels) return std::nullopt;
+    return "width * height = " + std::to_string(pixels) + " pixels exceeds the limit of " +
+           std::to_string(SceneLimits::maxImagePixels);
+}
+
+std::optional<std::string> upProblem(const Camera& camera)
+{
+    std::optional<glm::dvec3> up = normalized(camera.up);
+    if (!up) return "up: must not be zero-length";
+    glm::dvec3 view = *normalized(difference(camera.eye, camera.target));
+    if (glm::length(glm::cross(*up, view)) >= kParallelTolerance) return std::nullopt;
+    return "up: must not be parallel to the view direction (target - eye)";
+}
+
+} // namespace
+
+void applyResolution(Camera& camera, const ResolutionOverride& resolution)
+{
+    auto side = [](const std::optional<uint32_t>& value, const std::string& name, uint32_t current) {
+        if (!value) return current;
+        if (auto problem = sideProblem(*value)) throw InputError(name + ": " + *problem);
+        return *value;
+    };
+    uint32_t width = side(resolution.width, resolution.widthName, camera.width);
+    uint32_t height = side(resolution.height, resolution.heightName, camera.height);
+    if (auto problem = pixelCountProblem(width, height))
+        throw InputError((resolution.height ? resolution.heightName : resolution.widthName) + ": " + *problem);
+    camera.width = width;
+    camera.height = height;
+}
+
+std::optional<std::string> cameraProblem(const Camera& camera)
+{
+    if (!isFinite(camera.eye)) return std::string("eye: must be finite");
+    if (!isFinite(camera.target)) return std::string("target: must be finite");
+    if (!isFinite(camera.up)) return std::string("up: must be finite");
+    if (camera.target == camera.eye)
+        return std::string("target: must differ from camera.eye (the view direction would be undefined)");
+    if (auto problem = upProblem(camera)) return problem;
+    if (!(camera.fovY > 0 && camera.fovY < 180))
+        return "fov: must be strictly between 0 and 180 degrees, got " + formatNumber(camera.fovY);
+    if (auto problem = sideProblem(camera.width)) return "width: " + *problem;
+    if (auto problem = sideProblem(camera.height)) return "height: " + *problem;
+    if (auto problem = pixelCountProblem(camera.width, camera.height)) return "height: " + *problem;
+    return std::nullopt;
+}
+
+void checkCamera(const Camera& camera, const std::string& what)
+{
+    if (auto problem = cameraProblem(camera)) throw InputError(what + ": " + *problem);
+}
+
+} // namespace vkrt
