@@ -41,7 +41,10 @@ std::string formatNumber(double value)
 std::optional<std::string> sideProblem(uint32_t side)
 {
     if (side >= 1 && side <= SceneLimits::maxImageSide) return std::nullopt;
-    return "must be between 1 and " + std::to_string(SceneLimits::maxImageSide) + ", got " + std::to_string(side);
+    // Appended, not `std::string&& + "..."`: GCC 14 reports a false -Warray-bounds there at -O2.
+    std::string problem = "must be between 1 and " + std::to_string(SceneLimits::maxImageSide);
+    problem.append(", got ").append(std::to_string(side));
+    return problem;
 }
 
 std::optional<std::string> pixelCountProblem(uint32_t width, uint32_t height)

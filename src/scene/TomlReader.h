@@ -181,7 +181,10 @@ template <class Read>
 auto readTriple(const Field& field, std::string_view what, Read read)
 {
     const toml::array* array = field.node().as_array();
-    const std::string expected = "expected an array of 3 " + std::string(what) + ", got ";
+    // Appended, not `"..." + std::string(what) + "..."`: GCC 14 reports a false
+    // -Warray-bounds in the inlined `std::string&& + "..."` at -O2.
+    std::string expected = "expected an array of 3 ";
+    expected.append(what).append(", got ");
     if (!array) field.fail(expected + describeType(field.node()));
     if (array->size() != 3) field.fail(expected + std::to_string(array->size()) + " element(s)");
     std::array<decltype(read(field)), 3> out;
