@@ -1,42 +1,13 @@
 #include "scene/SceneOverrides.h"
 
+#include "scene/TomlReader.h"
+
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 
 namespace vkrt {
 
 namespace {
-
-// The parser's constant (SceneParser.cpp, camera section): sin of the smallest
-// accepted angle between up and the view direction.
-constexpr double kParallelTolerance = 1e-6;
-
-bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-/// As the parser's `normalized`: scaled by the largest component first, so
-/// that legal extreme vectors normalize; nullopt for the zero vector.
-std::optional<glm::dvec3> normalized(const glm::dvec3& v)
-{
-    double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-    if (largest == 0) return std::nullopt;
-    return glm::normalize(v / largest);
-}
-
-/// to - from, halved when the full difference of two finite points overflows.
-glm::dvec3 difference(const glm::dvec3& from, const glm::dvec3& to)
-{
-    glm::dvec3 d = to - from;
-    return isFinite(d) ? d : to * 0.5 - from * 0.5;
-}
-
-/// Shortest round-trip text of a number, as the parser prints them.
-std::string formatNumber(double value)
-{
-    char text[64];
-    auto result = std::to_chars(text, text + sizeof text, value);
-    return std::string(text, result.ptr);
-}
 
 std::optional<std::string> sideProblem(uint32_t side)
 {
@@ -60,11 +31,31 @@ std::optional<std::string> upProblem(const Camera& camera)
     std::optional<glm::dvec3> up = normalized(camera.up);
     if (!up) return "up: must not be zero-length";
     glm::dvec3 view = *normalized(difference(camera.eye, camera.target));
-    if (glm::length(glm::cross(*up, view)) >= kParallelTolerance) return std::nullopt;
+    if (!isParallel(*up, view)) return std::nullopt;
     return "up: must not be parallel to the view direction (target - eye)";
 }
 
 } // namespace
+
+bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::optional<glm::dvec3> normalized(const glm::dvec3& v)
+{
+    double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    if (largest == 0) return std::nullopt;
+    return glm::normalize(v / largest);
+}
+
+glm::dvec3 difference(const glm::dvec3& from, const glm::dvec3& to)
+{
+    glm::dvec3 d = to - from;
+    return isFinite(d) ? d : to * 0.5 - from * 0.5;
+}
+
+bool isParallel(const glm::dvec3& unitA, const glm::dvec3& unitB)
+{
+    return glm::length(glm::cross(unitA, unitB)) < 1e-6;
+}
 
 void applyResolution(Camera& camera, const ResolutionOverride& resolution)
 {

@@ -10,6 +10,23 @@
 
 namespace vkrt {
 
+// ------------------------------------------------- camera geometry rules
+// Shared by the scene parser and the overrides below.
+
+bool isFinite(const glm::dvec3& v);
+/// Scaling by the largest component first lets legal extreme vectors (1e300 or
+/// 1e-300) normalize without overflow or underflow; nullopt for the zero vector.
+std::optional<glm::dvec3> normalized(const glm::dvec3& v);
+/// to - from, halved when the full difference of two finite points overflows
+/// (only its direction is used).
+glm::dvec3 difference(const glm::dvec3& from, const glm::dvec3& to);
+/// Whether two unit vectors are parallel to within 1e-6 (the sine of the
+/// angle between them): an up vector that close to the view direction leaves
+/// the camera's right vector numerically meaningless.
+bool isParallel(const glm::dvec3& unitA, const glm::dvec3& unitB);
+
+// ---------------------------------------------------------------- overrides
+
 /// Image size from outside the scene file. `widthName`/`heightName` are how
 /// errors name each value: "--width", or "suite.toml: case foo: width".
 struct ResolutionOverride {

@@ -7,6 +7,8 @@
 // reading itself is scene/TomlReader.h; this file knows what a scene holds.
 #include "scene/SceneParser.h"
 
+#include "scene/SceneOverrides.h"
+
 #include "scene/TomlReader.h"
 #include "util/Hash.h"
 
@@ -73,27 +75,6 @@ Color readColor(const Field& field, ColorRange range)
 Color readUnitColor(const Field& field) { return readColor(field, ColorRange::Unit); }
 Color readRadiance(const Field& field) { return readColor(field, ColorRange::NonNegative); }
 
-// ------------------------------------------------------------------ geometry
-
-bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-/// Scaling by the largest component first lets legal extreme vectors (1e300 or
-/// 1e-300) normalize without overflow or underflow; nullopt for the zero vector.
-std::optional<glm::dvec3> normalized(const glm::dvec3& v)
-{
-    const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-    if (largest == 0) return std::nullopt;
-    return glm::normalize(v / largest);
-}
-
-/// to - from, halved when the full difference of two finite points overflows
-/// (only its direction is used).
-glm::dvec3 difference(const glm::dvec3& from, const glm::dvec3& to)
-{
-    const glm::dvec3 d = to - from;
-    return isFinite(d) ? d : to * 0.5 - from * 0.5;
-}
-
 // -------------------------------------------------------------------- render
 
 constexpr std::array<std::string_view, 2> renderKeys{"integrator", "max_depth"};
@@ -115,10 +96,6 @@ RenderSettings readRender(const TableField& table)
 
 constexpr std::array<std::string_view, 6> cameraKeys{"eye", "target", "up", "fov", "width", "height"};
 
-/// sin of the smallest accepted angle between up and the view direction; below
-/// it the camera's right vector is numerically meaningless.
-constexpr double parallelTolerance = 1e-6;
-
 glm::dvec3 readTarget(const Field& field, const glm::dvec3& eye)
 {
     const glm::dvec3 target = readVector(field);
@@ -132,7 +109,7 @@ glm::dvec3 readUp(const TableField& camera, const glm::dvec3& viewDirection)
     const glm::dvec3 up = field ? readVector(*field) : glm::dvec3(0, 1, 0);
     const std::optional<glm::dvec3> unitUp = normalized(up);
     if (!unitUp) field->fail("must not be zero-length"); // the default is not, so field exists
-    if (glm::length(glm::cross(*unitUp, viewDirection)) >= parallelTolerance) return up;
+    if (!isParallel(*unitUp, viewDirection)) return up;
     if (field) field->fail("must not be parallel to the view direction (target - eye)");
     camera.field().fail("the default up [0, 1, 0] is parallel to the view direction (target - eye); set 'up'");
 }
@@ -162,6 +139,8 @@ Camera readCamera(const TableField& table)
     camera.up = readUp(table, *normalized(difference(camera.eye, camera.target)));
     camera.fovY = readFov(table.require("fov"));
     readResolution(table, camera);
+    // The same rules that check overrides (SceneOverrides.h): the two can never disagree.
+    if (const auto problem = cameraProblem(camera)) table.field().fail(*problem);
     return camera;
 }
 
