@@ -19,7 +19,8 @@ int main(int argc, char** argv)
     app.add_option("--size", size, "Face width and height in texels")->check(CLI::Range(1u, 4096u));
     app.add_option("--sun-elevation", sky.sunElevationDegrees, "Degrees above the horizon")
         ->check(CLI::Range(-90.0, 90.0));
-    app.add_option("--sun-azimuth", sky.sunAzimuthDegrees, "Degrees from +z towards +x")->check(CLI::Range(-360.0, 360.0));
+    app.add_option("--sun-azimuth", sky.sunAzimuthDegrees, "Degrees from +z towards +x")
+        ->check(CLI::Range(-360.0, 360.0));
     app.add_option("--sun-radiance", sky.sunRadiance, "Radiance of the sun disk")->check(CLI::Range(0.0, 1e30));
     app.add_option("--sun-radius", sky.sunAngularRadiusDegrees, "Angular radius of the sun in degrees")
         ->check(CLI::Range(0.01, 45.0));

@@ -8,10 +8,10 @@
 VKRT_BEGIN_NAMESPACE
 
 // All kernels use descriptor set 0.
-VKRT_CONSTANT(uint, BINDING_UNIFORMS, 0)        // SceneUniforms (uniform buffer)
-VKRT_CONSTANT(uint, BINDING_ACCUMULATION, 1)    // AccumPixel[width*height]
-VKRT_CONSTANT(uint, BINDING_STATS, 2)           // RenderStats
-VKRT_CONSTANT(uint, BINDING_MATERIALS, 3)       // Material[]
+VKRT_CONSTANT(uint, BINDING_UNIFORMS, 0)     // SceneUniforms (uniform buffer)
+VKRT_CONSTANT(uint, BINDING_ACCUMULATION, 1) // AccumPixel[width*height]
+VKRT_CONSTANT(uint, BINDING_STATS, 2)        // RenderStats
+VKRT_CONSTANT(uint, BINDING_MATERIALS, 3)    // Material[]
 // Then one array per shape and light kind of the registry (shared/Kinds.h), in
 // its order: BINDING_SPHERES = 4 (Sphere[]), ..., BINDING_TRIANGLE_LIGHTS = 9.
 #define VKRT_SHAPE_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
@@ -24,7 +24,8 @@ VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 4 + SHAPE_KIND_COUNT + LIGHT_KIND_COUNT
 // Variance estimation: MomentPixel[width*height], or under the Sobol' sampler
 // AccumPixel[width*height*VARIANCE_BATCHES].
 VKRT_CONSTANT(uint, BINDING_MOMENTS, BINDING_ENVIRONMENT + 1)
-VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, BINDING_ENVIRONMENT + 2) // float[6 N^2 + 1]: cumulative texel probabilities
+// float[6 N^2 + 1]: cumulative texel probabilities.
+VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, BINDING_ENVIRONMENT + 2)
 VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 3)
 
 // Under the Sobol' sampler the variance comes from this many independently

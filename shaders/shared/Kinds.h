@@ -26,21 +26,21 @@
 #define VKRT_SHARED_KINDS_H
 #include "Interop.h"
 
-#define VKRT_MATERIAL_KINDS(X)                 \
-    X(LAMBERT, Lambert, lambert, 0, 0)         \
-    X(PHONG, Phong, phong, 1, 0)               \
-    X(MIRROR, Mirror, mirror, 2, 1)            \
-    X(GLOSSY, Glossy, glossy, 3, 0)            \
+#define VKRT_MATERIAL_KINDS(X)         \
+    X(LAMBERT, Lambert, lambert, 0, 0) \
+    X(PHONG, Phong, phong, 1, 0)       \
+    X(MIRROR, Mirror, mirror, 2, 1)    \
+    X(GLOSSY, Glossy, glossy, 3, 0)    \
     X(DIELECTRIC, Dielectric, dielectric, 4, 1)
 
-#define VKRT_SHAPE_KINDS(X)                                                   \
-    X(SPHERE, Sphere, sphere, 0, sphere, spheres, SPHERES, 819)               \
-    X(BOX, Box, box, 1, box, boxes, BOXES, 585)                               \
-    X(TRIANGLE, Triangle, triangle, 2, triangle, triangles, TRIANGLES, 409)   \
+#define VKRT_SHAPE_KINDS(X)                                                 \
+    X(SPHERE, Sphere, sphere, 0, sphere, spheres, SPHERES, 819)             \
+    X(BOX, Box, box, 1, box, boxes, BOXES, 585)                             \
+    X(TRIANGLE, Triangle, triangle, 2, triangle, triangles, TRIANGLES, 409) \
     X(PLANE, Plane, plane, 3, plane, planes, PLANES, 585)
 
-#define VKRT_LIGHT_KINDS(X)                                                                    \
-    X(POINT, PointLight, point, 0, pointLight, pointLights, POINT_LIGHTS, 682)                 \
+#define VKRT_LIGHT_KINDS(X)                                                    \
+    X(POINT, PointLight, point, 0, pointLight, pointLights, POINT_LIGHTS, 682) \
     X(TRIANGLE, TriangleLight, triangle, 1, triangleLight, triangleLights, TRIANGLE_LIGHTS, 292)
 
 // ------------------------------------------------------ derived constants

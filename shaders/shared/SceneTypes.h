@@ -85,9 +85,9 @@ VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 315) // 16384 / 52
 #define VKRT_COUNT_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) uint field##Count;
 
 struct SceneUniforms {
-    vec3 cameraRight;   // scaled by tan(fov/2) * aspect
+    vec3 cameraRight; // scaled by tan(fov/2) * aspect
     uint width;
-    vec3 cameraUp;      // scaled by tan(fov/2)
+    vec3 cameraUp; // scaled by tan(fov/2)
     uint height;
     vec3 cameraForward;
     uint flags;
@@ -95,9 +95,9 @@ struct SceneUniforms {
     uint maxDepth;
     VKRT_SHAPE_KINDS(VKRT_COUNT_MEMBER)
     VKRT_LIGHT_KINDS(VKRT_COUNT_MEMBER)
-    uint tileCount;     // workgroup tiles in the image
-    uint tileStride;    // coprime to tileCount: scatters tiles over the image
-    uint environmentSize; // cubemap face width N (0 without a cubemap)
+    uint tileCount;         // workgroup tiles in the image
+    uint tileStride;        // coprime to tileCount: scatters tiles over the image
+    uint environmentSize;   // cubemap face width N (0 without a cubemap)
     uint cameraMediumCount; // dielectrics containing the eye (lib/media.glsl)
     uvec4 cameraMedia;      // their materials, innermost last
 };

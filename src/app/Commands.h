@@ -21,11 +21,11 @@ CommandRunner addRegressCommand(CLI::App& app);
 /// Process exit codes.
 enum ExitCode : int {
     kExitOk = 0,
-    kExitFailure = 1,      ///< GPU, driver or internal failure
-    kExitBadInput = 2,     ///< scene file, option or input image error
-    kExitValidation = 3,   ///< Vulkan validation layer reported messages
+    kExitFailure = 1,       ///< GPU, driver or internal failure
+    kExitBadInput = 2,      ///< scene file, option or input image error
+    kExitValidation = 3,    ///< Vulkan validation layer reported messages
     kExitCompareFailed = 4, ///< `compare`: a threshold or the pixel test failed
-    kExitInterrupted = 130 ///< SIGINT; partial results were written
+    kExitInterrupted = 130  ///< SIGINT; partial results were written
 };
 
 } // namespace vkrt

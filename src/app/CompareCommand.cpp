@@ -68,7 +68,6 @@ std::optional<VarianceImage> varianceFor(const std::string& explicitPath, const 
     return variance;
 }
 
-
 void requireSameSize(const CompareOptions& o, const Image& a, const Image& b)
 {
     if (a.width != b.width || a.height != b.height)
@@ -93,15 +92,16 @@ int runCompare(const CompareOptions& o)
 
     std::vector<std::string> failures;
     if (e.nonFiniteA || e.nonFiniteB) failures.push_back("non-finite values");
-    if (o.maxRmse && !(e.rmse <= *o.maxRmse)) failures.push_back("RMSE exceeds --max-rmse " + std::to_string(*o.maxRmse));
+    if (o.maxRmse && !(e.rmse <= *o.maxRmse))
+        failures.push_back("RMSE exceeds --max-rmse " + std::to_string(*o.maxRmse));
     if (o.maxRelMse && !(e.relMse <= *o.maxRelMse))
         failures.push_back("relMSE exceeds --max-relmse " + std::to_string(*o.maxRelMse));
     if (va || vb) {
         VarianceImage zero{Image(a.image.width, a.image.height)};
         const VarianceImage& varA = va ? *va : zero;
         const VarianceImage& varB = vb ? *vb : zero;
-        PixelTestSummary t = pixelZTest(a.image, varA.image, b.image, varB.image, o.alpha, varA.degreesOfFreedom,
-                                        varB.degreesOfFreedom);
+        PixelTestSummary t =
+            pixelZTest(a.image, varA.image, b.image, varB.image, o.alpha, varA.degreesOfFreedom, varB.degreesOfFreedom);
         bool welch = std::isfinite(varA.degreesOfFreedom) || std::isfinite(varB.degreesOfFreedom);
         std::printf("pixel test  %zu of %zu values pass (%.4f%%), p >= %.3g (alpha %.3g, Sidak; %s); smallest p %.3g\n",
                     t.passed, t.tested, 100.0 * t.fractionPassed(), t.threshold, o.alpha,
@@ -126,7 +126,8 @@ CommandRunner addCompareCommand(CLI::App& app)
     cmd->add_option("--variance-b", o->varianceB, "Variance of B's pixel means (default: B's 'variance' layer)");
     cmd->add_option("--max-rmse", o->maxRmse, "Fail when the RMSE exceeds this")->check(CLI::NonNegativeNumber);
     cmd->add_option("--max-relmse", o->maxRelMse, "Fail when the relMSE exceeds this")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--alpha", o->alpha, "Significance of the pixel test over all values")->check(CLI::Range(1e-12, 0.5));
+    cmd->add_option("--alpha", o->alpha, "Significance of the pixel test over all values")
+        ->check(CLI::Range(1e-12, 0.5));
     cmd->add_option("--min-pass", o->minPass, "Fraction of values that must pass the pixel test")
         ->check(CLI::Range(0.0, 1.0));
     return [o] { return runCompare(*o); };

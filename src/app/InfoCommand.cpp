@@ -48,10 +48,12 @@ int runInfo(const InfoOptions& options)
     std::printf("defines:        %s\n", describeDefines(features.defines()).c_str());
     std::printf("bindings:       %zu\n", features.bindings().size());
     std::printf("spirv bytes:    %zu\n", kernel.spirv.size() * sizeof(uint32_t));
-    std::printf("glslang:        %s\n", kernel.fromCache ? "cache hit (0 s)" : (std::to_string(kernel.compileSeconds) + " s").c_str());
+    std::printf("glslang:        %s\n",
+                kernel.fromCache ? "cache hit (0 s)" : (std::to_string(kernel.compileSeconds) + " s").c_str());
     std::printf("spirv cache:    %s\n", renderOptions.cacheDirectory.c_str());
     std::printf("set-up:         %.3f s (parse excluded: compile or load, pipeline, buffers)\n", setupSeconds);
-    std::printf("first frame:    %.3f s after set-up began (includes the driver's shader compile)\n", firstFrameSeconds);
+    std::printf("first frame:    %.3f s after set-up began (includes the driver's shader compile)\n",
+                firstFrameSeconds);
     std::printf("loop cap:       %s\n", context.loopCap().describe().c_str());
     std::printf("loop passes:    worst case %llu per invocation%s\n",
                 static_cast<unsigned long long>(worstCaseLoopIterations(scene)),

@@ -12,8 +12,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -156,7 +156,8 @@ Outcome runRender(const RenderCommandOptions& options)
     LoopResult loop = renderWithProgress(session, report, lastCheckpoint);
     const Renderer& renderer = session.renderer();
     if (renderer.completedFrames() == 0)
-        return Outcome::of(OutcomeKind::Interrupted, {"vkrt: interrupted before the first frame finished; nothing written"});
+        return Outcome::of(OutcomeKind::Interrupted,
+                           {"vkrt: interrupted before the first frame finished; nothing written"});
 
     Film film = session.film();
     Metadata metadata = session.metadata(film);
@@ -189,7 +190,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     CLI::App* cmd = app.add_subcommand("render", "Render a scene file to an OpenEXR image");
     cmd->add_option("scene", options->scenePath, "Scene file (TOML, see docs/scene-format.md)")->required();
     cmd->add_option("-o,--output", options->output, "Output EXR (default: SCENE's name with .exr, here)");
-    cmd->add_option("--spp", options->spp, "Samples per pixel (default 64; with --time-budget or --target-error: no limit)")
+    cmd->add_option("--spp", options->spp,
+                    "Samples per pixel (default 64; with --time-budget or --target-error: no limit)")
         ->check(CLI::Range(1u, 1u << 30))
         ->each([options](const std::string&) { options->sppGiven = true; });
     // Checked with the scene parser's limits (SceneOverrides.h) once the scene is read.
@@ -198,7 +200,9 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--seed", options->seed, "Random seed (same seed, same image)");
     cmd->add_option("--device", options->device, "Vulkan device index or name (see `vkrt devices`)");
     cmd->add_option("--png", options->png, "Also write a tone-mapped 8-bit sRGB PNG preview");
-    cmd->add_option("--exposure", options->exposure, "PNG exposure in stops (x 2^E)")->check(finiteNumber)->check(CLI::Range(-64.0, 64.0));
+    cmd->add_option("--exposure", options->exposure, "PNG exposure in stops (x 2^E)")
+        ->check(finiteNumber)
+        ->check(CLI::Range(-64.0, 64.0));
     cmd->add_flag("--validation", options->validation,
                   "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");

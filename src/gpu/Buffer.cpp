@@ -35,9 +35,8 @@ void Buffer::upload(const VulkanContext& context, std::span<const std::byte> byt
     }
     Buffer staging(context, bytes.size(), vk::BufferUsageFlagBits::eTransferSrc, MemoryUse::Readback);
     staging.upload(context, bytes);
-    context.submitAndWait([&](vk::CommandBuffer cmd) {
-        cmd.copyBuffer(staging.handle(), handle(), vk::BufferCopy(0, 0, bytes.size()));
-    });
+    context.submitAndWait(
+        [&](vk::CommandBuffer cmd) { cmd.copyBuffer(staging.handle(), handle(), vk::BufferCopy(0, 0, bytes.size())); });
 }
 
 void Buffer::clear(const VulkanContext& context)
@@ -55,9 +54,8 @@ std::vector<std::byte> Buffer::download(const VulkanContext& context) const
         return bytes;
     }
     Buffer staging(context, m_size, vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Readback);
-    context.submitAndWait([&](vk::CommandBuffer cmd) {
-        cmd.copyBuffer(handle(), staging.handle(), vk::BufferCopy(0, 0, m_size));
-    });
+    context.submitAndWait(
+        [&](vk::CommandBuffer cmd) { cmd.copyBuffer(handle(), staging.handle(), vk::BufferCopy(0, 0, m_size)); });
     return staging.download(context);
 }
 

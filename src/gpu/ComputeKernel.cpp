@@ -24,7 +24,9 @@ std::vector<KernelBinding> renderKernelBindings(const std::vector<uint32_t>& ind
 
 ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv,
                              std::vector<KernelBinding> bindings, uint32_t pushConstantSize)
-    : m_context(context), m_bindings(std::move(bindings)), m_pushConstantSize(pushConstantSize)
+    : m_context(context),
+      m_bindings(std::move(bindings)),
+      m_pushConstantSize(pushConstantSize)
 {
     const auto& device = context.device();
     m_module = vk::raii::ShaderModule(device, vk::ShaderModuleCreateInfo({}, spirv.size_bytes(), spirv.data()));
@@ -44,17 +46,21 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
     m_pipelineLayout = vk::raii::PipelineLayout(device, layoutInfo);
 
     vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *m_module, "main");
-    m_pipeline = vk::raii::Pipeline(device, nullptr, vk::ComputePipelineCreateInfo(vk::PipelineCreateFlagBits::eDispatchBase, stage, *m_pipelineLayout));
+    m_pipeline = vk::raii::Pipeline(device, nullptr,
+                                    vk::ComputePipelineCreateInfo(vk::PipelineCreateFlagBits::eDispatchBase, stage,
+                                                                  *m_pipelineLayout));
 
-    m_pool = vk::raii::DescriptorPool(
-        device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
+    m_pool = vk::raii::DescriptorPool(device,
+                                      vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
+                                                                   1, poolSizes));
     vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*m_pool, setLayout));
     m_set = std::move(sets[0]);
 }
 
 bool ComputeKernel::uses(uint32_t binding) const
 {
-    return std::any_of(m_bindings.begin(), m_bindings.end(), [&](const KernelBinding& b) { return b.index == binding; });
+    return std::any_of(m_bindings.begin(), m_bindings.end(),
+                       [&](const KernelBinding& b) { return b.index == binding; });
 }
 
 vk::DescriptorType ComputeKernel::typeOf(uint32_t binding) const

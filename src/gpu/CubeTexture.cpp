@@ -42,14 +42,17 @@ CubeTexture::CubeTexture(const VulkanContext& context, const std::array<Image, 6
     vk::raii::Image image(device, info);
     auto requirements = image.getMemoryRequirements();
     m_memory = vk::raii::DeviceMemory(
-        device, vk::MemoryAllocateInfo(requirements.size, context.findMemoryType(requirements.memoryTypeBits,
-                                                                                vk::MemoryPropertyFlagBits::eDeviceLocal)));
+        device,
+        vk::MemoryAllocateInfo(requirements.size, context.findMemoryType(requirements.memoryTypeBits,
+                                                                         vk::MemoryPropertyFlagBits::eDeviceLocal)));
     m_image = std::move(image);
     m_image.bindMemory(*m_memory, 0);
     upload(context, faces, size);
 
-    m_view = vk::raii::ImageView(device, vk::ImageViewCreateInfo({}, *m_image, vk::ImageViewType::eCube, kFormat, {},
-                                                                 vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 6)));
+    m_view =
+        vk::raii::ImageView(device, vk::ImageViewCreateInfo({}, *m_image, vk::ImageViewType::eCube, kFormat, {},
+                                                            vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor,
+                                                                                      0, 1, 0, 6)));
     // Linear filtering when the device can filter float32, else nearest texels.
     bool linear = bool(context.physicalDevice().getFormatProperties(kFormat).optimalTilingFeatures &
                        vk::FormatFeatureFlagBits::eSampledImageFilterLinear);

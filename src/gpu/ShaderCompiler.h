@@ -22,7 +22,7 @@ struct KernelSource {
 
 struct CompiledKernel {
     std::vector<uint32_t> spirv;
-    std::string cacheKey;        ///< hex hash identifying the variant
+    std::string cacheKey; ///< hex hash identifying the variant
     bool fromCache = false;
     double compileSeconds = 0.0; ///< glslang time (0 on a cache hit)
 };

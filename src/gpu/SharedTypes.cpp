@@ -16,11 +16,12 @@ static_assert(sizeof(Material) == 52);
 // below: 16384 / (capacity + 1) < size <= 16384 / capacity admits one size.
 // Each uniform scene array fills at most the 16 KiB every Vulkan device allows.
 constexpr uint32_t kUniformArrayBytes = 16384;
-static_assert(UNIFORM_MATERIALS * sizeof(Material) <= kUniformArrayBytes && (UNIFORM_MATERIALS + 1) * sizeof(Material) > kUniformArrayBytes);
+static_assert(UNIFORM_MATERIALS * sizeof(Material) <= kUniformArrayBytes &&
+              (UNIFORM_MATERIALS + 1) * sizeof(Material) > kUniformArrayBytes);
 // The registry's capacities (shared/Kinds.h) are exactly what 16 KiB holds.
 #define VKRT_CHECK_CAPACITY(KIND, Type, name, value, field, array, ARRAY, capacity)                      \
     static_assert(capacity == UNIFORM_##ARRAY && UNIFORM_##ARRAY * sizeof(Type) <= kUniformArrayBytes && \
-                      (UNIFORM_##ARRAY + 1) * sizeof(Type) > kUniformArrayBytes,                        \
+                      (UNIFORM_##ARRAY + 1) * sizeof(Type) > kUniformArrayBytes,                         \
                   "shared/Kinds.h: the capacity of " #array " must be 16384 / sizeof(" #Type ")");
 VKRT_SHAPE_KINDS(VKRT_CHECK_CAPACITY)
 VKRT_LIGHT_KINDS(VKRT_CHECK_CAPACITY)
@@ -28,16 +29,17 @@ VKRT_LIGHT_KINDS(VKRT_CHECK_CAPACITY)
 
 // Every scene array has a binding of its own, distinct from the fixed ones.
 #define VKRT_BINDING_OF(KIND, Type, name, value, field, array, ARRAY, capacity) BINDING_##ARRAY,
-constexpr uint kSceneArrayBindings[] = {BINDING_MATERIALS, VKRT_SHAPE_KINDS(VKRT_BINDING_OF)
-                                            VKRT_LIGHT_KINDS(VKRT_BINDING_OF)};
+constexpr uint kSceneArrayBindings[] = {BINDING_MATERIALS,
+                                        VKRT_SHAPE_KINDS(VKRT_BINDING_OF) VKRT_LIGHT_KINDS(VKRT_BINDING_OF)};
 #undef VKRT_BINDING_OF
 constexpr bool bindingsDistinct()
 {
-    constexpr uint fixed[] = {BINDING_UNIFORMS, BINDING_ACCUMULATION, BINDING_STATS,
-                              BINDING_ENVIRONMENT, BINDING_MOMENTS, BINDING_ENVIRONMENT_CDF};
+    constexpr uint fixed[] = {BINDING_UNIFORMS,    BINDING_ACCUMULATION, BINDING_STATS,
+                              BINDING_ENVIRONMENT, BINDING_MOMENTS,      BINDING_ENVIRONMENT_CDF};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
-        for (uint f : fixed) if (a == f) return false;
+        for (uint f : fixed)
+            if (a == f) return false;
         int seen = 0;
         for (uint b : kSceneArrayBindings) seen += a == b;
         if (seen != 1) return false;

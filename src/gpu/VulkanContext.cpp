@@ -61,8 +61,7 @@ std::optional<uint32_t> findComputeQueueFamily(const vk::raii::PhysicalDevice& d
 
 std::string unsuitableReason(const vk::raii::PhysicalDevice& device, const DeviceInfo& info, vk::SurfaceKHR surface)
 {
-    if (info.apiVersion < kRequiredApiVersion)
-        return "supports Vulkan " + info.apiVersionString() + ", vkrt needs 1.2";
+    if (info.apiVersion < kRequiredApiVersion) return "supports Vulkan " + info.apiVersionString() + ", vkrt needs 1.2";
     if (!info.computeQueueFamily)
         return surface ? "has no queue that can compute, blit and present to this window" : "has no compute queue";
     auto features = device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features>();
@@ -183,8 +182,9 @@ void VulkanContext::chooseDevice(const std::string& selector)
         throw GpuError("no Vulkan device found; install mesa-vulkan-drivers for lavapipe (software Vulkan)");
     m_deviceIndex = selector.empty() ? defaultDeviceIndex(m_devices) : selectDevice(m_devices, selector);
     const DeviceInfo& chosen = m_devices[m_deviceIndex];
-    if (!chosen.suitable()) throw GpuError("device " + std::to_string(chosen.index) + " (" + chosen.name +
-                                           ") cannot run vkrt: it " + chosen.unsuitableReason);
+    if (!chosen.suitable())
+        throw GpuError("device " + std::to_string(chosen.index) + " (" + chosen.name + ") cannot run vkrt: it " +
+                       chosen.unsuitableReason);
     m_physicalDevice = std::move(physical[m_deviceIndex]);
 }
 
@@ -199,8 +199,9 @@ void VulkanContext::createDevice()
     chain.get<vk::PhysicalDeviceVulkan12Features>().setScalarBlockLayout(true);
     m_device = vk::raii::Device(m_physicalDevice, chain.get<vk::DeviceCreateInfo>());
     m_queue = vk::raii::Queue(m_device, queueFamily(), 0);
-    m_commandPool = vk::raii::CommandPool(
-        m_device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer, queueFamily()));
+    m_commandPool =
+        vk::raii::CommandPool(m_device, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer,
+                                                                  queueFamily()));
 }
 
 uint32_t VulkanContext::findMemoryType(uint32_t typeBits, vk::MemoryPropertyFlags required,
@@ -221,8 +222,8 @@ uint32_t VulkanContext::findMemoryType(uint32_t typeBits, vk::MemoryPropertyFlag
 
 vk::raii::CommandBuffer VulkanContext::beginOneShot() const
 {
-    vk::raii::CommandBuffers buffers(m_device,
-                                     vk::CommandBufferAllocateInfo(*m_commandPool, vk::CommandBufferLevel::ePrimary, 1));
+    vk::raii::CommandBuffers buffers(m_device, vk::CommandBufferAllocateInfo(*m_commandPool,
+                                                                             vk::CommandBufferLevel::ePrimary, 1));
     vk::raii::CommandBuffer cmd = std::move(buffers[0]);
     cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
     return cmd;
@@ -257,7 +258,8 @@ uint32_t defaultDeviceIndex(const std::vector<DeviceInfo>& devices)
     for (const auto& d : devices)
         if (d.suitable()) return d.index;
     std::string reasons;
-    for (const auto& d : devices) reasons += "\n  " + std::to_string(d.index) + ": " + d.name + ": " + d.unsuitableReason;
+    for (const auto& d : devices)
+        reasons += "\n  " + std::to_string(d.index) + ": " + d.name + ": " + d.unsuitableReason;
     throw GpuError("no Vulkan device can run vkrt:" + reasons);
 }
 

@@ -20,7 +20,7 @@ struct DeviceInfo {
     uint32_t index = 0;
     std::string name;
     vk::PhysicalDeviceType type = vk::PhysicalDeviceType::eOther;
-    std::string driver; ///< driver name and info, e.g. "llvmpipe: Mesa 22.3.6 (LLVM 15.0.6)"
+    std::string driver;      ///< driver name and info, e.g. "llvmpipe: Mesa 22.3.6 (LLVM 15.0.6)"
     vk::DriverId driverId{}; ///< e.g. eMesaLlvmpipe for lavapipe
     uint32_t apiVersion = 0;
     std::optional<uint32_t> computeQueueFamily;
@@ -89,7 +89,8 @@ public:
                             vk::MemoryPropertyFlags preferred = {}) const;
 
     /// Records commands with `record`, submits them and waits for completion.
-    template <typename Record> void submitAndWait(Record&& record) const
+    template <typename Record>
+    void submitAndWait(Record&& record) const
     {
         vk::raii::CommandBuffer cmd = beginOneShot();
         record(*cmd);

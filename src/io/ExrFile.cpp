@@ -20,7 +20,10 @@ namespace {
 
 const char* const kChannels[3] = {"R", "G", "B"};
 
-std::string channelName(const std::string& layer, int c) { return layer.empty() ? kChannels[c] : layer + "." + kChannels[c]; }
+std::string channelName(const std::string& layer, int c)
+{
+    return layer.empty() ? kChannels[c] : layer + "." + kChannels[c];
+}
 
 void addChannels(Imf::Header& header, Imf::FrameBuffer& frame, const std::string& layer, const Image& image)
 {
@@ -50,7 +53,8 @@ Metadata readAttributes(const Imf::Header& header)
     for (auto it = header.begin(); it != header.end(); ++it) {
         const Imf::Attribute& attribute = it.attribute();
         if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&attribute)) metadata[it.name()] = s->value();
-        else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&attribute)) metadata[it.name()] = int64_t(i->value());
+        else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&attribute))
+            metadata[it.name()] = int64_t(i->value());
         else if (auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&attribute)) metadata[it.name()] = d->value();
     }
     return metadata;

@@ -59,7 +59,7 @@ Image readPng(const std::filesystem::path& path)
 {
     int width = 0, height = 0, channels = 0;
     std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(path.c_str(), &width, &height, &channels, 3),
-                                                      stbi_image_free);
+                                                     stbi_image_free);
     if (!pixels)
         throw InputError(path.string() + ": cannot read PNG: " + (stbi_failure_reason() ? stbi_failure_reason() : "?"));
     Image image{uint32_t(width), uint32_t(height)};

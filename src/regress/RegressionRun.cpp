@@ -47,7 +47,8 @@ std::string makeHint(const RegressionCase& c)
 Image readReferenceImage(const RegressionCase& c, const fs::path& path, uint32_t width, uint32_t height,
                          bool isVariance)
 {
-    if (!fs::exists(path)) throw InputError("case " + c.name + ": missing reference " + path.string() + "; " + makeHint(c));
+    if (!fs::exists(path))
+        throw InputError("case " + c.name + ": missing reference " + path.string() + "; " + makeHint(c));
     Image image;
     try {
         image = readExr(path).image;
@@ -55,8 +56,8 @@ Image readReferenceImage(const RegressionCase& c, const fs::path& path, uint32_t
         throw InputError("case " + c.name + ": " + e.what());
     }
     if (image.width != width || image.height != height)
-        throw InputError("case " + c.name + ": reference " + path.string() + " is " + std::to_string(image.width) + "x" +
-                         std::to_string(image.height) + " but the case renders " + std::to_string(width) + "x" +
+        throw InputError("case " + c.name + ": reference " + path.string() + " is " + std::to_string(image.width) +
+                         "x" + std::to_string(image.height) + " but the case renders " + std::to_string(width) + "x" +
                          std::to_string(height) + " (match width/height in the manifest, or regenerate it)");
     size_t invalid = std::count_if(image.rgb.begin(), image.rgb.end(),
                                    [&](float v) { return !std::isfinite(v) || (isVariance && v < 0.0f); });
@@ -179,7 +180,7 @@ struct CaseResult {
     std::string name;
     bool passed = false;
     bool slow = false;
-    std::string error; ///< set when the case could not run
+    std::string error;                           ///< set when the case could not run
     OutcomeKind errorKind = OutcomeKind::Passed; ///< what that error was
     ReferenceTestResult test;
     MeasuredError measured;
@@ -243,7 +244,8 @@ std::optional<CaseResult> runCase(const VulkanContext& context, const Regression
     result.baseline = c.baselineSeconds;
     result.reference = referenceLabel(c);
     try {
-        std::optional<Rendered> r = renderCase(context, pc.scene, c.spp, suite.seed + options.seedOffset, options.kernelDefines);
+        std::optional<Rendered> r =
+            renderCase(context, pc.scene, c.spp, suite.seed + options.seedOffset, options.kernelDefines);
         if (!r) return std::nullopt;
         result.test = testRender(*r, c.spp, pc.reference, c.referenceSpp, suite);
         result.measured = measureError(r->mean, pc.reference.mean);
@@ -283,12 +285,13 @@ std::string markdownHeader(const RegressionSuite& suite, const std::vector<CaseR
        << context.deviceInfo().driver << ")\n"
        << "- driver manifest: " << (options.driver.empty() ? "system default" : "`" + options.driver + "`") << "\n"
        << "- seed: " << suite.seed + options.seedOffset << "\n";
-    for (const Define& d : options.kernelDefines) md << "- kernel define (test hook): `" << d.first << "=" << d.second << "`\n";
+    for (const Define& d : options.kernelDefines)
+        md << "- kernel define (test hook): `" << d.first << "=" << d.second << "`\n";
     md << "- rule: at least " << 100.0 * suite.minPass << " % of values pass a Sidak-corrected z-test at alpha "
        << suite.alpha << ", |pooled z| within alpha " << suite.pooledAlpha
        << " (per channel, Sidak over 3), no more rejected (non-finite) samples than the case's max_rejected (default 0)"
-       << " (docs/regress.md); slow = more than " << suite.maxSlowdown
-       << " x baseline\n- result: **" << passed << " passed, " << results.size() - passed << " failed**";
+       << " (docs/regress.md); slow = more than " << suite.maxSlowdown << " x baseline\n- result: **" << passed
+       << " passed, " << results.size() - passed << " failed**";
     if (results.size() < status.total)
         md << " (" << results.size() << " of " << status.total << " cases"
            << (status.interrupted ? ": **interrupted**" : " so far") << ")";
@@ -327,10 +330,11 @@ std::string markdownReport(const RegressionSuite& suite, const std::vector<CaseR
     for (const CaseResult& r : results) {
         if (r.passed || !r.error.empty() || r.test.tested == 0) continue;
         std::string base = safeName(r.name);
-        md << "\n## " << r.name << "\n\n" << r.test.tested - r.test.passed << " of " << r.test.tested
-           << " values beyond |z| = " << r.test.threshold << "; pooled z " << r.test.pooledZ << " (limit "
-           << r.test.pooledThreshold << "); " << r.rejectedSamples << " rejected samples. Result with variance: `"
-           << base << "-result.exr`, p-values: `" << base << "-pvalues.exr`.\n\n"
+        md << "\n## " << r.name << "\n\n"
+           << r.test.tested - r.test.passed << " of " << r.test.tested << " values beyond |z| = " << r.test.threshold
+           << "; pooled z " << r.test.pooledZ << " (limit " << r.test.pooledThreshold << "); " << r.rejectedSamples
+           << " rejected samples. Result with variance: `" << base << "-result.exr`, p-values: `" << base
+           << "-pvalues.exr`.\n\n"
            << "| reference | result | difference | significance |\n| --- | --- | --- | --- |\n"
            << "| ![](" << base << "-reference.png) | ![](" << base << "-result.png) | ![](" << base
            << "-difference.png) | ![](" << base << "-significance.png) |\n";
@@ -356,7 +360,8 @@ std::string failureMessage(const CaseResult& r)
 {
     std::ostringstream m;
     m << 100.0 * r.test.fractionPassed() << "% of values pass; pooled z " << r.test.pooledZ << "; smallest p "
-      << r.test.minPValue << "; " << r.rejectedSamples << " rejected samples" << (r.slow ? "; slower than baseline" : "");
+      << r.test.minPValue << "; " << r.rejectedSamples << " rejected samples"
+      << (r.slow ? "; slower than baseline" : "");
     return m.str();
 }
 
@@ -365,11 +370,13 @@ std::string junitReport(const std::vector<CaseResult>& results)
     std::ostringstream xml;
     size_t failures = 0, errors = 0;
     double total = 0;
-    for (const auto& r : results) failures += !r.passed && r.error.empty(), errors += !r.error.empty(), total += r.seconds;
+    for (const auto& r : results)
+        failures += !r.passed && r.error.empty(), errors += !r.error.empty(), total += r.seconds;
     xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuite name=\"vkrt-regress\" tests=\"" << results.size()
         << "\" failures=\"" << failures << "\" errors=\"" << errors << "\" time=\"" << total << "\">\n";
     for (const auto& r : results) {
-        xml << "  <testcase classname=\"vkrt.regress\" name=\"" << xmlEscape(r.name) << "\" time=\"" << r.seconds << "\"";
+        xml << "  <testcase classname=\"vkrt.regress\" name=\"" << xmlEscape(r.name) << "\" time=\"" << r.seconds
+            << "\"";
         if (r.passed) {
             xml << "/>\n";
             continue;
@@ -422,7 +429,7 @@ Outcome outcomeOf(const std::vector<CaseResult>& results)
 }
 
 Outcome runCases(const VulkanContext& context, const RegressionSuite& suite, const std::vector<PreparedCase>& cases,
-             const RegressOptions& options)
+                 const RegressOptions& options)
 {
     std::vector<CaseResult> results;
     RunStatus status{cases.size(), false};
@@ -496,7 +503,8 @@ void writeReferenceReadme(const VulkanContext& context, const RegressionSuite& s
            << context.deviceInfo().name << " (" << context.deviceInfo().driver << ") |\n| image | "
            << scene.camera.width << " x " << scene.camera.height << " |\n| spp | " << c.referenceSpp << " (seed "
            << kReferenceSeed << ") |\n| date | " << date << " |\n| render time | " << std::lround(seconds)
-           << " s |\n\n`mean.exr` is the per-pixel mean, `variance.exr` the variance of that mean (sample variance / spp).\n";
+           << " s |\n\n`mean.exr` is the per-pixel mean, `variance.exr` the variance of that mean (sample variance / "
+              "spp).\n";
     writeText(c.referenceDir / "README.md", readme.str());
 }
 
@@ -521,7 +529,8 @@ bool updateReference(const VulkanContext& context, const RegressionSuite& suite,
     return true;
 }
 
-Outcome updateReferences(const VulkanContext& context, const RegressionSuite& suite, const std::vector<RegressionCase>& cases)
+Outcome updateReferences(const VulkanContext& context, const RegressionSuite& suite,
+                         const std::vector<RegressionCase>& cases)
 {
     std::set<fs::path> updated;
     for (const RegressionCase& c : cases) {
@@ -548,9 +557,8 @@ std::vector<RegressionCase> selectedCases(const RegressionSuite& suite, const st
 {
     std::vector<RegressionCase> cases;
     auto matches = [&](const std::string& name) {
-        return filters.empty() || std::any_of(filters.begin(), filters.end(), [&](const std::string& f) {
-                   return name.find(f) != std::string::npos;
-               });
+        return filters.empty() || std::any_of(filters.begin(), filters.end(),
+                                              [&](const std::string& f) { return name.find(f) != std::string::npos; });
     };
     for (const auto& c : suite.cases)
         if (matches(c.name)) cases.push_back(c);
@@ -590,7 +598,8 @@ void createReportDir(const fs::path& dir)
     std::error_code error;
     fs::create_directories(dir, error);
     if (error || !fs::is_directory(dir))
-        throw InputError("--report-dir " + dir.string() + ": cannot create it (" + (error ? error.message() : "not a directory") + ")");
+        throw InputError("--report-dir " + dir.string() + ": cannot create it (" +
+                         (error ? error.message() : "not a directory") + ")");
 }
 
 } // namespace
@@ -608,7 +617,8 @@ void selectVulkanDriver(const fs::path& icdManifest)
     std::string library = jsonString(text, "library_path");
     if (library.empty()) throw InputError(option + ": the ICD manifest has no \"library_path\"");
     // A bare file name is looked up by the dynamic linker; a path is relative to the manifest.
-    fs::path libraryPath = (fs::path(library).is_absolute() ? fs::path(library) : path.parent_path() / library).lexically_normal();
+    fs::path libraryPath =
+        (fs::path(library).is_absolute() ? fs::path(library) : path.parent_path() / library).lexically_normal();
     if (library.find('/') != std::string::npos && !fs::exists(libraryPath))
         throw InputError(option + ": its library_path " + libraryPath.string() + " does not exist");
     setenv("VK_DRIVER_FILES", path.c_str(), 1);
@@ -619,7 +629,8 @@ Outcome runRegression(const RegressOptions& options)
 {
     RegressionSuite suite = readRegressionSuite(options.suite);
     if (options.update && !options.kernelDefines.empty())
-        throw InputError("--update cannot be combined with --kernel-define: references must come from unmodified kernels");
+        throw InputError(
+            "--update cannot be combined with --kernel-define: references must come from unmodified kernels");
     std::vector<RegressionCase> cases = selectedCases(suite, options.filters);
     if (!options.driver.empty()) selectVulkanDriver(options.driver);
     std::vector<PreparedCase> prepared;

@@ -12,13 +12,13 @@ namespace vkrt {
 
 struct RegressOptions {
     std::filesystem::path suite;
-    std::vector<std::string> filters;  ///< run cases whose name contains any of these (all when empty)
-    std::string driver;                ///< Vulkan ICD manifest (JSON) to load instead of the system's
+    std::vector<std::string> filters; ///< run cases whose name contains any of these (all when empty)
+    std::string driver;               ///< Vulkan ICD manifest (JSON) to load instead of the system's
     std::string device;
-    std::filesystem::path junit;       ///< JUnit XML output (optional)
-    std::filesystem::path reportDir;   ///< report.md and failure images
-    bool update = false;               ///< regenerate the vkrt-made references
-    uint32_t seedOffset = 0;           ///< added to the suite's seed (repeat runs)
+    std::filesystem::path junit;     ///< JUnit XML output (optional)
+    std::filesystem::path reportDir; ///< report.md and failure images
+    bool update = false;             ///< regenerate the vkrt-made references
+    uint32_t seedOffset = 0;         ///< added to the suite's seed (repeat runs)
     bool failOnSlowdown = false;
     std::vector<Define> kernelDefines; ///< test hooks: build every kernel with these
 };

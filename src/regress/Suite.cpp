@@ -20,9 +20,8 @@ namespace {
 
 constexpr std::array<std::string_view, 2> topLevelKeys{"suite", "case"};
 constexpr std::array<std::string_view, 5> suiteKeys{"alpha", "pooled_alpha", "min_pass", "max_slowdown", "seed"};
-constexpr std::array<std::string_view, 10> caseKeys{"name",          "scene", "reference", "reference_source",
-                                                    "reference_spp", "spp",   "width",     "height",
-                                                    "baseline_seconds", "max_rejected"};
+constexpr std::array<std::string_view, 10> caseKeys{"name", "scene", "reference", "reference_source", "reference_spp",
+                                                    "spp",  "width", "height",    "baseline_seconds", "max_rejected"};
 
 constexpr std::array<EnumName<ReferenceSource>, 2> referenceSources{
     {{"mitsuba", ReferenceSource::Mitsuba}, {"vkrt", ReferenceSource::Vkrt}}};
@@ -32,7 +31,10 @@ double readAlpha(const Field& field) { return readNumberIn(field, {0, 1, true, t
 /// A fraction of passing values: 1 (all must pass) is allowed.
 double readPassFraction(const Field& field) { return readNumberIn(field, {0, 1, true, false}); }
 
-uint32_t readUint32(const Field& field, int64_t min) { return static_cast<uint32_t>(readInteger(field, min, UINT32_MAX)); }
+uint32_t readUint32(const Field& field, int64_t min)
+{
+    return static_cast<uint32_t>(readInteger(field, min, UINT32_MAX));
+}
 uint32_t readCount(const Field& field) { return readUint32(field, 1); }
 uint32_t readSeed(const Field& field) { return readUint32(field, 0); }
 uint64_t readTolerance(const Field& field) { return readUint32(field, 0); }
@@ -81,8 +83,9 @@ public:
     {
         const Field field = table.require("name");
         const auto [first, inserted] = m_seen.emplace(name, field.location().line);
-        if (!inserted) field.fail("duplicate case name " + quote(name) + " (first used on line " +
-                                  std::to_string(first->second) + ")");
+        if (!inserted)
+            field.fail("duplicate case name " + quote(name) + " (first used on line " + std::to_string(first->second) +
+                       ")");
     }
 
 private:

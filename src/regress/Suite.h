@@ -16,11 +16,11 @@ struct RegressionCase {
     std::filesystem::path scene;
     std::filesystem::path referenceDir; ///< holds mean.exr and variance.exr
     ReferenceSource source = ReferenceSource::Vkrt;
-    uint64_t referenceSpp = 0;          ///< samples behind the reference mean
+    uint64_t referenceSpp = 0; ///< samples behind the reference mean
     uint32_t spp = 64;
     std::optional<uint32_t> width, height;
-    double baselineSeconds = 0.0;       ///< 0: no timing check
-    uint64_t maxRejected = 0;           ///< non-finite samples tolerated (known bugs only)
+    double baselineSeconds = 0.0; ///< 0: no timing check
+    uint64_t maxRejected = 0;     ///< non-finite samples tolerated (known bugs only)
 };
 
 struct RegressionSuite {

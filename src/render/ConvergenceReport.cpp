@@ -9,7 +9,9 @@
 namespace vkrt {
 
 ConvergenceReport::ConvergenceReport(std::filesystem::path path, std::string header, std::optional<Image> reference)
-    : m_path(std::move(path)), m_header(std::move(header)), m_reference(std::move(reference))
+    : m_path(std::move(path)),
+      m_header(std::move(header)),
+      m_reference(std::move(reference))
 {
 }
 

@@ -42,9 +42,9 @@ MeasuredError measureError(const Image& image, const Image& reference);
 struct PixelTestSummary {
     size_t tested = 0;
     size_t passed = 0;
-    double threshold = 0.0;   ///< per-value p-value limit after the correction
-    double zThreshold = 0.0;  ///< the same limit as |t| for a normal t (infinite dof)
-    double minPValue = 1.0;   ///< smallest two-sided p-value
+    double threshold = 0.0;  ///< per-value p-value limit after the correction
+    double zThreshold = 0.0; ///< the same limit as |t| for a normal t (infinite dof)
+    double minPValue = 1.0;  ///< smallest two-sided p-value
     double fractionPassed() const { return tested ? double(passed) / double(tested) : 1.0; }
 };
 
@@ -66,11 +66,11 @@ double studentTwoSidedTail(double t, double dof);
 /// small bias everywhere, invisible per pixel, shows there).
 struct ReferenceTestResult {
     size_t tested = 0, passed = 0;
-    double threshold = 0.0;   ///< per-value |z| limit
+    double threshold = 0.0; ///< per-value |z| limit
     double pooledZ = 0.0;
     double pooledThreshold = 0.0;
     double minPValue = 1.0;
-    Image pValues;            ///< per value, for failure reports
+    Image pValues; ///< per value, for failure reports
     double fractionPassed() const { return tested ? double(passed) / double(tested) : 1.0; }
     bool passedRule(double minFraction) const
     {

@@ -53,13 +53,14 @@ gpu::PointLight toGpu(const PointLight& l, const Relativizer& rel) { return {rel
 gpu::TriangleLight toGpu(const TriangleLight& l, const Relativizer& rel)
 {
     double area = triangleArea(l.vertices);
-    return {rel(l.vertices[0]), float(area), rel(l.vertices[1]), l.twoSided ? 1u : 0u, rel(l.vertices[2]),
-            toFloat(l.radiance)};
+    return {rel(l.vertices[0]),   float(area),        rel(l.vertices[1]),
+            l.twoSided ? 1u : 0u, rel(l.vertices[2]), toFloat(l.radiance)};
 }
 
 /// The records of a kind that reach the GPU: all of them, except that
 /// triangle lights that cannot emit are dropped.
-template <class Record> const std::vector<Record>& recordsToUpload(const Scene&, const std::vector<Record>& all)
+template <class Record>
+const std::vector<Record>& recordsToUpload(const Scene&, const std::vector<Record>& all)
 {
     return all;
 }

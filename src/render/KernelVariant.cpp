@@ -25,9 +25,11 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     const FeatureSet& f = v.features;
     std::vector<OptionalFeature> list;
 #define VKRT_SHAPE_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    list.push_back({f.has(ShapeKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(ShapeKind::Type)});
+    list.push_back(                                                                \
+        {f.has(ShapeKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(ShapeKind::Type)});
 #define VKRT_LIGHT_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    list.push_back({f.has(LightKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(LightKind::Type)});
+    list.push_back(                                                                \
+        {f.has(LightKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(LightKind::Type)});
     VKRT_SHAPE_KINDS(VKRT_SHAPE_FEATURE)
     VKRT_LIGHT_KINDS(VKRT_LIGHT_FEATURE)
 #undef VKRT_SHAPE_FEATURE
@@ -52,9 +54,10 @@ const std::vector<SceneArrayBinding>& sceneArrayBindings()
 {
 #define VKRT_ARRAY_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
     SceneArrayBinding{gpu::BINDING_##ARRAY, gpu::UNIFORM_##ARRAY},
-    static const std::vector<SceneArrayBinding> bindings{
-        SceneArrayBinding{gpu::BINDING_MATERIALS, gpu::UNIFORM_MATERIALS},
-        VKRT_SHAPE_KINDS(VKRT_ARRAY_BINDING) VKRT_LIGHT_KINDS(VKRT_ARRAY_BINDING)};
+    static const std::vector<SceneArrayBinding> bindings{SceneArrayBinding{gpu::BINDING_MATERIALS,
+                                                                           gpu::UNIFORM_MATERIALS},
+                                                         VKRT_SHAPE_KINDS(VKRT_ARRAY_BINDING)
+                                                             VKRT_LIGHT_KINDS(VKRT_ARRAY_BINDING)};
 #undef VKRT_ARRAY_BINDING
     return bindings;
 }

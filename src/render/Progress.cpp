@@ -19,7 +19,9 @@ std::string humanCount(double value)
 }
 
 Progress::Progress(uint32_t totalFrames, uint64_t pixelsPerFrame, bool interactive)
-    : m_total(totalFrames), m_pixels(pixelsPerFrame), m_interactive(interactive)
+    : m_total(totalFrames),
+      m_pixels(pixelsPerFrame),
+      m_interactive(interactive)
 {
 }
 

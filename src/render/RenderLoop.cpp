@@ -36,7 +36,8 @@ uint32_t framesForNextBatch(uint32_t batch, uint32_t done, const StopRules& rule
 void BatchPacer::record(uint32_t frames, double seconds)
 {
     uint32_t most = std::min(frames * 2, kMaxFramesPerSubmit);
-    m_frames = seconds <= 0.0 ? most : uint32_t(std::clamp(double(frames) * m_targetSeconds / seconds, 1.0, double(most)));
+    m_frames =
+        seconds <= 0.0 ? most : uint32_t(std::clamp(double(frames) * m_targetSeconds / seconds, 1.0, double(most)));
 }
 
 uint32_t nextCheckpoint(uint32_t spp)

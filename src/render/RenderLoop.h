@@ -16,8 +16,8 @@ namespace vkrt {
 /// When a render stops: whichever rule fires first.
 struct StopRules {
     uint32_t maxSpp = 64;
-    std::optional<double> timeBudgetSeconds;       ///< of rendering, start-up excluded
-    std::optional<double> targetRelMse;            ///< estimated relMSE; the checkpoint handler tests it (it needs the film)
+    std::optional<double> timeBudgetSeconds; ///< of rendering, start-up excluded
+    std::optional<double> targetRelMse;      ///< estimated relMSE; the checkpoint handler tests it (it needs the film)
     const std::atomic<bool>* interrupt = nullptr; ///< set asynchronously (SIGINT)
 };
 

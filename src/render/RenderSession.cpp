@@ -95,9 +95,8 @@ bool RenderSession::atCheckpoint(const RunHooks& hooks, uint32_t spp, double sec
 
 LoopResult RenderSession::run(const RunHooks& hooks)
 {
-    LoopResult loop = runRenderLoop(*m_renderer, m_config.stop, hooks.onProgress, [&](uint32_t spp, double seconds) {
-        return atCheckpoint(hooks, spp, seconds);
-    });
+    LoopResult loop = runRenderLoop(*m_renderer, m_config.stop, hooks.onProgress,
+                                    [&](uint32_t spp, double seconds) { return atCheckpoint(hooks, spp, seconds); });
     m_renderSeconds += loop.renderSeconds;
     m_stoppedBy = loop.reason;
     return loop;
@@ -172,9 +171,9 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
         // The variance's degrees of freedom: per-pixel tests on it (vkrt
         // compare) need Student's t rather than a normal when few.
         metadata["varianceDegreesOfFreedom"] = int64_t(renderer.varianceDegreesOfFreedom());
-        metadata["varianceEstimator"] = sampler() == Sampler::Sobol ? std::to_string(gpu::VARIANCE_BATCHES) +
-                                                                          " independently scrambled batches"
-                                                                    : std::string("independent samples");
+        metadata["varianceEstimator"] = sampler() == Sampler::Sobol
+                                            ? std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches"
+                                            : std::string("independent samples");
     }
     if (film.estimated) {
         metadata["estimatedRmse"] = film.estimated->rmse;

@@ -6,10 +6,10 @@
 #include "util/Error.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
-#include <numeric>
+#include <cstdio>
 #include <limits>
+#include <numeric>
 
 namespace vkrt {
 
@@ -70,7 +70,11 @@ Image constantFace(const glm::vec3& colour)
     return face;
 }
 
-template <typename T> std::span<const std::byte> bytesOf(const T& value) { return std::as_bytes(std::span(&value, 1)); }
+template <typename T>
+std::span<const std::byte> bytesOf(const T& value)
+{
+    return std::as_bytes(std::span(&value, 1));
+}
 
 /// Mean of a compensated sum's samples (one channel); it must have a sample.
 double compensatedMean(const gpu::AccumPixel& p, int channel)
@@ -176,8 +180,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
                                              "the error estimate's " + std::to_string(gpu::VARIANCE_BATCHES) +
                                                  " batch sums (Sobol' sampler)",
                                              ", or estimate the error with --sampler independent (one sum per pixel)"));
-        else
-            m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(false), "the variance estimate"));
+        else m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(false), "the variance estimate"));
         m_moments->clear(context);
     }
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
@@ -333,7 +336,8 @@ Image Renderer::varianceOfMean() const
             // unknown, huge variance: report +inf, never a reassuring 0.
             double m2 = double(moments[i].m2[c]) - double(moments[i].m2Compensation[c]);
             bool known = n >= 2 && std::isfinite(m2);
-            image.rgb[i * 3 + c] = known ? float(std::max(0.0, m2) / (n - 1) / n) : std::numeric_limits<float>::infinity();
+            image.rgb[i * 3 + c] =
+                known ? float(std::max(0.0, m2) / (n - 1) / n) : std::numeric_limits<float>::infinity();
         }
     }
     return image;

@@ -18,19 +18,19 @@ namespace vkrt {
 struct RenderOptions {
     uint32_t seed = 0;
     bool jitter = true;
-    bool uber = false;                 ///< all-features kernel instead of the scene's variant
-    bool variance = false;             ///< also estimate per-pixel variance (a kernel-variant flag)
-    bool sobol = false;                ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
-    bool storageScene = false;         ///< scene arrays in storage buffers even when they fit uniform ones
-    std::vector<Define> extraDefines;  ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
+    bool uber = false;                ///< all-features kernel instead of the scene's variant
+    bool variance = false;            ///< also estimate per-pixel variance (a kernel-variant flag)
+    bool sobol = false;               ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
+    bool storageScene = false;        ///< scene arrays in storage buffers even when they fit uniform ones
+    std::vector<Define> extraDefines; ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
 };
 
 struct RenderCounters {
-    uint64_t rejectedSamples = 0;    ///< non-finite samples dropped (all pixels)
-    uint32_t maxLoopIterations = 0;  ///< largest per-invocation loop count seen
-    uint32_t budgetExceeded = 0;     ///< invocations that reached lavapipe's loop budget
+    uint64_t rejectedSamples = 0;   ///< non-finite samples dropped (all pixels)
+    uint32_t maxLoopIterations = 0; ///< largest per-invocation loop count seen
+    uint32_t budgetExceeded = 0;    ///< invocations that reached lavapipe's loop budget
 };
 
 class Renderer {

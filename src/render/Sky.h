@@ -15,10 +15,10 @@ struct SkyParameters {
     glm::dvec3 ground{0.1, 0.09, 0.08};
     glm::dvec3 sunColor{1.0, 0.92, 0.8};
     double sunElevationDegrees = 35.0;
-    double sunAzimuthDegrees = 45.0;    ///< from +z towards +x
+    double sunAzimuthDegrees = 45.0; ///< from +z towards +x
     double sunAngularRadiusDegrees = 3.0;
-    double sunRadiance = 12.0;          ///< scale of sunColor inside the disk
-    double glowRadiance = 0.6;          ///< scale of the glow around the sun
+    double sunRadiance = 12.0; ///< scale of sunColor inside the disk
+    double glowRadiance = 0.6; ///< scale of the glow around the sun
 };
 
 /// Unit vector towards the sun.

@@ -12,7 +12,9 @@ std::string featureName(ShapeKind kind)
 {
 #define VKRT_ARRAY_NAME(KIND, Type, name, value, field, array, ARRAY, capacity) \
     case ShapeKind::Type: return #array;
-    switch (kind) { VKRT_SHAPE_KINDS(VKRT_ARRAY_NAME) }
+    switch (kind) {
+        VKRT_SHAPE_KINDS(VKRT_ARRAY_NAME)
+    }
 #undef VKRT_ARRAY_NAME
     return "unknown";
 }

@@ -11,8 +11,8 @@
 namespace vkrt {
 
 struct FeatureSet {
-    std::array<bool, kShapeKindCount> shapes{};          ///< indexed by ShapeKind
-    std::array<bool, kLightKindCount> lights{};          ///< indexed by LightKind
+    std::array<bool, kShapeKindCount> shapes{};           ///< indexed by ShapeKind
+    std::array<bool, kLightKindCount> lights{};           ///< indexed by LightKind
     std::array<bool, kMaterialKindCount> materialTypes{}; ///< indexed by MaterialType
     bool cubemap = false;
     bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)

@@ -68,7 +68,8 @@ inline constexpr std::array<std::string_view, kLightKindCount> kLightNames{VKRT_
 #undef VKRT_KIND_NAME
 
 /// Every kind of a concept, in value order (for loops over the registry).
-template <class Kind, size_t N> constexpr std::array<Kind, N> allKinds()
+template <class Kind, size_t N>
+constexpr std::array<Kind, N> allKinds()
 {
     std::array<Kind, N> kinds{};
     for (size_t i = 0; i < N; ++i) kinds[i] = Kind(i);
@@ -84,13 +85,26 @@ constexpr std::string_view kindName(LightKind kind) { return kLightNames[size_t(
 
 namespace kinds_check {
 /// The registry lists each kind with value = its position, so value-indexed tables line up.
-#define VKRT_KIND_IN_ORDER(KIND, Type, name, value, ...) && (value == position++)
-constexpr bool materialsInOrder() { int position = 0; return true VKRT_MATERIAL_KINDS(VKRT_KIND_IN_ORDER); }
-constexpr bool shapesInOrder() { int position = 0; return true VKRT_SHAPE_KINDS(VKRT_KIND_IN_ORDER); }
-constexpr bool lightsInOrder() { int position = 0; return true VKRT_LIGHT_KINDS(VKRT_KIND_IN_ORDER); }
+#define VKRT_KIND_IN_ORDER(KIND, Type, name, value, ...) &&(value == position++)
+constexpr bool materialsInOrder()
+{
+    int position = 0;
+    return true VKRT_MATERIAL_KINDS(VKRT_KIND_IN_ORDER);
+}
+constexpr bool shapesInOrder()
+{
+    int position = 0;
+    return true VKRT_SHAPE_KINDS(VKRT_KIND_IN_ORDER);
+}
+constexpr bool lightsInOrder()
+{
+    int position = 0;
+    return true VKRT_LIGHT_KINDS(VKRT_KIND_IN_ORDER);
+}
 #undef VKRT_KIND_IN_ORDER
 
-template <size_t N> constexpr bool namesUnique(const std::array<std::string_view, N>& names)
+template <size_t N>
+constexpr bool namesUnique(const std::array<std::string_view, N>& names)
 {
     for (size_t i = 0; i < N; ++i)
         for (size_t j = i + 1; j < N; ++j)
@@ -106,10 +120,8 @@ static_assert(kinds_check::namesUnique(kShapeNames), "shared/Kinds.h: two shapes
 static_assert(kinds_check::namesUnique(kLightNames), "shared/Kinds.h: two lights share a name");
 #define VKRT_CHECK_MATERIAL_VALUE(KIND, Type, name, value, ...) \
     static_assert(uint32_t(MaterialType::Type) == gpu::MATERIAL_##KIND);
-#define VKRT_CHECK_SHAPE_VALUE(KIND, Type, name, value, ...) \
-    static_assert(int(ShapeKind::Type) == gpu::SHAPE_##KIND);
-#define VKRT_CHECK_LIGHT_VALUE(KIND, Type, name, value, ...) \
-    static_assert(int(LightKind::Type) == gpu::LIGHT_##KIND);
+#define VKRT_CHECK_SHAPE_VALUE(KIND, Type, name, value, ...) static_assert(int(ShapeKind::Type) == gpu::SHAPE_##KIND);
+#define VKRT_CHECK_LIGHT_VALUE(KIND, Type, name, value, ...) static_assert(int(LightKind::Type) == gpu::LIGHT_##KIND);
 VKRT_MATERIAL_KINDS(VKRT_CHECK_MATERIAL_VALUE)
 VKRT_SHAPE_KINDS(VKRT_CHECK_SHAPE_VALUE)
 VKRT_LIGHT_KINDS(VKRT_CHECK_LIGHT_VALUE)
@@ -124,13 +136,13 @@ enum class FresnelMode { Default, None, Schlick, Exact };
 struct Material {
     std::string name;
     MaterialType type = MaterialType::Lambert;
-    Color diffuse{0.8};     ///< lambert `albedo`, phong `diffuse`
-    Color specular{0.0};    ///< phong `specular`; mirror/glossy `reflectance`
-    double exponent = 0.0;  ///< phong `shininess`, glossy `exponent`
-    double ior = 1.5;       ///< dielectric IOR; also Schlick's R0 for mirror/glossy
-    Color absorption{0.0};  ///< dielectric Beer–Lambert κ per unit length
+    Color diffuse{0.8};    ///< lambert `albedo`, phong `diffuse`
+    Color specular{0.0};   ///< phong `specular`; mirror/glossy `reflectance`
+    double exponent = 0.0; ///< phong `shininess`, glossy `exponent`
+    double ior = 1.5;      ///< dielectric IOR; also Schlick's R0 for mirror/glossy
+    Color absorption{0.0}; ///< dielectric Beer–Lambert κ per unit length
     FresnelMode fresnel = FresnelMode::Default;
-    SourceLocation where;   ///< the [materials.NAME] table
+    SourceLocation where; ///< the [materials.NAME] table
 };
 
 struct Sphere {
@@ -207,12 +219,16 @@ struct Scene {
     case decltype(kind)::Type: return array.size();
 inline size_t Scene::count(ShapeKind kind) const
 {
-    switch (kind) { VKRT_SHAPE_KINDS(VKRT_SCENE_COUNT_CASE) }
+    switch (kind) {
+        VKRT_SHAPE_KINDS(VKRT_SCENE_COUNT_CASE)
+    }
     return 0;
 }
 inline size_t Scene::count(LightKind kind) const
 {
-    switch (kind) { VKRT_LIGHT_KINDS(VKRT_SCENE_COUNT_CASE) }
+    switch (kind) {
+        VKRT_LIGHT_KINDS(VKRT_SCENE_COUNT_CASE)
+    }
     return 0;
 }
 #undef VKRT_SCENE_COUNT_CASE

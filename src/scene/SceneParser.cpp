@@ -43,7 +43,8 @@ double readIor(const Field& field)
 double readFov(const Field& field)
 {
     const double value = readNumber(field);
-    if (!(value > 0 && value < 180)) field.fail("must be strictly between 0 and 180 degrees, got " + formatNumber(value));
+    if (!(value > 0 && value < 180))
+        field.fail("must be strictly between 0 and 180 degrees, got " + formatNumber(value));
     return value;
 }
 
@@ -78,7 +79,8 @@ Color readRadiance(const Field& field) { return readColor(field, ColorRange::Non
 // -------------------------------------------------------------------- render
 
 constexpr std::array<std::string_view, 2> renderKeys{"integrator", "max_depth"};
-constexpr std::array<EnumName<Integrator>, 2> integrators{{{"whitted", Integrator::Whitted}, {"path", Integrator::Path}}};
+constexpr std::array<EnumName<Integrator>, 2> integrators{
+    {{"whitted", Integrator::Whitted}, {"path", Integrator::Path}}};
 
 Integrator readIntegrator(const Field& field) { return readChoice(field, "integrator", integrators).value; }
 int readMaxDepth(const Field& field) { return static_cast<int>(readInteger(field, 1, SceneLimits::maxDepth)); }
@@ -214,7 +216,8 @@ struct MaterialKind {
 };
 
 // The registry (shared/Kinds.h) names each kind's key list `nameKeys` and its reader `readType`.
-#define VKRT_MATERIAL_KIND_ENTRY(KIND, Type, name, value, delta) MaterialKind{#name, MaterialType::Type, name##Keys, read##Type},
+#define VKRT_MATERIAL_KIND_ENTRY(KIND, Type, name, value, delta) \
+    MaterialKind{#name, MaterialType::Type, name##Keys, read##Type},
 const std::array<MaterialKind, kMaterialKindCount> materialKinds{{VKRT_MATERIAL_KINDS(VKRT_MATERIAL_KIND_ENTRY)}};
 #undef VKRT_MATERIAL_KIND_ENTRY
 
@@ -248,7 +251,8 @@ Material readMaterial(std::string_view name, const TableField& table)
 std::vector<Material> readMaterials(const TableField& table)
 {
     std::vector<Material> materials;
-    for (const auto& [name, field] : table.entriesInFileOrder()) materials.push_back(readMaterial(name, TableField(field)));
+    for (const auto& [name, field] : table.entriesInFileOrder())
+        materials.push_back(readMaterial(name, TableField(field)));
     return materials;
 }
 
@@ -445,7 +449,8 @@ Background readBackground(const TableField& table)
 
 // --------------------------------------------------------------------- scene
 
-constexpr std::array<std::string_view, 6> topLevelKeys{"render", "camera", "materials", "objects", "lights", "background"};
+constexpr std::array<std::string_view, 6> topLevelKeys{"render",  "camera", "materials",
+                                                       "objects", "lights", "background"};
 
 Scene readScene(const TableField& top)
 {

@@ -12,7 +12,8 @@ namespace vkrt {
 /// Reads, parses and validates a scene file; throws SceneError (with file:line:column) or InputError (unreadable file).
 Scene parseSceneFile(const std::string& path);
 
-/// Same for text in memory; `path` is used in messages and to resolve relative paths (cubemap faces) against its directory.
+/// Same for text in memory; `path` is used in messages and to resolve relative paths (cubemap faces) against its
+/// directory.
 Scene parseSceneString(std::string_view text, const std::string& path = "<string>");
 
 } // namespace vkrt

@@ -73,7 +73,9 @@ SourceLocation locate(const TomlSource& source, const toml::source_position& pos
 class Field {
 public:
     Field(const TomlSource& source, const toml::node& node, std::string path)
-        : m_source(&source), m_node(&node), m_path(std::move(path))
+        : m_source(&source),
+          m_node(&node),
+          m_path(std::move(path))
     {
     }
     const TomlSource& context() const { return *m_source; }

@@ -30,7 +30,9 @@ public:
 class SceneError : public InputError {
 public:
     SceneError(const SourceLocation& where, const std::string& message)
-        : InputError(where.str() + ": " + message), m_where(where), m_message(message)
+        : InputError(where.str() + ": " + message),
+          m_where(where),
+          m_message(message)
     {
     }
     const SourceLocation& where() const { return m_where; }

@@ -15,8 +15,9 @@ Camera orbit(const Camera& camera, double yawDegrees, double pitchDegrees)
     double polar = std::acos(std::clamp(glm::dot(dir, up), -1.0, 1.0));
     glm::dvec3 horizontal = dir - glm::dot(dir, up) * up;
     glm::dvec3 side = glm::length(horizontal) > 1e-12 ? glm::normalize(horizontal) : glm::dvec3(0);
-    if (side == glm::dvec3(0)) side = std::abs(up.x) < 0.9 ? glm::normalize(glm::cross(up, glm::dvec3(1, 0, 0)))
-                                                            : glm::normalize(glm::cross(up, glm::dvec3(0, 0, 1)));
+    if (side == glm::dvec3(0))
+        side = std::abs(up.x) < 0.9 ? glm::normalize(glm::cross(up, glm::dvec3(1, 0, 0)))
+                                    : glm::normalize(glm::cross(up, glm::dvec3(0, 0, 1)));
     glm::dvec3 tangent = glm::cross(up, side);
     double yaw = glm::radians(yawDegrees);
     glm::dvec3 rotatedSide = std::cos(yaw) * side + std::sin(yaw) * tangent;

@@ -55,8 +55,9 @@ DisplayPass::DisplayPass(const VulkanContext& context, const Buffer& accumulatio
     vk::raii::Image image(device, info);
     auto requirements = image.getMemoryRequirements();
     m_memory = vk::raii::DeviceMemory(
-        device, vk::MemoryAllocateInfo(requirements.size, context.findMemoryType(requirements.memoryTypeBits,
-                                                                                vk::MemoryPropertyFlagBits::eDeviceLocal)));
+        device,
+        vk::MemoryAllocateInfo(requirements.size, context.findMemoryType(requirements.memoryTypeBits,
+                                                                         vk::MemoryPropertyFlagBits::eDeviceLocal)));
     m_image = std::move(image);
     m_image.bindMemory(*m_memory, 0);
     m_view = vk::raii::ImageView(device, vk::ImageViewCreateInfo({}, *m_image, vk::ImageViewType::e2D, kDisplayFormat,
@@ -104,7 +105,8 @@ void DisplayPass::recordBlit(vk::CommandBuffer cmd, vk::Image target, vk::Extent
     vk::ImageSubresourceLayers layers(vk::ImageAspectFlagBits::eColor, 0, 0, 1);
     vk::ImageBlit region(layers, {vk::Offset3D(0, 0, 0), vk::Offset3D(int32_t(m_width), int32_t(m_height), 1)}, layers,
                          letterbox(m_width, m_height, targetExtent));
-    cmd.blitImage(*m_image, Layout::eTransferSrcOptimal, target, Layout::eTransferDstOptimal, region, vk::Filter::eLinear);
+    cmd.blitImage(*m_image, Layout::eTransferSrcOptimal, target, Layout::eTransferDstOptimal, region,
+                  vk::Filter::eLinear);
     imageBarrier(cmd, target, Layout::eTransferDstOptimal, Layout::ePresentSrcKHR, vk::AccessFlagBits::eTransferWrite,
                  {}, Stage::eTransfer, Stage::eBottomOfPipe);
 }

@@ -123,7 +123,7 @@ private:
     bool m_paused = false;
     bool m_swapchainStale = false;
     BatchPacer m_pacer{kFrameSeconds}; ///< one display refresh holds about kFrameSeconds of rendering
-    std::deque<std::string> m_keys; ///< pressed keys not yet handled
+    std::deque<std::string> m_keys;    ///< pressed keys not yet handled
     bool m_dragging = false;
     double m_lastX = 0, m_lastY = 0;
     double m_pendingYaw = 0, m_pendingPitch = 0, m_pendingZoom = 1;
@@ -179,8 +179,8 @@ Viewer::Viewer(const ViewOptions& options)
 
 void Viewer::createDisplay()
 {
-    m_display = std::make_unique<DisplayPass>(m_context, renderer().accumulation(), renderer().width(),
-                                              renderer().height());
+    m_display =
+        std::make_unique<DisplayPass>(m_context, renderer().accumulation(), renderer().width(), renderer().height());
 }
 
 void Viewer::recreateSwapchain()

@@ -13,7 +13,7 @@ struct ViewOptions {
     std::string scenePath;
     std::string device;
     uint32_t seed = 0;
-    std::optional<uint32_t> width;  ///< render size (default: the scene's)
+    std::optional<uint32_t> width; ///< render size (default: the scene's)
     std::optional<uint32_t> height;
     std::optional<uint32_t> frames; ///< render this many frames, then exit (after --screenshot)
     std::string screenshot;         ///< PNG of the displayed image at exit

@@ -16,8 +16,8 @@ struct Signature {
 };
 
 const std::map<std::string, Signature> kCommands = {
-    {"frames", {1}}, {"orbit", {2}},      {"fly", {3}},  {"zoom", {1}},
-    {"exposure", {1}}, {"key", {-1}}, {"save", {-1}}, {"screenshot", {-1}},
+    {"frames", {1}},   {"orbit", {2}}, {"fly", {3}},   {"zoom", {1}},
+    {"exposure", {1}}, {"key", {-1}},  {"save", {-1}}, {"screenshot", {-1}},
 };
 
 const char* const kKeys[] = {"S", "R", "I", "P", "H", "+", "-", "F"};
@@ -64,14 +64,15 @@ ViewerCommand parseLine(const std::vector<std::pair<std::string, size_t>>& w, co
              "unknown command '" + w[0].first + "' (frames, orbit, fly, zoom, exposure, key, save, screenshot)");
     int expected = it->second.numbers < 0 ? 1 : it->second.numbers;
     if (int(w.size()) - 1 != expected)
-        fail(path, line, w[0].second, "'" + w[0].first + "' takes " + std::to_string(expected) + " argument(s), got " +
-                                          std::to_string(w.size() - 1));
+        fail(path, line, w[0].second,
+             "'" + w[0].first + "' takes " + std::to_string(expected) + " argument(s), got " +
+                 std::to_string(w.size() - 1));
     ViewerCommand command{w[0].first, {}, "", line};
     if (it->second.numbers < 0) command.text = w[1].first;
     else
         for (size_t i = 1; i < w.size(); ++i) command.numbers.push_back(number(path, line, w[i]));
-    if (command.name == "frames" && (command.numbers[0] < 0 || command.numbers[0] != std::floor(command.numbers[0]) ||
-                                     command.numbers[0] > 1e6))
+    if (command.name == "frames" &&
+        (command.numbers[0] < 0 || command.numbers[0] != std::floor(command.numbers[0]) || command.numbers[0] > 1e6))
         fail(path, line, w[1].second, "frames needs a whole number from 0 to 1000000");
     if (command.name == "zoom" && !(command.numbers[0] > 0)) fail(path, line, w[1].second, "zoom factor must be > 0");
     if (command.name == "key" && std::find(std::begin(kKeys), std::end(kKeys), command.text) == std::end(kKeys))

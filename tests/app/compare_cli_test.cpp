@@ -23,8 +23,8 @@ protected:
 
     ProcessResult render(const std::string& output, std::vector<std::string> extra)
     {
-        std::vector<std::string> args = {"render", kScene, "-o", (m_dir / output).string(), "--width", "48",
-                                         "--height", "36"};
+        std::vector<std::string> args = {"render",  kScene, "-o",       (m_dir / output).string(),
+                                         "--width", "48",   "--height", "36"};
         args.insert(args.end(), extra.begin(), extra.end());
         return runVkrt(args);
     }
@@ -52,7 +52,8 @@ std::vector<CsvRow> readReport(const fs::path& path)
 TEST_F(StatsCli, CompareIdenticalIsZeroAndPerturbedFails)
 {
     ASSERT_EQ(render("a.exr", {"--spp", "8", "--variance"}).exitCode, 0);
-    ProcessResult same = runVkrt({"compare", (m_dir / "a.exr").string(), (m_dir / "a.exr").string(), "--max-rmse", "0"});
+    ProcessResult same =
+        runVkrt({"compare", (m_dir / "a.exr").string(), (m_dir / "a.exr").string(), "--max-rmse", "0"});
     EXPECT_EQ(same.exitCode, 0) << same.output;
     EXPECT_NE(same.output.find("RMSE        0\n"), std::string::npos) << same.output;
 

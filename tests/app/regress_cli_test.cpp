@@ -43,8 +43,9 @@ std::string manifestText(const std::vector<ManifestCase>& cases, const std::stri
     toml << "[suite]\nseed = 1\n" << suiteLines << "\n";
     for (const ManifestCase& c : cases)
         toml << "[[case]]\nname = \"" << c.name << "\"\nscene = \"" << c.scene.string() << "\"\nreference = \""
-             << c.reference.string() << "\"\nreference_source = \"" << c.source << "\"\nreference_spp = "
-             << c.referenceSpp << "\nspp = " << c.spp << "\n" << c.extra << "\n";
+             << c.reference.string() << "\"\nreference_source = \"" << c.source
+             << "\"\nreference_spp = " << c.referenceSpp << "\nspp = " << c.spp << "\n"
+             << c.extra << "\n";
     return toml.str();
 }
 
@@ -52,7 +53,8 @@ std::string manifestText(const std::vector<ManifestCase>& cases, const std::stri
 ManifestCase shipped(const std::string& name, uint32_t spp, const std::string& extra = "")
 {
     std::string folder = name.substr(0, name.find('/')), file = name.substr(name.find('/') + 1);
-    return {name, kSource / "scenes" / folder / (file + ".toml"), kSource / "tests/references" / name, 4096, spp, extra};
+    return {name, kSource / "scenes" / folder / (file + ".toml"), kSource / "tests/references" / name, 4096, spp,
+            extra};
 }
 
 std::string readFile(const fs::path& path)
@@ -73,7 +75,7 @@ std::map<std::string, std::string> junitOutcomes(const fs::path& path)
         body = body.substr(0, body.find("</testcase>"));
         outcomes[name] = body.find("<failure") != std::string::npos ? "failure"
                          : body.find("<error") != std::string::npos ? "error"
-                                                                     : "pass";
+                                                                    : "pass";
     }
     return outcomes;
 }
@@ -196,7 +198,8 @@ TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
     std::map<std::string, std::vector<double>> zs;
     for (int offset = 1; offset <= kRuns; ++offset) {
         fs::path junit = m_dir / ("run" + std::to_string(offset) + ".xml");
-        ProcessResult r = regress({"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--junit", junit.string()});
+        ProcessResult r =
+            regress({"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--junit", junit.string()});
         ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 4) << r.output;
         std::map<std::string, std::string> outcome = junitOutcomes(junit);
         ASSERT_EQ(outcome.size(), cases.size()) << r.output;
@@ -204,11 +207,13 @@ TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
             ASSERT_NE(result, "error") << r.output;
             failures += result == "failure";
         }
-        EXPECT_EQ(r.exitCode == 4, std::any_of(outcome.begin(), outcome.end(), [](auto& o) { return o.second == "failure"; }));
+        EXPECT_EQ(r.exitCode == 4,
+                  std::any_of(outcome.begin(), outcome.end(), [](auto& o) { return o.second == "failure"; }));
         for (const auto& [name, z] : pooledZ(r.output)) zs[name].push_back(z);
     }
     int allowed = binomialUpperBound(kRuns * int(cases.size()), 0.01, 1e-3);
-    std::printf("[ measured ] %d failing cases in %d runs x %zu cases (allowed %d)\n", failures, kRuns, cases.size(), allowed);
+    std::printf("[ measured ] %d failing cases in %d runs x %zu cases (allowed %d)\n", failures, kRuns, cases.size(),
+                allowed);
     EXPECT_LE(failures, allowed);
     for (const auto& [name, values] : zs) {
         ASSERT_EQ(values.size(), size_t(kRuns)) << name;
@@ -258,7 +263,8 @@ TEST_F(RegressCli, CaseResolutionIsValidatedLikeTheSceneFile)
 {
     fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8, "width = 99999\nheight = 24")});
     ProcessResult r = regress({"--suite", suite.string()});
-    expectInputError(r, {suite.string() + ": case extreme/kappa-shadow: width: must be between 1 and 16384, got 99999"});
+    expectInputError(r,
+                     {suite.string() + ": case extreme/kappa-shadow: width: must be between 1 and 16384, got 99999"});
 }
 
 TEST_F(RegressCli, UnusableDriverManifestIsNamed)
@@ -280,7 +286,8 @@ TEST_F(RegressCli, UnusableDriverManifestIsNamed)
     ProcessResult bare = regress({"--suite", suite.string(), "--driver", (m_dir / "bare.json").string()});
     EXPECT_EQ(bare.exitCode, 1) << bare.output;
     EXPECT_NE(bare.output.find("--driver " + (m_dir / "bare.json").string() + ": the Vulkan loader could not use"),
-              std::string::npos) << bare.output;
+              std::string::npos)
+        << bare.output;
 }
 
 TEST_F(RegressCli, ManifestErrorsNameFileLineAndColumn)
@@ -289,14 +296,16 @@ TEST_F(RegressCli, ManifestErrorsNameFileLineAndColumn)
     fs::path suite = m_dir / "suite.toml";
     std::string good = manifestText({c});
     // A misspelt key: reported where it stands, with the key it resembles.
-    writeText(suite, good + "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() + "\"\nreference = \"r\"\n"
-                                "reference_source = \"vkrt\"\nreference_spp = 16\nsp = 4\n");
+    writeText(suite, good + "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() +
+                         "\"\nreference = \"r\"\n"
+                         "reference_source = \"vkrt\"\nreference_spp = 16\nsp = 4\n");
     int line = int(std::count(good.begin(), good.end(), '\n')) + 7;
     expectInputError(regress({"--suite", suite.string()}),
                      {suite.string() + ":" + std::to_string(line) + ":1", "unknown key 'sp'", "did you mean 'spp'"});
     // A missing field: reported at its case's table.
-    writeText(suite, "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() + "\"\nreference_source = \"vkrt\"\n"
-                     "reference_spp = 16\nspp = 4\n");
+    writeText(suite, "[[case]]\nname = \"x\"\nscene = \"" + c.scene.string() +
+                         "\"\nreference_source = \"vkrt\"\n"
+                         "reference_spp = 16\nspp = 4\n");
     expectInputError(regress({"--suite", suite.string()}), {suite.string() + ":", "missing required key 'reference'"});
     // A value out of range, and a TOML syntax error.
     writeManifest({c}, "alpha = 1.5");
@@ -323,7 +332,8 @@ TEST_F(RegressCli, UpdateMakesReferencesTheSuiteAccepts)
     std::string before = readFile(mitsuba.reference / "mean.exr");
     fs::path suite = writeManifest({made, mitsuba});
 
-    expectInputError(regress({"--suite", suite.string(), "--update", "--kernel-define", "VKRT_TEST_FRESNEL_SCALE=1.02"}),
+    expectInputError(regress(
+                         {"--suite", suite.string(), "--update", "--kernel-define", "VKRT_TEST_FRESNEL_SCALE=1.02"}),
                      {"--update", "--kernel-define"});
     EXPECT_FALSE(fs::exists(made.reference));
 
@@ -352,8 +362,8 @@ TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
     ManifestCase quick = shipped("extreme/kappa-shadow", 8);
     ManifestCase endless = shipped("extreme/degenerate-lights", 1000000);
     fs::path suite = writeManifest({quick, endless}), junit = m_dir / "junit.xml", report = m_dir / "report";
-    std::vector<std::string> args = {"vkrt", "regress", "--suite", suite.string(), "--junit", junit.string(),
-                                     "--report-dir", report.string()};
+    std::vector<std::string> args = {"vkrt",    "regress",      "--suite",      suite.string(),
+                                     "--junit", junit.string(), "--report-dir", report.string()};
     for (const std::string& a : deviceArgs()) args.push_back(a);
     pid_t child = fork();
     ASSERT_GE(child, 0);

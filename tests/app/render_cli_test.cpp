@@ -4,9 +4,9 @@
 #include "support/TestSupport.h"
 
 #include <chrono>
-#include <fstream>
 #include <cmath>
 #include <csignal>
+#include <fstream>
 #include <thread>
 
 #include <sys/wait.h>
@@ -30,8 +30,9 @@ protected:
 
     ProcessResult render(const std::string& output, std::vector<std::string> extra = {})
     {
-        std::vector<std::string> args = {"render", kDefaultScene, "-o", (m_dir / output).string(),
-                                         "--width", "64", "--height", "48", "--validation"};
+        std::vector<std::string> args = {"render",      kDefaultScene, "-o",       (m_dir / output).string(),
+                                         "--width",     "64",          "--height", "48",
+                                         "--validation"};
         args.insert(args.end(), extra.begin(), extra.end());
         const char* device = std::getenv("VKRT_TEST_DEVICE");
         if (device && std::find(extra.begin(), extra.end(), "--device") == extra.end())
@@ -106,9 +107,9 @@ TEST_F(RenderCli, SamplerAutoPicksSobolUnlessAVarianceLayerIsAsked)
     // device guarantees (lavapipe: 128 MiB, 0.6 M pixels), auto estimates with
     // independent samples instead: the run stays valid Vulkan (--validation
     // would fail it with exit 3 otherwise).
-    ProcessResult wide = runVkrt({"render", kDefaultScene, "-o", (m_dir / "wide.exr").string(), "--width", "1024",
-                                  "--height", "768", "--spp", "2", "--report", (m_dir / "w.csv").string(),
-                                  "--validation"});
+    ProcessResult wide =
+        runVkrt({"render", kDefaultScene, "-o", (m_dir / "wide.exr").string(), "--width", "1024", "--height", "768",
+                 "--spp", "2", "--report", (m_dir / "w.csv").string(), "--validation"});
     ASSERT_EQ(wide.exitCode, 0) << wide.output;
     EXPECT_EQ(wide.output.find("maxStorageBufferRange"), std::string::npos) << wide.output;
     ASSERT_EQ(render("batched.exr", {"--spp", "16", "--sampler", "sobol", "--variance"}).exitCode, 0);
@@ -174,8 +175,8 @@ TEST_F(RenderCli, InterruptWritesPartialImageWithTrueSpp)
     pid_t child = fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
-        execl(VKRT_BINARY, "vkrt", "render", kDefaultScene.c_str(), "-o", output.c_str(), "--width", "64",
-              "--height", "48", "--spp", "1000000", (char*)nullptr);
+        execl(VKRT_BINARY, "vkrt", "render", kDefaultScene.c_str(), "-o", output.c_str(), "--width", "64", "--height",
+              "48", "--spp", "1000000", (char*)nullptr);
         _exit(127);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(2500));

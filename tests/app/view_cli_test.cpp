@@ -81,7 +81,8 @@ TEST_F(ViewCli, CameraMoveResetsAccumulationAndSaveRecordsTrueSpp)
                           "\norbit 15 5\nframes 3\nsave " + (m_dir / "after.exr").string() +
                           "\nkey I\nframes 2\nsave " + (m_dir / "path.exr").string() + "\nkey R\nframes 1\nsave " +
                           (m_dir / "reset.exr").string() + "\n");
-    ProcessResult r = runViewer({kScene, "--script", script.string(), "--width", "96", "--height", "72", "--validation"});
+    ProcessResult r =
+        runViewer({kScene, "--script", script.string(), "--width", "96", "--height", "72", "--validation"});
     ASSERT_EQ(r.exitCode, 0) << r.output;
     auto spp = [&](const char* name) { return std::get<int64_t>(readExr(m_dir / name).metadata.at("spp")); };
     EXPECT_EQ(spp("before.exr"), 4);
@@ -99,7 +100,8 @@ TEST_F(ViewCli, InvalidCameraMoveIsIgnoredWithAMessage)
 {
     fs::path script = m_dir / "session.txt";
     writeText(script, "frames 3\nfly 0 0 1e308\nframes 2\nsave " + (m_dir / "kept.exr").string() + "\n");
-    ProcessResult r = runViewer({kScene, "--script", script.string(), "--width", "48", "--height", "36", "--validation"});
+    ProcessResult r =
+        runViewer({kScene, "--script", script.string(), "--width", "48", "--height", "36", "--validation"});
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("fly ignored: the camera would be invalid (eye: must be finite)"), std::string::npos)
         << r.output;
@@ -118,7 +120,8 @@ TEST_F(ViewCli, BadScriptNamesFileLineAndColumn)
 
 TEST(ViewNoDisplay, SuggestsRender)
 {
-    std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " + shellQuote(kScene);
+    std::string command =
+        "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " + shellQuote(kScene);
     ProcessResult r = runShell(command);
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.output.find("vkrt render"), std::string::npos) << r.output;
@@ -128,8 +131,8 @@ TEST(ViewNoDisplay, SuggestsRender)
 // so this needs no display.
 TEST(ViewNoDisplay, ResolutionOverridesAreValidatedLikeTheSceneFile)
 {
-    std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " +
-                          shellQuote(kScene) + " --width 0";
+    std::string command =
+        "env -u DISPLAY -u WAYLAND_DISPLAY " + shellQuote(VKRT_BINARY) + " view " + shellQuote(kScene) + " --width 0";
     ProcessResult r = runShell(command);
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("--width: must be between 1 and 16384, got 0"), std::string::npos) << r.output;
@@ -143,8 +146,11 @@ TEST(ViewerScript, ParsesCommandsAndRejectsMistakes)
     EXPECT_EQ(commands[1].numbers, (std::vector<double>{1.5, -2}));
     EXPECT_EQ(commands[2].text, "+");
     EXPECT_EQ(commands[3].line, 5);
-    for (auto [text, where] : {std::pair{"jump 3\n", "s.txt:1:1"}, {"frames -1\n", "s.txt:1:8"},
-                               {"frames 2 3\n", "s.txt:1:1"}, {"zoom 0\n", "s.txt:1:6"}, {"key X\n", "s.txt:1:5"},
+    for (auto [text, where] : {std::pair{"jump 3\n", "s.txt:1:1"},
+                               {"frames -1\n", "s.txt:1:8"},
+                               {"frames 2 3\n", "s.txt:1:1"},
+                               {"zoom 0\n", "s.txt:1:6"},
+                               {"key X\n", "s.txt:1:5"},
                                {"fly 1 nan 0\n", "s.txt:1:7"}}) {
         try {
             parseViewerScript(text, "s.txt");

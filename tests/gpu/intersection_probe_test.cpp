@@ -78,7 +78,10 @@ struct Shape {
     std::array<glm::vec3, 3> p{};
 };
 
-Shape sphereShape(glm::vec3 centre, float radius) { return {Kind::Sphere, {centre, glm::vec3(radius, 0, 0), glm::vec3(0)}}; }
+Shape sphereShape(glm::vec3 centre, float radius)
+{
+    return {Kind::Sphere, {centre, glm::vec3(radius, 0, 0), glm::vec3(0)}};
+}
 Shape boxShape(glm::vec3 lower, glm::vec3 upper) { return {Kind::Box, {lower, upper, glm::vec3(0)}}; }
 Shape triangleShape(glm::vec3 a, glm::vec3 b, glm::vec3 c) { return {Kind::Triangle, {a, b, c}}; }
 Shape planeShape(glm::vec3 point, glm::vec3 normal) { return {Kind::Plane, {point, normal, glm::vec3(0)}}; }
@@ -193,7 +196,7 @@ struct SpawnCase {
     glm::vec3 local{0.0f, 0.0f, 1.0f}; ///< direction in the frame of the side normal, z > 0
     int mode = kBounce;
     float lightDistance = 0.0f;
-    double scale = 0.0;  ///< of the sweep's configuration (0: not from the sweep)
+    double scale = 0.0; ///< of the sweep's configuration (0: not from the sweep)
     double offset = 0.0;
 };
 
@@ -344,11 +347,10 @@ std::string describe(const SpawnCase& c, const SpawnResult& r)
     std::ostringstream text;
     text << std::setprecision(9) << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode];
     if (c.scale > 0.0) text << " offset " << c.offset << " scale " << c.scale;
-    text << " shape " << str(c.shape.p[0]) << " " << str(c.shape.p[1]) << " "
-         << str(c.shape.p[2]) << " primary origin " << str(c.primaryOrigin) << " aim " << str(c.aim) << " local "
-         << str(c.local) << " light distance " << c.lightDistance << " -> surface point " << str(r.position)
-         << " new origin " << str(r.origin) << " dir " << str(r.dir) << " second hit " << r.secondHit << " at t "
-         << r.secondT;
+    text << " shape " << str(c.shape.p[0]) << " " << str(c.shape.p[1]) << " " << str(c.shape.p[2]) << " primary origin "
+         << str(c.primaryOrigin) << " aim " << str(c.aim) << " local " << str(c.local) << " light distance "
+         << c.lightDistance << " -> surface point " << str(r.position) << " new origin " << str(r.origin) << " dir "
+         << str(r.dir) << " second hit " << r.secondHit << " at t " << r.secondT;
     return text.str();
 }
 
@@ -459,9 +461,9 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
         // At least half the primary rays must hit or the configuration tests little.
         if (hits < kRays / 2) {
             ++configsTooFewHits;
-            ADD_FAILURE() << "only " << hits << " of " << kRays << " primary rays hit: "
-                          << kKindNames[int(cases[first].shape.kind)] << " offset " << cases[first].offset << " scale "
-                          << cases[first].scale;
+            ADD_FAILURE() << "only " << hits << " of " << kRays
+                          << " primary rays hit: " << kKindNames[int(cases[first].shape.kind)] << " offset "
+                          << cases[first].offset << " scale " << cases[first].scale;
         }
     }
     EXPECT_EQ(anyHitDisagreements, 0) << "traceAny must find a blocker exactly when the closest-hit query does";
@@ -470,9 +472,11 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     int64_t total = 0;
     for (int kind = 0; kind < 4; ++kind)
         for (int mode = 0; mode < 3; ++mode) {
-            reportStat(std::string("Failures_") + kKindNames[kind] + "_" + kModeNames[mode], double(failures[kind][mode]));
+            reportStat(std::string("Failures_") + kKindNames[kind] + "_" + kModeNames[mode],
+                       double(failures[kind][mode]));
             reportStat(std::string("Tested_") + kKindNames[kind] + "_" + kModeNames[mode], double(tested[kind][mode]));
-            reportStat(std::string("FailuresWithFlippedSide_") + kKindNames[kind] + "_" + kModeNames[mode], double(failuresWithFlip[kind][mode]));
+            reportStat(std::string("FailuresWithFlippedSide_") + kKindNames[kind] + "_" + kModeNames[mode],
+                       double(failuresWithFlip[kind][mode]));
             EXPECT_EQ(failures[kind][mode], 0) << kKindNames[kind] << " " << kModeNames[mode];
             EXPECT_GT(tested[kind][mode], 84 * kRays / 4 / 2) << kKindNames[kind] << " " << kModeNames[mode];
             total += failures[kind][mode];
@@ -480,8 +484,9 @@ TEST_F(IntersectionProbeSelfIntersection, SpawnedRaysNeverHitTheirOwnSurface)
     for (size_t k = 0; k < configFailures.size(); ++k)
         if (configFailures[k] > 0) {
             const SpawnCase& c = cases[k * kRays];
-            std::cout << "[   STAT   ] failures " << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode] << " offset "
-                      << c.offset << " scale " << c.scale << ": " << configFailures[k] << " of " << kRays << std::endl;
+            std::cout << "[   STAT   ] failures " << kKindNames[int(c.shape.kind)] << " " << kModeNames[c.mode]
+                      << " offset " << c.offset << " scale " << c.scale << ": " << configFailures[k] << " of " << kRays
+                      << std::endl;
         }
     // The side comes from which sphere root was taken (box: entry or exit), not from
     // the sign of dot(normal, dir), which rounding flips for grazing hits far away.
@@ -528,8 +533,8 @@ TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
          make(sphereShape({0.0f, 0.0f, -1000.0f}, 1.0f), {0.0f, 0.0f, 0.0f}, {0.99981302f, 0.0193104576f, -999.998962f},
               {-0.682120204f, -0.731239319f, 0.00106611324f}, kBounce)},
         {"sphere side flipped at grazing incidence (bounce)",
-         make(sphereShape({-1000.0f, 0.0f, 0.0f}, 1.0f), {0.0f, 0.0f, 0.0f}, {-999.999207f, 0.781252742f, -0.624214292f},
-              {0.610685408f, 0.330188155f, 0.719749331f}, kBounce)},
+         make(sphereShape({-1000.0f, 0.0f, 0.0f}, 1.0f), {0.0f, 0.0f, 0.0f},
+              {-999.999207f, 0.781252742f, -0.624214292f}, {0.610685408f, 0.330188155f, 0.719749331f}, kBounce)},
         // Was: box hit points origin + t * dir, whose error grows with |origin| and t,
         // while offsetRayOrigin moved by 256 ulps of the point's own coordinates: a face
         // near a zero coordinate hit from 2500 units away left the origin inside the box.
@@ -573,15 +578,15 @@ TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
     for (size_t i = 0; i < cases.size(); ++i) {
         const SpawnCase& c = cases[i].c;
         const SpawnResult& r = results[i];
-        std::string what = std::string(cases[i].cause) + ": " + describe(c, r) +
-                           " front face " + std::to_string(r.frontFace) + ", exact " +
-                           std::to_string(frontFaceReference(c));
+        std::string what = std::string(cases[i].cause) + ": " + describe(c, r) + " front face " +
+                           std::to_string(r.frontFace) + ", exact " + std::to_string(frontFaceReference(c));
         ASSERT_TRUE(r.primaryHit) << what;
         EXPECT_TRUE(finite(r.position) && finite(r.origin) && finite(r.dir)) << what;
         EXPECT_EQ(r.frontFace, frontFaceReference(c)) << what;
         if (c.mode == kTransmit && c.shape.kind == Kind::Sphere) {
             // Into the sphere: the exit, not the entry point again.
-            RefHit ref = sphereReference(glm::dvec3(c.shape.p[0]), c.shape.p[1].x, glm::dvec3(r.origin), glm::dvec3(r.dir));
+            RefHit ref =
+                sphereReference(glm::dvec3(c.shape.p[0]), c.shape.p[1].x, glm::dvec3(r.origin), glm::dvec3(r.dir));
             EXPECT_TRUE(!ref.hit || (r.secondHit && r.secondT > 0.5 * ref.t)) << what;
         } else {
             EXPECT_FALSE(r.secondHit) << what;
@@ -1044,8 +1049,7 @@ TEST_F(IntersectionProbeWatertight, EdgeBetweenBoxesSharingAFaceNeverLeaks)
         const Answer& b = answers[2 * i + 1];
         const Query& q = queries[2 * i];
         if (!a.hit && !b.hit) {
-            if (leaks++ < 5)
-                ADD_FAILURE() << "leak between boxes: origin " << str(q.origin) << " dir " << str(q.dir);
+            if (leaks++ < 5) ADD_FAILURE() << "leak between boxes: origin " << str(q.origin) << " dir " << str(q.dir);
             continue;
         }
         double tExact = expected[i]; // in units of the (float, not exactly unit) direction
@@ -1247,8 +1251,8 @@ TEST_F(IntersectionProbeZeroComponents, BoxHitMissAndDistanceMatchReference)
         const Answer& a = answers[i];
         glm::dvec3 lo(q.shape.p[0]), hi(q.shape.p[1]), o(q.origin), d(q.dir);
         RefHit ref = boxReference(lo, hi, o, d);
-        std::string what = "box " + str(q.shape.p[0]) + " " + str(q.shape.p[1]) + " origin " + str(q.origin) +
-                           " dir " + str(q.dir);
+        std::string what =
+            "box " + str(q.shape.p[0]) + " " + str(q.shape.p[1]) + " origin " + str(q.origin) + " dir " + str(q.dir);
         if (!(a.rawFlag == 0.0f || a.rawFlag == 1.0f) || !std::isfinite(a.t) || !finite(a.normal)) {
             if (nonFinite++ < 5) ADD_FAILURE() << "non-finite output: " << what;
             continue;
@@ -1336,7 +1340,8 @@ TEST_F(IntersectionProbeZeroComponents, TriangleAndPlaneWithAxisDirections)
             double margin = std::min({std::abs(p.x), std::abs(p.y), std::abs(4.0 - p.x - p.y)});
             if (margin < 1e-6 && !(d.x == 0.0 && d.y == 0.0)) continue;
         }
-        std::string what = std::string(kKindNames[int(q.shape.kind)]) + " origin " + str(q.origin) + " dir " + str(q.dir);
+        std::string what =
+            std::string(kKindNames[int(q.shape.kind)]) + " origin " + str(q.origin) + " dir " + str(q.dir);
         if (!(r.rawFlag == 0.0f || r.rawFlag == 1.0f) || !std::isfinite(r.t)) {
             if (nonFinite++ < 5) ADD_FAILURE() << "non-finite: " << what;
             continue;

@@ -23,12 +23,13 @@ namespace {
 std::vector<std::pair<std::string, int64_t>> cppConstants()
 {
     std::vector<std::pair<std::string, int64_t>> constants;
-#define VKRT_CPP_MATERIAL(KIND, Type, name, value, delta) constants.emplace_back("material_" #KIND, gpu::MATERIAL_##KIND);
+#define VKRT_CPP_MATERIAL(KIND, Type, name, value, delta) \
+    constants.emplace_back("material_" #KIND, gpu::MATERIAL_##KIND);
 #define VKRT_CPP_SHAPE(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    constants.emplace_back("shape_" #KIND, gpu::SHAPE_##KIND);                  \
+    constants.emplace_back("shape_" #KIND, gpu::SHAPE_##KIND);                 \
     constants.emplace_back("capacity_" #ARRAY, gpu::UNIFORM_##ARRAY);
 #define VKRT_CPP_LIGHT(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    constants.emplace_back("light_" #KIND, gpu::LIGHT_##KIND);                  \
+    constants.emplace_back("light_" #KIND, gpu::LIGHT_##KIND);                 \
     constants.emplace_back("capacity_" #ARRAY, gpu::UNIFORM_##ARRAY);
     VKRT_MATERIAL_KINDS(VKRT_CPP_MATERIAL)
     VKRT_SHAPE_KINDS(VKRT_CPP_SHAPE)
@@ -151,7 +152,8 @@ std::string parseError(const std::string& text)
     return "";
 }
 
-template <size_t N> std::string joined(const std::array<std::string_view, N>& names)
+template <size_t N>
+std::string joined(const std::array<std::string_view, N>& names)
 {
     std::string out;
     for (std::string_view name : names) out += (out.empty() ? "" : ", ") + std::string(name);
@@ -159,8 +161,9 @@ template <size_t N> std::string joined(const std::array<std::string_view, N>& na
 }
 
 /// Each name with its second letter doubled: close enough for a suggestion, never a kind itself.
-template <size_t N> void expectMisspellingsSuggestTheKind(const std::array<std::string_view, N>& names,
-                                                           const std::function<std::string(std::string)>& scene)
+template <size_t N>
+void expectMisspellingsSuggestTheKind(const std::array<std::string_view, N>& names,
+                                      const std::function<std::string(std::string)>& scene)
 {
     for (std::string_view name : names) {
         std::string typo = std::string(name.substr(0, 2)) + std::string(name.substr(1));
@@ -190,8 +193,9 @@ TEST(KindRegistry, KeyOfAnotherKindIsNamedAsSuch)
 {
     std::string message = parseError(std::string(kCamera) + "[materials.m]\ntype = \"lambert\"\nshininess = 3\n");
     EXPECT_NE(message.find("key 'shininess' is not used by material type 'lambert'"), std::string::npos) << message;
-    message = parseError(std::string(kCamera) + "[materials.m]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
-                                                "material = \"m\"\ncenter = [0, 0, 0]\nradius = 1\nnormal = [0, 1, 0]\n");
+    message =
+        parseError(std::string(kCamera) + "[materials.m]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
+                                          "material = \"m\"\ncenter = [0, 0, 0]\nradius = 1\nnormal = [0, 1, 0]\n");
     EXPECT_NE(message.find("key 'normal' is not used by shape 'sphere'"), std::string::npos) << message;
 }
 

@@ -83,7 +83,8 @@ std::string hex(const U4& v)
 std::vector<U4> specialInputs()
 {
     std::vector<U4> inputs;
-    const std::array<uint32_t, 8> values = {0u, 1u, 0xffffffffu, 0x80000000u, 0x7fffffffu, 0x0000ffffu, 0xffff0000u, 0x10000u};
+    const std::array<uint32_t, 8> values = {0u,          1u,          0xffffffffu, 0x80000000u,
+                                            0x7fffffffu, 0x0000ffffu, 0xffff0000u, 0x10000u};
     for (uint32_t a : values)
         for (uint32_t b : values) inputs.push_back({a, b, a ^ b, b});
     return inputs;
@@ -178,12 +179,14 @@ TEST_F(RngProbe, GpuPcg4dMatchesCpu)
 {
     std::vector<U4> inputs = specialInputs();
     std::mt19937 rng(1618u);
-    for (int i = 0; i < 200000; ++i) inputs.push_back({uint32_t(rng()), uint32_t(rng()), uint32_t(rng()), uint32_t(rng())});
+    for (int i = 0; i < 200000; ++i)
+        inputs.push_back({uint32_t(rng()), uint32_t(rng()), uint32_t(rng()), uint32_t(rng())});
     // Corners and random points of the (pixel, frame, seed, dimension) grid.
     for (uint32_t pixel : {0u, 1u, 511u, 512u, 262143u})
         for (uint32_t frame : {0u, 1u, 1023u})
             for (uint32_t dimension : {0u, 1u, 2u}) inputs.push_back({pixel, frame, 0u, dimension});
-    for (int i = 0; i < 50000; ++i) inputs.push_back({uint32_t(rng() % 262144u), uint32_t(rng() % 1024u), 7u, uint32_t(rng() % 8u)});
+    for (int i = 0; i < 50000; ++i)
+        inputs.push_back({uint32_t(rng() % 262144u), uint32_t(rng() % 1024u), 7u, uint32_t(rng() % 8u)});
     std::vector<U4> gpu = gpuPcg4d(inputs);
     int64_t mismatches = 0;
     for (size_t i = 0; i < inputs.size(); ++i)
@@ -231,12 +234,15 @@ Draws cpuDraws(const Hash& hash)
     return d;
 }
 
-U4 renderHash(uint32_t pixel, uint32_t frame, uint32_t seed, uint32_t dimension) { return pcg4d({pixel, frame, seed, dimension}); }
+U4 renderHash(uint32_t pixel, uint32_t frame, uint32_t seed, uint32_t dimension)
+{
+    return pcg4d({pixel, frame, seed, dimension});
+}
 
 const Draws& gpuDraws()
 {
     static const Draws draws = [] {
-        std::vector<float> input = {float(kImageWidth), float(kTileX), float(kTileY), float(kTileWidth),
+        std::vector<float> input = {float(kImageWidth), float(kTileX),  float(kTileY), float(kTileWidth),
                                     float(kTileHeight), float(kFrames), float(kSeed)};
         uint32_t invocations = kTileWidth * kTileHeight * kFrames;
         Draws d;
@@ -255,7 +261,8 @@ struct Correlation {
 };
 
 /// Pearson correlation of the pairs (a(i), b(i)) that `pairs` enumerates.
-Correlation pearson(const std::string& name, const std::function<void(const std::function<void(double, double)>&)>& pairs)
+Correlation pearson(const std::string& name,
+                    const std::function<void(const std::function<void(double, double)>&)>& pairs)
 {
     double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
     int64_t n = 0;
@@ -305,7 +312,8 @@ std::vector<Correlation> correlations(const Draws& d)
     for (uint32_t k = 0; k < 7; ++k)
         result.push_back(pearson("number " + std::to_string(k) + " vs " + std::to_string(k + 1) + ", same sample",
                                  [&](const auto& add) {
-                                     for (size_t i = 0; i < d.values.size(); i += 8) add(d.values[i + k], d.values[i + k + 1]);
+                                     for (size_t i = 0; i < d.values.size(); i += 8)
+                                         add(d.values[i + k], d.values[i + k + 1]);
                                  }));
     result.push_back(pearson("dimension 0 vs 1, lane x", [&](const auto& add) {
         for (size_t i = 0; i < d.values.size(); i += 8) add(d.values[i], d.values[i + 4]);
@@ -319,8 +327,8 @@ int failedCorrelations(const Draws& d, bool print)
     for (const Correlation& c : correlations(d)) {
         if (!c.ok()) ++failed;
         if (print)
-            std::cout << "[   STAT   ] " << std::setw(46) << std::left << c.name << std::right << " r = " << std::setw(12)
-                      << c.r << "  bound " << c.bound() << "  N " << c.n << std::endl;
+            std::cout << "[   STAT   ] " << std::setw(46) << std::left << c.name << std::right
+                      << " r = " << std::setw(12) << c.r << "  bound " << c.bound() << "  N " << c.n << std::endl;
     }
     return failed;
 }

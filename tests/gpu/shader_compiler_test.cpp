@@ -46,7 +46,8 @@ TEST(ShaderCompiler, ErrorsNameIncludedFileLineAndDefines)
 
 TEST(ShaderCompiler, ProducesSpirv)
 {
-    auto spirv = compileGlsl(renderKernel(defaultShaderRoot(), KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()));
+    auto spirv = compileGlsl(
+        renderKernel(defaultShaderRoot(), KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()));
     ASSERT_GT(spirv.size(), 5u);
     EXPECT_EQ(spirv[0], 0x07230203u);
 }
@@ -124,10 +125,14 @@ TEST(SpirvCache, ConcurrentProcessesOnColdCacheBothSucceed)
     ScopedEnv cacheDir("VKRT_CACHE_DIR", (dir / "cache").c_str());
     std::string scene = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/default.toml";
     ProcessResult results[2];
-    std::thread a([&] { results[0] = runVkrt({"render", scene, "-o", (dir / "a.exr").string(), "--spp", "2",
-                                              "--width", "32", "--height", "24"}); });
-    std::thread b([&] { results[1] = runVkrt({"render", scene, "-o", (dir / "b.exr").string(), "--spp", "2",
-                                              "--width", "32", "--height", "24"}); });
+    std::thread a([&] {
+        results[0] =
+            runVkrt({"render", scene, "-o", (dir / "a.exr").string(), "--spp", "2", "--width", "32", "--height", "24"});
+    });
+    std::thread b([&] {
+        results[1] =
+            runVkrt({"render", scene, "-o", (dir / "b.exr").string(), "--spp", "2", "--width", "32", "--height", "24"});
+    });
     a.join();
     b.join();
     for (const auto& r : results) EXPECT_EQ(r.exitCode, 0) << r.output;

@@ -308,8 +308,8 @@ TEST_F(SnellProbe, RefractionObeysSnellOrReflectsBeyondCriticalAngle)
             for (int k = 0; k < 1500; ++k) {
                 glm::dvec3 outward = randomUnit();
                 glm::dvec3 side = entering ? outward : -outward; // the normal on wo's side
-                glm::dvec3 t = glm::normalize(glm::cross(side, std::abs(side.x) < 0.9 ? glm::dvec3(1, 0, 0)
-                                                                                       : glm::dvec3(0, 1, 0)));
+                glm::dvec3 t = glm::normalize(
+                    glm::cross(side, std::abs(side.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
                 glm::dvec3 b = glm::cross(side, t);
                 // sin(theta_i) over [0, 1), plus exact normal incidence.
                 double sinI = k == 0 ? 0.0 : 0.9999 * uniform(rng);
@@ -491,8 +491,8 @@ double ksStatisticOfVertexCoordinate(const std::vector<Barycentric>& points)
 }
 
 constexpr uint32_t kSampleCount = 1000000;
-constexpr int kGrid = 16;                 // 256 cells, ~3906 expected points each
-constexpr double kKsCritical = 1.63;      // sqrt(n) D at alpha = 0.01
+constexpr int kGrid = 16;            // 256 cells, ~3906 expected points each
+constexpr double kKsCritical = 1.63; // sqrt(n) D at alpha = 0.01
 constexpr double kSignificance = 0.01;
 
 /// The GPU's points (sampleTriangle with the render kernels' sampler), computed once.

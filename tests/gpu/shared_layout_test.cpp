@@ -16,7 +16,8 @@ namespace {
 
 std::map<std::string, int> reflectedOffsets()
 {
-    KernelSource source{defaultShaderRoot(), "kernels/render.comp", KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()};
+    KernelSource source{defaultShaderRoot(), "kernels/render.comp",
+                        KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()};
     std::map<std::string, int> offsets;
     for (const auto& [name, offset] : reflectBlockMemberOffsets(source)) offsets[name] = offset;
     return offsets;
@@ -27,41 +28,68 @@ struct Member {
     size_t offset;             // offsetof in C++ plus the array element's base
 };
 
-#define ARRAY_MEMBER(array, Type, field) Member{#array "[0]." #field, offsetof(gpu::Type, field)}
-#define BLOCK_MEMBER(instance, Type, field) Member{#instance "." #field, offsetof(gpu::Type, field)}
+#define ARRAY_MEMBER(array, Type, field) \
+    Member { #array "[0]." #field, offsetof(gpu::Type, field) }
+#define BLOCK_MEMBER(instance, Type, field) \
+    Member { #instance "." #field, offsetof(gpu::Type, field) }
 
 std::vector<Member> expectedMembers()
 {
     return {
-        ARRAY_MEMBER(materials, Material, diffuse), ARRAY_MEMBER(materials, Material, type),
-        ARRAY_MEMBER(materials, Material, specular), ARRAY_MEMBER(materials, Material, exponent),
-        ARRAY_MEMBER(materials, Material, absorption), ARRAY_MEMBER(materials, Material, ior),
+        ARRAY_MEMBER(materials, Material, diffuse),
+        ARRAY_MEMBER(materials, Material, type),
+        ARRAY_MEMBER(materials, Material, specular),
+        ARRAY_MEMBER(materials, Material, exponent),
+        ARRAY_MEMBER(materials, Material, absorption),
+        ARRAY_MEMBER(materials, Material, ior),
         ARRAY_MEMBER(materials, Material, fresnel),
-        ARRAY_MEMBER(spheres, Sphere, center), ARRAY_MEMBER(spheres, Sphere, radius),
+        ARRAY_MEMBER(spheres, Sphere, center),
+        ARRAY_MEMBER(spheres, Sphere, radius),
         ARRAY_MEMBER(spheres, Sphere, material),
-        ARRAY_MEMBER(boxes, Box, lower), ARRAY_MEMBER(boxes, Box, material), ARRAY_MEMBER(boxes, Box, upper),
-        ARRAY_MEMBER(triangles, Triangle, v0), ARRAY_MEMBER(triangles, Triangle, material),
-        ARRAY_MEMBER(triangles, Triangle, v1), ARRAY_MEMBER(triangles, Triangle, v2),
-        ARRAY_MEMBER(planes, Plane, point), ARRAY_MEMBER(planes, Plane, material),
+        ARRAY_MEMBER(boxes, Box, lower),
+        ARRAY_MEMBER(boxes, Box, material),
+        ARRAY_MEMBER(boxes, Box, upper),
+        ARRAY_MEMBER(triangles, Triangle, v0),
+        ARRAY_MEMBER(triangles, Triangle, material),
+        ARRAY_MEMBER(triangles, Triangle, v1),
+        ARRAY_MEMBER(triangles, Triangle, v2),
+        ARRAY_MEMBER(planes, Plane, point),
+        ARRAY_MEMBER(planes, Plane, material),
         ARRAY_MEMBER(planes, Plane, normal),
-        ARRAY_MEMBER(pointLights, PointLight, position), ARRAY_MEMBER(pointLights, PointLight, intensity),
-        ARRAY_MEMBER(triangleLights, TriangleLight, v0), ARRAY_MEMBER(triangleLights, TriangleLight, area),
-        ARRAY_MEMBER(triangleLights, TriangleLight, v1), ARRAY_MEMBER(triangleLights, TriangleLight, twoSided),
-        ARRAY_MEMBER(triangleLights, TriangleLight, v2), ARRAY_MEMBER(triangleLights, TriangleLight, radiance),
-        ARRAY_MEMBER(accum, AccumPixel, sum), ARRAY_MEMBER(accum, AccumPixel, count),
+        ARRAY_MEMBER(pointLights, PointLight, position),
+        ARRAY_MEMBER(pointLights, PointLight, intensity),
+        ARRAY_MEMBER(triangleLights, TriangleLight, v0),
+        ARRAY_MEMBER(triangleLights, TriangleLight, area),
+        ARRAY_MEMBER(triangleLights, TriangleLight, v1),
+        ARRAY_MEMBER(triangleLights, TriangleLight, twoSided),
+        ARRAY_MEMBER(triangleLights, TriangleLight, v2),
+        ARRAY_MEMBER(triangleLights, TriangleLight, radiance),
+        ARRAY_MEMBER(accum, AccumPixel, sum),
+        ARRAY_MEMBER(accum, AccumPixel, count),
         ARRAY_MEMBER(accum, AccumPixel, compensation),
-        BLOCK_MEMBER(stats, RenderStats, maxLoopIterations), BLOCK_MEMBER(stats, RenderStats, budgetExceeded),
-        BLOCK_MEMBER(u, SceneUniforms, cameraRight), BLOCK_MEMBER(u, SceneUniforms, width),
-        BLOCK_MEMBER(u, SceneUniforms, cameraUp), BLOCK_MEMBER(u, SceneUniforms, height),
-        BLOCK_MEMBER(u, SceneUniforms, cameraForward), BLOCK_MEMBER(u, SceneUniforms, flags),
-        BLOCK_MEMBER(u, SceneUniforms, backgroundColor), BLOCK_MEMBER(u, SceneUniforms, maxDepth),
-        BLOCK_MEMBER(u, SceneUniforms, sphereCount), BLOCK_MEMBER(u, SceneUniforms, boxCount),
-        BLOCK_MEMBER(u, SceneUniforms, triangleCount), BLOCK_MEMBER(u, SceneUniforms, planeCount),
-        BLOCK_MEMBER(u, SceneUniforms, pointLightCount), BLOCK_MEMBER(u, SceneUniforms, triangleLightCount),
-        BLOCK_MEMBER(u, SceneUniforms, tileCount), BLOCK_MEMBER(u, SceneUniforms, tileStride),
-        BLOCK_MEMBER(u, SceneUniforms, environmentSize), BLOCK_MEMBER(u, SceneUniforms, cameraMediumCount),
+        BLOCK_MEMBER(stats, RenderStats, maxLoopIterations),
+        BLOCK_MEMBER(stats, RenderStats, budgetExceeded),
+        BLOCK_MEMBER(u, SceneUniforms, cameraRight),
+        BLOCK_MEMBER(u, SceneUniforms, width),
+        BLOCK_MEMBER(u, SceneUniforms, cameraUp),
+        BLOCK_MEMBER(u, SceneUniforms, height),
+        BLOCK_MEMBER(u, SceneUniforms, cameraForward),
+        BLOCK_MEMBER(u, SceneUniforms, flags),
+        BLOCK_MEMBER(u, SceneUniforms, backgroundColor),
+        BLOCK_MEMBER(u, SceneUniforms, maxDepth),
+        BLOCK_MEMBER(u, SceneUniforms, sphereCount),
+        BLOCK_MEMBER(u, SceneUniforms, boxCount),
+        BLOCK_MEMBER(u, SceneUniforms, triangleCount),
+        BLOCK_MEMBER(u, SceneUniforms, planeCount),
+        BLOCK_MEMBER(u, SceneUniforms, pointLightCount),
+        BLOCK_MEMBER(u, SceneUniforms, triangleLightCount),
+        BLOCK_MEMBER(u, SceneUniforms, tileCount),
+        BLOCK_MEMBER(u, SceneUniforms, tileStride),
+        BLOCK_MEMBER(u, SceneUniforms, environmentSize),
+        BLOCK_MEMBER(u, SceneUniforms, cameraMediumCount),
         BLOCK_MEMBER(u, SceneUniforms, cameraMedia),
-        BLOCK_MEMBER(frame, FrameConstants, firstFrame), BLOCK_MEMBER(frame, FrameConstants, seed),
+        BLOCK_MEMBER(frame, FrameConstants, firstFrame),
+        BLOCK_MEMBER(frame, FrameConstants, seed),
     };
 }
 

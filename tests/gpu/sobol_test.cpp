@@ -180,7 +180,8 @@ struct Grid {
     }
     Draw drawAt(uint32_t pixel, uint32_t frame, uint32_t draw) const
     {
-        return {at(pixel, frame, draw, 0), at(pixel, frame, draw, 1), at(pixel, frame, draw, 2), at(pixel, frame, draw, 3)};
+        return {at(pixel, frame, draw, 0), at(pixel, frame, draw, 1), at(pixel, frame, draw, 2),
+                at(pixel, frame, draw, 3)};
     }
 };
 
@@ -228,7 +229,8 @@ TEST(SobolCpu, ReferencePointsMatchJoeKuo)
 {
     for (uint32_t k = 0; k < 8; ++k) {
         U4 x = sobolPoint(k ^ (k >> 1));
-        for (int d = 0; d < 4; ++d) EXPECT_EQ(double(x[d]) / 4294967296.0, kJoeKuoPoints[k][d]) << "row " << k << " dim " << d;
+        for (int d = 0; d < 4; ++d)
+            EXPECT_EQ(double(x[d]) / 4294967296.0, kJoeKuoPoints[k][d]) << "row " << k << " dim " << d;
     }
     // Every generator matrix is upper triangular with a unit diagonal (as read
     // most significant digit first), which makes each dimension a (0,1)-sequence.
@@ -251,9 +253,9 @@ TEST(SobolCpu, NestedUniformScrambleFlipsEachDigitByTheDigitsBeforeIt)
         uint32_t seed = uint32_t(rng()), x = uint32_t(rng());
         int k = int(rng() % 32u);
         uint32_t digit = 0x80000000u >> k;
-        uint32_t prefix = k == 0 ? 0u : x & ~(0xffffffffu >> k);  // the first k digits of x
+        uint32_t prefix = k == 0 ? 0u : x & ~(0xffffffffu >> k);   // the first k digits of x
         uint32_t rest = k == 31 ? 0u : uint32_t(rng()) >> (k + 1); // anything after digit k+1
-        uint32_t y = prefix | (~x & digit) | rest;                  // digit k+1 differs
+        uint32_t y = prefix | (~x & digit) | rest;                 // digit k+1 differs
         uint32_t diff = nestedUniformScramble(x, seed) ^ nestedUniformScramble(y, seed);
         if ((diff >> (31 - k)) != 1u && failures++ < 5) ADD_FAILURE() << "seed " << seed << " x " << x << " k " << k;
     }
@@ -284,7 +286,8 @@ std::vector<U4> gpuUnscrambled(uint32_t stride)
     std::vector<float> out = timedProbe("unscrambled", {2.0f, float(stride)}, 8 * size_t(kPoints), kPoints, {});
     std::vector<U4> points(kPoints);
     for (uint32_t i = 0; i < kPoints; ++i)
-        for (int d = 0; d < 4; ++d) points[i][d] = uint32_t(out[8 * i + 2 * d]) | (uint32_t(out[8 * i + 2 * d + 1]) << 16u);
+        for (int d = 0; d < 4; ++d)
+            points[i][d] = uint32_t(out[8 * i + 2 * d]) | (uint32_t(out[8 * i + 2 * d + 1]) << 16u);
     return points;
 }
 
@@ -306,7 +309,8 @@ TEST_F(SobolProbe, UnscrambledPointsMatchTheReference)
         if (stride != 1u) continue;
         for (uint32_t k = 0; k < 8; ++k)
             for (int d = 0; d < 4; ++d)
-                EXPECT_EQ(double(gpu[k ^ (k >> 1)][d]) / 4294967296.0, kJoeKuoPoints[k][d]) << "row " << k << " dim " << d;
+                EXPECT_EQ(double(gpu[k ^ (k >> 1)][d]) / 4294967296.0, kJoeKuoPoints[k][d])
+                    << "row " << k << " dim " << d;
     }
 }
 
@@ -448,8 +452,8 @@ TEST_F(SobolProbe, ValuesAreUniformAcrossPixels)
                 }
                 double expected = double(kPixels) / (kBins * kBins), chi2 = 0.0;
                 for (double c : counts) chi2 += (c - expected) * (c - expected) / expected;
-                EXPECT_LT(chi2, critical) << "frame " << frames[f] << " draw " << draw << " dims " << 2 * pair << ","
-                                          << 2 * pair + 1;
+                EXPECT_LT(chi2, critical)
+                    << "frame " << frames[f] << " draw " << draw << " dims " << 2 * pair << "," << 2 * pair + 1;
                 worst = std::max(worst, chi2);
             }
     EXPECT_GE(lo, 0.0);
@@ -483,7 +487,8 @@ using Value = std::function<float(uint32_t pixel, uint32_t frame, uint32_t draw,
 /// frames x (mean over pixels of r^2), r being the correlation of one dimension
 /// of draw k with the same dimension of draw k + 1 over one pixel's frames.
 /// Independent draws give about 1; draws that share a randomization give ~frames.
-double perPixelSquaredCorrelation(const Value& value, uint32_t pixels, uint32_t frames, uint32_t draw, uint32_t dimension)
+double perPixelSquaredCorrelation(const Value& value, uint32_t pixels, uint32_t frames, uint32_t draw,
+                                  uint32_t dimension)
 {
     double meanSquare = 0.0;
     for (uint32_t p = 0; p < pixels; ++p) {
@@ -509,7 +514,8 @@ TEST_F(SobolProbe, SuccessiveDrawsAreUncorrelated)
             // All pixels and frames pooled: |r| < 4 / sqrt(N).
             Correlation c = pearson([&](const auto& add) {
                 for (uint32_t p = 0; p < grid.pixels; ++p)
-                    for (uint32_t f = 0; f < grid.frames; ++f) add(grid.at(p, f, draw, dim), grid.at(p, f, draw + 1, dim));
+                    for (uint32_t f = 0; f < grid.frames; ++f)
+                        add(grid.at(p, f, draw, dim), grid.at(p, f, draw + 1, dim));
             });
             bound = 4.0 / std::sqrt(double(c.n));
             EXPECT_LT(std::abs(c.r), bound) << "dim " << dim << ", draw " << draw << " vs " << draw + 1;
@@ -526,7 +532,8 @@ TEST_F(SobolProbe, SuccessiveDrawsAreUncorrelated)
     reportStat("DrawLag1WorstPooledR", worstPooled);
     reportStat("DrawLag1Bound", bound);
     reportStat("DrawLag1PerPixelRSquaredTimesN_worst", worstPerPixel);
-    reportStat("DrawLag1PerPixelRSquaredTimesN_pcg", perPixelSquaredCorrelation(gridValue(pcgGrid()), 256, grid.frames, 0, 0));
+    reportStat("DrawLag1PerPixelRSquaredTimesN_pcg",
+               perPixelSquaredCorrelation(gridValue(pcgGrid()), 256, grid.frames, 0, 0));
     // The per-pixel check can fail: without the index shuffle, successive draws
     // are scrambles of the same point, and correlate.
     Value unpadded = [](uint32_t p, uint32_t f, uint32_t draw, uint32_t d) {
@@ -631,7 +638,7 @@ TEST_F(SobolProbe, IntegrationErrorFallsFasterThanMonteCarlo)
         reportStat("Slope_sobol_batches8_" + integrand.name, batchedSlope);
         reportStat("Slope_pcg_" + integrand.name, pcg);
         reportStat("MseRatio_pcg_over_sobol_1024spp_" + integrand.name,
-               meanSquaredError(pcgGrid(), integrand, 1024) / meanSquaredError(sobolGrid(), integrand, 1024));
+                   meanSquaredError(pcgGrid(), integrand, 1024) / meanSquaredError(sobolGrid(), integrand, 1024));
         EXPECT_NEAR(pcg, -1.0, 0.2) << integrand.name;
         if (integrand.name.rfind("smooth", 0) == 0) {
             EXPECT_LT(sobol, -1.3) << integrand.name; // Owen: n^-3 for smooth 2D integrands
@@ -643,7 +650,8 @@ TEST_F(SobolProbe, IntegrationErrorFallsFasterThanMonteCarlo)
         if (integrand.name.rfind("interaction", 0) == 0) {
             // A pure coupling of two draws: the nested pairing gives about 1.6 times
             // Monte Carlo's error (see SuccessiveDrawsAreUncorrelated), no worse.
-            EXPECT_GT(meanSquaredError(pcgGrid(), integrand, 1024) / meanSquaredError(sobolGrid(), integrand, 1024), 0.45);
+            EXPECT_GT(meanSquaredError(pcgGrid(), integrand, 1024) / meanSquaredError(sobolGrid(), integrand, 1024),
+                      0.45);
         }
     }
 }
@@ -652,10 +660,10 @@ TEST_F(SobolProbe, IntegrationErrorFallsFasterThanMonteCarlo)
 // Honest variance estimates
 
 struct VarianceCheck {
-    double trueMse = 0.0;     ///< mean over pixels of (mean - exact)^2
-    double welford = 0.0;     ///< mean over pixels of s^2 / n (frames taken as independent)
-    double batchMeans = 0.0;  ///< mean over pixels of the batch-means estimate
-    double blockMeans = 0.0;  ///< the same with batches of consecutive frames
+    double trueMse = 0.0;    ///< mean over pixels of (mean - exact)^2
+    double welford = 0.0;    ///< mean over pixels of s^2 / n (frames taken as independent)
+    double batchMeans = 0.0; ///< mean over pixels of the batch-means estimate
+    double blockMeans = 0.0; ///< the same with batches of consecutive frames
 };
 
 /// Variance of the mean from K group means: sum (mean_b - mean)^2 / (K (K - 1)).

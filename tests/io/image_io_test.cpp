@@ -95,9 +95,9 @@ TEST(ToneMap, SrgbEncodingOfKnownValues)
     EXPECT_EQ(toneMapToSrgb8(5.0f, 0.0f), 255);
     EXPECT_EQ(toneMapToSrgb8(-1.0f, 0.0f), 0);
     EXPECT_EQ(toneMapToSrgb8(std::nanf(""), 0.0f), 0);
-    EXPECT_EQ(toneMapToSrgb8(0.18f, 0.0f), 118);  // 18 % grey
-    EXPECT_EQ(toneMapToSrgb8(0.25f, 0.0f), 137);  // 1.055 * 0.25^(1/2.4) - 0.055 = 0.5371
-    EXPECT_EQ(toneMapToSrgb8(0.125f, 1.0f), 137); // one stop up doubles it
+    EXPECT_EQ(toneMapToSrgb8(0.18f, 0.0f), 118);        // 18 % grey
+    EXPECT_EQ(toneMapToSrgb8(0.25f, 0.0f), 137);        // 1.055 * 0.25^(1/2.4) - 0.055 = 0.5371
+    EXPECT_EQ(toneMapToSrgb8(0.125f, 1.0f), 137);       // one stop up doubles it
     EXPECT_EQ(toneMapToSrgb8(0.0031308f / 2, 0.0f), 5); // linear segment: 12.92 * x
 }
 

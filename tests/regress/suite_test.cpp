@@ -69,15 +69,17 @@ protected:
 /// One complete case, lines 1-7 (8 with `extra`).
 std::string caseText(const std::string& name = "a", const std::string& extra = "", const std::string& source = "vkrt")
 {
-    return "[[case]]\nname = \"" + name + "\"\nscene = \"scenes/a.toml\"\nreference = \"refs/a\"\nreference_source = \"" +
-           source + "\"\nreference_spp = 4096\nspp = 32\n" + extra;
+    return "[[case]]\nname = \"" + name +
+           "\"\nscene = \"scenes/a.toml\"\nreference = \"refs/a\"\nreference_source = \"" + source +
+           "\"\nreference_spp = 4096\nspp = 32\n" + extra;
 }
 
 TEST_F(SuiteFile, ValidManifestWithDefaultsAndResolvedPaths)
 {
-    const RegressionSuite suite = readRegressionSuite(write(
-        "[suite]\nalpha = 0.05\nmin_pass = 1\nseed = 0\n" + caseText("a", "width = 32\nheight = 24\nmax_rejected = 3\n") +
-        caseText("b", "baseline_seconds = 2\n", "mitsuba")));
+    const RegressionSuite suite =
+        readRegressionSuite(write("[suite]\nalpha = 0.05\nmin_pass = 1\nseed = 0\n" +
+                                  caseText("a", "width = 32\nheight = 24\nmax_rejected = 3\n") +
+                                  caseText("b", "baseline_seconds = 2\n", "mitsuba")));
     EXPECT_DOUBLE_EQ(suite.alpha, 0.05);
     EXPECT_DOUBLE_EQ(suite.pooledAlpha, 0.001);
     EXPECT_DOUBLE_EQ(suite.minPass, 1.0);
@@ -102,7 +104,8 @@ TEST_F(SuiteFile, UnknownKeysSuggestTheCloseOneWhereTheyStand)
 {
     expectError(caseText("a", "sp = 4\n"), 8, 1, "case[0]: unknown key 'sp'; did you mean 'spp'?");
     // Two swapped pairs: two edits with transpositions (plain Levenshtein: four, no hint).
-    expectError("[suite]\nmni_psas = 0.5\n" + caseText(), 2, 1, "suite: unknown key 'mni_psas'; did you mean 'min_pass'?");
+    expectError("[suite]\nmni_psas = 0.5\n" + caseText(), 2, 1,
+                "suite: unknown key 'mni_psas'; did you mean 'min_pass'?");
     expectError("[suit]\n" + caseText(), 1, 2, "unknown top-level table 'suit'; did you mean 'suite'?");
     expectError("title = \"x\"\n" + caseText(), 1, 1, "unknown top-level key 'title'");
 }

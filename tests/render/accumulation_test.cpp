@@ -35,8 +35,7 @@ TEST_F(AccumulationTest, CompensatedSumKeepsTheMeanExact)
     Image image = renderer.mean();
     const double expected[3] = {double(0.1f), double(0.3f), double(0.7f)};
     for (size_t i = 0; i < image.pixelCount(); ++i)
-        for (int c = 0; c < 3; ++c)
-            ASSERT_NEAR(image.rgb[i * 3 + c], expected[c], expected[c] * 1e-6) << "pixel " << i;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(image.rgb[i * 3 + c], expected[c], expected[c] * 1e-6) << "pixel " << i;
 }
 
 // The test hook poisons every 7th pixel with NaN: those samples must be

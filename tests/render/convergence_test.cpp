@@ -67,8 +67,8 @@ Image exactImage(const Scene& scene)
             for (int j = 0; j < kGrid; ++j)
                 for (int i = 0; i < kGrid; ++i) {
                     double fx = (x + (i + 0.5) / kGrid) / c.width, fy = (y + (j + 0.5) / kGrid) / c.height;
-                    glm::dvec3 d = glm::normalize((2 * fx - 1) * t * c.width / c.height * right + (1 - 2 * fy) * t * up +
-                                                  forward);
+                    glm::dvec3 d =
+                        glm::normalize((2 * fx - 1) * t * c.width / c.height * right + (1 - 2 * fy) * t * up + forward);
                     glm::dvec3 p = c.eye + (-c.eye.y / d.y) * d;
                     sum += 0.7 / M_PI * polygonIrradiance(p, {0, 1, 0}, kLight);
                 }

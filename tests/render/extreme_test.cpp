@@ -454,8 +454,9 @@ TEST_F(ExtremeIor, IndexMatchedSchlickGlassShowsOnlyARim)
              t.passed, t.tested, t.fraction(), t.pooledZ);
     for (int b = 0; b < 5; ++b)
         if (binCount[b])
-            measured("IOR 1 Schlick: entry cosine in [%.1f, %.1f): %d pixels, image / light reaching the wall behind = %.4f", b * 0.2,
-                     b * 0.2 + 0.2, binCount[b], binSum[b] / binBehind[b]);
+            measured(
+                "IOR 1 Schlick: entry cosine in [%.1f, %.1f): %d pixels, image / light reaching the wall behind = %.4f",
+                b * 0.2, b * 0.2 + 0.2, binCount[b], binSum[b] / binBehind[b]);
     EXPECT_GE(t.fraction(), 0.9975);
     EXPECT_LT(std::abs(t.pooledZ), 4.0);
     // The rim is real: at grazing entry Schlick's sphere differs visibly from the invisible one.
@@ -559,10 +560,8 @@ TEST_F(ExtremeIor, Ior1e20And1e30StayFinite)
                     for (float x : r.mean.rgb) sum += x, brightest = std::max(brightest, double(x));
                     measured("%s: rejected %llu, image mean %.4g, brightest %.4g", what,
                              (unsigned long long)r.counters.rejectedSamples, sum / r.mean.rgb.size(), brightest);
-                    if (&v == &views[0])
-                        EXPECT_EQ(r.mean.rgb, reference.mean.rgb) << what << ": must equal the mirror";
-                    else
-                        EXPECT_LE(brightest, 1e-6) << what << ": no light gets into the sphere";
+                    if (&v == &views[0]) EXPECT_EQ(r.mean.rgb, reference.mean.rgb) << what << ": must equal the mirror";
+                    else EXPECT_LE(brightest, 1e-6) << what << ": no light gets into the sphere";
                 }
     }
 }
@@ -737,8 +736,12 @@ TEST_F(ExtremeAbsorption, WhittedShadowThroughOpaqueGlassIsExactlyZero)
             if (d.y >= 0) continue;
             glm::dvec3 p = scene.camera.eye + (-scene.camera.eye.y / d.y) * d;
             // Skip pixels whose camera ray meets the slab, and shadow rays near its sides.
-            auto at = [&](const glm::dvec3& a, const glm::dvec3& b, double h) { return a + (h - a.y) / (b.y - a.y) * (b - a); };
-            auto inside = [&](const glm::dvec3& q, double m) { return std::abs(q.x) < half - m && std::abs(q.z) < half - m; };
+            auto at = [&](const glm::dvec3& a, const glm::dvec3& b, double h) {
+                return a + (h - a.y) / (b.y - a.y) * (b - a);
+            };
+            auto inside = [&](const glm::dvec3& q, double m) {
+                return std::abs(q.x) < half - m && std::abs(q.z) < half - m;
+            };
             if (segmentMeetsBox(scene.camera.eye, p, slabMin, slabMax, 1e-3)) continue;
             glm::dvec3 s0 = at(p, light, y0), s1 = at(p, light, y1);
             bool crosses = inside(s0, 1e-3) && inside(s1, 1e-3);
@@ -757,7 +760,8 @@ TEST_F(ExtremeAbsorption, WhittedShadowThroughOpaqueGlassIsExactlyZero)
                 worst = std::max(worst, std::abs(v[0] - e) / e);
             } else {
                 ++lit;
-                for (int k = 0; k < 3; ++k) EXPECT_NEAR(v[k], unshadowed, 1e-4 * unshadowed) << "pixel " << x << "," << y;
+                for (int k = 0; k < 3; ++k)
+                    EXPECT_NEAR(v[k], unshadowed, 1e-4 * unshadowed) << "pixel " << x << "," << y;
             }
         }
     measured("kappa shadow (Whitted): %zu shadowed pixels with green exactly 0, red within %.3g of (1-F)^2 E; %zu lit",
@@ -1053,10 +1057,10 @@ TEST(ExtremeMediaAroundCamera, NestedSpheresOutermostFirstOthersIgnored)
 {
     Scene scene = mediaScene(3);
     const uint32_t opaque = 3;
-    scene.spheres = {{{0.2, 0, 0}, 1.0, 1},  // small glass around the eye
+    scene.spheres = {{{0.2, 0, 0}, 1.0, 1},    // small glass around the eye
                      {{0, 0, 0}, 3.0, opaque}, // opaque around the eye: not a medium
-                     {{0, 1, 0}, 5.0, 0},  // big glass around the eye
-                     {{10, 0, 0}, 2.0, 2}}; // glass elsewhere
+                     {{0, 1, 0}, 5.0, 0},      // big glass around the eye
+                     {{10, 0, 0}, 2.0, 2}};    // glass elsewhere
     EXPECT_EQ(mediaAroundCamera(scene), (Media{0, 1}));
     scene.spheres[0].center = {1.5, 0, 0}; // the small sphere no longer holds the eye
     EXPECT_EQ(mediaAroundCamera(scene), (Media{0}));
@@ -1198,8 +1202,8 @@ TEST_F(ExtremeLights, VarianceOfAnOverflowingLightIsNeverZero)
             zero += r.variance.rgb[i] == 0.0f;
             infinite += std::isinf(r.variance.rgb[i]);
         }
-        measured("tiny light, radiance %g with variance: of %zu noisy values, %zu report variance 0, %zu +inf", radiance,
-                 noisy, zero, infinite);
+        measured("tiny light, radiance %g with variance: of %zu noisy values, %zu report variance 0, %zu +inf",
+                 radiance, noisy, zero, infinite);
         EXPECT_EQ(zero, 0u) << radiance;
     }
 }
@@ -1252,8 +1256,8 @@ TEST_F(ExtremeAccumulation, MillionSamplesWithRareOutliersKeepAnExactMean)
             EXPECT_NEAR(v, exact, 1e-6 * exact) << "pixel " << p;
             sum += v, expectedSum += exact;
             if (k > 0)
-                worstVariance = std::max(worstVariance,
-                                         std::abs(r.variance.rgb[p * 3 + ch] - varianceOfMean) / varianceOfMean);
+                worstVariance =
+                    std::max(worstVariance, std::abs(r.variance.rgb[p * 3 + ch] - varianceOfMean) / varianceOfMean);
         }
     }
     measured("outliers: %zu outliers among %u samples; worst per-pixel relative error of the mean %.3g, of the image "

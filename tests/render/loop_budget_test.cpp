@@ -38,7 +38,8 @@ std::string manyLightsScene(int spheres, int lights, double intensity)
         text += ", 0, -50]\nradius = 0.1\nmaterial = \"m\"\n";
     }
     for (int i = 0; i < lights; ++i)
-        text += "[[lights]]\ntype = \"point\"\nposition = [0.5, 3, 0.5]\nintensity = " + std::to_string(intensity) + "\n";
+        text +=
+            "[[lights]]\ntype = \"point\"\nposition = [0.5, 3, 0.5]\nintensity = " + std::to_string(intensity) + "\n";
     return text;
 }
 

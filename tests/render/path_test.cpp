@@ -117,7 +117,8 @@ TEST_F(PathTest, WhiteFurnaceLambertMirrorAndGlassAreInvisible)
         // Pixels off the sphere see the environment (1): expected there too for albedo 1.
         for (uint32_t y = 0; y < 24; ++y)
             for (uint32_t x = 0; x < 24; ++x) {
-                double sx = (2.0 * (x + 0.5) / 24 - 1) * std::tan(M_PI / 9), sy = (1 - 2.0 * (y + 0.5) / 24) * std::tan(M_PI / 9);
+                double sx = (2.0 * (x + 0.5) / 24 - 1) * std::tan(M_PI / 9),
+                       sy = (1 - 2.0 * (y + 0.5) / 24) * std::tan(M_PI / 9);
                 double b = 3.0 / std::sqrt(1 + sx * sx + sy * sy); // distance of closest approach test
                 bool hits = 9.0 - b * b < 1.0;
                 for (int k = 0; k < 3; ++k) expected[(y * 24 + x) * 3 + k] = hits ? c.expected : 1.0;
@@ -233,11 +234,13 @@ two_sided = true
         double t = std::tan(c.fovY * M_PI / 360.0);
         for (uint32_t y = 0; y < c.height; ++y)
             for (uint32_t x = 0; x < c.width; ++x) {
-                double sx = (2.0 * (x + 0.5) / c.width - 1) * t * c.width / c.height, sy = (1 - 2.0 * (y + 0.5) / c.height) * t;
+                double sx = (2.0 * (x + 0.5) / c.width - 1) * t * c.width / c.height,
+                       sy = (1 - 2.0 * (y + 0.5) / c.height) * t;
                 glm::dvec3 d = glm::normalize(sx * right + sy * up + forward);
                 glm::dvec3 p = c.eye + (-c.eye.y / d.y) * d;
                 // Pixels whose centre ray meets the (two-sided) light see its radiance.
-                double factor = hitsTriangle(c.eye, d, light) ? 1.0 : 0.6 / M_PI * polygonIrradiance(p, {0, 1, 0}, light);
+                double factor =
+                    hitsTriangle(c.eye, d, light) ? 1.0 : 0.6 / M_PI * polygonIrradiance(p, {0, 1, 0}, light);
                 for (int k = 0; k < 3; ++k) expected[(y * c.width + x) * 3 + k] = factor * glm::dvec3(4, 2, 1)[k];
             }
         EXPECT_GE(fractionPassingZTest(e, expected), 0.9975) << integrator;
@@ -252,7 +255,7 @@ two_sided = true
 TEST_F(PathTest, LambertSphereInFaceColouredCubemapMatchesIrradiance)
 {
     const std::array<glm::dvec3, 6> colours = {glm::dvec3{2.0, 0.1, 0.1}, {0.1, 1.5, 0.1}, {4.0, 4.0, 3.5},
-                                               {0.05, 0.05, 0.05}, {0.3, 0.3, 1.2}, {1.0, 0.6, 0.2}};
+                                               {0.05, 0.05, 0.05},        {0.3, 0.3, 1.2}, {1.0, 0.6, 0.2}};
     std::filesystem::path dir = freshTempDir("env-irradiance");
     const char* names[6] = {"px", "nx", "py", "ny", "pz", "nz"};
     std::string text = R"([render]

@@ -2,8 +2,8 @@
 // writes for every command, and the validation of overrides (resolution from
 // options or a suite, viewer camera moves) with the scene parser's rules.
 #include "render/RenderSession.h"
-#include "shared/Bindings.h"
 #include "scene/SceneOverrides.h"
+#include "shared/Bindings.h"
 #include "support/TestSupport.h"
 #include "view/CameraControl.h"
 
@@ -55,13 +55,22 @@ std::string errorOf(const std::function<void()>& action)
 TEST(SceneOverrides, ResolutionErrorsNameTheOptionWithTheParsersWording)
 {
     Camera camera;
-    EXPECT_EQ(errorOf([&] { applyResolution(camera, {0u, std::nullopt}); }), "--width: must be between 1 and 16384, got 0");
-    EXPECT_EQ(errorOf([&] { applyResolution(camera, {std::nullopt, 16385u}); }),
+    EXPECT_EQ(errorOf([&] {
+                  applyResolution(camera, {0u, std::nullopt});
+              }),
+              "--width: must be between 1 and 16384, got 0");
+    EXPECT_EQ(errorOf([&] {
+                  applyResolution(camera, {std::nullopt, 16385u});
+              }),
               "--height: must be between 1 and 16384, got 16385");
-    EXPECT_EQ(errorOf([&] { applyResolution(camera, {16384u, 16384u}); }),
+    EXPECT_EQ(errorOf([&] {
+                  applyResolution(camera, {16384u, 16384u});
+              }),
               "--height: width * height = 268435456 pixels exceeds the limit of 67108864");
     camera.height = 16384;
-    EXPECT_EQ(errorOf([&] { applyResolution(camera, {8192u, std::nullopt}); }),
+    EXPECT_EQ(errorOf([&] {
+                  applyResolution(camera, {8192u, std::nullopt});
+              }),
               "--width: width * height = 134217728 pixels exceeds the limit of 67108864")
         << "only the width was given: it is to blame";
     EXPECT_EQ(camera.width, 640u) << "a refused override changes nothing";
@@ -114,11 +123,11 @@ TEST(BatchPacer, GrowsAtMostTwofoldTowardsTheTargetAndShrinksAtOnce)
     EXPECT_EQ(pacer.nextFrames(), 1u);
     pacer.record(1, 0.001); // far below the target: double, no more
     EXPECT_EQ(pacer.nextFrames(), 2u);
-    pacer.record(40, 0.0);  // unmeasurably fast: double up to the cap
+    pacer.record(40, 0.0); // unmeasurably fast: double up to the cap
     EXPECT_EQ(pacer.nextFrames(), 64u);
-    pacer.record(64, 1.0);  // four times too long: a quarter
+    pacer.record(64, 1.0); // four times too long: a quarter
     EXPECT_EQ(pacer.nextFrames(), 16u);
-    pacer.record(1, 10.0);  // one slow frame: still at least one
+    pacer.record(1, 10.0); // one slow frame: still at least one
     EXPECT_EQ(pacer.nextFrames(), 1u);
 }
 
@@ -235,10 +244,10 @@ TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
     session.run();
     Film film = session.film();
     Metadata m = session.metadata(film);
-    for (const char* key : {"vkrtVersion", "spp", "seed", "renderSeconds", "stoppedBy", "device", "driver", "scene",
-                            "sceneHash", "integrator", "kernelVariant", "sampler", "rejectedSamples", "loopCap",
-                            "varianceDegreesOfFreedom", "varianceEstimator", "estimatedRmse", "estimatedRelMse",
-                            "timeBudgetSeconds"})
+    for (const char* key :
+         {"vkrtVersion", "spp", "seed", "renderSeconds", "stoppedBy", "device", "driver", "scene", "sceneHash",
+          "integrator", "kernelVariant", "sampler", "rejectedSamples", "loopCap", "varianceDegreesOfFreedom",
+          "varianceEstimator", "estimatedRmse", "estimatedRelMse", "timeBudgetSeconds"})
         EXPECT_EQ(m.count(key), 1u) << key;
     EXPECT_EQ(m.count("savedBy"), 0u);
     EXPECT_EQ(std::get<int64_t>(m.at("spp")), 8);
@@ -249,7 +258,8 @@ TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
     EXPECT_EQ(std::get<std::string>(m.at("sceneHash")).rfind("fnv1a64:", 0), 0u);
     EXPECT_EQ(std::get<std::string>(m.at("loopCap")), gpu().loopCap().describe());
     std::string expectedStart = gpu().loopCap().capped() ? std::to_string(gpu::LOOP_BUDGET) : "none";
-    EXPECT_EQ(std::get<std::string>(m.at("loopCap")).rfind(expectedStart, 0), 0u) << std::get<std::string>(m.at("loopCap"));
+    EXPECT_EQ(std::get<std::string>(m.at("loopCap")).rfind(expectedStart, 0), 0u)
+        << std::get<std::string>(m.at("loopCap"));
 }
 
 TEST_F(RenderSessionTest, ViewerSaveMetadataAddsSavedByAndFollowsMovesAndResets)
@@ -261,9 +271,10 @@ TEST_F(RenderSessionTest, ViewerSaveMetadataAddsSavedByAndFollowsMovesAndResets)
     EXPECT_EQ(std::get<int64_t>(saved.at("spp")), 3);
     EXPECT_EQ(saved.count("stoppedBy"), 0u) << "no stop rule ran";
     EXPECT_EQ(saved.count("estimatedRmse"), 0u) << "no variance estimated";
-    std::set<std::string> expected = {"vkrtVersion", "spp",         "seed",          "renderSeconds", "device",
-                                      "driver",      "scene",       "sceneHash",     "integrator",    "kernelVariant",
-                                      "sampler",     "rejectedSamples", "loopCap",       "savedBy"};
+    std::set<std::string> expected = {"vkrtVersion", "spp",           "seed",    "renderSeconds",
+                                      "device",      "driver",        "scene",   "sceneHash",
+                                      "integrator",  "kernelVariant", "sampler", "rejectedSamples",
+                                      "loopCap",     "savedBy"};
     EXPECT_EQ(keysOf(saved), expected);
 
     Camera before = session.scene().camera;

@@ -28,7 +28,8 @@ SpirvSummary summarize(const std::vector<uint32_t>& spirv)
             std::string name(reinterpret_cast<const char*>(&spirv[i + 2]), (words - 2) * 4);
             if (name.rfind("refractDirection(", 0) == 0) summary.refract = true;
         }
-        if (opcode == kOpDecorate && words >= 4 && spirv[i + 2] == kDecorationBinding) summary.bindings.insert(spirv[i + 3]);
+        if (opcode == kOpDecorate && words >= 4 && spirv[i + 2] == kDecorationBinding)
+            summary.bindings.insert(spirv[i + 3]);
         i += words;
     }
     return summary;
@@ -68,7 +69,8 @@ TEST_F(VariantTest, SpecializedAndUberKernelsGiveIdenticalImages)
         for (size_t i = 0; i < a.rgb.size(); ++i) {
             if (a.rgb[i] == b.rgb[i]) continue;
             ++differing;
-            worst = std::max(worst, std::abs(double(a.rgb[i]) - b.rgb[i]) / std::max(1e-30, std::abs(double(b.rgb[i]))));
+            worst =
+                std::max(worst, std::abs(double(a.rgb[i]) - b.rgb[i]) / std::max(1e-30, std::abs(double(b.rgb[i]))));
         }
         EXPECT_EQ(differing, 0u) << name << ": worst relative difference " << worst;
     }
@@ -204,7 +206,8 @@ TEST(InfoCli, PrintsVariantAndCacheState)
     ASSERT_EQ(cold.exitCode, 0) << cold.output;
     ASSERT_EQ(warm.exitCode, 0) << warm.output;
     EXPECT_NE(cold.output.find("features:       whitted; spheres boxes triangles planes point-lights cubemap;"),
-              std::string::npos) << cold.output;
+              std::string::npos)
+        << cold.output;
     EXPECT_NE(cold.output.find("spirv bytes:"), std::string::npos);
     EXPECT_NE(cold.output.find("loop cap:       " + gpu().loopCap().describe()), std::string::npos) << cold.output;
     EXPECT_EQ(cold.output.find("cache hit"), std::string::npos) << cold.output;

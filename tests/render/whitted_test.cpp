@@ -79,11 +79,12 @@ intensity = 50
     for (size_t i = 0; i < slabs.size(); ++i) {
         const Slab& s = slabs[i];
         char buffer[512];
-        std::snprintf(buffer, sizeof buffer,
-                      "[materials.glass%zu]\ntype = \"dielectric\"\nior = 1.5\nfresnel = \"schlick\"\n"
-                      "absorption = [%g, %g, %g]\n[[objects]]\nshape = \"box\"\nmin = [%g, %g, %g]\nmax = [%g, %g, %g]\n"
-                      "material = \"glass%zu\"\n",
-                      i, s.kappa.x, s.kappa.y, s.kappa.z, s.x0, s.y0, s.z0, s.x1, s.y1, s.z1, i);
+        std::snprintf(
+            buffer, sizeof buffer,
+            "[materials.glass%zu]\ntype = \"dielectric\"\nior = 1.5\nfresnel = \"schlick\"\n"
+            "absorption = [%g, %g, %g]\n[[objects]]\nshape = \"box\"\nmin = [%g, %g, %g]\nmax = [%g, %g, %g]\n"
+            "material = \"glass%zu\"\n",
+            i, s.kappa.x, s.kappa.y, s.kappa.z, s.x0, s.y0, s.z0, s.x1, s.y1, s.z1, i);
         text += buffer;
     }
     return text;
@@ -176,8 +177,8 @@ TEST_F(WhittedTest, AbsorbingGlassSlabAddsBeerLambert)
 
 TEST_F(WhittedTest, OverlappingGlassShadowsAreDarkerButNeverOpaque)
 {
-    auto means = checkSlabShadows({{-3, 0.4, 3.0, 3.2, -3, 3, glm::dvec3(0.3, 0.3, 0.3)},
-                                   {-0.4, 3, 4.0, 4.3, -3, 3, glm::dvec3(0.2, 0.2, 0.2)}});
+    auto means = checkSlabShadows(
+        {{-3, 0.4, 3.0, 3.2, -3, 3, glm::dvec3(0.3, 0.3, 0.3)}, {-0.4, 3, 4.0, 4.3, -3, 3, glm::dvec3(0.2, 0.2, 0.2)}});
     ASSERT_TRUE(means.count(0) && means.count(1) && means.count(2)) << "need lit, single and double shadow pixels";
     EXPECT_LT(means[2], means[1]);
     EXPECT_LT(means[1], means[0]);
@@ -201,7 +202,8 @@ height = 32
 [background]
 color = 1
 [materials.m]
-)" + material + R"(
+)" + material +
+           R"(
 [[objects]]
 shape = "sphere"
 center = [0, 0, 0]

@@ -21,8 +21,8 @@ inline const std::vector<TomlTrap> kTomlTraps = {
     {"TableNameStartsWithDot", "[."},
     {"ArrayClosedByBrace", "v=[}"},
     {"DateTimeWithoutHour", "A=1979-05-27T:"},
-    {"LoneNonAsciiLetterUtf8", "\xC3\xA9"},           // 'é' in UTF-8: the __builtin_unreachable
-    {"LoneInvalidByte", "\xE9"},                      // 'é' in Latin-1: not UTF-8 at all
+    {"LoneNonAsciiLetterUtf8", "\xC3\xA9"}, // 'é' in UTF-8: the __builtin_unreachable
+    {"LoneInvalidByte", "\xE9"},            // 'é' in Latin-1: not UTF-8 at all
     {"NonAsciiKeyUtf8", "\xC3\xA9 = 1"},
     {"InvalidByteInKey", "\xE9 = 1"},
 };

@@ -32,8 +32,8 @@ std::string vector(const glm::dvec3& v) { return "[" + number(v.x) + ", " + numb
 std::string cameraScene(const Camera& c)
 {
     return "[camera]\neye = " + vector(c.eye) + "\ntarget = " + vector(c.target) + "\nup = " + vector(c.up) +
-           "\nfov = " + number(c.fovY) + "\nwidth = " + std::to_string(c.width) + "\nheight = " +
-           std::to_string(c.height) + "\n";
+           "\nfov = " + number(c.fovY) + "\nwidth = " + std::to_string(c.width) +
+           "\nheight = " + std::to_string(c.height) + "\n";
 }
 
 TEST(CameraRules, ParserAcceptsExactlyTheCamerasOverridesAccept)
@@ -61,9 +61,8 @@ TEST(CameraRules, ParserAcceptsExactlyTheCamerasOverridesAccept)
                             parsed = false;
                             message = e.what();
                         }
-                        ASSERT_EQ(parsed, !problem.has_value())
-                            << text << "parser: " << (parsed ? "accepted" : message)
-                            << "\ncameraProblem: " << problem.value_or("none");
+                        ASSERT_EQ(parsed, !problem.has_value()) << text << "parser: " << (parsed ? "accepted" : message)
+                                                                << "\ncameraProblem: " << problem.value_or("none");
                         (parsed ? accepted : refused)++;
                     }
     EXPECT_GT(accepted, 50);

@@ -409,7 +409,8 @@ nx = "sky/nx.exr"
 py = "sky/py.png"
 ny = "sky/ny.png"
 pz = "sky/pz.EXR"
-nz = ")" + absolute.string() + "\"\n";
+nz = ")" + absolute.string() +
+                             "\"\n";
     const fs::path scenePath = dir.write("scene.toml", text);
 
     const Scene scene = parseSceneFile(scenePath.string());
@@ -493,8 +494,7 @@ const std::vector<BadScene> kBadScenes = {
     {"UnknownKeySuggestion", kCamera + "fvo = 45\n", 5, 1, "camera: unknown key 'fvo'; did you mean 'fov'?"},
     {"UnknownKeyCaseInsensitive", kCamera + "WIDTH = 45\n", 5, 1, "unknown key 'WIDTH'; did you mean 'width'?"},
     {"UnknownKeyNoSuggestion", kCamera + "zoom = 2\n", 5, 1, "camera: unknown key 'zoom'"},
-    {"UnknownTopLevelTable", kCamera + "[camra]\n", 5, 2,
-     "unknown top-level table 'camra'; did you mean 'camera'?"},
+    {"UnknownTopLevelTable", kCamera + "[camra]\n", 5, 2, "unknown top-level table 'camra'; did you mean 'camera'?"},
     {"UnknownTopLevelKey", "title = 1\n" + kCamera, 1, 1, "unknown top-level key 'title'"},
     {"UnknownMaterialType", kCamera + "[materials.red]\ntype = \"lambret\"\n", 6, 8,
      "materials.red.type: unknown material type 'lambret'; did you mean 'lambert'?"},
@@ -526,7 +526,8 @@ const std::vector<BadScene> kBadScenes = {
     {"WrongTypeString", "[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\nfov = \"45\"\n", 4, 7,
      "camera.fov: expected a number, got a string"},
     {"WrongTypeElement", "[camera]\neye = [0, true, 5]\n", 2, 11, "camera.eye[1]: expected a number, got a boolean"},
-    {"WrongArrayLength", "[camera]\neye = [0, 1]\n", 2, 7, "camera.eye: expected an array of 3 numbers, got 2 element(s)"},
+    {"WrongArrayLength", "[camera]\neye = [0, 1]\n", 2, 7,
+     "camera.eye: expected an array of 3 numbers, got 2 element(s)"},
     {"VectorNotArray", "[camera]\neye = 5\n", 2, 7, "camera.eye: expected an array of 3 numbers, got an integer"},
     {"NaN", "[camera]\neye = [0, nan, 5]\n", 2, 11, "camera.eye[1]: must be finite, got nan"},
     {"Inf",
@@ -546,8 +547,7 @@ const std::vector<BadScene> kBadScenes = {
     {"EyeEqualsTarget", "[camera]\neye = [1, 2, 3]\ntarget = [1, 2, 3]\nfov = 45\n", 3, 10,
      "camera.target: must differ from camera.eye"},
     {"ZeroLengthUp", kCamera + "up = [0, 0, 0]\n", 5, 6, "camera.up: must not be zero-length"},
-    {"UpParallelToView", kCamera + "up = [0, 0, -2]\n", 5, 6,
-     "camera.up: must not be parallel to the view direction"},
+    {"UpParallelToView", kCamera + "up = [0, 0, -2]\n", 5, 6, "camera.up: must not be parallel to the view direction"},
     {"DefaultUpParallelToView", "[camera]\neye = [0, 5, 0]\ntarget = [0, 0, 0]\nfov = 45\n", 1, 1,
      "camera: the default up [0, 1, 0] is parallel to the view direction"},
     {"FovZero", "[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\nfov = 0\n", 4, 7,
@@ -555,7 +555,8 @@ const std::vector<BadScene> kBadScenes = {
     {"Fov180", "[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\nfov = 180\n", 4, 7,
      "camera.fov: must be strictly between 0 and 180 degrees, got 180"},
     {"WidthZero", kCamera + "width = 0\n", 5, 9, "camera.width: must be between 1 and 16384, got 0"},
-    {"HeightAboveSideLimit", kCamera + "height = 16385\n", 5, 10, "camera.height: must be between 1 and 16384, got 16385"},
+    {"HeightAboveSideLimit", kCamera + "height = 16385\n", 5, 10,
+     "camera.height: must be between 1 and 16384, got 16385"},
     {"WidthNotInteger", kCamera + "width = 640.0\n", 5, 9, "camera.width: expected an integer, got a float"},
     {"TooManyPixels", kCamera + "width = 16384\nheight = 8192\n", 6, 10,
      "camera.height: width * height = 134217728 pixels exceeds the limit of 67108864"},
@@ -603,14 +604,16 @@ const std::vector<BadScene> kBadScenes = {
      kCamera + "[[lights]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nradiance = 1\n"
                "two_sided = \"yes\"\n",
      9, 13, "lights[0].two_sided: expected a boolean"},
-    {"ColorPlusCubemap",
-     kCamera + "[background]\ncolor = 0.5\n[background.cubemap]\npx = \"a.exr\"\n", 7, 1,
+    {"ColorPlusCubemap", kCamera + "[background]\ncolor = 0.5\n[background.cubemap]\npx = \"a.exr\"\n", 7, 1,
      "background.cubemap: cannot be combined with background.color (line 6)"},
     {"MaxDepthZero", "[render]\nmax_depth = 0\n" + kCamera, 2, 13, "render.max_depth: must be between 1 and 64, got 0"},
     {"MaxDepthTooLarge", "[render]\nmax_depth = 65\n" + kCamera, 2, 13,
      "render.max_depth: must be between 1 and 64, got 65"},
     {"InvalidUtf8InComment", kCamera + "# caf\xE9\n", 5, 6, "invalid TOML: invalid UTF-8 (byte 0xE9)"},
-    {"InvalidUtf8InString", kCamera + "[materials.\"r\xC3\xA9" "d\xFF\"]\n", 5, 16, "invalid TOML: invalid UTF-8 (byte 0xFF)"},
+    {"InvalidUtf8InString",
+     kCamera + "[materials.\"r\xC3\xA9"
+               "d\xFF\"]\n",
+     5, 16, "invalid TOML: invalid UTF-8 (byte 0xFF)"},
     {"UnknownIntegrator", "[render]\nintegrator = \"pathh\"\n" + kCamera, 2, 14,
      "render.integrator: unknown integrator 'pathh'; did you mean 'path'?"},
 };
@@ -648,8 +651,10 @@ SceneError longNameError(size_t length)
 {
     const std::string defined(length, 'a');
     const std::string used = std::string(length - 1, 'a') + "b";
-    return parseError(kCamera + "[materials." + defined + "]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
-                                "material = \"" + used + "\"\ncenter = [0, 0, 0]\nradius = 1\n");
+    return parseError(kCamera + "[materials." + defined +
+                      "]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
+                      "material = \"" +
+                      used + "\"\ncenter = [0, 0, 0]\nradius = 1\n");
 }
 
 TEST(SceneParserSuggestions, VeryLongUnknownNameIsLocatedQuicklyWithoutSuggestion)
@@ -671,8 +676,10 @@ TEST(SceneParserSuggestions, LongButPlausibleNameIsStillSuggested)
 {
     const std::string name = "wall_left_" + std::string(50, 'x') + "_painted_red";
     const std::string typo = "wall_left_" + std::string(50, 'x') + "_painted_rde";
-    const std::string text = kCamera + "[materials." + name + "]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
-                                       "material = \"" + typo + "\"\ncenter = [0, 0, 0]\nradius = 1\n";
+    const std::string text = kCamera + "[materials." + name +
+                             "]\ntype = \"lambert\"\n[[objects]]\nshape = \"sphere\"\n"
+                             "material = \"" +
+                             typo + "\"\ncenter = [0, 0, 0]\nradius = 1\n";
     EXPECT_EQ(parseError(text).message(),
               "objects[0].material: unknown material '" + typo + "'; did you mean '" + name + "'?");
 }

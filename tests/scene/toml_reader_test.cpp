@@ -66,7 +66,7 @@ TEST(TomlReaderEditDistance, LongWordsAreCheap)
     // 40,000 x 40,000 cells would be 12.8 GB as a full table.
     const std::string a(40000, 'a');
     std::string b(39999, 'a');
-    b += 'b';  // not `std::string&& + "b"`: GCC 14 reports a false -Warray-bounds there at -O2
+    b += 'b'; // not `std::string&& + "b"`: GCC 14 reports a false -Warray-bounds there at -O2
     EXPECT_EQ(boundedEditDistance(a, b, 2), 1u);
     EXPECT_EQ(boundedEditDistance(a, std::string(40000, 'b'), 2), 3u);
 }
@@ -164,12 +164,12 @@ TEST(TomlReaderUtf8, InvalidBytesAreLocatedExactly)
     const auto at4 = [](const std::string& hex) {
         return "t.toml:2:4: invalid TOML: invalid UTF-8 (byte " + hex + "); TOML files must be UTF-8";
     };
-    EXPECT_EQ(parseOutcome(prefix + "\xE9\n"), at4("0xE9"));         // Latin-1 'e acute'
-    EXPECT_EQ(parseOutcome(prefix + "\x80\n"), at4("0x80"));         // a lone continuation byte
-    EXPECT_EQ(parseOutcome(prefix + "\xC0\xAF\n"), at4("0xC0"));     // overlong '/'
-    EXPECT_EQ(parseOutcome(prefix + "\xED\xA0\x80\n"), at4("0xED")); // a UTF-16 surrogate
+    EXPECT_EQ(parseOutcome(prefix + "\xE9\n"), at4("0xE9"));             // Latin-1 'e acute'
+    EXPECT_EQ(parseOutcome(prefix + "\x80\n"), at4("0x80"));             // a lone continuation byte
+    EXPECT_EQ(parseOutcome(prefix + "\xC0\xAF\n"), at4("0xC0"));         // overlong '/'
+    EXPECT_EQ(parseOutcome(prefix + "\xED\xA0\x80\n"), at4("0xED"));     // a UTF-16 surrogate
     EXPECT_EQ(parseOutcome(prefix + "\xF4\x90\x80\x80\n"), at4("0xF4")); // above U+10FFFF
-    EXPECT_EQ(parseOutcome(prefix + "\xE2\x82"), at4("0xE2"));       // cut short by the end of the file
+    EXPECT_EQ(parseOutcome(prefix + "\xE2\x82"), at4("0xE2"));           // cut short by the end of the file
 }
 
 TEST(TomlReaderTables, UnknownKeysAreReportedInFileOrder)

@@ -18,7 +18,8 @@ std::vector<float> runProbe(const std::string& kernel, const std::vector<float>&
     constexpr vk::BufferUsageFlags kUsage = vk::BufferUsageFlagBits::eStorageBuffer;
     Buffer in = makeBufferFrom(context, input.empty() ? std::vector<float>{0.0f} : input, kUsage);
     Buffer out(context, std::max<size_t>(1, outputFloats) * sizeof(float),
-               kUsage | vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Device);
+               kUsage | vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst,
+               MemoryUse::Device);
     out.clear(context);
     ComputeKernel probe(context, spirv,
                         {{0, vk::DescriptorType::eStorageBuffer}, {1, vk::DescriptorType::eStorageBuffer}},

@@ -41,7 +41,7 @@ std::filesystem::path testCacheDir();
 Scene sceneFromText(const std::string& text, const std::string& path = "test.toml");
 
 struct ProcessResult {
-    int exitCode = -1; ///< exit status, or 128 + signal
+    int exitCode = -1;  ///< exit status, or 128 + signal
     std::string output; ///< stdout and stderr interleaved
 };
 
