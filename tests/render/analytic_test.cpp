@@ -8,14 +8,6 @@
 namespace vkrt::test {
 namespace {
 
-RenderOptions centreSamples()
-{
-    RenderOptions options;
-    options.jitter = false;
-    options.cacheDirectory = testCacheDir();
-    return options;
-}
-
 /// Direction of the ray through the centre of pixel (x, y) for a pinhole camera.
 glm::dvec3 pixelCentreRay(const Camera& c, uint32_t x, uint32_t y)
 {
@@ -58,7 +50,7 @@ class AnalyticTest : public GpuTest {};
 TEST_F(AnalyticTest, PointLightOverLambertPlaneMatchesClosedForm)
 {
     Scene scene = sceneFromText(kLambertPlaneScene);
-    Renderer renderer(gpu(), scene, centreSamples());
+    Renderer renderer(gpu(), scene, pixelCentreOptions());
     renderer.renderFrames(1);
     Image image = renderer.mean();
     const glm::dvec3 rho(0.5, 0.25, 0.8), intensity(10, 20, 5), light(0.5, 1.5, -1.0);
@@ -89,7 +81,7 @@ TEST_F(AnalyticTest, LightBehindSurfaceGivesNoRadiance)
 {
     std::string text = kLambertPlaneScene;
     text.replace(text.find("position = [0.5, 1.5, -1.0]"), 27, "position = [0.5, -1.5, -1.0]");
-    Renderer renderer(gpu(), sceneFromText(text), centreSamples());
+    Renderer renderer(gpu(), sceneFromText(text), pixelCentreOptions());
     renderer.renderFrames(1);
     Image image = renderer.mean();
     for (float v : image.rgb) ASSERT_EQ(v, 0.0f);
@@ -110,7 +102,7 @@ radius = 0.3
 material = "grey"
 )";
     Scene scene = sceneFromText(text);
-    Renderer renderer(gpu(), scene, centreSamples());
+    Renderer renderer(gpu(), scene, pixelCentreOptions());
     renderer.renderFrames(1);
     Image image = renderer.mean();
     const glm::dvec3 light(0.5, 1.5, -1.0), centre(0.35, 0.75, -0.6);

@@ -14,14 +14,6 @@
 namespace vkrt::test {
 namespace {
 
-RenderOptions pixelCentreOptions()
-{
-    RenderOptions options;
-    options.jitter = false;
-    options.cacheDirectory = testCacheDir();
-    return options;
-}
-
 /// A lit plane seen by the camera, `spheres` small spheres beside it and
 /// `lights` point lights of intensity `intensity` at one position: each pixel
 /// of the plane runs one shadow query over every primitive per light.

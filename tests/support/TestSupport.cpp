@@ -68,6 +68,14 @@ fs::path testCacheDir()
     return dir;
 }
 
+RenderOptions pixelCentreOptions()
+{
+    RenderOptions options;
+    options.jitter = false;
+    options.cacheDirectory = testCacheDir();
+    return options;
+}
+
 Scene sceneFromText(const std::string& text, const std::string& path) { return parseSceneString(text, path); }
 
 ProcessResult runVkrt(const std::vector<std::string>& args)

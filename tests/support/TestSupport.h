@@ -4,6 +4,7 @@
 // scenes from text, and running the vkrt executable.
 #include "gpu/VulkanContext.h"
 #include "io/Image.h"
+#include "render/Renderer.h"
 #include "scene/Scene.h"
 
 #include <gtest/gtest.h>
@@ -36,6 +37,10 @@ std::filesystem::path freshTempDir(const std::string& name);
 
 /// SPIR-V cache directory private to this test process.
 std::filesystem::path testCacheDir();
+
+/// Render options that sample pixel centres only (no jitter), with the test
+/// cache: deterministic geometry for analytic and exact comparisons.
+RenderOptions pixelCentreOptions();
 
 /// Parses scene text (path used for messages and relative files).
 Scene sceneFromText(const std::string& text, const std::string& path = "test.toml");
