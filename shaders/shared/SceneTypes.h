@@ -67,6 +67,25 @@ struct TriangleLight {
     vec3 radiance;
 };
 
+/// One node of a bounding volume hierarchy (src/accel/Bvh.h). Inner node
+/// (count == 0): children `first` and `first + 1`, relative to the tree's
+/// root. Leaf (count > 0): primitives first ... first + count - 1 of the
+/// tree's primitive list.
+struct BvhNode {
+    vec3 lower;
+    uint first;
+    vec3 upper;
+    uint count;
+};
+
+/// One mesh triangle's object-space vertices, stored in its mesh's BVH leaf
+/// order so that a leaf's triangles are contiguous (no index indirection).
+struct MeshTriangle {
+    vec3 v0;
+    vec3 v1;
+    vec3 v2;
+};
+
 // SceneUniforms::flags
 VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
 

@@ -10,12 +10,15 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace vkrt {
+
+struct MeshGeometry; // mesh/MeshGeometry.h
 
 using Color = glm::dvec3; ///< linear RGB
 
@@ -168,6 +171,20 @@ struct Plane {
     glm::dvec3 point;
     glm::dvec3 normal;
     uint32_t material;
+};
+
+/// An instance of a mesh file: its shared geometry (object space) placed by
+/// objectToWorld (scale, then rotation, then translation, or a `matrix`).
+/// With a non-zero emission every triangle is an area light of that
+/// radiance on its counter-clockwise side (both sides if twoSided), like a
+/// `[[lights]] type = "triangle"`; its material still scatters.
+struct Mesh {
+    std::shared_ptr<const MeshGeometry> geometry;
+    glm::dmat4 objectToWorld{1.0};
+    uint32_t material = 0;
+    Color emission{0.0};
+    bool twoSided = false;
+    SourceLocation where; ///< the [[objects]] table
 };
 
 /// Isotropic point light; intensity is radiant intensity (W/sr) per channel.

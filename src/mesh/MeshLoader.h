@@ -1,0 +1,22 @@
+#pragma once
+// Mesh files -> MeshData, through Open Asset Import Library (assimp): OBJ,
+// PLY (ASCII and binary, either byte order) and glTF 2.0 (.gltf + .bin, .glb).
+// Every failure is an InputError whose message names the file and, where the
+// format allows, the line (OBJ) or element and byte offset (PLY): unreadable
+// or unsupported files, syntax errors, indices out of range, NaN or infinite
+// coordinates, files without triangles. Never a crash, whatever the bytes.
+#include "mesh/MeshData.h"
+
+#include <filesystem>
+
+namespace vkrt {
+
+/// Loads every mesh of the file (all objects, groups, glTF nodes with their
+/// node transforms applied) as one MeshData; polygons are triangulated,
+/// triangle strips expanded; points and lines are ignored.
+MeshData loadMeshFile(const std::filesystem::path& file);
+
+/// The extensions loadMeshFile accepts (lower case, with the dot).
+const std::vector<std::string>& supportedMeshExtensions();
+
+} // namespace vkrt
