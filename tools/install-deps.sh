@@ -31,7 +31,7 @@ backports_source=/etc/apt/sources.list.d/vkrt-bookworm-backports.sources
 
 codename=$( (. /etc/os-release && echo "${VERSION_CODENAME:-}") 2>/dev/null || true)
 
-installed_version() { dpkg-query -W -f='${Status} ${Version}' "$1" 2>/dev/null | sed -n 's/^install ok installed //p'; }
+installed_version() { dpkg-query -W -f='${Status} ${Version}' "$1" 2>/dev/null | sed -n 's/^install ok installed //p' || true; }
 
 # The URI of the Debian mirror this machine already uses for `bookworm`
 # (deb822 .sources stanzas or one-line .list entries), so that backports come
