@@ -2,6 +2,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
+#ifdef VKRT_GROUP_LOOP_COUNT
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#endif
 
 #include "lib/bindings.glsl"
 
@@ -11,6 +14,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/ray.glsl"
 #include "lib/camera.glsl"
 #include "lib/intersect.glsl"
+#include "lib/bvh.glsl"
 #include "lib/scene.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/fresnel.glsl"
@@ -37,10 +41,17 @@ uvec2 scatteredPixel()
     return tileOrigin + gl_LocalInvocationID.xy;
 }
 
+// A capping driver counts the loop passes of a whole subgroup, and a pass
+// runs while any lane needs it: the lanes' sum bounds the group's count.
 void reportLoopIterations()
 {
-    atomicMax(stats.maxLoopIterations, g_loopIterations);
-    if (g_loopIterations >= LOOP_BUDGET)
+#ifdef VKRT_GROUP_LOOP_COUNT
+    uint count = subgroupAdd(g_loopIterations);
+#else
+    uint count = g_loopIterations;
+#endif
+    atomicMax(stats.maxLoopIterations, count);
+    if (count >= LOOP_BUDGET)
         atomicAdd(stats.budgetExceeded, 1u);
 }
 

@@ -43,6 +43,19 @@ VKRT_SCENE_ARRAY(BINDING_TRIANGLES, TriangleBlock, Triangle, triangles, UNIFORM_
 #ifdef VKRT_HAS_PLANES
 VKRT_SCENE_ARRAY(BINDING_PLANES, PlaneBlock, Plane, planes, UNIFORM_PLANES)
 #endif
+#ifdef VKRT_HAS_MESHES
+VKRT_SCENE_ARRAY(BINDING_MESHES, MeshBlock, Mesh, meshes, UNIFORM_MESHES)
+layout(scalar, binding = BINDING_MESH_NODES) readonly buffer MeshNodeBlock { BvhNode meshNodes[]; };
+layout(scalar, binding = BINDING_MESH_TRIANGLES) readonly buffer MeshTriangleBlock { MeshTriangle meshTriangles[]; };
+layout(scalar, binding = BINDING_TOP_NODES) readonly buffer TopNodeBlock { BvhNode topNodes[]; };
+layout(scalar, binding = BINDING_TOP_REFS) readonly buffer TopRefBlock { uint topRefs[]; };
+#endif
+#ifdef VKRT_HAS_MESH_NORMALS
+layout(scalar, binding = BINDING_MESH_NORMALS) readonly buffer MeshNormalBlock { MeshNormals meshNormals[]; };
+#endif
+#ifdef VKRT_HAS_EMITTERS
+layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitter emitters[]; };
+#endif
 #ifdef VKRT_HAS_POINT_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
 #endif

@@ -68,31 +68,35 @@ struct LightSample {
 };
 
 #ifdef VKRT_HAS_POINT_LIGHTS
+// Every light function takes the geometric normal n (the side the shadow ray
+// leaves from, for offsets) and the shading normal ns on the same side (for
+// the BSDF and its cosine); ns == n except on meshes with vertex normals.
+
 // One point light: f * I * cos / d^2. Geometry from the surface point itself;
 // only the shadow ray starts at the offset origin (measuring from it would
 // bias 1/d^2 by the offset).
-LightSample samplePointLight(PointLight light, Material m, SurfaceHit hit, vec3 n, vec3 wo)
+LightSample samplePointLight(PointLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo)
 {
     vec3 toLight = light.position - hit.position;
     float distSq = dot(toLight, toLight);
     vec3 wi = toLight * inversesqrt(distSq);
-    float cosTheta = dot(n, wi);
+    float cosTheta = dot(ns, wi);
     if (cosTheta <= 0.0)
         return LightSample(vec3(0.0), light.position);
-    vec3 f = evalBsdf(m, n, wo, wi);
+    vec3 f = evalBsdf(m, ns, wo, wi);
     return LightSample(f * light.intensity * (cosTheta / distSq), light.position);
 }
 #endif
 
 // Every point light (the Whitted integrator).
-vec3 directFromPointLights(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media)
+vec3 directFromPointLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_POINT_LIGHTS
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     for (uint i = 0u; i < u.pointLightCount; ++i) {
         ++g_loopIterations;
-        LightSample s = samplePointLight(pointLights[i], m, hit, n, wo);
+        LightSample s = samplePointLight(pointLights[i], m, hit, ns, wo);
         if (s.unshadowed != vec3(0.0))
             radiance += s.unshadowed * transmittanceTo(s.target, origin, n, media);
     }
@@ -129,7 +133,7 @@ float triangleLightPdf(float area, float distSq, float cosLight) { return distSq
 // One triangle light through a uniformly sampled point on it (pdf = 1 / area,
 // `u` its two coordinates): f * Le * cos_surface * cos_light / d^2 * area; the
 // path integrator weighs it against BSDF sampling (MIS).
-LightSample sampleTriangleLight(TriangleLight light, vec2 u, Material m, SurfaceHit hit, vec3 n, vec3 wo, vec3 origin)
+LightSample sampleTriangleLight(TriangleLight light, vec2 u, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin)
 {
     vec3 point = sampleTriangle(light.v0, light.v1, light.v2, u);
     // Aim just short of the light so it does not shadow itself.
@@ -137,34 +141,95 @@ LightSample sampleTriangleLight(TriangleLight light, vec2 u, Material m, Surface
     vec3 toLight = point - hit.position;
     float distSq = dot(toLight, toLight);
     vec3 wi = toLight * inversesqrt(distSq);
-    float cosSurface = dot(n, wi);
+    float cosSurface = dot(ns, wi);
     float cosLight = abs(dot(triangleLightNormal(light), wi));
     vec3 le = emittedRadiance(light, -wi);
     if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0))
         return LightSample(vec3(0.0), target);
-    vec3 f = evalBsdf(m, n, wo, wi);
+    vec3 f = evalBsdf(m, ns, wo, wi);
     vec3 contribution = f * le * (cosSurface * cosLight * light.area / distSq);
 #ifdef VKRT_INTEGRATOR_PATH
-    contribution *= powerHeuristic(triangleLightPdf(light.area, distSq, cosLight), pdfBsdf(m, n, wo, wi));
+    contribution *= powerHeuristic(triangleLightPdf(light.area, distSq, cosLight), pdfBsdf(m, ns, wo, wi));
 #endif
     return LightSample(contribution, target);
 }
 #endif
 
 // One sampled point on every triangle light (the Whitted integrator).
-vec3 directFromTriangleLights(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
+vec3 directFromTriangleLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
+                              inout Sampler rng)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
-        LightSample s = sampleTriangleLight(triangleLights[i], sampleNext2D(rng), m, hit, n, wo, origin);
+        LightSample s = sampleTriangleLight(triangleLights[i], sampleNext2D(rng), m, hit, ns, wo, origin);
         if (s.unshadowed != vec3(0.0))
             radiance += s.unshadowed * transmittanceTo(s.target, origin, n, media);
     }
 #endif
     return radiance;
+}
+
+#ifdef VKRT_HAS_EMITTERS
+// Unit normal of an emissive mesh triangle: its counter-clockwise side.
+vec3 emitterNormal(Emitter e) { return normalize(cross(e.v1 - e.v0, e.v2 - e.v0)); }
+
+vec3 emitterRadiance(Emitter e, vec3 towards)
+{
+    float facing = dot(emitterNormal(e), towards);
+    return (facing > 0.0 || (e.twoSided != 0u && facing < 0.0)) ? e.radiance : vec3(0.0);
+}
+
+// Solid-angle density of choosing emitter e (in proportion to power) and
+// then a uniform point on it, seen at squared distance distSq and |cos| cosLight.
+float emitterPdf(Emitter e, float distSq, float cosLight) { return e.pdf * distSq / (cosLight * e.area); }
+
+// Walker's alias method: slot from uSlot, then the slot or its alias by uAlias.
+uint pickEmitter(float uSlot, float uAlias)
+{
+    uint slot = min(uint(uSlot * float(u.emitterCount)), u.emitterCount - 1u);
+    return uAlias < emitters[slot].aliasThreshold ? slot : emitters[slot].alias;
+}
+
+// One emissive mesh triangle, chosen in proportion to power, through a
+// uniformly sampled point on it: an unbiased estimate of the direct light
+// from every emitter, MIS-weighted against BSDF sampling (path integrator).
+LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin)
+{
+    Emitter e = emitters[pickEmitter(u4.x, u4.y)];
+    vec3 point = sampleTriangle(e.v0, e.v1, e.v2, u4.zw);
+    vec3 target = mix(origin, point, 1.0 - 1.0 / 65536.0);
+    vec3 toLight = point - hit.position;
+    float distSq = dot(toLight, toLight);
+    vec3 wi = toLight * inversesqrt(distSq);
+    float cosSurface = dot(ns, wi);
+    float cosLight = abs(dot(emitterNormal(e), wi));
+    vec3 le = emitterRadiance(e, -wi);
+    if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0) || !(e.pdf > 0.0) || distSq == 0.0)
+        return LightSample(vec3(0.0), target);
+    float lightPdf = emitterPdf(e, distSq, cosLight);
+    vec3 contribution = evalBsdf(m, ns, wo, wi) * le * (cosSurface / lightPdf);
+#ifdef VKRT_INTEGRATOR_PATH
+    contribution *= powerHeuristic(lightPdf, pdfBsdf(m, ns, wo, wi));
+#endif
+    return LightSample(contribution, target);
+}
+#endif
+
+// One sample of the emissive meshes (the Whitted integrator).
+vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+{
+#ifdef VKRT_HAS_EMITTERS
+    if (u.emitterCount == 0u)
+        return vec3(0.0);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightSample s = sampleEmitters(sampleNext4D(rng), m, hit, ns, wo, origin);
+    if (s.unshadowed != vec3(0.0))
+        return s.unshadowed * transmittanceTo(s.target, origin, n, media);
+#endif
+    return vec3(0.0);
 }
 
 // Picks one of a stream of light samples with probability proportional to its
@@ -200,21 +265,30 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 // it equals that sum up to the lights' colour differences (no added
 // variance), and under partial occlusion it adds some: measured as a whole,
 // 1.09-1.27x more efficient on the validation scenes (docs/performance.md).
-vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
+vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
+                                  inout Sampler rng)
 {
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
 #ifdef VKRT_HAS_POINT_LIGHTS
     for (uint i = 0u; i < u.pointLightCount; ++i) {
         ++g_loopIterations;
-        offerLightSample(r, samplePointLight(pointLights[i], m, hit, n, wo), sampleNext1D(rng));
+        offerLightSample(r, samplePointLight(pointLights[i], m, hit, ns, wo), sampleNext1D(rng));
     }
 #endif
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
         vec3 u3 = sampleNext4D(rng).xyz;
-        offerLightSample(r, sampleTriangleLight(triangleLights[i], u3.xy, m, hit, n, wo, origin), u3.z);
+        offerLightSample(r, sampleTriangleLight(triangleLights[i], u3.xy, m, hit, ns, wo, origin), u3.z);
+    }
+#endif
+#ifdef VKRT_HAS_EMITTERS
+    // All emissive meshes are one more candidate: a power-proportional
+    // choice of one of their triangles (its estimate is unbiased for their sum).
+    if (u.emitterCount > 0u) {
+        vec4 u4 = sampleNext4D(rng);
+        offerLightSample(r, sampleEmitters(u4, m, hit, ns, wo, origin), sampleNext1D(rng));
     }
 #endif
     if (r.totalWeight == 0.0)

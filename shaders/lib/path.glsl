@@ -37,20 +37,36 @@ vec3 emissionOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
 #endif
 }
 
+// Emission of an emissive mesh triangle hit by a BSDF-sampled ray, weighted
+// like emissionOnHit against having sampled it (lib/lights.glsl: sampleEmitters).
+vec3 emitterOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
+{
+#ifdef VKRT_HAS_EMITTERS
+    Emitter e = emitters[hit.emitter];
+    vec3 le = emitterRadiance(e, -ray.dir);
+    if (path.specular || le == vec3(0.0))
+        return le;
+    float cosLight = abs(dot(emitterNormal(e), ray.dir));
+    return le * powerHeuristic(path.bsdfPdf, emitterPdf(e, hit.t * hit.t, cosLight));
+#else
+    return vec3(0.0);
+#endif
+}
+
 // Next-event estimation of the cubemap environment, MIS-weighted against
 // BSDF sampling (which finds the same light when a ray escapes).
-vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 wo, MediumStack media, inout Sampler rng)
+vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
 {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     float pdf;
     vec3 wi = sampleEnvironment(sampleNext4D(rng).xyz, pdf);
-    float cosI = dot(n, wi);
+    float cosI = dot(ns, wi);
     if (pdf <= 0.0 || cosI <= 0.0)
         return vec3(0.0);
-    vec3 f = evalBsdf(m, n, wo, wi);
+    vec3 f = evalBsdf(m, ns, wo, wi);
     if (f == vec3(0.0))
         return vec3(0.0);
-    float weight = powerHeuristic(pdf, pdfBsdf(m, n, wo, wi));
+    float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
     vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
     return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
 #else
@@ -99,24 +115,27 @@ vec3 tracePath(Ray ray, inout Sampler rng)
             path.radiance += path.throughput * emissionOnHit(path, ray, hit);
             break;
         }
+        if (hit.emitter != NO_EMITTER)
+            path.radiance += path.throughput * emitterOnHit(path, ray, hit);
         if (depth == u.maxDepth + 1u)
             break; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
         vec3 n = hit.front ? hit.normal : -hit.normal;
+        vec3 ns = hit.front ? hit.shading : -hit.shading;
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
-            path.radiance += path.throughput * (directFromLightsOneShadowRay(m, hit, n, wo, path.media, rng) +
-                                                directFromEnvironment(m, hit, n, wo, path.media, rng));
+            path.radiance += path.throughput * (directFromLightsOneShadowRay(m, hit, n, ns, wo, path.media, rng) +
+                                                directFromEnvironment(m, hit, n, ns, wo, path.media, rng));
         }
         vec4 u4 = sampleNext4D(rng);
         float eta = interfaceEta(path.media, hit.material, hit.front);
-        BsdfSample s = sampleBsdf(m, n, wo, eta, u4.xyz);
+        BsdfSample s = sampleBsdf(m, ns, wo, eta, u4.xyz);
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;
         path.specular = s.specular;
-        path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, n, wo, s.dir);
+        path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
         if (s.transmitted)
             path.media = crossInterface(path.media, hit.material, hit.front);
         if (!survivesRoulette(path, depth, u4.w))

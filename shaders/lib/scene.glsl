@@ -24,12 +24,16 @@ struct SurfaceHit {
     float t;
     vec3 position;
     vec3 error;  // bound on |position - exact point| per coordinate (offsetRayOrigin)
-    vec3 normal; // unit geometric normal; outward for spheres and boxes
-    bool front;  // the ray arrived on the side `normal` points to
+    vec3 normal;  // unit geometric normal; outward for spheres and boxes
+    vec3 shading; // unit shading normal, on the side of `normal` (meshes with vertex normals; else = normal)
+    bool front;   // the ray arrived on the side `normal` points to
     uint material;
     int shape;
     uint index;
+    uint emitter; // the Emitter this surface is (emissive meshes), else NO_EMITTER
 };
+
+const uint NO_EMITTER = 0xffffffffu;
 
 bool hitsLight(SurfaceHit hit) { return hit.shape >= SHAPE_LIGHT; }
 
@@ -43,20 +47,36 @@ struct HitId {
     float t;
     vec3 detail;
     bool front;
+    uint primitive; // a mesh's triangle (its leaf slot); 0 for other kinds
 };
 
 // ------------------------------------------------------------------ spheres
+
+#ifdef VKRT_HAS_SPHERES
+void closestOneSphere(Ray r, uint i, inout HitId best)
+{
+    float t;
+    vec3 local;
+    bool front;
+    if (intersectSphere(spheres[i], r, best.t, t, local, front))
+        best = HitId(SHAPE_SPHERE, i, t, local, front, 0u);
+}
+
+bool anyHitOneSphere(Ray r, uint i, float tMax)
+{
+    float t;
+    vec3 local;
+    bool front;
+    return intersectSphere(spheres[i], r, tMax, t, local, front);
+}
+#endif
 
 void closestSphere(Ray r, inout HitId best)
 {
 #ifdef VKRT_HAS_SPHERES
     for (uint i = 0u; i < u.sphereCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 local;
-        bool front;
-        if (intersectSphere(spheres[i], r, best.t, t, local, front))
-            best = HitId(SHAPE_SPHERE, i, t, local, front);
+        closestOneSphere(r, i, best);
     }
 #endif
 }
@@ -66,10 +86,7 @@ bool anyHitSphere(Ray r, float tMax)
 #ifdef VKRT_HAS_SPHERES
     for (uint i = 0u; i < u.sphereCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 local;
-        bool front;
-        if (intersectSphere(spheres[i], r, tMax, t, local, front))
+        if (anyHitOneSphere(r, i, tMax))
             return true;
     }
 #endif
@@ -97,16 +114,31 @@ void describeSphere(Ray r, HitId id, inout SurfaceHit hit)
 
 // -------------------------------------------------------------------- boxes
 
+#ifdef VKRT_HAS_BOXES
+void closestOneBox(Ray r, uint i, inout HitId best)
+{
+    float t;
+    vec3 n;
+    bool front;
+    if (intersectBox(boxes[i], r, best.t, t, n, front))
+        best = HitId(SHAPE_BOX, i, t, n, front, 0u);
+}
+
+bool anyHitOneBox(Ray r, uint i, float tMax)
+{
+    float t;
+    vec3 n;
+    bool front;
+    return intersectBox(boxes[i], r, tMax, t, n, front);
+}
+#endif
+
 void closestBox(Ray r, inout HitId best)
 {
 #ifdef VKRT_HAS_BOXES
     for (uint i = 0u; i < u.boxCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 n;
-        bool front;
-        if (intersectBox(boxes[i], r, best.t, t, n, front))
-            best = HitId(SHAPE_BOX, i, t, n, front);
+        closestOneBox(r, i, best);
     }
 #endif
 }
@@ -116,10 +148,7 @@ bool anyHitBox(Ray r, float tMax)
 #ifdef VKRT_HAS_BOXES
     for (uint i = 0u; i < u.boxCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 n;
-        bool front;
-        if (intersectBox(boxes[i], r, tMax, t, n, front))
+        if (anyHitOneBox(r, i, tMax))
             return true;
     }
 #endif
@@ -141,17 +170,32 @@ void describeBox(Ray r, HitId id, inout SurfaceHit hit)
 
 // ---------------------------------------------------------------- triangles
 
+#ifdef VKRT_HAS_TRIANGLES
+void closestOneTriangle(Ray r, TriangleRay tr, uint i, inout HitId best)
+{
+    float t;
+    vec3 bary;
+    Triangle tri = triangles[i];
+    if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, best.t, t, bary))
+        best = HitId(SHAPE_TRIANGLE, i, t, bary, true, 0u);
+}
+
+bool anyHitOneTriangle(Ray r, TriangleRay tr, uint i, float tMax)
+{
+    float t;
+    vec3 bary;
+    Triangle tri = triangles[i];
+    return intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, tMax, t, bary);
+}
+#endif
+
 void closestTriangle(Ray r, inout HitId best)
 {
 #ifdef VKRT_HAS_TRIANGLES
     TriangleRay tr = triangleRaySetup(r);
     for (uint i = 0u; i < u.triangleCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 bary;
-        Triangle tri = triangles[i];
-        if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, best.t, t, bary))
-            best = HitId(SHAPE_TRIANGLE, i, t, bary, true);
+        closestOneTriangle(r, tr, i, best);
     }
 #endif
 }
@@ -162,10 +206,7 @@ bool anyHitTriangle(Ray r, float tMax)
     TriangleRay tr = triangleRaySetup(r);
     for (uint i = 0u; i < u.triangleCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 bary;
-        Triangle tri = triangles[i];
-        if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, tMax, t, bary))
+        if (anyHitOneTriangle(r, tr, i, tMax))
             return true;
     }
 #endif
@@ -195,7 +236,7 @@ void closestPlane(Ray r, inout HitId best)
         ++g_loopIterations;
         float t;
         if (intersectPlane(planes[i], r, best.t, t))
-            best = HitId(SHAPE_PLANE, i, t, vec3(0.0), true);
+            best = HitId(SHAPE_PLANE, i, t, vec3(0.0), true, 0u);
     }
 #endif
 }
@@ -226,6 +267,176 @@ void describePlane(Ray r, HitId id, inout SurfaceHit hit)
 #endif
 }
 
+// ------------------------------------------------------------------- meshes
+// A mesh instance is traversed in its own coordinates: the ray is moved
+// into object space (the parameter t stays the same, so hits of different
+// instances compare directly), and its geometry's BVH is walked with a
+// bounded stack, near child first, skipping nodes beyond the closest hit.
+// Every node visit and triangle test counts as a loop iteration.
+
+#ifdef VKRT_HAS_MESHES
+Ray rayToObject(Mesh mesh, Ray r)
+{
+    vec3 o = vec3(dot(mesh.toObject0.xyz, r.origin) + mesh.toObject0.w,
+                  dot(mesh.toObject1.xyz, r.origin) + mesh.toObject1.w,
+                  dot(mesh.toObject2.xyz, r.origin) + mesh.toObject2.w);
+    vec3 d = vec3(dot(mesh.toObject0.xyz, r.dir), dot(mesh.toObject1.xyz, r.dir), dot(mesh.toObject2.xyz, r.dir));
+    return Ray(o, d);
+}
+
+vec3 objectToWorldPoint(Mesh mesh, vec3 p)
+{
+    return vec3(dot(mesh.toWorld0.xyz, p) + mesh.toWorld0.w, dot(mesh.toWorld1.xyz, p) + mesh.toWorld1.w,
+                dot(mesh.toWorld2.xyz, p) + mesh.toWorld2.w);
+}
+
+// Normals transform by the inverse transpose: n_world = transpose(toObject) n.
+vec3 objectToWorldNormal(Mesh mesh, vec3 n)
+{
+    return mesh.toObject0.xyz * n.x + mesh.toObject1.xyz * n.y + mesh.toObject2.xyz * n.z;
+}
+
+// The closest (anyHit: any) triangle of mesh instance `index` before best.t
+// (tMax). Returns whether one was found.
+bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId best)
+{
+    Mesh mesh = meshes[index];
+    Ray r = rayToObject(mesh, worldRay);
+    TriangleRay tr = triangleRaySetup(r);
+    BvhRay br = bvhRaySetup(r);
+    uint stackNode[BVH_STACK_SIZE];
+    float stackEntry[BVH_STACK_SIZE];
+    uint depth = 0u;
+    uint node = 0u; // relative to mesh.root
+    float tEntry;
+    BvhNode root = meshNodes[mesh.root];
+    bool visiting = entersBox(root.lower, root.upper, br, anyHit ? tMax : best.t, tEntry);
+    bool found = false;
+    while (visiting) {
+        ++g_loopIterations;
+        BvhNode n = meshNodes[mesh.root + node];
+        float limit = anyHit ? tMax : best.t;
+        bool descend = false;
+        if (n.count > 0u) {
+            for (uint k = 0u; k < n.count; ++k) {
+                ++g_loopIterations;
+                uint slot = n.first + k;
+                MeshTriangle tri = meshTriangles[mesh.firstTriangle + slot];
+                float t;
+                vec3 bary;
+                if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, limit, t, bary)) {
+                    found = true;
+                    if (anyHit)
+                        return true;
+                    best = HitId(SHAPE_MESH, index, t, bary, true, slot);
+                    limit = t;
+                }
+            }
+        } else {
+            BvhNode a = meshNodes[mesh.root + n.first];
+            BvhNode b = meshNodes[mesh.root + n.first + 1u];
+            float ta, tb;
+            bool ha = entersBox(a.lower, a.upper, br, limit, ta);
+            bool hb = entersBox(b.lower, b.upper, br, limit, tb);
+            if (ha && hb) {
+                bool aFirst = ta <= tb;
+                stackNode[depth] = aFirst ? n.first + 1u : n.first;
+                stackEntry[depth] = aFirst ? tb : ta;
+                ++depth;
+                node = aFirst ? n.first : n.first + 1u;
+                descend = true;
+            } else if (ha || hb) {
+                node = ha ? n.first : n.first + 1u;
+                descend = true;
+            }
+        }
+        if (!descend) {
+            visiting = false;
+            while (depth > 0u) {
+                ++g_loopIterations;
+                --depth;
+                if (stackEntry[depth] <= (anyHit ? tMax : best.t)) {
+                    node = stackNode[depth];
+                    visiting = true;
+                    break;
+                }
+            }
+        }
+    }
+    return found;
+}
+
+void closestOneMesh(Ray r, uint i, inout HitId best) { traverseMesh(r, i, false, 0.0, best); }
+
+bool anyHitOneMesh(Ray r, uint i, float tMax)
+{
+    HitId unused = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true, 0u);
+    return traverseMesh(r, i, true, tMax, unused);
+}
+#endif
+
+void closestMesh(Ray r, inout HitId best)
+{
+#ifdef VKRT_HAS_MESHES
+    for (uint i = 0u; i < u.meshCount; ++i) {
+        ++g_loopIterations;
+        closestOneMesh(r, i, best);
+    }
+#endif
+}
+
+bool anyHitMesh(Ray r, float tMax)
+{
+#ifdef VKRT_HAS_MESHES
+    for (uint i = 0u; i < u.meshCount; ++i) {
+        ++g_loopIterations;
+        if (anyHitOneMesh(r, i, tMax))
+            return true;
+    }
+#endif
+    return false;
+}
+
+void describeMesh(Ray r, HitId id, inout SurfaceHit hit)
+{
+#ifdef VKRT_HAS_MESHES
+    // Interpolated in object space (error gamma(7) sum |b_i v_i|, as for
+    // triangles), then transformed: the transform's own rounding is gamma(3)
+    // of |M| |p| + |t| per coordinate, and it scales the object-space error
+    // by |M| (pbrt-v4 section 6.8.5).
+    Mesh mesh = meshes[id.index];
+    MeshTriangle tri = meshTriangles[mesh.firstTriangle + id.primitive];
+    vec3 b0 = id.detail.x * tri.v0, b1 = id.detail.y * tri.v1, b2 = id.detail.z * tri.v2;
+    vec3 p = b0 + b1 + b2;
+    vec3 objectError = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2));
+    mat3 absM = mat3(abs(vec3(mesh.toWorld0.x, mesh.toWorld1.x, mesh.toWorld2.x)),
+                     abs(vec3(mesh.toWorld0.y, mesh.toWorld1.y, mesh.toWorld2.y)),
+                     abs(vec3(mesh.toWorld0.z, mesh.toWorld1.z, mesh.toWorld2.z)));
+    vec3 absT = abs(vec3(mesh.toWorld0.w, mesh.toWorld1.w, mesh.toWorld2.w));
+    hit.position = objectToWorldPoint(mesh, p);
+    hit.error = (1.0 + gammaBound(3)) * (absM * objectError) + gammaBound(3) * (absM * abs(p) + absT);
+    hit.normal = normalize(objectToWorldNormal(mesh, cross(tri.v1 - tri.v0, tri.v2 - tri.v0)));
+    hit.front = dot(hit.normal, r.dir) < 0.0;
+    hit.shading = hit.normal;
+#ifdef VKRT_HAS_MESH_NORMALS
+    if ((mesh.flags & MESH_FLAG_NORMALS) != 0u) {
+        MeshNormals normals = meshNormals[mesh.firstNormals + id.primitive];
+        vec3 ns = id.detail.x * normals.n0 + id.detail.y * normals.n1 + id.detail.z * normals.n2;
+        vec3 world = objectToWorldNormal(mesh, ns);
+        float len = length(world);
+        // A zero or vanishing interpolated normal keeps the face normal.
+        if (len > 0.0 && !isinf(len))
+            hit.shading = faceforward(world / len, -hit.normal, world);
+    }
+#endif
+    hit.material = mesh.material;
+#ifdef VKRT_HAS_EMITTERS
+    if ((mesh.flags & MESH_FLAG_EMISSIVE) != 0u)
+        hit.emitter = mesh.firstEmitter + id.primitive;
+#endif
+#endif
+}
+
 // ------------------------------------------------------------- point lights
 
 void closestPointLight(Ray r, inout HitId best) {}
@@ -239,17 +450,32 @@ void describePointLight(Ray r, HitId id, inout SurfaceHit hit) {}
 vec3 triangleLightNormal(TriangleLight light) { return normalize(cross(light.v1 - light.v0, light.v2 - light.v0)); }
 #endif
 
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+void closestOneTriangleLight(Ray r, TriangleRay tr, uint i, inout HitId best)
+{
+    float t;
+    vec3 bary;
+    TriangleLight light = triangleLights[i];
+    if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, best.t, t, bary))
+        best = HitId(SHAPE_LIGHT + LIGHT_TRIANGLE, i, t, bary, true, 0u);
+}
+
+bool anyHitOneTriangleLight(Ray r, TriangleRay tr, uint i, float tMax)
+{
+    float t;
+    vec3 bary;
+    TriangleLight light = triangleLights[i];
+    return intersectTriangle(light.v0, light.v1, light.v2, r, tr, tMax, t, bary);
+}
+#endif
+
 void closestTriangleLight(Ray r, inout HitId best)
 {
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
     TriangleRay tr = triangleRaySetup(r);
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 bary;
-        TriangleLight light = triangleLights[i];
-        if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, best.t, t, bary))
-            best = HitId(SHAPE_LIGHT + LIGHT_TRIANGLE, i, t, bary, true);
+        closestOneTriangleLight(r, tr, i, best);
     }
 #endif
 }
@@ -260,10 +486,7 @@ bool anyHitTriangleLight(Ray r, float tMax)
     TriangleRay tr = triangleRaySetup(r);
     for (uint i = 0u; i < u.triangleLightCount; ++i) {
         ++g_loopIterations;
-        float t;
-        vec3 bary;
-        TriangleLight light = triangleLights[i];
-        if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, tMax, t, bary))
+        if (anyHitOneTriangleLight(r, tr, i, tMax))
             return true;
     }
 #endif
@@ -291,10 +514,133 @@ void describeTriangleLight(Ray r, HitId id, inout SurfaceHit hit)
     if (id.shape == SHAPE_LIGHT + LIGHT_##KIND)                                     \
         describe##Type(r, id, hit);
 
+#ifdef VKRT_HAS_MESHES
+// One record of the top-level BVH: TOP_REF(kind, index), shared/SceneTypes.h.
+void closestRecord(Ray r, TriangleRay tr, uint ref, inout HitId best)
+{
+    int kind = int(ref >> TOP_REF_INDEX_BITS);
+    uint i = ref & TOP_REF_MAX_INDEX;
+#ifdef VKRT_HAS_SPHERES
+    if (kind == SHAPE_SPHERE)
+        closestOneSphere(r, i, best);
+#endif
+#ifdef VKRT_HAS_BOXES
+    if (kind == SHAPE_BOX)
+        closestOneBox(r, i, best);
+#endif
+#ifdef VKRT_HAS_TRIANGLES
+    if (kind == SHAPE_TRIANGLE)
+        closestOneTriangle(r, tr, i, best);
+#endif
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    if (kind == SHAPE_LIGHT + LIGHT_TRIANGLE)
+        closestOneTriangleLight(r, tr, i, best);
+#endif
+    if (kind == SHAPE_MESH)
+        closestOneMesh(r, i, best);
+}
+
+bool anyHitRecord(Ray r, TriangleRay tr, uint ref, float tMax)
+{
+    int kind = int(ref >> TOP_REF_INDEX_BITS);
+    uint i = ref & TOP_REF_MAX_INDEX;
+#ifdef VKRT_HAS_SPHERES
+    if (kind == SHAPE_SPHERE)
+        return anyHitOneSphere(r, i, tMax);
+#endif
+#ifdef VKRT_HAS_BOXES
+    if (kind == SHAPE_BOX)
+        return anyHitOneBox(r, i, tMax);
+#endif
+#ifdef VKRT_HAS_TRIANGLES
+    if (kind == SHAPE_TRIANGLE)
+        return anyHitOneTriangle(r, tr, i, tMax);
+#endif
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    if (kind == SHAPE_LIGHT + LIGHT_TRIANGLE)
+        return anyHitOneTriangleLight(r, tr, i, tMax);
+#endif
+    if (kind == SHAPE_MESH)
+        return anyHitOneMesh(r, i, tMax);
+    return false;
+}
+
+// The top-level BVH over every bounded record (planes stay a list): the
+// closest hit, or (anyHit) whether anything lies before tMax.
+bool traverseTop(Ray r, bool anyHit, float tMax, inout HitId best)
+{
+    TriangleRay tr = triangleRaySetup(r);
+    BvhRay br = bvhRaySetup(r);
+    uint stackNode[BVH_STACK_SIZE];
+    float stackEntry[BVH_STACK_SIZE];
+    uint depth = 0u;
+    uint node = 0u;
+    float tEntry;
+    BvhNode root = topNodes[0];
+    bool visiting = entersBox(root.lower, root.upper, br, anyHit ? tMax : best.t, tEntry);
+    while (visiting) {
+        ++g_loopIterations;
+        BvhNode n = topNodes[node];
+        bool descend = false;
+        if (n.count > 0u) {
+            for (uint k = 0u; k < n.count; ++k) {
+                ++g_loopIterations;
+                uint ref = topRefs[n.first + k];
+                if (anyHit) {
+                    if (anyHitRecord(r, tr, ref, tMax))
+                        return true;
+                } else {
+                    closestRecord(r, tr, ref, best);
+                }
+            }
+        } else {
+            float limit = anyHit ? tMax : best.t;
+            BvhNode a = topNodes[n.first];
+            BvhNode b = topNodes[n.first + 1u];
+            float ta, tb;
+            bool ha = entersBox(a.lower, a.upper, br, limit, ta);
+            bool hb = entersBox(b.lower, b.upper, br, limit, tb);
+            if (ha && hb) {
+                bool aFirst = ta <= tb;
+                stackNode[depth] = aFirst ? n.first + 1u : n.first;
+                stackEntry[depth] = aFirst ? tb : ta;
+                ++depth;
+                node = aFirst ? n.first : n.first + 1u;
+                descend = true;
+            } else if (ha || hb) {
+                node = ha ? n.first : n.first + 1u;
+                descend = true;
+            }
+        }
+        if (!descend) {
+            visiting = false;
+            while (depth > 0u) {
+                ++g_loopIterations;
+                --depth;
+                if (stackEntry[depth] <= (anyHit ? tMax : best.t)) {
+                    node = stackNode[depth];
+                    visiting = true;
+                    break;
+                }
+            }
+        }
+    }
+    return false;
+}
+#endif
+
 // The closest hit over every kind, shapes first, in registry order.
+// With meshes, the top-level BVH replaces the per-kind loops (planes, unbounded, stay a loop).
 HitId findClosest(Ray r, float tMax)
 {
-    HitId best = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true);
+    HitId best = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true, 0u);
+#ifdef VKRT_HAS_MESHES
+    if (u.topNodeCount > 0u) {
+        closestPlane(r, best);
+        traverseTop(r, false, tMax, best);
+        return best;
+    }
+#endif
     VKRT_SHAPE_KINDS(VKRT_CLOSEST_OF_KIND)
     VKRT_LIGHT_KINDS(VKRT_CLOSEST_OF_KIND)
     return best;
@@ -311,11 +657,14 @@ SurfaceHit describeHit(Ray r, HitId id)
     hit.error = gammaBound(3) * (abs(r.origin) + abs(id.t * r.dir));
     hit.normal = -r.dir;
     hit.front = id.front;
+    hit.emitter = NO_EMITTER;
     hit.shape = id.shape;
     hit.index = id.index;
     hit.material = 0u;
     VKRT_SHAPE_KINDS(VKRT_DESCRIBE_SHAPE)
     VKRT_LIGHT_KINDS(VKRT_DESCRIBE_LIGHT)
+    if (id.shape != SHAPE_MESH)
+        hit.shading = hit.normal;
     return hit;
 }
 
@@ -335,6 +684,14 @@ bool traceClosest(Ray r, float tMax, out SurfaceHit hit)
 // interfaces in order with traceClosest instead (lib/lights.glsl).
 bool traceAny(Ray r, float tMax)
 {
+#ifdef VKRT_HAS_MESHES
+    if (u.topNodeCount > 0u) {
+        if (anyHitPlane(r, tMax))
+            return true;
+        HitId unused = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true, 0u);
+        return traverseTop(r, true, tMax, unused);
+    }
+#endif
     VKRT_SHAPE_KINDS(VKRT_ANY_HIT_OF_KIND)
     VKRT_LIGHT_KINDS(VKRT_ANY_HIT_OF_KIND)
     return false;

@@ -30,6 +30,15 @@ void addEscapedRadiance(inout PathState path, Ray ray, SurfaceHit hit, bool miss
 #endif
 }
 
+// An emissive mesh seen along a specular chain from the camera.
+void addEmitterRadiance(inout PathState path, Ray ray, SurfaceHit hit)
+{
+#ifdef VKRT_HAS_EMITTERS
+    if (path.countEmission && hit.emitter != NO_EMITTER)
+        path.radiance += path.throughput * emitterRadiance(emitters[hit.emitter], -ray.dir);
+#endif
+}
+
 vec3 traceWhitted(Ray ray, inout Sampler rng)
 {
     PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true);
@@ -43,18 +52,21 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
             addEscapedRadiance(path, ray, hit, missed);
             break;
         }
+        addEmitterRadiance(path, ray, hit);
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
         vec3 n = hit.front ? hit.normal : -hit.normal;
+        vec3 ns = hit.front ? hit.shading : -hit.shading;
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
-            path.radiance += path.throughput * (directFromPointLights(m, hit, n, wo, path.media) +
-                                                directFromTriangleLights(m, hit, n, wo, path.media, rng));
+            path.radiance += path.throughput * (directFromPointLights(m, hit, n, ns, wo, path.media) +
+                                                directFromTriangleLights(m, hit, n, ns, wo, path.media, rng) +
+                                                directFromEmitters(m, hit, n, ns, wo, path.media, rng));
         }
         if (depth == u.maxDepth)
             break;
         float eta = interfaceEta(path.media, hit.material, hit.front);
-        BsdfSample s = sampleBsdf(m, n, wo, eta, sampleNext4D(rng).xyz);
+        BsdfSample s = sampleBsdf(m, ns, wo, eta, sampleNext4D(rng).xyz);
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;

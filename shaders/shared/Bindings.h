@@ -26,7 +26,20 @@ VKRT_CONSTANT(uint, BINDING_ENVIRONMENT, 4 + SHAPE_KIND_COUNT + LIGHT_KIND_COUNT
 VKRT_CONSTANT(uint, BINDING_MOMENTS, BINDING_ENVIRONMENT + 1)
 // float[6 N^2 + 1]: cumulative texel probabilities.
 VKRT_CONSTANT(uint, BINDING_ENVIRONMENT_CDF, BINDING_ENVIRONMENT + 2)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 3)
+// Meshes (always storage buffers): every geometry's BVH nodes, triangles
+// in leaf order and shading normals; the top-level BVH over every bounded
+// record and its leaf references (uint TOP_REF); emissive mesh triangles.
+VKRT_CONSTANT(uint, BINDING_MESH_NODES, BINDING_ENVIRONMENT + 3)
+VKRT_CONSTANT(uint, BINDING_MESH_TRIANGLES, BINDING_ENVIRONMENT + 4)
+VKRT_CONSTANT(uint, BINDING_MESH_NORMALS, BINDING_ENVIRONMENT + 5)
+VKRT_CONSTANT(uint, BINDING_TOP_NODES, BINDING_ENVIRONMENT + 6)
+VKRT_CONSTANT(uint, BINDING_TOP_REFS, BINDING_ENVIRONMENT + 7)
+VKRT_CONSTANT(uint, BINDING_EMITTERS, BINDING_ENVIRONMENT + 8)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 9)
+
+// BVH traversal keeps a stack of this many nodes per level (top and mesh);
+// the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).
+VKRT_CONSTANT(uint, BVH_STACK_SIZE, 64)
 
 // Under the Sobol' sampler the variance comes from this many independently
 // scrambled batches (frame f is sample f / K of batch f % K; lib/sobol.glsl):

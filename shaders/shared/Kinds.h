@@ -37,7 +37,8 @@
     X(SPHERE, Sphere, sphere, 0, sphere, spheres, SPHERES, 819)             \
     X(BOX, Box, box, 1, box, boxes, BOXES, 585)                             \
     X(TRIANGLE, Triangle, triangle, 2, triangle, triangles, TRIANGLES, 409) \
-    X(PLANE, Plane, plane, 3, plane, planes, PLANES, 585)
+    X(PLANE, Plane, plane, 3, plane, planes, PLANES, 585)                   \
+    X(MESH, Mesh, mesh, 4, mesh, meshes, MESHES, 124)
 
 #define VKRT_LIGHT_KINDS(X)                                                    \
     X(POINT, PointLight, point, 0, pointLight, pointLights, POINT_LIGHTS, 682) \

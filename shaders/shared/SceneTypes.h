@@ -53,6 +53,54 @@ struct Plane {
     vec3 normal;
 };
 
+// Mesh::flags
+VKRT_CONSTANT(uint, MESH_FLAG_NORMALS, 1)   // meshNormals holds shading normals for its triangles
+VKRT_CONSTANT(uint, MESH_FLAG_EMISSIVE, 2)  // its triangles are emitters firstEmitter, ...
+VKRT_CONSTANT(uint, MESH_FLAG_TWO_SIDED, 4) // they emit on both sides
+
+/// One instance of a mesh (src/scene/Scene.h: Mesh). The matrices are the
+/// object -> camera-relative world transform and its inverse, as three rows
+/// of a 3x4 matrix each, composed in double on the host.
+struct Mesh {
+    vec4 toWorld0;
+    vec4 toWorld1;
+    vec4 toWorld2;
+    vec4 toObject0;
+    vec4 toObject1;
+    vec4 toObject2;
+    vec3 emission;
+    uint material;
+    uint root;          // its geometry's root node in meshNodes
+    uint firstTriangle; // its geometry's first MeshTriangle in meshTriangles
+    uint firstNormals;  // its geometry's first MeshNormals in meshNormals (MESH_FLAG_NORMALS)
+    uint flags;
+    uint firstEmitter;  // its first triangle's Emitter (MESH_FLAG_EMISSIVE)
+};
+
+/// Shading normals at a mesh triangle's three vertices (object space; a zero
+/// normal means "use the face normal").
+struct MeshNormals {
+    vec3 n0;
+    vec3 n1;
+    vec3 n2;
+};
+
+/// One emissive mesh triangle as a light, camera-relative world space. Lights
+/// are chosen in proportion to power with Walker's alias method: pick slot i
+/// uniformly, keep it if u < aliasThreshold, else take `alias`; `pdf` is the
+/// probability of choosing this triangle.
+struct Emitter {
+    vec3 v0;
+    float area;
+    vec3 v1;
+    uint twoSided;
+    vec3 v2;
+    float pdf;
+    vec3 radiance;
+    float aliasThreshold;
+    uint alias;
+};
+
 struct PointLight {
     vec3 position;
     vec3 intensity;
@@ -85,6 +133,12 @@ struct MeshTriangle {
     vec3 v1;
     vec3 v2;
 };
+
+// Top-level BVH leaves reference records as TOP_REF(kind, index): the
+// shape kind (SHAPE_*, or SHAPE_KIND_COUNT + a LIGHT_* kind for lights) in
+// the top 8 bits, the record's index in the low 24.
+VKRT_CONSTANT(uint, TOP_REF_INDEX_BITS, 24)
+VKRT_CONSTANT(uint, TOP_REF_MAX_INDEX, 16777215)
 
 // SceneUniforms::flags
 VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
@@ -119,6 +173,10 @@ struct SceneUniforms {
     uint environmentSize;   // cubemap face width N (0 without a cubemap)
     uint cameraMediumCount; // dielectrics containing the eye (lib/media.glsl)
     uvec4 cameraMedia;      // their materials, innermost last
+    uint emitterCount;      // Emitter records (emissive mesh triangles)
+    float emitterPower;     // their total power (W), for choosing between emitters and other lights
+    uint topNodeCount;      // nodes of the top-level BVH (0: none; the kernel loops over the arrays)
+    uint pad0;
 };
 
 /// Per-batch values (push constants), pushed once per submission: lavapipe

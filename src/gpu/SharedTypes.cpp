@@ -34,8 +34,9 @@ constexpr uint kSceneArrayBindings[] = {BINDING_MATERIALS,
 #undef VKRT_BINDING_OF
 constexpr bool bindingsDistinct()
 {
-    constexpr uint fixed[] = {BINDING_UNIFORMS,    BINDING_ACCUMULATION, BINDING_STATS,
-                              BINDING_ENVIRONMENT, BINDING_MOMENTS,      BINDING_ENVIRONMENT_CDF};
+    constexpr uint fixed[] = {BINDING_UNIFORMS,    BINDING_ACCUMULATION,   BINDING_STATS,         BINDING_ENVIRONMENT,
+                              BINDING_MOMENTS,     BINDING_ENVIRONMENT_CDF, BINDING_MESH_NODES,   BINDING_MESH_TRIANGLES,
+                              BINDING_MESH_NORMALS, BINDING_TOP_NODES,     BINDING_TOP_REFS,      BINDING_EMITTERS};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -47,14 +48,19 @@ constexpr bool bindingsDistinct()
     return true;
 }
 static_assert(bindingsDistinct(), "shared/Bindings.h: every scene array needs its own binding below BINDING_COUNT");
-static_assert(sizeof(SceneUniforms) == 96 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
+static_assert(sizeof(SceneUniforms) == 112 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
               "SceneUniforms holds one count per shape and light kind");
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
+static_assert(sizeof(BvhNode) == 32);
+static_assert(sizeof(MeshTriangle) == 36);
+static_assert(sizeof(MeshNormals) == 36);
+static_assert(sizeof(Emitter) == 68);
+static_assert(offsetof(Mesh, emission) == 96 && offsetof(Mesh, firstEmitter) == 128);
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);
 static_assert(sizeof(MomentPixel) == 36);
-static_assert(offsetof(SceneUniforms, tileStride) == 92);
+static_assert(offsetof(SceneUniforms, tileStride) == 96);
 static_assert(offsetof(Material, fresnel) == 48);
 static_assert(offsetof(TriangleLight, radiance) == 44);
 

@@ -1,6 +1,10 @@
 #include "render/GpuScene.h"
 
+#include "mesh/MeshGeometry.h"
 #include "shared/Bindings.h"
+
+#include <chrono>
+#include <glm/gtc/constants.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -67,6 +71,240 @@ const std::vector<Record>& recordsToUpload(const Scene&, const std::vector<Recor
 std::vector<TriangleLight> recordsToUpload(const Scene& scene, const std::vector<TriangleLight>&)
 {
     return emittingTriangleLights(scene);
+}
+/// Mesh instances need their geometry's offsets: convertMeshes does them.
+std::vector<Mesh> recordsToUpload(const Scene&, const std::vector<Mesh>&) { return {}; }
+gpu::Mesh toGpu(const Mesh&, const Relativizer&) { return {}; }
+
+// ------------------------------------------------------------------ meshes
+
+glm::vec4 row(const glm::dmat4& m, int r) { return glm::vec4(glm::dvec4(m[0][r], m[1][r], m[2][r], m[3][r])); }
+
+/// Object -> camera-relative world, composed in double: a mesh far from the
+/// origin keeps full float precision near the camera.
+glm::dmat4 toCameraRelative(const Mesh& mesh, const glm::dvec3& eye)
+{
+    glm::dmat4 m = mesh.objectToWorld;
+    m[3] = glm::dvec4(glm::dvec3(m[3]) - eye, 1.0);
+    return m;
+}
+
+double meanOf(const Color& c) { return (c.r + c.g + c.b) / 3.0; }
+
+bool isEmissive(const Mesh& mesh) { return mesh.emission != Color(0.0); }
+
+std::array<glm::dvec3, 3> worldVertices(const Mesh& mesh, const MeshGeometry& g, uint32_t slot, const glm::dvec3& eye)
+{
+    const glm::dmat4 m = toCameraRelative(mesh, eye);
+    const glm::uvec3 t = g.data.triangles[slot];
+    std::array<glm::dvec3, 3> v;
+    for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(m * glm::dvec4(glm::dvec3(g.data.positions[t[k]]), 1.0));
+    return v;
+}
+
+/// Walker's alias table (Vose's construction) over non-negative weights.
+EmitterTable aliasTable(const std::vector<double>& power)
+{
+    EmitterTable table;
+    const size_t n = power.size();
+    table.pdf.resize(n);
+    table.threshold.assign(n, 1.0f);
+    table.alias.resize(n);
+    for (double p : power) table.totalPower += p;
+    if (n == 0 || !(table.totalPower > 0.0)) return table;
+    std::vector<double> scaled(n);
+    std::vector<uint32_t> small, large;
+    for (size_t i = 0; i < n; ++i) {
+        table.pdf[i] = power[i] / table.totalPower;
+        scaled[i] = table.pdf[i] * double(n);
+        table.alias[i] = uint32_t(i);
+        (scaled[i] < 1.0 ? small : large).push_back(uint32_t(i));
+    }
+    while (!small.empty() && !large.empty()) {
+        const uint32_t s = small.back(), l = large.back();
+        small.pop_back();
+        table.threshold[s] = float(scaled[s]);
+        table.alias[s] = l;
+        scaled[l] -= 1.0 - scaled[s];
+        if (scaled[l] < 1.0) {
+            large.pop_back();
+            small.push_back(l);
+        }
+    }
+    // What remains is 1 up to rounding: always kept.
+    for (uint32_t i : small) table.threshold[i] = 1.0f;
+    for (uint32_t i : large) table.threshold[i] = 1.0f;
+    return table;
+}
+
+EmitterTable emitterTableOf(const Scene& scene)
+{
+    std::vector<double> power;
+    for (const Mesh& mesh : scene.meshes) {
+        if (!isEmissive(mesh)) continue;
+        const MeshGeometry& g = *mesh.geometry;
+        const double sides = mesh.twoSided ? 2.0 : 1.0;
+        for (uint32_t slot = 0; slot < g.data.triangles.size(); ++slot) {
+            const double area = triangleArea(worldVertices(mesh, g, slot, glm::dvec3(0.0)));
+            const bool emits = area > 0.0 && float(area) > 0.0 && std::isfinite(area);
+            power.push_back(emits ? meanOf(mesh.emission) * area * sides * glm::pi<double>() : 0.0);
+        }
+    }
+    return aliasTable(power);
+}
+
+Aabb worldBox(const Mesh& mesh)
+{
+    Aabb box;
+    const Aabb& b = mesh.geometry->bounds;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p((corner & 1) ? b.upper.x : b.lower.x, (corner & 2) ? b.upper.y : b.lower.y,
+                           (corner & 4) ? b.upper.z : b.lower.z);
+        box.extend(glm::dvec3(mesh.objectToWorld * glm::dvec4(p, 1.0)));
+    }
+    // The transform itself rounds: widen by a few ulps of the box's size.
+    const glm::dvec3 margin = (glm::abs(box.lower) + glm::abs(box.upper)) * 1e-12;
+    box.lower -= margin;
+    box.upper += margin;
+    return box;
+}
+
+uint32_t topRef(int kind, size_t index)
+{
+    if (index > gpu::TOP_REF_MAX_INDEX)
+        throw InputError("a scene may hold at most " + std::to_string(gpu::TOP_REF_MAX_INDEX + 1) +
+                         " records of one kind");
+    return (uint32_t(kind) << gpu::TOP_REF_INDEX_BITS) | uint32_t(index);
+}
+
+TopLevel buildTopLevel(const Scene& scene)
+{
+    std::vector<Aabb> boxes;
+    std::vector<uint32_t> refs;
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Sphere& s = scene.spheres[i];
+        boxes.push_back({s.center - glm::dvec3(s.radius), s.center + glm::dvec3(s.radius)});
+        refs.push_back(topRef(gpu::SHAPE_SPHERE, i));
+    }
+    for (size_t i = 0; i < scene.boxes.size(); ++i) {
+        boxes.push_back({scene.boxes[i].min, scene.boxes[i].max});
+        refs.push_back(topRef(gpu::SHAPE_BOX, i));
+    }
+    auto triangleBox = [](const std::array<glm::dvec3, 3>& v) {
+        Aabb box;
+        for (const auto& p : v) box.extend(p);
+        return box;
+    };
+    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+        boxes.push_back(triangleBox(scene.triangles[i].vertices));
+        refs.push_back(topRef(gpu::SHAPE_TRIANGLE, i));
+    }
+    const std::vector<TriangleLight> lights = emittingTriangleLights(scene);
+    for (size_t i = 0; i < lights.size(); ++i) {
+        boxes.push_back(triangleBox(lights[i].vertices));
+        refs.push_back(topRef(gpu::SHAPE_KIND_COUNT + gpu::LIGHT_TRIANGLE, i));
+    }
+    for (size_t i = 0; i < scene.meshes.size(); ++i) {
+        boxes.push_back(worldBox(scene.meshes[i]));
+        refs.push_back(topRef(gpu::SHAPE_MESH, i));
+    }
+    TopLevel top;
+    top.bvh = buildBvh(boxes, BvhOptions{.maxLeafSize = 2});
+    for (uint32_t slot : top.bvh.order) {
+        top.refs.push_back(refs[slot]);
+        top.boxes.push_back(boxes[slot]);
+    }
+    return top;
+}
+
+/// The top-level nodes with camera-relative boxes, from the leaves up
+/// (children always follow their parent in the array).
+std::vector<gpu::BvhNode> refitTopLevel(const TopLevel& top, const glm::dvec3& eye)
+{
+    std::vector<Aabb> nodeBoxes(top.bvh.nodes.size());
+    for (size_t i = top.bvh.nodes.size(); i-- > 0;) {
+        const gpu::BvhNode& node = top.bvh.nodes[i];
+        Aabb box;
+        if (node.count > 0) {
+            for (uint32_t k = 0; k < node.count; ++k) {
+                const Aabb& leaf = top.boxes[node.first + k];
+                if (!leaf.empty()) box.extend(Aabb{leaf.lower - eye, leaf.upper - eye});
+            }
+        } else {
+            box.extend(nodeBoxes[node.first]);
+            box.extend(nodeBoxes[node.first + 1]);
+        }
+        nodeBoxes[i] = box;
+    }
+    std::vector<gpu::BvhNode> nodes = top.bvh.nodes;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        if (nodeBoxes[i].empty()) {
+            // Nothing to hit: a box no ray enters.
+            nodes[i].lower = glm::vec3(std::numeric_limits<float>::infinity());
+            nodes[i].upper = glm::vec3(-std::numeric_limits<float>::infinity());
+        } else {
+            roundOutwards(nodeBoxes[i], nodes[i].lower, nodes[i].upper);
+        }
+    }
+    return nodes;
+}
+
+void checkBufferSize(uint64_t bytes, uint64_t maxBytes, const std::string& what, const Scene& scene)
+{
+    if (bytes <= maxBytes) return;
+    // Name the geometry that contributes most, the one to decimate.
+    const MeshGeometry* biggest = nullptr;
+    for (const Mesh& m : scene.meshes)
+        if (!biggest || m.geometry->gpuBytes() > biggest->gpuBytes()) biggest = m.geometry.get();
+    throw InputError(scene.path + ": the scene's " + what + " need " + std::to_string(bytes >> 20) +
+                     " MiB, more than the device's maxStorageBufferRange of " + std::to_string(maxBytes >> 20) +
+                     " MiB" +
+                     (biggest ? " (the largest mesh is " + biggest->file.string() + ", " +
+                                    std::to_string(biggest->data.triangles.size()) + " triangles)"
+                              : std::string()) +
+                     "; use fewer or smaller meshes");
+}
+
+void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::dvec3& eye, GpuSceneData& data)
+{
+    uint32_t firstEmitter = 0;
+    for (const Mesh& mesh : scene.meshes) {
+        const MeshGeometry& g = *mesh.geometry;
+        const GeometryOffsets& at = fixed.offsets.at(&g);
+        const glm::dmat4 toWorld = toCameraRelative(mesh, eye);
+        const glm::dmat4 toObject = glm::inverse(toWorld);
+        gpu::Mesh record{};
+        record.toWorld0 = row(toWorld, 0);
+        record.toWorld1 = row(toWorld, 1);
+        record.toWorld2 = row(toWorld, 2);
+        record.toObject0 = row(toObject, 0);
+        record.toObject1 = row(toObject, 1);
+        record.toObject2 = row(toObject, 2);
+        record.emission = toFloat(mesh.emission);
+        record.material = mesh.material;
+        record.root = at.root;
+        record.firstTriangle = at.firstTriangle;
+        record.firstNormals = at.firstNormals;
+        record.flags = (at.normals ? gpu::MESH_FLAG_NORMALS : 0u) | (isEmissive(mesh) ? gpu::MESH_FLAG_EMISSIVE : 0u) |
+                       (mesh.twoSided ? gpu::MESH_FLAG_TWO_SIDED : 0u);
+        record.firstEmitter = firstEmitter;
+        data.meshes.push_back(record);
+        if (!isEmissive(mesh)) continue;
+        for (uint32_t slot = 0; slot < g.data.triangles.size(); ++slot, ++firstEmitter) {
+            const auto v = worldVertices(mesh, g, slot, eye);
+            gpu::Emitter e{};
+            e.v0 = toFloat(v[0]);
+            e.v1 = toFloat(v[1]);
+            e.v2 = toFloat(v[2]);
+            e.area = float(triangleArea(v));
+            e.twoSided = mesh.twoSided ? 1u : 0u;
+            e.pdf = float(fixed.emitters.pdf[firstEmitter]);
+            e.radiance = toFloat(mesh.emission);
+            e.aliasThreshold = fixed.emitters.threshold[firstEmitter];
+            e.alias = fixed.emitters.alias[firstEmitter];
+            data.emitters.push_back(e);
+        }
+    }
 }
 
 void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
@@ -159,7 +397,51 @@ std::vector<uint32_t> mediaAroundCamera(const Scene& scene)
     return materials;
 }
 
-GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
+uint64_t meshTriangleCount(const Scene& scene)
+{
+    uint64_t total = 0;
+    for (const Mesh& m : scene.meshes) total += m.geometry->data.triangles.size();
+    return total;
+}
+
+uint64_t emissiveTriangleCount(const Scene& scene)
+{
+    uint64_t total = 0;
+    for (const Mesh& m : scene.meshes)
+        if (isEmissive(m)) total += m.geometry->data.triangles.size();
+    return total;
+}
+
+GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
+{
+    GpuSceneStatic fixed;
+    if (scene.meshes.empty()) return fixed;
+    for (const Mesh& mesh : scene.meshes) {
+        const MeshGeometry& g = *mesh.geometry;
+        if (fixed.offsets.count(&g)) continue;
+        GeometryOffsets at{uint32_t(fixed.meshNodes.size()), uint32_t(fixed.meshTriangles.size()),
+                           uint32_t(fixed.meshNormals.size()), !g.data.normals.empty()};
+        fixed.offsets[&g] = at;
+        fixed.meshNodes.insert(fixed.meshNodes.end(), g.bvh.nodes.begin(), g.bvh.nodes.end());
+        const auto& p = g.data.positions;
+        for (const glm::uvec3& t : g.data.triangles) fixed.meshTriangles.push_back({p[t.x], p[t.y], p[t.z]});
+        if (at.normals) {
+            const auto& n = g.data.normals;
+            for (const glm::uvec3& t : g.data.triangles) fixed.meshNormals.push_back({n[t.x], n[t.y], n[t.z]});
+        }
+    }
+    checkBufferSize(fixed.meshNodes.size() * sizeof(gpu::BvhNode), maxBytes, "BVH nodes", scene);
+    checkBufferSize(fixed.meshTriangles.size() * sizeof(gpu::MeshTriangle), maxBytes, "mesh triangles", scene);
+    checkBufferSize(fixed.meshNormals.size() * sizeof(gpu::MeshNormals), maxBytes, "mesh normals", scene);
+    const auto start = std::chrono::steady_clock::now();
+    fixed.top = buildTopLevel(scene);
+    fixed.topBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fixed.emitters = emitterTableOf(scene);
+    checkBufferSize(fixed.emitters.pdf.size() * sizeof(gpu::Emitter), maxBytes, "emissive triangles", scene);
+    return fixed;
+}
+
+GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, const GpuSceneStatic& fixed)
 {
     GpuSceneData data;
     Relativizer rel{scene.camera.eye};
@@ -169,6 +451,11 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
     VKRT_SHAPE_KINDS(VKRT_CONVERT_RECORDS)
     VKRT_LIGHT_KINDS(VKRT_CONVERT_RECORDS)
 #undef VKRT_CONVERT_RECORDS
+    convertMeshes(scene, fixed, scene.camera.eye, data);
+    if (fixed.top) {
+        data.topNodes = refitTopLevel(*fixed.top, scene.camera.eye);
+        data.topRefs = fixed.top->refs;
+    }
 
     gpu::SceneUniforms& u = data.uniforms;
     convertCamera(scene.camera, u);
@@ -185,6 +472,9 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings)
     std::vector<uint32_t> media = mediaAroundCamera(scene);
     u.cameraMediumCount = uint32_t(media.size());
     for (size_t i = 0; i < media.size(); ++i) u.cameraMedia[int(i)] = media[i];
+    u.emitterCount = uint32_t(data.emitters.size());
+    u.emitterPower = float(fixed.emitters.totalPower);
+    u.topNodeCount = uint32_t(data.topNodes.size());
     return data;
 }
 

@@ -2,15 +2,64 @@
 // Scene -> the GPU records of shaders/shared/SceneTypes.h. Positions are made
 // camera-relative in double precision before rounding to float32, so a scene
 // far from the world origin keeps full float precision near the camera.
+#include "accel/Bvh.h"
 #include "scene/Scene.h"
 #include "shared/SceneTypes.h"
 
+#include <map>
+#include <optional>
 #include <vector>
 
 namespace vkrt {
 
+/// Where one geometry's records start in the concatenated mesh buffers.
+struct GeometryOffsets {
+    uint32_t root = 0;
+    uint32_t firstTriangle = 0;
+    uint32_t firstNormals = 0;
+    bool normals = false;
+};
+
+/// The top-level BVH over every bounded record of a scene with meshes
+/// (spheres, boxes, triangles, triangle lights, mesh instances; planes are
+/// unbounded and stay a list). Built once in world space; only its boxes
+/// depend on the camera (refitted, never rebuilt, when the camera moves).
+struct TopLevel {
+    Bvh bvh;
+    std::vector<uint32_t> refs;      ///< leaf slot -> gpu::TOP_REF
+    std::vector<Aabb> boxes;         ///< leaf slot -> world box (double)
+};
+
+/// Emissive mesh triangles chosen in proportion to power (Walker's alias method).
+struct EmitterTable {
+    std::vector<double> pdf;         ///< per emitter, in instance-then-leaf order
+    std::vector<float> threshold;
+    std::vector<uint32_t> alias;
+    double totalPower = 0.0;
+};
+
+/// Everything about a scene's meshes that no camera move changes: the
+/// geometries concatenated (each once, however many instances share it),
+/// the top-level BVH's topology and the emitters' alias table.
+struct GpuSceneStatic {
+    std::vector<gpu::BvhNode> meshNodes;
+    std::vector<gpu::MeshTriangle> meshTriangles;
+    std::vector<gpu::MeshNormals> meshNormals;
+    std::map<const MeshGeometry*, GeometryOffsets> offsets;
+    std::optional<TopLevel> top; ///< only for scenes with meshes
+    EmitterTable emitters;
+    double topBuildSeconds = 0.0;
+};
+
+/// Fails (InputError naming the mesh and the limit) if a mesh buffer would
+/// exceed `maxBytes` (the device's maxStorageBufferRange).
+GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes = ~0ull);
+
 struct GpuSceneData {
     gpu::SceneUniforms uniforms{};
+    std::vector<gpu::BvhNode> topNodes;
+    std::vector<uint32_t> topRefs;
+    std::vector<gpu::Emitter> emitters;
     std::vector<gpu::Material> materials;
     // One array per shape and light kind (shared/Kinds.h), named as in Scene.
 #define VKRT_GPU_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) std::vector<gpu::Type> array;
@@ -23,7 +72,11 @@ struct FrameSettings {
     bool jitter = true; ///< random point in each pixel; off = pixel centres
 };
 
-GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings);
+GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, const GpuSceneStatic& fixed);
+
+/// Mesh triangles (all instances) and emissive ones.
+uint64_t meshTriangleCount(const Scene& scene);
+uint64_t emissiveTriangleCount(const Scene& scene);
 
 /// Materials of the dielectric spheres and boxes that contain the camera's
 /// eye, outermost first (the medium stack a camera ray starts with).

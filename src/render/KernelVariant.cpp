@@ -34,6 +34,14 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     VKRT_LIGHT_KINDS(VKRT_LIGHT_FEATURE)
 #undef VKRT_SHAPE_FEATURE
 #undef VKRT_LIGHT_FEATURE
+    // Meshes: the geometry buffers and the top-level BVH come with the mesh array.
+    const bool meshes = f.has(ShapeKind::Mesh);
+    list.push_back({meshes, "VKRT_HAS_MESH_NODES", int(gpu::BINDING_MESH_NODES), ""});
+    list.push_back({meshes, "VKRT_HAS_MESH_TRIANGLES", int(gpu::BINDING_MESH_TRIANGLES), ""});
+    list.push_back({meshes, "VKRT_HAS_TOP_NODES", int(gpu::BINDING_TOP_NODES), ""});
+    list.push_back({meshes, "VKRT_HAS_TOP_REFS", int(gpu::BINDING_TOP_REFS), ""});
+    list.push_back({meshes && f.meshNormals, "VKRT_HAS_MESH_NORMALS", int(gpu::BINDING_MESH_NORMALS), "mesh-normals"});
+    list.push_back({meshes && f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emissive-meshes"});
     list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});
     list.push_back({f.environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
                     "environment-sampling"});
@@ -92,6 +100,7 @@ std::vector<std::pair<std::string, std::string>> KernelVariant::defines() const
     for (MaterialType type : kAllMaterialTypes)
         if (features.has(type)) result.emplace_back("VKRT_MATERIAL_" + upper(materialTypeName(type)), "1");
     if (uniformScene) result.emplace_back("VKRT_UNIFORM_SCENE", "1");
+    if (groupLoopCount) result.emplace_back("VKRT_GROUP_LOOP_COUNT", "1");
     // Variance under the Sobol' sampler comes from independently scrambled batches.
     if (variance && sobolSampler) result.emplace_back("VKRT_SOBOL_BATCHES", std::to_string(gpu::VARIANCE_BATCHES));
     return result;
@@ -110,7 +119,7 @@ std::string KernelVariant::describe() const
 {
     std::string text = integratorName(features.integrator) + ";";
     for (const auto& feature : optionalFeatures(*this))
-        if (feature.on) text += " " + feature.name;
+        if (feature.on && !feature.name.empty()) text += " " + feature.name;
     text += ";";
     for (MaterialType type : kAllMaterialTypes)
         if (features.has(type)) text += " " + materialTypeName(type);

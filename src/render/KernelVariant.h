@@ -29,6 +29,10 @@ struct KernelVariant {
     bool variance = false;     ///< per-pixel variance estimation (a render option)
     bool sobolSampler = false; ///< Owen-scrambled Sobol' points instead of independent ones (a render option)
     bool uniformScene = false; ///< scene arrays in uniform buffers: every array fits (shared/SceneTypes.h)
+    /// Count loop passes per subgroup (the unit a capping driver counts in),
+    /// for mesh scenes on a device that caps loops: their traversal has no
+    /// useful static bound, so a group that reaches the cap is detected at run time.
+    bool groupLoopCount = false;
 
     /// Preprocessor defines selecting this variant, in a stable order.
     std::vector<std::pair<std::string, std::string>> defines() const;

@@ -32,6 +32,7 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
         throw InputError("VKRT_SOBOL_BATCHES cannot be overridden when the Sobol' sampler estimates variance "
                          "(its batch count is VARIANCE_BATCHES)");
     variant.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
+    variant.groupLoopCount = context.loopCap().capped() && !scene.meshes.empty();
     return variant;
 }
 
@@ -150,6 +151,9 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
 void checkLoopBudget(const Scene& scene, const LoopCap& cap)
 {
     if (!cap.capped()) return; // the device runs every loop to completion
+    // BVH traversal has no useful static bound: a mesh scene's kernel counts
+    // every subgroup's passes and renderFrames fails if one reached the cap.
+    if (!scene.meshes.empty()) return;
     uint64_t worst = worstCaseLoopIterations(scene);
     if (worst >= *cap.budget)
         throw InputError(scene.path + ": scene too large for this device: one pixel sample may need " +
@@ -163,7 +167,8 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_scene(scene),
       m_options(std::move(options)),
       m_variant(chooseVariant(context, scene, m_options)),
-      m_data(convertScene(scene, FrameSettings{m_options.jitter})),
+      m_static(prepareStaticScene(scene, context.physicalDevice().getProperties().limits.maxStorageBufferRange)),
+      m_data(convertScene(scene, FrameSettings{m_options.jitter}, m_static)),
       m_compiled(compileVariant(m_variant, m_options)),
       m_accumulation(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel), "the accumulation buffer")),
       m_stats(context, sizeof(gpu::RenderStats),
@@ -187,7 +192,21 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
     if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
     bindEnvironment();
+    uploadMeshBuffers();
     uploadSceneBuffers();
+}
+
+void Renderer::uploadMeshBuffers()
+{
+    auto addBuffer = [&](uint32_t binding, const auto& records) {
+        if (!m_kernel.uses(binding)) return;
+        m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage));
+        m_kernel.bind(binding, m_meshBuffers.back());
+    };
+    m_meshBuffers.reserve(3); // bind() keeps references: no reallocation
+    addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
+    addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles);
+    addBuffer(gpu::BINDING_MESH_NORMALS, m_static.meshNormals);
 }
 
 void Renderer::bindEnvironment()
@@ -225,6 +244,14 @@ void Renderer::uploadSceneBuffers()
     VKRT_SHAPE_KINDS(VKRT_UPLOAD_ARRAY)
     VKRT_LIGHT_KINDS(VKRT_UPLOAD_ARRAY)
 #undef VKRT_UPLOAD_ARRAY
+    auto addStorage = [&](uint32_t binding, const auto& records) {
+        if (!m_kernel.uses(binding)) return;
+        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, kStorage));
+        m_kernel.bind(binding, m_sceneBuffers.back());
+    };
+    addStorage(gpu::BINDING_TOP_NODES, m_data.topNodes);
+    addStorage(gpu::BINDING_TOP_REFS, m_data.topRefs);
+    addStorage(gpu::BINDING_EMITTERS, m_data.emitters);
 }
 
 void Renderer::reset()
@@ -239,7 +266,7 @@ void Renderer::moveCamera(const Camera& camera)
 {
     VKRT_CHECK(camera.width == width() && camera.height == height());
     m_scene.camera = camera;
-    m_data = convertScene(m_scene, FrameSettings{m_options.jitter});
+    m_data = convertScene(m_scene, FrameSettings{m_options.jitter}, m_static);
     uploadSceneBuffers();
     reset();
 }
@@ -273,6 +300,13 @@ void Renderer::renderFrames(uint32_t frames)
             recordFrames(cmd, m_frames + done, std::min(maxRun, frames - done));
     });
     m_frames += frames;
+    if (m_variant.groupLoopCount && counters().budgetExceeded)
+        throw InputError(m_scene.path + ": " + std::to_string(counters().budgetExceeded) +
+                         " shader invocations reached this device's loop cap of " +
+                         std::to_string(*m_context.loopCap().budget) + " passes per subgroup (" +
+                         m_context.loopCap().evidence +
+                         ") while traversing the scene's meshes, so their samples may be cut short; the image is "
+                         "not written. Use Mesa 25's lavapipe, which has no such cap, or simpler meshes");
 }
 
 void Renderer::warmUp()

@@ -70,6 +70,8 @@ public:
 
     const KernelVariant& variant() const { return m_variant; }
     const CompiledKernel& kernel() const { return m_compiled; }
+    /// The scene's mesh data as uploaded (empty for a scene without meshes).
+    const GpuSceneStatic& meshData() const { return m_static; }
     uint32_t width() const { return m_data.uniforms.width; }
     uint32_t height() const { return m_data.uniforms.height; }
 
@@ -78,8 +80,10 @@ private:
     Scene m_scene;
     RenderOptions m_options;
     KernelVariant m_variant;
+    GpuSceneStatic m_static; ///< mesh geometry and the top-level topology: uploaded once
     GpuSceneData m_data;
     CompiledKernel m_compiled;
+    std::vector<Buffer> m_meshBuffers;
     std::vector<Buffer> m_sceneBuffers;
     Buffer m_accumulation;
     Buffer m_stats;
@@ -96,6 +100,7 @@ private:
     Image meanOfBatchMeans() const;
     void bindEnvironment();
     void uploadSceneBuffers();
+    void uploadMeshBuffers();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
 };
 

@@ -1,5 +1,7 @@
 #include "scene/FeatureSet.h"
 
+#include "mesh/MeshGeometry.h"
+
 #include <algorithm>
 
 namespace vkrt {
@@ -31,6 +33,8 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.materialTypes.fill(true);
     all.cubemap = true;
     all.environmentSampling = integrator == Integrator::Path;
+    all.meshNormals = true;
+    all.emitters = true;
     all.integrator = integrator;
     return all;
 }
@@ -57,6 +61,10 @@ FeatureSet featuresOf(const Scene& scene)
     set.cubemap = scene.background.cubemap.has_value();
     set.environmentSampling = set.cubemap && scene.render.integrator == Integrator::Path;
     set.integrator = scene.render.integrator;
+    for (const Mesh& mesh : scene.meshes) {
+        set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();
+        set.emitters = set.emitters || mesh.emission != Color(0.0);
+    }
     markMaterialsUsed(scene, set);
     return set;
 }

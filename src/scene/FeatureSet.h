@@ -16,6 +16,8 @@ struct FeatureSet {
     std::array<bool, kMaterialKindCount> materialTypes{}; ///< indexed by MaterialType
     bool cubemap = false;
     bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
+    bool meshNormals = false;         ///< some mesh has per-vertex shading normals
+    bool emitters = false;            ///< some mesh emits (its triangles are lights)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).

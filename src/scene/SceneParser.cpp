@@ -7,6 +7,8 @@
 // reading itself is scene/TomlReader.h; this file knows what a scene holds.
 #include "scene/SceneParser.h"
 
+#include "mesh/MeshGeometry.h"
+#include "mesh/MeshLoader.h"
 #include "scene/SceneOverrides.h"
 
 #include "scene/TomlReader.h"
@@ -17,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
 #include <map>
 #include <optional>
 #include <span>
@@ -338,6 +341,122 @@ void readPlane(const TableField& table, uint32_t material, Scene& scene)
     scene.planes.push_back({point, *normal, material});
 }
 
+constexpr std::array<std::string_view, 10> meshKeys{"shape",  "material", "file",     "scale",    "rotate",
+                                                    "translate", "matrix", "normals", "emission", "two_sided"};
+
+void checkRegularFile(const Field& field, const fs::path& path);
+constexpr std::array<std::string_view, 2> rotateKeys{"axis", "angle"};
+
+/// The geometries of the scene being parsed, so that instances of one file
+/// share one (set by parseSceneString for the duration of a parse).
+thread_local MeshGeometryCache* t_meshCache = nullptr;
+
+/// `scale`: one number or three, none zero (a negative one mirrors).
+glm::dvec3 readScale(const Field& field)
+{
+    glm::dvec3 scale = field.node().is_array() ? readVector(field) : glm::dvec3(readNumber(field));
+    for (int axis = 0; axis < 3; ++axis)
+        if (scale[axis] == 0.0) field.fail("must not be zero (it would flatten the mesh)");
+    return scale;
+}
+
+/// `rotate = { axis = [x, y, z], angle = degrees }`, right-handed about the axis.
+glm::dmat4 readRotation(const Field& field)
+{
+    const TableField table(field);
+    table.rejectUnknownKeys(rotateKeys);
+    const Field axisField = table.require("axis");
+    const std::optional<glm::dvec3> axis = normalized(readVector(axisField));
+    if (!axis) axisField.fail("must not be zero-length");
+    const double angle = readNumber(table.require("angle"));
+    return glm::rotate(glm::dmat4(1.0), glm::radians(angle), *axis);
+}
+
+/// `matrix`: four rows of four numbers, an invertible affine transform.
+glm::dmat4 readMatrix(const Field& field)
+{
+    const toml::array* rows = field.node().as_array();
+    if (!rows || rows->size() != 4)
+        field.fail("expected 4 rows of 4 numbers, got " +
+                   (rows ? std::to_string(rows->size()) + " row(s)" : describeType(field.node())));
+    glm::dmat4 m(1.0);
+    for (size_t r = 0; r < 4; ++r) {
+        const Field row = field.element(r, *rows->get(r));
+        const toml::array* values = row.node().as_array();
+        if (!values || values->size() != 4)
+            row.fail("expected a row of 4 numbers, got " +
+                     (values ? std::to_string(values->size()) + " element(s)" : describeType(row.node())));
+        for (size_t c = 0; c < 4; ++c) m[int(c)][int(r)] = readNumber(row.element(c, *values->get(c)));
+    }
+    if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+        field.fail("the last row must be [0, 0, 0, 1] (an affine transform)");
+    const double det = glm::determinant(glm::dmat3(m));
+    if (!(std::abs(det) > 0.0) || !std::isfinite(det)) field.fail("is singular (its 3x3 part has determinant 0)");
+    const glm::dmat4 inverse = glm::inverse(m);
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            if (!std::isfinite(inverse[c][r])) field.fail("cannot be inverted in double precision");
+    return m;
+}
+
+glm::dmat4 readObjectToWorld(const TableField& table)
+{
+    if (const auto matrix = table.find("matrix")) {
+        for (std::string_view key : {"scale", "rotate", "translate"})
+            if (const auto other = table.find(key))
+                other->fail("cannot be combined with matrix (line " + std::to_string(matrix->location().line) +
+                            "); give the whole transform as the matrix, or use scale, rotate and translate");
+        return readMatrix(*matrix);
+    }
+    const glm::dvec3 scale = readOr(table, "scale", glm::dvec3(1.0), readScale);
+    const glm::dmat4 rotation = readOr(table, "rotate", glm::dmat4(1.0), readRotation);
+    const glm::dvec3 translation = readOr(table, "translate", glm::dvec3(0.0), readVector);
+    return glm::translate(glm::dmat4(1.0), translation) * rotation * glm::scale(glm::dmat4(1.0), scale);
+}
+
+constexpr std::array<EnumName<NormalMode>, 3> normalModes{
+    {{"file", NormalMode::File}, {"smooth", NormalMode::Smooth}, {"face", NormalMode::Face}}};
+
+std::filesystem::path readMeshPath(const Field& field)
+{
+    const fs::path path = readPath(field);
+    const std::string extension = lowercase(path.extension().string());
+    const auto& supported = supportedMeshExtensions();
+    if (std::find(supported.begin(), supported.end(), extension) == supported.end()) {
+        std::vector<std::string_view> names(supported.begin(), supported.end());
+        field.fail("unsupported mesh file " + quote(path.string()) + " (supported: " + joinList(names) + ")");
+    }
+    checkRegularFile(field, path);
+    return path;
+}
+
+void readMesh(const TableField& table, uint32_t material, Scene& scene)
+{
+    Mesh mesh;
+    mesh.material = material;
+    mesh.where = table.field().location();
+    const Field fileField = table.require("file");
+    const fs::path file = readMeshPath(fileField);
+    const NormalMode normals = readOr(table, "normals", NormalMode::File, [](const Field& field) {
+        return readChoice(field, "normals mode", normalModes).value;
+    });
+    mesh.objectToWorld = readObjectToWorld(table);
+    mesh.emission = readOr(table, "emission", Color(0.0), readRadiance);
+    if (const auto twoSided = table.find("two_sided")) {
+        if (!table.find("emission")) twoSided->fail("only applies to an emissive mesh (one with `emission`)");
+        mesh.twoSided = readBool(*twoSided);
+    }
+    try {
+        VKRT_CHECK(t_meshCache != nullptr);
+        mesh.geometry = t_meshCache->get(file, normals);
+    } catch (const SceneError&) {
+        throw;
+    } catch (const InputError& error) {
+        fileField.fail(std::string("cannot load the mesh: ") + error.what());
+    }
+    scene.meshes.push_back(std::move(mesh));
+}
+
 struct ShapeReader {
     std::string_view name;
     Keys keys;
@@ -472,6 +591,12 @@ Scene readScene(const TableField& top)
 
 Scene parseSceneString(std::string_view text, const std::string& path)
 {
+    MeshGeometryCache meshes;
+    struct CacheInUse {
+        explicit CacheInUse(MeshGeometryCache* cache) : previous(t_meshCache) { t_meshCache = cache; }
+        ~CacheInUse() { t_meshCache = previous; }
+        MeshGeometryCache* previous;
+    } inUse(&meshes);
     const TomlSource source{path, fs::path(path).parent_path()};
     const toml::table root = parseToml(text, source);
     Scene scene = readScene(TableField(Field(source, root, "")));

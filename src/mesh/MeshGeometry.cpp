@@ -1,0 +1,78 @@
+#include "mesh/MeshGeometry.h"
+
+#include "mesh/MeshLoader.h"
+#include "shared/Bindings.h"
+#include "util/Error.h"
+
+#include <chrono>
+
+namespace vkrt {
+
+namespace {
+
+/// Puts the triangles (and what belongs to them) in the BVH's leaf order, so
+/// that a leaf's triangles are contiguous on the GPU.
+void reorderTriangles(MeshData& data, const std::vector<uint32_t>& order)
+{
+    std::vector<glm::uvec3> reordered(order.size());
+    for (size_t slot = 0; slot < order.size(); ++slot) reordered[slot] = data.triangles[order[slot]];
+    data.triangles = std::move(reordered);
+}
+
+Aabb boundsOf(const MeshData& data)
+{
+    Aabb box;
+    for (const glm::uvec3& t : data.triangles)
+        for (int k = 0; k < 3; ++k) box.extend(glm::dvec3(data.positions[t[k]]));
+    return box;
+}
+
+} // namespace
+
+size_t MeshGeometry::gpuBytes() const
+{
+    size_t bytes = bvh.nodes.size() * sizeof(gpu::BvhNode) + data.triangles.size() * sizeof(gpu::MeshTriangle);
+    if (!data.normals.empty()) bytes += data.triangles.size() * sizeof(gpu::MeshNormals);
+    return bytes;
+}
+
+std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode normals, std::filesystem::path name)
+{
+    auto geometry = std::make_shared<MeshGeometry>();
+    geometry->file = std::move(name);
+    geometry->normals = normals;
+    applyNormalMode(data, normals);
+    const std::vector<Aabb> boxes = triangleBoxes(data.positions, data.triangles);
+    geometry->bvh = buildBvh(boxes);
+    if (geometry->bvh.depth > gpu::BVH_STACK_SIZE)
+        throw InputError(geometry->file.string() + ": the mesh's BVH is " + std::to_string(geometry->bvh.depth) +
+                         " levels deep, more than the " + std::to_string(gpu::BVH_STACK_SIZE) +
+                         " the kernel's traversal stack holds");
+    reorderTriangles(data, geometry->bvh.order);
+    geometry->bounds = boundsOf(data);
+    geometry->data = std::move(data);
+    return geometry;
+}
+
+std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path& file, NormalMode normals)
+{
+    const auto start = std::chrono::steady_clock::now();
+    MeshData data = loadMeshFile(file);
+    const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    auto geometry = makeMeshGeometry(std::move(data), normals, file);
+    auto editable = std::const_pointer_cast<MeshGeometry>(geometry);
+    editable->loadSeconds = loadSeconds;
+    return geometry;
+}
+
+std::shared_ptr<const MeshGeometry> MeshGeometryCache::get(const std::filesystem::path& file, NormalMode normals)
+{
+    std::error_code error;
+    std::filesystem::path key = std::filesystem::weakly_canonical(file, error);
+    if (error) key = file;
+    auto& slot = m_loaded[{key, normals}];
+    if (!slot) slot = makeMeshGeometry(file, normals);
+    return slot;
+}
+
+} // namespace vkrt
