@@ -1,6 +1,7 @@
 // `vkrt info SCENE`: what the scene needs (its FeatureSet), the kernel
 // variant that was built for it, and how long it took to get a first frame.
 #include "app/Commands.h"
+#include "mesh/MeshGeometry.h"
 #include "render/RenderSession.h"
 
 #include <CLI/CLI.hpp>
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <set>
 
 namespace vkrt {
 
@@ -24,9 +26,41 @@ double secondsSince(std::chrono::steady_clock::time_point start)
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// Instances, geometries, triangles, BVH nodes, build times and GPU memory of the meshes.
+void printMeshes(const Scene& scene, const GpuSceneStatic& meshData, double parseSeconds)
+{
+    std::set<const MeshGeometry*> geometries;
+    double loadSeconds = 0, buildSeconds = 0;
+    uint64_t uniqueTriangles = 0;
+    uint32_t deepest = 0;
+    for (const Mesh& mesh : scene.meshes) {
+        if (!geometries.insert(mesh.geometry.get()).second) continue;
+        loadSeconds += mesh.geometry->loadSeconds;
+        buildSeconds += mesh.geometry->bvh.buildSeconds;
+        uniqueTriangles += mesh.geometry->data.triangles.size();
+        deepest = std::max(deepest, mesh.geometry->bvh.depth);
+    }
+    const size_t topNodes = meshData.top ? meshData.top->bvh.nodes.size() : 0;
+    const double bytes = double(meshData.meshNodes.size() * sizeof(gpu::BvhNode) +
+                                meshData.meshTriangles.size() * sizeof(gpu::MeshTriangle) +
+                                meshData.meshNormals.size() * sizeof(gpu::MeshNormals) +
+                                emissiveTriangleCount(scene) * sizeof(gpu::Emitter) + topNodes * sizeof(gpu::BvhNode));
+    std::printf("meshes:         %zu instances of %zu files; %llu triangles (%llu rendered), %llu emissive\n",
+                scene.meshes.size(), geometries.size(), static_cast<unsigned long long>(uniqueTriangles),
+                static_cast<unsigned long long>(meshTriangleCount(scene)),
+                static_cast<unsigned long long>(emissiveTriangleCount(scene)));
+    std::printf("bvh:            %zu mesh nodes (deepest %u levels), %zu top-level nodes over %zu records\n",
+                meshData.meshNodes.size(), deepest, topNodes, meshData.top ? meshData.top->refs.size() : 0);
+    std::printf("mesh times:     load %.3f s, BVH build %.3f s (+ top level %.4f s); whole parse %.3f s\n",
+                loadSeconds, buildSeconds, meshData.topBuildSeconds, parseSeconds);
+    std::printf("mesh memory:    %.1f MiB on the GPU\n", bytes / (1024.0 * 1024.0));
+}
+
 int runInfo(const InfoOptions& options)
 {
+    const auto parseStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(options.scenePath);
+    const double parseSeconds = secondsSince(parseStart);
     VulkanContext context({options.device, false});
     SessionConfig config;
     config.uber = options.uber;
@@ -58,6 +92,7 @@ int runInfo(const InfoOptions& options)
     std::printf("loop passes:    worst case %llu per invocation%s\n",
                 static_cast<unsigned long long>(worstCaseLoopIterations(scene)),
                 context.loopCap().capped() ? (" of " + std::to_string(*context.loopCap().budget)).c_str() : "");
+    if (!scene.meshes.empty()) printMeshes(scene, session.renderer().meshData(), parseSeconds);
     std::printf("device:         %s\n", context.deviceInfo().name.c_str());
     return kExitOk;
 }
