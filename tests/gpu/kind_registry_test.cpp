@@ -100,7 +100,19 @@ const std::map<std::string_view, std::string> kShapeExamples{
     {"box", "min = [0, 0, 0]\nmax = [1, 1, 1]\n"},
     {"triangle", "vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n"},
     {"plane", "point = [0, 0, 0]\nnormal = [0, 1, 0]\n"},
+    {"mesh", "file = "}, // + the path of a one-triangle OBJ (meshFileExample)
 };
+
+/// The `file` value of the mesh example: a one-triangle OBJ written once.
+std::string meshFileExample()
+{
+    static const std::filesystem::path file = [] {
+        const auto path = freshTempDir("kind-registry") / "triangle.obj";
+        writeText(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        return path;
+    }();
+    return "\"" + file.string() + "\"\n";
+}
 const std::map<std::string_view, std::string> kLightExamples{
     {"point", "position = [0, 3, 0]\nintensity = 1\n"},
     {"triangle", "vertices = [[0, 2, 0], [1, 2, 0], [0, 2, 1]]\nradiance = 1\n"},
@@ -123,6 +135,7 @@ TEST(KindRegistry, ParserAcceptsEveryShapeKind)
         ASSERT_NE(example, kShapeExamples.end()) << "add an example of the new shape " << kShapeNames[i];
         std::string text = std::string(kCamera) + "[materials.m]\ntype = \"lambert\"\n[[objects]]\nshape = \"" +
                            std::string(kShapeNames[i]) + "\"\nmaterial = \"m\"\n" + example->second;
+        if (kShapeNames[i] == "mesh") text += meshFileExample();
         Scene scene = sceneFromText(text);
         for (ShapeKind kind : kAllShapeKinds)
             EXPECT_EQ(scene.count(kind), kind == ShapeKind(i) ? 1u : 0u) << kShapeNames[i];

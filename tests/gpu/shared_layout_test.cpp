@@ -56,6 +56,32 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(planes, Plane, point),
         ARRAY_MEMBER(planes, Plane, material),
         ARRAY_MEMBER(planes, Plane, normal),
+        ARRAY_MEMBER(meshes, Mesh, toWorld0),
+        ARRAY_MEMBER(meshes, Mesh, toWorld2),
+        ARRAY_MEMBER(meshes, Mesh, toObject0),
+        ARRAY_MEMBER(meshes, Mesh, toObject2),
+        ARRAY_MEMBER(meshes, Mesh, material),
+        ARRAY_MEMBER(meshes, Mesh, root),
+        ARRAY_MEMBER(meshes, Mesh, firstTriangle),
+        ARRAY_MEMBER(meshes, Mesh, firstNormals),
+        ARRAY_MEMBER(meshes, Mesh, flags),
+        ARRAY_MEMBER(meshes, Mesh, firstEmitter),
+        ARRAY_MEMBER(meshNodes, BvhNode, lower),
+        ARRAY_MEMBER(meshNodes, BvhNode, first),
+        ARRAY_MEMBER(meshNodes, BvhNode, upper),
+        ARRAY_MEMBER(meshNodes, BvhNode, count),
+        ARRAY_MEMBER(meshTriangles, MeshTriangle, v0),
+        ARRAY_MEMBER(meshTriangles, MeshTriangle, v1),
+        ARRAY_MEMBER(meshTriangles, MeshTriangle, v2),
+        ARRAY_MEMBER(meshNormals, MeshNormals, n0),
+        ARRAY_MEMBER(meshNormals, MeshNormals, n2),
+        ARRAY_MEMBER(emitters, Emitter, v0),
+        ARRAY_MEMBER(emitters, Emitter, area),
+        ARRAY_MEMBER(emitters, Emitter, twoSided),
+        ARRAY_MEMBER(emitters, Emitter, pdf),
+        ARRAY_MEMBER(emitters, Emitter, radiance),
+        ARRAY_MEMBER(emitters, Emitter, aliasThreshold),
+        ARRAY_MEMBER(emitters, Emitter, alias),
         ARRAY_MEMBER(pointLights, PointLight, position),
         ARRAY_MEMBER(pointLights, PointLight, intensity),
         ARRAY_MEMBER(triangleLights, TriangleLight, v0),
@@ -81,6 +107,7 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, boxCount),
         BLOCK_MEMBER(u, SceneUniforms, triangleCount),
         BLOCK_MEMBER(u, SceneUniforms, planeCount),
+        BLOCK_MEMBER(u, SceneUniforms, meshCount),
         BLOCK_MEMBER(u, SceneUniforms, pointLightCount),
         BLOCK_MEMBER(u, SceneUniforms, triangleLightCount),
         BLOCK_MEMBER(u, SceneUniforms, tileCount),
@@ -88,6 +115,8 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, environmentSize),
         BLOCK_MEMBER(u, SceneUniforms, cameraMediumCount),
         BLOCK_MEMBER(u, SceneUniforms, cameraMedia),
+        BLOCK_MEMBER(u, SceneUniforms, emitterCount),
+        BLOCK_MEMBER(u, SceneUniforms, topNodeCount),
         BLOCK_MEMBER(frame, FrameConstants, firstFrame),
         BLOCK_MEMBER(frame, FrameConstants, seed),
     };
@@ -115,7 +144,9 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
     EXPECT_EQ(offsets.at("materials[0].fresnel") + 4, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].radiance") + 12, int(sizeof(gpu::TriangleLight)));
-    EXPECT_EQ(offsets.at("u.cameraMedia") + 16, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("u.topNodeCount") + 8, int(sizeof(gpu::SceneUniforms))); // + pad0
+    EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));
+    EXPECT_EQ(offsets.at("emitters[0].alias") + 4, int(sizeof(gpu::Emitter)));
 }
 
 } // namespace
