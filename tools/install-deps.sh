@@ -24,6 +24,10 @@ packages=(
   # glslang-tools because glslang-dev's CMake package refers to glslangValidator
   # and find_package fails without it (it is only a Recommends, not installed here)
   glslang-dev glslang-tools libglm-dev libglfw3-dev libopenexr-dev libtomlplusplus-dev libcli11-dev libstb-dev libboost-dev libgtest-dev
+  # mesh files: OBJ, PLY and glTF through one API
+  libassimp-dev
+  # tools/fuzz.sh: libFuzzer needs clang (clang++-14) and its runtime
+  clang-14 libclang-rt-14-dev
   # a real X display for the viewer's tests
   xvfb xauth
 )
@@ -31,6 +35,7 @@ backports_source=/etc/apt/sources.list.d/vkrt-bookworm-backports.sources
 
 codename=$( (. /etc/os-release && echo "${VERSION_CODENAME:-}") 2>/dev/null || true)
 
+# Empty (and status 0, so `set -e` assignments survive) for a package dpkg has never seen.
 installed_version() { dpkg-query -W -f='${Status} ${Version}' "$1" 2>/dev/null | sed -n 's/^install ok installed //p' || true; }
 
 # The URI of the Debian mirror this machine already uses for `bookworm`

@@ -1,0 +1,396 @@
+#include "mesh/MeshLoader.h"
+
+#include "util/Error.h"
+#include "util/Hash.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+#include <unordered_map>
+
+namespace fs = std::filesystem;
+
+namespace vkrt {
+namespace {
+
+// ---------------------------------------------------------------------------
+// Messages: every error starts with the file (and the line where known).
+
+[[noreturn]] void fail(const fs::path& file, const std::string& message, int line = 0)
+{
+    throw InputError(file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
+}
+
+std::string lowerExtension(const fs::path& file)
+{
+    std::string extension = file.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
+
+std::string formatName(const std::string& extension)
+{
+    if (extension == ".obj") return "OBJ";
+    if (extension == ".ply") return "PLY";
+    return "glTF";
+}
+
+std::string describe(const glm::vec3& v)
+{
+    std::ostringstream text;
+    text << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+    return text.str();
+}
+
+std::string readText(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// ---------------------------------------------------------------------------
+// OBJ line finding. Assimp's OBJ errors carry no line number and its output
+// has one vertex per face corner, so the file's own vertex number is lost.
+// These scans only locate a problem assimp (or our validation) already found;
+// they never decide what the mesh is.
+
+/// Calls visit(lineNumber, keyword, rest) for each line; stops when it returns true.
+template <typename Visit> std::optional<int> findObjLine(std::string_view text, Visit visit)
+{
+    int lineNumber = 0;
+    while (!text.empty()) {
+        const size_t end = std::min(text.find('\n'), text.size());
+        std::string_view line = text.substr(0, end);
+        text.remove_prefix(std::min(end + 1, text.size()));
+        ++lineNumber;
+        const size_t start = line.find_first_not_of(" \t");
+        if (start == std::string_view::npos) continue;
+        line.remove_prefix(start);
+        const size_t keywordEnd = std::min(line.find_first_of(" \t\r"), line.size());
+        if (visit(lineNumber, line.substr(0, keywordEnd), line.substr(keywordEnd))) return lineNumber;
+    }
+    return std::nullopt;
+}
+
+std::vector<std::string> tokens(std::string_view rest)
+{
+    std::vector<std::string> result;
+    std::istringstream in{std::string(rest)};
+    for (std::string token; in >> token;) result.push_back(token);
+    return result;
+}
+
+/// The line of the first `v` line with a NaN or infinite coordinate, and that vertex's 1-based number.
+std::optional<std::pair<int, int>> findObjNonFiniteVertex(std::string_view text)
+{
+    int vertexNumber = 0;
+    const std::optional<int> line = findObjLine(text, [&](int, std::string_view keyword, std::string_view rest) {
+        if (keyword != "v") return false;
+        ++vertexNumber;
+        const std::vector<std::string> coordinates = tokens(rest);
+        for (size_t i = 0; i < coordinates.size() && i < 3; ++i) {
+            if (!std::isfinite(std::strtod(coordinates[i].c_str(), nullptr))) return true;
+        }
+        return false;
+    });
+    if (!line) return std::nullopt;
+    return std::make_pair(*line, vertexNumber);
+}
+
+/// The first f/l/p line with an index of 0 or beyond the file's v/vt/vn lines (negative: relative to those so far).
+std::optional<int> findObjBadIndex(std::string_view text)
+{
+    std::array<long, 3> totals{}; // v, vt, vn
+    findObjLine(text, [&](int, std::string_view keyword, std::string_view) {
+        if (keyword == "v") ++totals[0];
+        if (keyword == "vt") ++totals[1];
+        if (keyword == "vn") ++totals[2];
+        return false;
+    });
+    std::array<long, 3> sofar{};
+    auto badCorner = [&](const std::string& corner) {
+        size_t start = 0;
+        for (size_t kind = 0; kind < 3 && start <= corner.size(); ++kind) {
+            const size_t end = std::min(corner.find('/', start), corner.size());
+            long index = 0;
+            const auto [rest, error] = std::from_chars(corner.data() + start, corner.data() + end, index);
+            if (end > start && (error != std::errc() || rest != corner.data() + end)) return true; // not a number
+            if (end > start && (index == 0 || index > totals[kind] || index < -sofar[kind])) return true;
+            start = end + 1;
+        }
+        return false;
+    };
+    return findObjLine(text, [&](int, std::string_view keyword, std::string_view rest) {
+        if (keyword == "v") ++sofar[0];
+        if (keyword == "vt") ++sofar[1];
+        if (keyword == "vn") ++sofar[2];
+        if (keyword != "f" && keyword != "l" && keyword != "p") return false;
+        const std::vector<std::string> corners = tokens(rest);
+        return std::any_of(corners.begin(), corners.end(), badCorner);
+    });
+}
+
+// ---------------------------------------------------------------------------
+// Before assimp: clear messages for what is not a mesh file at all.
+
+void checkIsMeshFile(const fs::path& file)
+{
+    std::error_code error;
+    const fs::file_status status = fs::status(file, error);
+    if (!fs::exists(status)) fail(file, "no such file");
+    if (fs::is_directory(status)) fail(file, "is a directory, not a mesh file");
+    if (!fs::is_regular_file(status)) fail(file, "is not a regular file");
+    const std::string extension = lowerExtension(file);
+    const std::vector<std::string>& supported = supportedMeshExtensions();
+    if (std::find(supported.begin(), supported.end(), extension) == supported.end()) {
+        std::string list;
+        for (const std::string& each : supported) list += (list.empty() ? "" : ", ") + each;
+        fail(file, "unsupported mesh file extension '" + extension + "' (supported: " + list + ")");
+    }
+    if (fs::file_size(file, error) == 0 && !error) fail(file, "empty file");
+}
+
+/// Assimp up to at least 5.4 keeps one triangle per `tristrips` element
+/// (assimp issue #2337): refuse such files rather than render a wrong mesh.
+void rejectPlyTriangleStrips(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    std::string header(4096, '\0');
+    in.read(header.data(), static_cast<std::streamsize>(header.size()));
+    header.resize(static_cast<size_t>(in.gcount()));
+    header = header.substr(0, header.find("end_header"));
+    std::istringstream lines(header);
+    for (std::string line; std::getline(lines, line);) {
+        const std::vector<std::string> words = tokens(line);
+        if (words.size() >= 2 && words[0] == "element" && words[1] == "tristrips") {
+            fail(file, "PLY triangle strips (element 'tristrips') are not supported: the Open Asset Import Library "
+                       "loads only one triangle of each strip; convert the strips to faces (e.g. with MeshLab)");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Assimp import.
+
+constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure // first: out-of-range indices, broken buffers
+                                  | aiProcess_Triangulate          // polygons -> triangles
+                                  | aiProcess_SortByPType          // one primitive type per mesh
+                                  | aiProcess_PreTransformVertices; // glTF node transforms, one flat list
+
+[[noreturn]] void failImport(const fs::path& file, const std::string& extension, const std::string& reason)
+{
+    std::optional<int> line;
+    if (extension == ".obj" && reason.find("index") != std::string::npos) line = findObjBadIndex(readText(file));
+    fail(file, "cannot read the " + formatName(extension) + " file: " + reason, line.value_or(0));
+}
+
+const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, const std::string& extension)
+{
+    // Points and lines are dropped by SortByPType; an all-lines file then has no meshes, reported below.
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const aiScene* scene = nullptr;
+    try {
+        // No logger is ever created, so assimp writes nothing to stdout/stderr (its default is a null logger).
+        scene = importer.ReadFile(file.string(), kImportSteps);
+    } catch (const std::exception& error) {
+        failImport(file, extension, error.what());
+    }
+    if (scene) return scene;
+    const std::string reason = importer.GetErrorString();
+    if (reason.find("No meshes remaining") != std::string::npos ||
+        reason.find("mNumMeshes is 0") != std::string::npos) {
+        fail(file, "no triangles in " + file.string() + " (only points or lines, or not a " + formatName(extension) +
+                       " file at all)");
+    }
+    failImport(file, extension, reason);
+}
+
+// ---------------------------------------------------------------------------
+// aiScene -> MeshData, checking every value.
+
+struct MeshCheck {
+    const fs::path& file;
+    std::string extension;
+    size_t meshCount = 0;
+
+    std::string where(size_t mesh, size_t vertex) const
+    {
+        return (meshCount > 1 ? "mesh " + std::to_string(mesh) + ", " : "") + "vertex " + std::to_string(vertex) +
+               " (counting from 0)";
+    }
+
+    [[noreturn]] void nonFinitePosition(size_t mesh, size_t vertex, const glm::vec3& value) const
+    {
+        if (extension == ".obj") {
+            if (const auto found = findObjNonFiniteVertex(readText(file))) {
+                fail(file, "vertex " + std::to_string(found->second) + " has a non-finite coordinate", found->first);
+            }
+        }
+        fail(file, where(mesh, vertex) + " has a non-finite coordinate " + describe(value));
+    }
+};
+
+glm::vec3 toGlm(const aiVector3D& v) { return {v.x, v.y, v.z}; }
+
+bool allFinite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::vector<const aiMesh*> triangleMeshes(const aiScene& scene)
+{
+    std::vector<const aiMesh*> meshes;
+    for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
+        const aiMesh* mesh = scene.mMeshes[i];
+        if (mesh && (mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) && mesh->mNumFaces > 0) meshes.push_back(mesh);
+    }
+    return meshes;
+}
+
+/// A file normal made unit length; zero-length ones become (0, 0, 0), "use the face normal".
+glm::vec3 unitNormal(const MeshCheck& check, size_t mesh, size_t vertex, const aiVector3D& normal)
+{
+    const glm::vec3 n = toGlm(normal);
+    if (!allFinite(n)) fail(check.file, check.where(mesh, vertex) + " has a non-finite normal " + describe(n));
+    const float length = glm::length(n);
+    return length > 0.0f && std::isfinite(length) ? n / length : glm::vec3(0.0f);
+}
+
+void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const MeshCheck& check, bool normals,
+                    bool uvs)
+{
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+        const glm::vec3 position = toGlm(mesh.mVertices[v]);
+        if (!allFinite(position)) check.nonFinitePosition(meshIndex, v, position);
+        out.positions.push_back(position);
+        if (normals) out.normals.push_back(unitNormal(check, meshIndex, v, mesh.mNormals[v]));
+        if (uvs) {
+            const glm::vec2 uv(mesh.mTextureCoords[0][v].x, mesh.mTextureCoords[0][v].y);
+            if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
+                fail(check.file, check.where(meshIndex, v) + " has a non-finite texture coordinate");
+            }
+            out.uvs.push_back(uv);
+        }
+    }
+}
+
+void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const MeshCheck& check)
+{
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+        const aiFace& face = mesh.mFaces[f];
+        if (face.mNumIndices != 3) continue; // points/lines left in a mixed mesh
+        glm::uvec3 triangle;
+        for (int corner = 0; corner < 3; ++corner) {
+            if (face.mIndices[corner] >= mesh.mNumVertices) {
+                fail(check.file, "triangle " + std::to_string(f) + " uses vertex " +
+                                     std::to_string(face.mIndices[corner]) + " of only " +
+                                     std::to_string(mesh.mNumVertices));
+            }
+            triangle[corner] = base + face.mIndices[corner];
+        }
+        out.triangles.push_back(triangle);
+    }
+}
+
+MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
+{
+    const std::vector<const aiMesh*> meshes = triangleMeshes(scene);
+    MeshCheck check = baseCheck;
+    check.meshCount = meshes.size();
+    // Attributes only where every sub-mesh has them: a partial set would need a per-vertex "absent" marker.
+    const bool normals = std::all_of(meshes.begin(), meshes.end(), [](const aiMesh* m) { return m->HasNormals(); });
+    const bool uvs = std::all_of(meshes.begin(), meshes.end(), [](const aiMesh* m) { return m->HasTextureCoords(0); });
+    MeshData out;
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        if (out.positions.size() + meshes[i]->mNumVertices > std::numeric_limits<uint32_t>::max()) {
+            fail(check.file, "more than 2^32 vertices");
+        }
+        const auto base = static_cast<uint32_t>(out.positions.size());
+        appendVertices(out, *meshes[i], i, check, normals, uvs);
+        appendTriangles(out, *meshes[i], base, check);
+    }
+    if (out.triangles.empty()) fail(check.file, "no triangles in " + check.file.string());
+    return out;
+}
+
+// ---------------------------------------------------------------------------
+// OBJ: assimp gives each face corner its own vertex. Joining corners whose
+// position, normal and uv are bit-for-bit equal restores the file's
+// v/vt/vn sharing, so that smooth normals (shared by index) are smooth.
+
+struct CornerKey {
+    std::array<uint32_t, 8> bits{};
+    bool operator==(const CornerKey&) const = default;
+};
+
+struct CornerKeyHash {
+    size_t operator()(const CornerKey& key) const
+    {
+        return Fnv1a64().add({reinterpret_cast<const char*>(key.bits.data()), sizeof key.bits}).value();
+    }
+};
+
+CornerKey cornerKey(const MeshData& mesh, uint32_t vertex)
+{
+    std::array<float, 8> values{};
+    std::memcpy(values.data(), &mesh.positions[vertex], sizeof(glm::vec3));
+    if (!mesh.normals.empty()) std::memcpy(values.data() + 3, &mesh.normals[vertex], sizeof(glm::vec3));
+    if (!mesh.uvs.empty()) std::memcpy(values.data() + 6, &mesh.uvs[vertex], sizeof(glm::vec2));
+    CornerKey key;
+    std::memcpy(key.bits.data(), values.data(), sizeof values);
+    return key;
+}
+
+void joinIdenticalCorners(MeshData& mesh)
+{
+    std::unordered_map<CornerKey, uint32_t, CornerKeyHash> firstUse;
+    std::vector<uint32_t> remap(mesh.positions.size());
+    MeshData joined;
+    for (uint32_t vertex = 0; vertex < mesh.positions.size(); ++vertex) {
+        const auto [entry, inserted] = firstUse.try_emplace(cornerKey(mesh, vertex), joined.positions.size());
+        remap[vertex] = entry->second;
+        if (!inserted) continue;
+        joined.positions.push_back(mesh.positions[vertex]);
+        if (!mesh.normals.empty()) joined.normals.push_back(mesh.normals[vertex]);
+        if (!mesh.uvs.empty()) joined.uvs.push_back(mesh.uvs[vertex]);
+    }
+    joined.triangles = std::move(mesh.triangles);
+    for (glm::uvec3& triangle : joined.triangles) triangle = {remap[triangle.x], remap[triangle.y], remap[triangle.z]};
+    mesh = std::move(joined);
+}
+
+} // namespace
+
+const std::vector<std::string>& supportedMeshExtensions()
+{
+    static const std::vector<std::string> extensions{".obj", ".ply", ".gltf", ".glb"};
+    return extensions;
+}
+
+MeshData loadMeshFile(const fs::path& file)
+{
+    checkIsMeshFile(file);
+    const std::string extension = lowerExtension(file);
+    if (extension == ".ply") rejectPlyTriangleStrips(file);
+    Assimp::Importer importer;
+    const aiScene* scene = importScene(importer, file, extension);
+    MeshData mesh = convertScene(*scene, MeshCheck{file, extension});
+    if (extension == ".obj") joinIdenticalCorners(mesh);
+    return mesh;
+}
+
+} // namespace vkrt
