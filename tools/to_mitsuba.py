@@ -33,6 +33,13 @@ The conversion follows the semantics of vkrt's path integrator
 * sphere -> `sphere`; box -> `cube` with a scale+translate to_world; triangle ->
   a one-triangle PLY mesh; infinite plane -> a large `rectangle` (an
   approximation: see --plane-half-size).
+* mesh (OBJ, PLY) -> `obj` / `ply` reading the same file, to_world = the
+  object's matrix (or T * R * S); normals = "face", or "file" for a file
+  without vertex normals -> face_normals = true (Mitsuba would compute smooth
+  normals where vkrt uses face normals); normals = "smooth" -> a PLY written
+  with vkrt's area-weighted vertex normals (Mitsuba's own are angle-weighted);
+  emission -> an `area` emitter on the mesh, which keeps its material. glTF
+  (Mitsuba has no loader) and two-sided emissive meshes are refused.
 
 What has no Mitsuba equivalent (phong, glossy, Schlick Fresnel, the Whitted
 integrator) is refused with an error naming the scene file, table and key.
@@ -370,6 +377,288 @@ def _matrix_transform(mi, m):
 
 
 # ----------------------------------------------------------------------------
+# Mesh files (shape = "mesh")
+# ----------------------------------------------------------------------------
+
+MESH_KEYS = ["shape", "material", "file", "scale", "rotate", "translate", "matrix", "normals", "emission",
+             "two_sided"]
+NORMAL_MODES = ("file", "smooth", "face")
+MESH_EXTENSIONS = (".obj", ".ply", ".gltf", ".glb")
+
+
+class _MeshFileError(Exception):
+    """A mesh file this converter cannot read; the caller adds the scene context."""
+
+
+class _MeshFile:
+    """What the converter needs of a mesh file: object-space positions (float64,
+    N x 3), triangles (M x 3 vertex indices, polygons fanned from their first
+    corner as Mitsuba's and assimp's loaders do) and whether the file gives
+    every triangle corner a vertex normal."""
+
+    def __init__(self, positions, triangles, has_normals: bool):
+        self.positions = positions
+        self.triangles = triangles
+        self.has_normals = has_normals
+
+
+def _fan(polygon):
+    return [(polygon[0], polygon[k], polygon[k + 1]) for k in range(1, len(polygon) - 1)]
+
+
+def _read_obj(path: Path) -> _MeshFile:
+    import numpy as np
+
+    positions, triangles = [], []
+    corners = with_normal = 0
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line_no, line in enumerate(f, 1):
+            parts = line.split()
+            if not parts:
+                continue
+            if parts[0] == "v":
+                try:
+                    positions.append([float(x) for x in parts[1:4]])
+                except ValueError as e:
+                    raise _MeshFileError(f"{path}:{line_no}: bad vertex: {e}") from e
+                if len(positions[-1]) != 3:
+                    raise _MeshFileError(f"{path}:{line_no}: a vertex needs three coordinates")
+            elif parts[0] == "f":
+                polygon = []
+                for corner in parts[1:]:
+                    fields = corner.split("/")
+                    try:
+                        index = int(fields[0])
+                    except ValueError as e:
+                        raise _MeshFileError(f"{path}:{line_no}: bad face corner '{corner}'") from e
+                    index = index - 1 if index > 0 else len(positions) + index
+                    if not 0 <= index < len(positions):
+                        raise _MeshFileError(f"{path}:{line_no}: vertex index {fields[0]} out of range")
+                    polygon.append(index)
+                    corners += 1
+                    with_normal += len(fields) >= 3 and fields[2] != ""
+                triangles += _fan(polygon)
+    if with_normal not in (0, corners):
+        # assimp and Mitsuba fill the missing normals differently.
+        raise _MeshFileError(f"{path}: only {with_normal} of {corners} face corners have a normal index "
+                             "(give all or none normals)")
+    return _MeshFile(np.array(positions, float).reshape(-1, 3), np.array(triangles, np.int64).reshape(-1, 3),
+                     corners > 0 and with_normal == corners)
+
+
+_PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
+              "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+              "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
+
+
+def _read_ply_header(f, path: Path):
+    if f.readline().strip() != b"ply":
+        raise _MeshFileError(f"{path}: not a PLY file (no 'ply' magic)")
+    fmt, elements = None, []
+    while True:
+        line = f.readline()
+        if not line:
+            raise _MeshFileError(f"{path}: PLY header has no end_header")
+        parts = line.decode("ascii", "replace").split()
+        if not parts or parts[0] in ("comment", "obj_info"):
+            continue
+        if parts[0] == "end_header":
+            return fmt, elements
+        if parts[0] == "format":
+            fmt = parts[1]
+        elif parts[0] == "element":
+            elements.append((parts[1], int(parts[2]), []))
+        elif parts[0] == "property" and elements:
+            if parts[1] == "list":
+                elements[-1][2].append((parts[4], _PLY_TYPES[parts[2]], _PLY_TYPES[parts[3]]))
+            else:
+                elements[-1][2].append((parts[2], None, _PLY_TYPES[parts[1]]))
+
+
+def _read_ply(path: Path) -> _MeshFile:
+    """ASCII and binary PLY (either byte order): vertex x, y, z (nx, ny, nz) and
+    face vertex_indices (or vertex_index) lists."""
+    import numpy as np
+
+    with open(path, "rb") as f:
+        try:
+            fmt, elements = _read_ply_header(f, path)
+        except (KeyError, IndexError, ValueError) as e:
+            raise _MeshFileError(f"{path}: bad PLY header ({e})") from e
+        if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
+            raise _MeshFileError(f"{path}: unknown PLY format '{fmt}'")
+        body = f.read()
+    order = "<" if fmt == "binary_little_endian" else ">"
+    tokens = body.split() if fmt == "ascii" else None
+    pos = 0
+    data = {}
+    for name, count, props in elements:
+        scalar_only = all(lt is None for _, lt, _ in props)
+        if tokens is not None:
+            rows = []
+            for _ in range(count):
+                row = {}
+                for pname, lt, vt in props:
+                    if lt is None:
+                        row[pname] = float(tokens[pos])
+                        pos += 1
+                    else:
+                        n = int(tokens[pos])
+                        row[pname] = [int(t) for t in tokens[pos + 1:pos + 1 + n]]
+                        pos += 1 + n
+                rows.append(row)
+            data[name] = rows
+        elif scalar_only:
+            dtype = np.dtype([(p, order + vt) for p, _, vt in props])
+            data[name] = np.frombuffer(body, dtype, count, pos)
+            pos += dtype.itemsize * count
+        else:
+            data[name] = rows = []
+            for _ in range(count):
+                row = {}
+                for pname, lt, vt in props:
+                    if lt is None:
+                        row[pname] = np.frombuffer(body, order + vt, 1, pos)[0]
+                        pos += np.dtype(vt).itemsize
+                    else:
+                        n = int(np.frombuffer(body, order + lt, 1, pos)[0])
+                        pos += np.dtype(lt).itemsize
+                        row[pname] = np.frombuffer(body, order + vt, n, pos).tolist()
+                        pos += np.dtype(vt).itemsize * n
+                rows.append(row)
+    vertices = data.get("vertex")
+    if vertices is None or len(vertices) == 0:
+        raise _MeshFileError(f"{path}: no vertex element")
+    if isinstance(vertices, list):
+        positions = np.array([[v["x"], v["y"], v["z"]] for v in vertices], float)
+    else:
+        positions = np.stack([vertices[k].astype(float) for k in "xyz"], -1)
+    vertex_props = [p for p, _, _ in next(e for e in elements if e[0] == "vertex")[2]]
+    triangles = []
+    for face in data.get("face", []):
+        polygon = face.get("vertex_indices", face.get("vertex_index"))
+        if polygon is None:
+            raise _MeshFileError(f"{path}: face element without vertex_indices")
+        triangles += _fan(list(polygon))
+    triangles = np.array(triangles, np.int64).reshape(-1, 3)
+    if triangles.size and (triangles.min() < 0 or triangles.max() >= len(positions)):
+        raise _MeshFileError(f"{path}: vertex index out of range")
+    return _MeshFile(positions, triangles, all(k in vertex_props for k in ("nx", "ny", "nz")))
+
+
+def read_mesh_file(path: Path) -> _MeshFile:
+    """The geometry of an OBJ or PLY file (glTF is not read: see convert())."""
+    try:
+        mesh = _read_obj(path) if path.suffix.lower() == ".obj" else _read_ply(path)
+    except (OSError, ValueError, IndexError, KeyError) as e:
+        raise _MeshFileError(f"{path}: cannot read: {e}") from e
+    if len(mesh.triangles) == 0:
+        raise _MeshFileError(f"{path}: no triangles")
+    import numpy as np
+
+    if not np.all(np.isfinite(mesh.positions)):
+        raise _MeshFileError(f"{path}: a vertex coordinate is NaN or infinite")
+    return mesh
+
+
+def area_weighted_normals(positions, triangles):
+    """vkrt's normals = "smooth" (computeSmoothNormals in MeshData.h): each vertex
+    gets the normalised sum of its triangles' cross(v1 - v0, v2 - v0), i.e. of
+    their unit normals weighted by area. Vertices are shared by index only.
+    A vertex whose triangles are all degenerate gets (0, 0, 0).
+    (Mitsuba's own recomputed normals weight by corner angle instead.)"""
+    import numpy as np
+
+    p = positions[triangles]
+    face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normals = np.zeros_like(positions)
+    for corner in range(3):
+        np.add.at(normals, triangles[:, corner], face)
+    length = np.linalg.norm(normals, axis=1, keepdims=True)
+    return np.where(length > 0, normals / np.maximum(length, 1e-300), 0.0)
+
+
+def write_ply_with_normals(path: Path, positions, normals, triangles) -> None:
+    """Binary little-endian PLY with float32 positions and vertex normals."""
+    import numpy as np
+
+    header = ("ply\nformat binary_little_endian 1.0\ncomment written by vkrt tools/to_mitsuba.py\n"
+              f"element vertex {len(positions)}\n"
+              + "".join(f"property float {k}\n" for k in ("x", "y", "z", "nx", "ny", "nz"))
+              + f"element face {len(triangles)}\nproperty list uchar int vertex_indices\nend_header\n")
+    vertex = np.concatenate([positions, normals], 1).astype("<f4")
+    faces = np.zeros(len(triangles), dtype=[("n", "u1"), ("i", "<i4", 3)])
+    faces["n"] = 3
+    faces["i"] = triangles
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(vertex.tobytes())
+        f.write(faces.tobytes())
+
+
+def _rotation_matrix(axis, degrees):
+    """Right-handed rotation by `degrees` about `axis` (Rodrigues' formula)."""
+    n = _norm(axis)
+    x, y, z = (a / n for a in axis)
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    k = 1 - c
+    return [[c + x * x * k, x * y * k - z * s, x * z * k + y * s],
+            [y * x * k + z * s, c + y * y * k, y * z * k - x * s],
+            [z * x * k - y * s, z * y * k + x * s, c + z * z * k]]
+
+
+def _matmul4(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def _det3(m):
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def mesh_transform(r: _Reader, o: dict, where: str):
+    """The object's 4 x 4 object-to-world matrix: `matrix`, or T * R * S."""
+    if "matrix" in o:
+        for key in ("scale", "rotate", "translate"):
+            if key in o:
+                r.fail(f"{where}.{key}", "cannot be combined with matrix (matrix gives the whole transform)")
+        rows = o["matrix"]
+        if not isinstance(rows, list) or len(rows) != 4:
+            r.fail(f"{where}.matrix", f"expected 4 rows of 4 numbers, got {rows!r}")
+        m = []
+        for i, row in enumerate(rows):
+            if not isinstance(row, list) or len(row) != 4:
+                r.fail(f"{where}.matrix[{i}]", f"expected a row of 4 numbers, got {row!r}")
+            for j, x in enumerate(row):
+                if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                    r.fail(f"{where}.matrix[{i}][{j}]", f"expected a finite number, got {x!r}")
+            m.append([float(x) for x in row])
+        if m[3] != [0.0, 0.0, 0.0, 1.0]:
+            r.fail(f"{where}.matrix[3]", f"the last row must be [0, 0, 0, 1] (an affine transform), got {m[3]}")
+        if _det3(m) == 0:
+            r.fail(f"{where}.matrix", "is singular (it flattens the mesh)")
+        return m
+    s = [1.0, 1.0, 1.0]
+    if "scale" in o:
+        v = o["scale"]
+        uniform = isinstance(v, (int, float)) and not isinstance(v, bool)
+        s = [r.number(o, "scale", where)] * 3 if uniform else r.vector(o, "scale", where)
+        if any(x == 0 for x in s):
+            r.fail(f"{where}.scale", f"every component must be non-zero, got {s}")
+    rot = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    if "rotate" in o:
+        rw = f"{where}.rotate"
+        rt = r.table(o["rotate"], rw)
+        r.check_keys(rt, rw, ["axis", "angle"])
+        axis = r.vector(rt, "axis", rw)
+        if _norm(axis) == 0:
+            r.fail(f"{rw}.axis", "must be non-zero")
+        rot = _rotation_matrix(axis, r.number(rt, "angle", rw))
+    t = r.vector(o, "translate", where, [0, 0, 0])
+    return [[rot[i][j] * s[j] for j in range(3)] + [t[i]] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
+
+
+# ----------------------------------------------------------------------------
 # Conversion
 # ----------------------------------------------------------------------------
 
@@ -537,6 +826,59 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         mesh_count += 1
         return {"type": "ply", "filename": str(file.resolve()), "face_normals": True}
 
+    def mesh_object(o, where):
+        """A `shape = "mesh"` object as an obj/ply shape (material and medium are added by the caller)."""
+        import numpy as np
+
+        r.check_keys(o, where, MESH_KEYS)
+        file = Path(r.string(o, "file", where))
+        if not file.is_absolute():
+            file = path.parent / file
+        suffix = file.suffix.lower()
+        if suffix not in MESH_EXTENSIONS:
+            r.fail(f"{where}.file", f"'{file}': expected a .obj, .ply, .gltf or .glb file")
+        if not file.is_file():
+            r.fail(f"{where}.file", f"'{file}' does not exist or is not a regular file")
+        if suffix in (".gltf", ".glb"):
+            r.fail(f"{where}.file", f"'{file}': Mitsuba 3 has no glTF loader and this converter does not "
+                                    "translate glTF; export the mesh as OBJ or PLY for a Mitsuba reference")
+        normals = r.string(o, "normals", where, "file")
+        if normals not in NORMAL_MODES:
+            r.fail(f"{where}.normals", f"unknown normals mode '{normals}' (expected file, smooth or face)")
+        m4 = mesh_transform(r, o, where)
+        emission = r.color(o, "emission", where, 0.0, 0.0) if "emission" in o else None
+        two_sided = r.boolean(o, "two_sided", where, False)
+        if two_sided and emission is None:
+            r.fail(f"{where}.two_sided", "only applies to an emissive mesh (set emission too)")
+        if two_sided:
+            r.fail(f"{where}.two_sided", "a two-sided emissive mesh has no Mitsuba equivalent (its area "
+                                         "emitter emits on the front side only); use two_sided = false")
+        try:
+            geometry = read_mesh_file(file)
+        except _MeshFileError as e:
+            r.fail(f"{where}.file", str(e))
+        shape_dict = {"type": suffix[1:], "filename": str(file.resolve())}
+        if normals == "smooth":
+            # Mitsuba's recomputed vertex normals are angle-weighted and it
+            # prefers the file's own; vkrt's are area-weighted from the
+            # triangles alone: write them into a PLY of our own.
+            smooth = files_dir / f"{where.replace('[', '').replace(']', '')}_smooth.ply"
+            write_ply_with_normals(smooth, geometry.positions,
+                                   area_weighted_normals(geometry.positions, geometry.triangles),
+                                   geometry.triangles)
+            shape_dict = {"type": "ply", "filename": str(smooth.resolve())}
+        elif normals == "face" or not geometry.has_normals:
+            # vkrt: no file normals means face normals; Mitsuba would compute smooth ones.
+            shape_dict["face_normals"] = True
+        shape_dict["to_world"] = _matrix_transform(mi, m4)
+        if emission is not None and any(c > 0 for c in emission):
+            shape_dict["emitter"] = {"type": "area", "radiance": _rgb(emission)}
+            if not shape_dict.get("face_normals"):
+                _note(f"{path}: {where}: Mitsuba's area emitter picks its emitting side by the shading "
+                      "normal, vkrt by the winding; they agree where the two normals are on the same side")
+        world = geometry.positions @ np.array(m4)[:3, :3].T + np.array(m4)[:3, 3]
+        return shape_dict, [world.min(0).tolist(), world.max(0).tolist()]
+
     plane_count = 0
     for i, o in enumerate(objects):
         where = f"objects[{i}]"
@@ -570,6 +912,9 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 continue
             shape_dict = mesh([v], f"object{i}")
             extent_points += v
+        elif shape == "mesh":
+            shape_dict, points = mesh_object(o, where)
+            extent_points += points
         elif shape == "plane":
             r.check_keys(o, where, ["shape", "material", "point", "normal"])
             p = r.vector(o, "point", where)
@@ -591,7 +936,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
             extent_points += [[p[k] + s * hs * (t[k] + bt[k]) for k in range(3)] for s in (-1, 1)]
             plane_count += 1
         else:
-            r.fail(f"{where}.shape", f"unknown shape '{shape}' (expected sphere, box, triangle or plane)")
+            r.fail(f"{where}.shape", f"unknown shape '{shape}' (expected sphere, box, triangle, plane or mesh)")
         shape_dict["bsdf"] = ref(bsdf_ids[mat])
         if mat in media_ids:
             shape_dict["interior"] = ref(media_ids[mat])
@@ -697,7 +1042,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
 
 _PLUGIN_TAGS = {
     "twosided": "bsdf", "diffuse": "bsdf", "conductor": "bsdf", "dielectric": "bsdf",
-    "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape",
+    "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape", "obj": "shape",
     "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter",
     "homogeneous": "medium", "perspective": "sensor", "hdrfilm": "film", "independent": "sampler",
     "box": "rfilter", "path": "integrator", "volpath": "integrator",

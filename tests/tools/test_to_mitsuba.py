@@ -12,7 +12,9 @@ them with closed forms (a few seconds each).
 """
 from __future__ import annotations
 
+import atexit
 import math
+import shutil
 import sys
 import tempfile
 import textwrap
@@ -113,6 +115,228 @@ def test_refuses_whitted():
 
 def test_refuses_unknown_keys():
     _refusal('type = "lambert"\nalbedo = 0.5\nshininess = 3', 'materials."odd one".shininess')
+
+
+# ----------------------------------------------------------------------------
+# Meshes (the dict only; numpy and Mitsuba for the transform objects)
+# ----------------------------------------------------------------------------
+
+QUAD_OBJ = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
+QUAD_OBJ_WITH_NORMALS = QUAD_OBJ.replace("f 1 2 3 4", "vn 0 0 1\nf 1//1 2//1 3//1 4//1")
+# A pyramid without its base: four outward-facing triangles meeting at the apex (vertex 4).
+PYRAMID_PLY = """ply
+format ascii 1.0
+element vertex 5
+property float x
+property float y
+property float z
+element face 4
+property list uchar int vertex_indices
+end_header
+-1 0 -1
+1 0 -1
+1 0 1
+-1 0 1
+0 2 0
+3 1 0 4
+3 2 1 4
+3 3 2 4
+3 0 3 4
+"""
+
+
+def _mesh_scene(tmp: Path, objects: str, files=None) -> Path:
+    for name, text in (files or {"quad.obj": QUAD_OBJ}).items():
+        (tmp / name).write_text(text)
+    return _write(tmp, HEADER + '[materials.clay]\ntype = "lambert"\n' + textwrap.dedent(objects))
+
+
+def _mesh_dict(objects: str, files=None, key="object0"):
+    _need(mi, "mitsuba")
+    tmp = Path(tempfile.mkdtemp(prefix="vkrt-mesh-test-"))
+    atexit.register(shutil.rmtree, tmp, True)  # the dict refers to files in it
+    d = to_mitsuba.convert(_mesh_scene(tmp, objects, files), files_dir=tmp / "files")
+    return d[key], tmp
+
+
+def _mesh_refusal(objects: str, key: str, files=None, fragment: str = ""):
+    with tempfile.TemporaryDirectory() as tmp:
+        path = _mesh_scene(Path(tmp), objects, files)
+        try:
+            to_mitsuba.convert(path, files_dir=Path(tmp) / "files")
+        except to_mitsuba.ConversionError as e:
+            message = str(e)
+        else:
+            raise AssertionError(f"converted: {objects}")
+    assert str(path) in message and key in message and fragment in message, message
+    return message
+
+
+def _to_world(shape):
+    return np.array(shape["to_world"].matrix, dtype=np.float64).reshape(4, 4)
+
+
+def test_mesh_obj_without_normals_reads_the_same_file_with_face_normals():
+    shape, tmp = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        """)
+    assert shape["type"] == "obj"
+    assert shape["filename"] == str((tmp / "quad.obj").resolve())
+    # vkrt's "file" mode falls back to face normals; Mitsuba would make smooth ones.
+    assert shape["face_normals"] is True
+    assert np.allclose(_to_world(shape), np.eye(4))
+    assert shape["bsdf"] == {"type": "ref", "id": "mat0"} and "emitter" not in shape
+
+
+def test_mesh_obj_with_normals_keeps_them():
+    shape, _ = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        normals = "file"
+        """, {"quad.obj": QUAD_OBJ_WITH_NORMALS})
+    assert shape["type"] == "obj" and "face_normals" not in shape
+    face, _ = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        normals = "face"
+        """, {"quad.obj": QUAD_OBJ_WITH_NORMALS})
+    assert face["face_normals"] is True
+
+
+def test_mesh_transform_is_translate_rotate_scale():
+    shape, _ = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        scale = [2, 3, 4]
+        rotate = { axis = [0, 2, 0], angle = 90 }
+        translate = [1, -2, 5]
+        """)
+    # Right-handed 90 degrees about +y: x -> -z, z -> +x; scale first, translate last.
+    expected = np.array([[0, 0, 4, 1], [0, 3, 0, -2], [-2, 0, 0, 5], [0, 0, 0, 1]], float)
+    assert np.allclose(_to_world(shape), expected, atol=1e-6), _to_world(shape)
+    uniform, _ = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        scale = 0.5
+        rotate = { axis = [1, 1, 1], angle = 120 }
+        """)
+    # 120 degrees about the diagonal cycles the axes: x -> y -> z -> x.
+    expected = 0.5 * np.array([[0, 0, 1], [1, 0, 0], [0, 1, 0]], float)
+    assert np.allclose(_to_world(uniform)[:3, :3], expected, atol=1e-6), _to_world(uniform)
+
+
+def test_mesh_matrix_is_used_as_given():
+    rows = [[0, -1, 0, 0.5], [2, 0, 0, 1.5], [0, 0, 3, -1], [0, 0, 0, 1]]
+    shape, _ = _mesh_dict(f"""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        matrix = {rows}
+        """)
+    assert np.allclose(_to_world(shape), np.array(rows, float))
+
+
+def test_mesh_ply_smooth_writes_area_weighted_normals():
+    shape, tmp = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "pyramid.ply"
+        material = "clay"
+        normals = "smooth"
+        """, {"pyramid.ply": PYRAMID_PLY})
+    assert shape["type"] == "ply" and "face_normals" not in shape
+    written = Path(shape["filename"])
+    assert written.parent == (tmp / "files").resolve() and written.name.endswith(".ply")
+    mesh = mi.load_dict({"type": "ply", "filename": str(written)})
+    assert mesh.has_vertex_normals()
+    n = np.array(mesh.vertex_normals_buffer()).reshape(-1, 3)
+    # Apex: four equal faces, normals (0, 1, +-2)/sqrt5 and (+-2, 1, 0)/sqrt5 sum to +y.
+    assert np.allclose(n[4], [0, 1, 0], atol=1e-6), n[4]
+    # Corner (-1, 0, -1): two faces of the same area, normals along (0, 1, -2) and (-2, 1, 0).
+    assert np.allclose(n[0], np.array([-2, 2, -2]) / np.sqrt(12), atol=1e-6), n[0]
+
+
+def test_area_weighted_normals_weight_by_area_not_angle():
+    _need(np, "numpy")
+    # Vertex 0 is shared by a large triangle in z = 0 and a small one in x = 0,
+    # with the same corner angle (90 degrees) at vertex 0.
+    p = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 1, 0], [0, 0, 1]], float)
+    t = np.array([[0, 1, 2], [0, 3, 4]])
+    n = to_mitsuba.area_weighted_normals(p, t)
+    # Cross products (0, 0, 16) and (1, 0, 0); angle weighting would give (1, 0, 1) / sqrt(2).
+    expected = np.array([1.0, 0.0, 16.0]) / np.sqrt(257)
+    assert np.allclose(n[0], expected), n[0]
+
+
+def test_mesh_emission_is_a_one_sided_area_emitter_that_still_scatters():
+    shape, _ = _mesh_dict("""
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "clay"
+        emission = [18.4, 11.0, 2.75]
+        """)
+    assert shape["emitter"] == {"type": "area", "radiance": {"type": "rgb", "value": [18.4, 11.0, 2.75]}}
+    assert shape["bsdf"] == {"type": "ref", "id": "mat0"}
+
+
+def test_mesh_emission_side_is_counter_clockwise():
+    """The quad (counter-clockwise seen from +z) glows seen from +z, is black from -z."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    objects = """
+        [materials.black]
+        type = "lambert"
+        albedo = 0
+        [[objects]]
+        shape = "mesh"
+        file = "quad.obj"
+        material = "black"
+        translate = [-0.5, -0.5, 0]
+        emission = [3, 2, 1]
+        """
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        front = _mesh_scene(tmp, objects)
+        d = to_mitsuba.convert(front, files_dir=tmp / "files")
+        img_front = np.array(mi.render(mi.load_dict(d), spp=4), dtype=np.float64)
+        back = _write(tmp, front.read_text().replace("eye = [0.0, 0.0, 5.0]", "eye = [0.0, 0.0, -5.0]"))
+        img_back = np.array(mi.render(mi.load_dict(to_mitsuba.convert(back, files_dir=tmp / "files")), spp=4),
+                            dtype=np.float64)
+    assert np.allclose(img_front[2:4, 3:5], [3, 2, 1]), img_front[2:4, 3:5]
+    assert np.all(img_back == 0), img_back.max()
+
+
+def test_mesh_refusals():
+    mesh = '[[objects]]\nshape = "mesh"\nmaterial = "clay"\n'
+    _mesh_refusal(mesh + 'file = "quad.obj"\nscale = 2\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], '
+                  '[0, 0, 1, 0], [0, 0, 0, 1]]\n', "objects[0].scale", fragment="matrix")
+    _mesh_refusal(mesh + 'file = "quad.obj"\nnormal = "face"\n', "objects[0].normal", fragment="unknown key")
+    _mesh_refusal(mesh + 'file = "quad.obj"\nnormals = "flat"\n', "objects[0].normals")
+    _mesh_refusal(mesh + 'file = "missing.obj"\n', "objects[0].file", fragment="missing.obj")
+    _mesh_refusal(mesh + 'file = "quad.stl"\n', "objects[0].file", {"quad.stl": "solid"})
+    _mesh_refusal(mesh + 'file = "box.gltf"\n', "objects[0].file", {"box.gltf": "{}"}, fragment="glTF")
+    _mesh_refusal(mesh + 'file = "quad.obj"\nemission = 1\ntwo_sided = true\n', "objects[0].two_sided")
+    _mesh_refusal(mesh + 'file = "quad.obj"\nscale = [1, 0, 1]\n', "objects[0].scale")
+    _mesh_refusal(mesh + 'file = "quad.obj"\nrotate = { axis = [0, 0, 0], angle = 3 }\n',
+                  "objects[0].rotate.axis")
+    _mesh_refusal(mesh + 'file = "quad.obj"\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]\n',
+                  "objects[0].matrix")
+    _mesh_refusal(mesh + 'file = "bad.obj"\n', "objects[0].file", {"bad.obj": "v 0 0 0\nf 1 2 3\n"},
+                  fragment="bad.obj:2")
 
 
 # ----------------------------------------------------------------------------
