@@ -18,6 +18,19 @@ struct BsdfSample {
     bool transmitted; // crossed the surface
 };
 
+// The side of the surface a continuation ray leaves from (its offset
+// direction): the one the sampled direction points into. With shading
+// normals (ns != n) a reflection about ns can point below the geometric
+// surface, or a refraction above it; the ray then leaves through that side,
+// as Mitsuba's spawn_ray does, instead of re-hitting the surface at once.
+vec3 continuationSide(vec3 n, vec3 ns, BsdfSample s)
+{
+    vec3 side = s.transmitted ? -n : n;
+    if (ns != n && dot(s.dir, side) < 0.0)
+        side = -side;
+    return side;
+}
+
 #define VKRT_IS_DELTA_KIND(KIND, Type, name, value, delta) || (delta != 0 && type == MATERIAL_##KIND)
 bool isDeltaMaterial(uint type) { return false VKRT_MATERIAL_KINDS(VKRT_IS_DELTA_KIND); }
 

@@ -60,6 +60,18 @@ vec3 transmittanceTo(vec3 point, vec3 origin, vec3 n, MediumStack media)
     return shadowTransmittance(origin, shadowDir / shadowDist, shadowDist, media);
 }
 
+// Transmittance to a light sample from a surface with geometric normal n
+// and shading normal ns (both on the side the ray arrived from). With
+// shading normals a light above the shading plane can lie below the
+// geometric one: its shadow ray then starts on that side, through the
+// surface (as Mitsuba's spawn_ray does), instead of counting as visible.
+vec3 transmittanceFromSurface(SurfaceHit hit, vec3 n, vec3 ns, vec3 origin, vec3 target, MediumStack media)
+{
+    if (ns != n && dot(target - hit.position, n) < 0.0)
+        return transmittanceTo(target, offsetRayOrigin(hit.position, hit.error, -n), -n, media);
+    return transmittanceTo(target, origin, n, media);
+}
+
 // A light's contribution to a surface point before visibility, and the point
 // a shadow ray must reach for it to count.
 struct LightSample {
@@ -98,7 +110,7 @@ vec3 directFromPointLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
         ++g_loopIterations;
         LightSample s = samplePointLight(pointLights[i], m, hit, ns, wo);
         if (s.unshadowed != vec3(0.0))
-            radiance += s.unshadowed * transmittanceTo(s.target, origin, n, media);
+            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
     }
 #endif
     return radiance;
@@ -166,7 +178,7 @@ vec3 directFromTriangleLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 
         ++g_loopIterations;
         LightSample s = sampleTriangleLight(triangleLights[i], sampleNext2D(rng), m, hit, ns, wo, origin);
         if (s.unshadowed != vec3(0.0))
-            radiance += s.unshadowed * transmittanceTo(s.target, origin, n, media);
+            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
     }
 #endif
     return radiance;
@@ -227,7 +239,7 @@ vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Me
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     LightSample s = sampleEmitters(sampleNext4D(rng), m, hit, ns, wo, origin);
     if (s.unshadowed != vec3(0.0))
-        return s.unshadowed * transmittanceTo(s.target, origin, n, media);
+        return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
 #endif
     return vec3(0.0);
 }
@@ -293,7 +305,8 @@ vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 ns, v
 #endif
     if (r.totalWeight == 0.0)
         return vec3(0.0);
-    return r.kept.unshadowed * (r.totalWeight / r.keptWeight) * transmittanceTo(r.kept.target, origin, n, media);
+    return r.kept.unshadowed * (r.totalWeight / r.keptWeight) *
+           transmittanceFromSurface(hit, n, ns, origin, r.kept.target, media);
 }
 
 #endif

@@ -67,7 +67,9 @@ vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
     if (f == vec3(0.0))
         return vec3(0.0);
     float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
-    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
+    // Through the surface when wi lies below its geometric plane (shading normals; lib/lights.glsl).
+    vec3 side = (ns != n && dot(wi, n) < 0.0) ? -n : n;
+    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, side), wi, FLT_MAX, media);
     return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
 #else
     return vec3(0.0);
@@ -140,7 +142,7 @@ vec3 tracePath(Ray ray, inout Sampler rng)
             path.media = crossInterface(path.media, hit.material, hit.front);
         if (!survivesRoulette(path, depth, u4.w))
             break;
-        ray = Ray(offsetRayOrigin(hit.position, hit.error, s.transmitted ? -n : n), s.dir);
+        ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);
 #endif
     }
     return path.radiance;

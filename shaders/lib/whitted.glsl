@@ -73,7 +73,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         path.countEmission = path.countEmission && s.specular;
         if (s.transmitted)
             path.media = crossInterface(path.media, hit.material, hit.front);
-        ray = Ray(offsetRayOrigin(hit.position, hit.error, s.transmitted ? -n : n), s.dir);
+        ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);
 #endif
     }
     return path.radiance;

@@ -89,9 +89,14 @@ int runInfo(const InfoOptions& options)
     std::printf("first frame:    %.3f s after set-up began (includes the driver's shader compile)\n",
                 firstFrameSeconds);
     std::printf("loop cap:       %s\n", context.loopCap().describe().c_str());
-    std::printf("loop passes:    worst case %llu per invocation%s\n",
-                static_cast<unsigned long long>(worstCaseLoopIterations(scene)),
-                context.loopCap().capped() ? (" of " + std::to_string(*context.loopCap().budget)).c_str() : "");
+    if (scene.meshes.empty())
+        std::printf("loop passes:    worst case %llu per invocation%s\n",
+                    static_cast<unsigned long long>(worstCaseLoopIterations(scene)),
+                    context.loopCap().capped() ? (" of " + std::to_string(*context.loopCap().budget)).c_str() : "");
+    else
+        std::printf("loop passes:    no static bound (BVH traversal)%s\n",
+                    context.loopCap().capped() ? "; each subgroup's count is checked against the cap as it renders"
+                                               : "");
     if (!scene.meshes.empty()) printMeshes(scene, session.renderer().meshData(), parseSeconds);
     std::printf("device:         %s\n", context.deviceInfo().name.c_str());
     return kExitOk;

@@ -29,7 +29,8 @@ enum class NormalMode {
 };
 
 /// Replaces mesh.normals by area-weighted averages of the adjacent faces'
-/// normals (vertices shared by index only); a vertex whose faces are all
+/// normals, vertices at exactly the same position sharing one (mesh files
+/// and assimp's OBJ importer split a surface's vertices); a vertex whose faces are all
 /// degenerate gets no valid normal and its triangles fall back to the face
 /// normal (its normal is stored as (0, 0, 0)).
 void computeSmoothNormals(MeshData& mesh);
