@@ -195,7 +195,7 @@ SahSplit bestSahSplit(const BuildInput& in, uint32_t begin, uint32_t end, const 
     std::array<bool, 3> spread{};
     for (int axis = 0; axis < 3; ++axis) {
         const double extent = r.centroids.upper[axis] - r.centroids.lower[axis];
-        spread[axis] = extent > 0.0;
+        spread[axis] = extent > 0.0 && std::isfinite(bins / extent);
         mappings[axis] = BinMapping{r.centroids.lower[axis], spread[axis] ? bins / extent : 0.0, bins};
         s.bins[axis].assign(bins, Bin{});
     }
@@ -244,18 +244,16 @@ uint32_t splitPoint(BuildInput& in, const PendingNode& p, const RangeBounds& r, 
     // weighted by the chance (area ratio) of entering it; a leaf costs its count.
     const double area = r.box.surfaceArea();
     const double splitCost = o.traversalCost + (area > 0.0 ? sah.cost / area : 0.0);
-    const bool sahPays = sah.axis >= 0 && splitCost < double(count);
-    if (count <= o.maxLeafSize && !sahPays) return 0;
-    if (sah.axis >= 0) {
-        // A lopsided split is taken only while the larger side still fits in
-        // the depth budget (the GPU's traversal stack) with median splits.
-        const uint32_t larger = std::max(sah.leftCount, count - sah.leftCount);
-        if (p.depth + medianDepth(larger, o.maxLeafSize) <= o.maxDepth) {
-            const BinMapping& map = mappings[sah.axis];
-            const auto left = [&in, &map, &sah](uint32_t prim) { return map(in.centroids[prim][sah.axis]) < sah.plane; };
-            const auto mid = std::partition(in.order.begin() + p.begin, in.order.begin() + p.end, left);
-            return uint32_t(mid - in.order.begin());
-        }
+    // A lopsided split is taken only while its larger side still fits in the
+    // depth budget (the GPU's traversal stack) when built with median splits.
+    const bool fits = sah.axis >= 0 && p.depth + medianDepth(std::max(sah.leftCount, count - sah.leftCount),
+                                                             o.maxLeafSize) <= o.maxDepth;
+    if (count <= o.maxLeafSize && !(fits && splitCost < double(count))) return 0;
+    if (fits) {
+        const BinMapping& map = mappings[sah.axis];
+        const auto left = [&in, &map, &sah](uint32_t prim) { return map(in.centroids[prim][sah.axis]) < sah.plane; };
+        const auto mid = std::partition(in.order.begin() + p.begin, in.order.begin() + p.end, left);
+        return uint32_t(mid - in.order.begin());
     }
     // Coincident centroids, or the budget is tight: halve the range.
     return medianSplit(in, p.begin, p.end, r);
@@ -400,7 +398,9 @@ Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options)
         return tasks[a].end - tasks[a].begin > tasks[b].end - tasks[b].begin;
     });
     std::vector<Subtree> subtrees(tasks.size());
-    const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    // Small trees (the top level over a scene's objects) are not worth a thread.
+    const uint32_t threads = n < 16384 ? 1 : options.threads ? options.threads
+                                                            : std::max(1u, std::thread::hardware_concurrency());
     runInParallel(uint32_t(tasks.size()), threads, [&](uint32_t k) {
         const PendingNode& t = tasks[bySize[k]];
         Subtree& sub = subtrees[bySize[k]];
