@@ -39,8 +39,8 @@ int main(int argc, char** argv)
     const std::string kind = argv[1];
     const uint32_t triangles = uint32_t(std::strtoul(argv[2], nullptr, 10));
     const uint32_t threads = argc > 3 ? uint32_t(std::strtoul(argv[3], nullptr, 10)) : 0;
-    const vkrt::MeshData mesh = kind == "sphere" ? vkrt::makeUvSphere(triangles, glm::vec3(0.0f), 1.0f)
-                                                 : vkrt::makeRandomSoup(triangles, 1);
+    const vkrt::MeshData mesh =
+        kind == "sphere" ? vkrt::makeUvSphere(triangles, glm::vec3(0.0f), 1.0f) : vkrt::makeRandomSoup(triangles, 1);
     const auto start = std::chrono::steady_clock::now();
     const std::vector<vkrt::Aabb> boxes = vkrt::triangleBoxes(mesh.positions, mesh.triangles);
     const double boxSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -65,8 +65,8 @@ int main(int argc, char** argv)
     }
     std::printf("%s triangles=%zu threads=%u boxes_s=%.3f build_s=%.3f nodes=%zu depth=%u build_peak_MiB=%.1f "
                 "(nodes+order %.1f MiB) nodes/ray=%.1f tests/ray=%.1f\n",
-                kind.c_str(), mesh.triangles.size(), threads, boxSeconds, bvh.buildSeconds, bvh.nodes.size(),
-                bvh.depth, (peak - before) / 1024.0,
+                kind.c_str(), mesh.triangles.size(), threads, boxSeconds, bvh.buildSeconds, bvh.nodes.size(), bvh.depth,
+                (peak - before) / 1024.0,
                 (bvh.nodes.size() * sizeof(vkrt::gpu::BvhNode) + bvh.order.size() * 4) / 1048576.0, nodes / rays,
                 tests / rays);
     return 0;

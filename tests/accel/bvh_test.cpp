@@ -68,7 +68,8 @@ bool containsExactly(const gpu::BvhNode& outer, const Aabb& box)
         }
     }
     for (size_t s = 0; s < n; ++s)
-        if (slotSeen[s] != 1) return ::testing::AssertionFailure() << "slot " << s << " in " << slotSeen[s] << " leaves";
+        if (slotSeen[s] != 1)
+            return ::testing::AssertionFailure() << "slot " << s << " in " << slotSeen[s] << " leaves";
     for (size_t i = 0; i < nodeSeen.size(); ++i)
         if (!nodeSeen[i]) return ::testing::AssertionFailure() << "node " << i << " unreachable";
     if (n > 0 && depth != bvh.depth)
@@ -90,8 +91,9 @@ TEST(BvhBuild, InvariantsOnRandomSoups)
 
 TEST(BvhBuild, InvariantsOnGridsAndSpheres)
 {
-    for (const MeshData& mesh : {makeGrid(30), makeUvSphere(2000, glm::vec3(1.0f, 2.0f, 3.0f), 0.5f),
-                                 makeIcosphere(3, glm::vec3(0.0f), 100.0f), makeQuad({0, 0, 0}, {1, 0, 0}, {0, 1, 0})}) {
+    for (const MeshData& mesh :
+         {makeGrid(30), makeUvSphere(2000, glm::vec3(1.0f, 2.0f, 3.0f), 0.5f),
+          makeIcosphere(3, glm::vec3(0.0f), 100.0f), makeQuad({0, 0, 0}, {1, 0, 0}, {0, 1, 0})}) {
         const std::vector<Aabb> boxes = boxesOf(mesh);
         for (uint32_t leaf : {1u, 2u, 4u, 8u}) {
             EXPECT_TRUE(wellFormed(buildBvh(boxes, BvhOptions{.maxLeafSize = leaf}), boxes, leaf))
