@@ -91,12 +91,44 @@ uint32_t medianDepth(uint64_t count, uint32_t maxLeafSize)
     return depth;
 }
 
-/// What every part of one build shares; primitives are referred to by their
-/// slot in `order`, which the build permutes.
+/// A float box; rounding a double box outwards is monotonic, so the union of
+/// rounded boxes is exactly the rounded union (the node box Bvh.h promises).
+struct FloatBox {
+    glm::vec3 lower{std::numeric_limits<float>::infinity()};
+    glm::vec3 upper{-std::numeric_limits<float>::infinity()};
+    void extend(const glm::vec3& p)
+    {
+        lower = glm::min(lower, p);
+        upper = glm::max(upper, p);
+    }
+    void extend(const FloatBox& b)
+    {
+        lower = glm::min(lower, b.lower);
+        upper = glm::max(upper, b.upper);
+    }
+    double surfaceArea() const
+    {
+        if (!(lower.x <= upper.x)) return 0.0;
+        const glm::dvec3 d = glm::dvec3(upper) - glm::dvec3(lower);
+        return 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+    }
+};
+
+/// One primitive as the build moves it around: its box rounded outwards and
+/// its index. The build permutes these (sequential memory, unlike an index
+/// array into the boxes), and `order` is read off them at the end.
+struct PrimRef {
+    FloatBox box;
+    uint32_t index;
+    /// Halves first: no overflow to infinity near FLT_MAX.
+    glm::vec3 centroid() const { return 0.5f * box.lower + 0.5f * box.upper; }
+};
+
+/// What every part of one build shares. Refs [0, firstEmpty) have boxes,
+/// the rest (empty boxes) only need leaves.
 struct BuildInput {
-    std::span<const Aabb> boxes;
-    std::vector<glm::dvec3> centroids;
-    std::vector<uint32_t> order;
+    std::vector<PrimRef> refs;
+    uint32_t firstEmpty = 0;
     BvhOptions options;
 };
 
@@ -108,19 +140,30 @@ struct PendingNode {
     uint32_t depth;
 };
 
+/// Stores a node box; an empty one as roundOutwards stores it (never entered).
+void setBox(gpu::BvhNode& node, const FloatBox& box)
+{
+    if (box.lower.x <= box.upper.x) {
+        node.lower = box.lower;
+        node.upper = box.upper;
+    } else {
+        roundOutwards(Aabb{}, node.lower, node.upper);
+    }
+}
+
 /// The box of a range's primitives and the box of their centroids.
 struct RangeBounds {
-    Aabb box;
-    Aabb centroids;
+    FloatBox box;
+    FloatBox centroids;
 };
 
 RangeBounds boundsOf(const BuildInput& in, uint32_t begin, uint32_t end)
 {
     RangeBounds r;
+    if (begin >= in.firstEmpty) return r;
     for (uint32_t i = begin; i < end; ++i) {
-        const uint32_t p = in.order[i];
-        r.box.extend(in.boxes[p]);
-        r.centroids.extend(in.centroids[p]);
+        r.box.extend(in.refs[i].box);
+        r.centroids.extend(in.refs[i].centroid());
     }
     return r;
 }
@@ -131,11 +174,11 @@ struct BinMapping {
     double lower = 0.0;
     double scale = 0.0;
     uint32_t bins = 0;
-    uint32_t operator()(double c) const { return std::min(bins - 1, uint32_t((c - lower) * scale)); }
+    uint32_t operator()(float c) const { return std::min(bins - 1, uint32_t((double(c) - lower) * scale)); }
 };
 
 struct Bin {
-    Aabb box;
+    FloatBox box;
     uint32_t count = 0;
 };
 
@@ -168,7 +211,7 @@ void sweepAxis(const std::vector<Bin>& bins, int axis, uint32_t count, Scratch& 
     const uint32_t n = uint32_t(bins.size());
     s.rightArea.resize(n);
     s.rightCount.resize(n);
-    Aabb box;
+    FloatBox box;
     uint32_t c = 0;
     for (uint32_t b = n; b-- > 1;) {
         box.extend(bins[b].box);
@@ -176,7 +219,7 @@ void sweepAxis(const std::vector<Bin>& bins, int axis, uint32_t count, Scratch& 
         s.rightArea[b] = box.surfaceArea();
         s.rightCount[b] = c;
     }
-    box = Aabb{};
+    box = FloatBox{};
     c = 0;
     for (uint32_t plane = 1; plane < n; ++plane) {
         box.extend(bins[plane - 1].box);
@@ -191,21 +234,23 @@ void sweepAxis(const std::vector<Bin>& bins, int axis, uint32_t count, Scratch& 
 SahSplit bestSahSplit(const BuildInput& in, uint32_t begin, uint32_t end, const RangeBounds& r,
                       std::array<BinMapping, 3>& mappings, Scratch& s)
 {
-    const uint32_t bins = in.options.bins;
+    // A node of few primitives needs no more bins than it has primitives:
+    // the per-node sweep, not the binning, dominates deep in the tree.
+    const uint32_t bins = std::clamp(end - begin, 2u, in.options.bins);
     std::array<bool, 3> spread{};
     for (int axis = 0; axis < 3; ++axis) {
-        const double extent = r.centroids.upper[axis] - r.centroids.lower[axis];
-        spread[axis] = extent > 0.0;
+        const double extent = double(r.centroids.upper[axis]) - double(r.centroids.lower[axis]);
+        spread[axis] = extent > 0.0 && std::isfinite(bins / extent);
         mappings[axis] = BinMapping{r.centroids.lower[axis], spread[axis] ? bins / extent : 0.0, bins};
         s.bins[axis].assign(bins, Bin{});
     }
     for (uint32_t i = begin; i < end; ++i) {
-        const uint32_t p = in.order[i];
-        const glm::dvec3& c = in.centroids[p];
+        const PrimRef& ref = in.refs[i];
+        const glm::vec3 c = ref.centroid();
         for (int axis = 0; axis < 3; ++axis) {
             if (!spread[axis]) continue;
             Bin& bin = s.bins[axis][mappings[axis](c[axis])];
-            bin.box.extend(in.boxes[p]);
+            bin.box.extend(ref.box);
             ++bin.count;
         }
     }
@@ -220,14 +265,14 @@ SahSplit bestSahSplit(const BuildInput& in, uint32_t begin, uint32_t end, const 
 uint32_t medianSplit(BuildInput& in, uint32_t begin, uint32_t end, const RangeBounds& r)
 {
     const uint32_t middle = begin + (end - begin) / 2;
-    const glm::dvec3 extent = r.centroids.upper - r.centroids.lower;
+    const glm::vec3 extent = r.centroids.upper - r.centroids.lower;
     const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-    if (extent[axis] > 0.0) {
-        const auto less = [&in, axis](uint32_t a, uint32_t b) {
-            const double ca = in.centroids[a][axis], cb = in.centroids[b][axis];
-            return ca < cb || (ca == cb && a < b);
+    if (begin < in.firstEmpty && extent[axis] > 0.0f) {
+        const auto less = [axis](const PrimRef& a, const PrimRef& b) {
+            const float ca = a.centroid()[axis], cb = b.centroid()[axis];
+            return ca < cb || (ca == cb && a.index < b.index);
         };
-        std::nth_element(in.order.begin() + begin, in.order.begin() + middle, in.order.begin() + end, less);
+        std::nth_element(in.refs.begin() + begin, in.refs.begin() + middle, in.refs.begin() + end, less);
     }
     return middle;
 }
@@ -238,24 +283,24 @@ uint32_t splitPoint(BuildInput& in, const PendingNode& p, const RangeBounds& r, 
     const BvhOptions& o = in.options;
     const uint32_t count = p.end - p.begin;
     if (count == 1) return 0;
+    if (p.begin >= in.firstEmpty) return count <= o.maxLeafSize ? 0 : medianSplit(in, p.begin, p.end, r);
     std::array<BinMapping, 3> mappings;
     const SahSplit sah = bestSahSplit(in, p.begin, p.end, r, mappings, scratch);
     // SAH: a split costs one traversal step plus each side's primitives
     // weighted by the chance (area ratio) of entering it; a leaf costs its count.
     const double area = r.box.surfaceArea();
     const double splitCost = o.traversalCost + (area > 0.0 ? sah.cost / area : 0.0);
-    const bool sahPays = sah.axis >= 0 && splitCost < double(count);
-    if (count <= o.maxLeafSize && !sahPays) return 0;
-    if (sah.axis >= 0) {
-        // A lopsided split is taken only while the larger side still fits in
-        // the depth budget (the GPU's traversal stack) with median splits.
-        const uint32_t larger = std::max(sah.leftCount, count - sah.leftCount);
-        if (p.depth + medianDepth(larger, o.maxLeafSize) <= o.maxDepth) {
-            const BinMapping& map = mappings[sah.axis];
-            const auto left = [&in, &map, &sah](uint32_t prim) { return map(in.centroids[prim][sah.axis]) < sah.plane; };
-            const auto mid = std::partition(in.order.begin() + p.begin, in.order.begin() + p.end, left);
-            return uint32_t(mid - in.order.begin());
-        }
+    // A lopsided split is taken only while its larger side still fits in the
+    // depth budget (the GPU's traversal stack) when built with median splits.
+    const bool fits =
+        sah.axis >= 0 &&
+        p.depth + medianDepth(std::max(sah.leftCount, count - sah.leftCount), o.maxLeafSize) <= o.maxDepth;
+    if (count <= o.maxLeafSize && !(fits && splitCost < double(count))) return 0;
+    if (fits) {
+        const BinMapping& map = mappings[sah.axis];
+        const auto left = [&map, &sah](const PrimRef& ref) { return map(ref.centroid()[sah.axis]) < sah.plane; };
+        const auto mid = std::partition(in.refs.begin() + p.begin, in.refs.begin() + p.end, left);
+        return uint32_t(mid - in.refs.begin());
     }
     // Coincident centroids, or the budget is tight: halve the range.
     return medianSplit(in, p.begin, p.end, r);
@@ -286,7 +331,7 @@ void buildSubtree(BuildInput& in, PendingNode root, Subtree& out, uint32_t defer
         const uint32_t mid = splitPoint(in, p, r, scratch);
         const uint32_t left = uint32_t(out.nodes.size());
         gpu::BvhNode& node = out.nodes[p.node];
-        roundOutwards(r.box, node.lower, node.upper);
+        setBox(node, r.box);
         node.first = mid == 0 ? p.begin : left;
         node.count = mid == 0 ? p.end - p.begin : 0;
         if (mid == 0) {
@@ -340,25 +385,25 @@ void checkOptions(const BvhOptions& o, size_t primitives)
     VKRT_CHECK(medianDepth(primitives, o.maxLeafSize) + 1 <= o.maxDepth);
 }
 
-/// Primitives with holdsSomething() boxes first, the others (never hit) after
-/// them, in index order; their centroids (0 for the empty ones).
-BuildInput prepare(std::span<const Aabb> boxes, const BvhOptions& options, uint32_t& emptyCount)
+/// Refs of the primitives with holdsSomething() boxes first, the others
+/// (never hit) after them, each group in index order.
+BuildInput prepare(std::span<const Aabb> boxes, const BvhOptions& options)
 {
-    BuildInput in{boxes, std::vector<glm::dvec3>(boxes.size()), std::vector<uint32_t>(boxes.size()), options};
+    BuildInput in;
+    in.options = options;
+    in.refs.resize(boxes.size());
     uint32_t front = 0;
-    emptyCount = 0;
     for (uint32_t i = 0; i < boxes.size(); ++i) {
-        if (holdsSomething(boxes[i])) {
-            VKRT_CHECK(std::isfinite(boxes[i].lower.x + boxes[i].lower.y + boxes[i].lower.z + boxes[i].upper.x +
-                                     boxes[i].upper.y + boxes[i].upper.z));
-            in.centroids[i] = boxes[i].centre();
-            in.order[front++] = i;
-        } else {
-            ++emptyCount;
-        }
+        if (!holdsSomething(boxes[i])) continue;
+        VKRT_CHECK(std::isfinite(boxes[i].lower.x + boxes[i].lower.y + boxes[i].lower.z + boxes[i].upper.x +
+                                 boxes[i].upper.y + boxes[i].upper.z));
+        PrimRef& ref = in.refs[front++];
+        roundOutwards(boxes[i], ref.box.lower, ref.box.upper);
+        ref.index = i;
     }
+    in.firstEmpty = front;
     for (uint32_t i = 0, back = front; i < boxes.size(); ++i)
-        if (!holdsSomething(boxes[i])) in.order[back++] = i;
+        if (!holdsSomething(boxes[i])) in.refs[back++] = PrimRef{FloatBox{}, i};
     return in;
 }
 
@@ -368,9 +413,9 @@ Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options)
 {
     const auto start = std::chrono::steady_clock::now();
     checkOptions(options, boxes.size());
-    uint32_t emptyCount = 0;
-    BuildInput in = prepare(boxes, options, emptyCount);
+    BuildInput in = prepare(boxes, options);
     const uint32_t n = uint32_t(boxes.size());
+    const uint32_t emptyCount = n - in.firstEmpty;
 
     // ---- the top of the tree, serially, down to ranges of taskSize(n)
     Subtree top;
@@ -381,9 +426,7 @@ Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options)
         top.depth = 1;
     } else if (emptyCount > 0 && emptyCount < n) {
         // Empty boxes get a subtree of their own, beside the real ones.
-        Aabb all;
-        for (uint32_t i = 0; i < n - emptyCount; ++i) all.extend(boxes[in.order[i]]);
-        roundOutwards(all, top.nodes[0].lower, top.nodes[0].upper);
+        setBox(top.nodes[0], boundsOf(in, 0, in.firstEmpty).box);
         top.nodes[0].first = 1;
         top.nodes.resize(3);
         roots = {{1, 0, n - emptyCount, 2}, {2, n - emptyCount, n, 2}};
@@ -400,7 +443,10 @@ Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options)
         return tasks[a].end - tasks[a].begin > tasks[b].end - tasks[b].begin;
     });
     std::vector<Subtree> subtrees(tasks.size());
-    const uint32_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    // Small trees (the top level over a scene's objects) are not worth a thread.
+    const uint32_t threads = n < 16384         ? 1
+                             : options.threads ? options.threads
+                                               : std::max(1u, std::thread::hardware_concurrency());
     runInParallel(uint32_t(tasks.size()), threads, [&](uint32_t k) {
         const PendingNode& t = tasks[bySize[k]];
         Subtree& sub = subtrees[bySize[k]];
@@ -415,7 +461,8 @@ Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options)
 
     Bvh bvh;
     bvh.nodes = std::move(top.nodes);
-    bvh.order = std::move(in.order);
+    bvh.order.resize(n);
+    for (uint32_t i = 0; i < n; ++i) bvh.order[i] = in.refs[i].index;
     bvh.depth = top.depth;
     bvh.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;

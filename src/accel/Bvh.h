@@ -28,10 +28,10 @@ struct Aabb {
 };
 
 struct BvhOptions {
-    uint32_t maxLeafSize = 4;  ///< never more primitives in a leaf
-    uint32_t bins = 16;        ///< SAH bins per axis
+    uint32_t maxLeafSize = 4;   ///< never more primitives in a leaf
+    uint32_t bins = 16;         ///< SAH bins per axis
     double traversalCost = 1.0; ///< SAH cost of one node visit, per primitive test
-    uint32_t threads = 0;      ///< 0: std::thread::hardware_concurrency(); the tree is the same for any count
+    uint32_t threads = 0;       ///< 0: std::thread::hardware_concurrency(); the tree is the same for any count
     /// Never deeper (in nodes, root to leaf) than this: the GPU's traversal
     /// stack (BVH_STACK_SIZE). SAH splits too lopsided to stay within it
     /// give way to median splits.

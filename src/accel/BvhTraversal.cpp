@@ -75,8 +75,7 @@ bool entersBox(const glm::vec3& lower, const glm::vec3& upper, const TraversalRa
     const glm::vec3 tNear = glm::min(t0, t1);
     const glm::vec3 tFar = glm::max(t0, t1);
     tEntry = std::max(std::max(tNear.x, tNear.y), std::max(tNear.z, 0.0f));
-    const float tExit =
-        std::min(std::min(tFar.x, tFar.y), std::min(tFar.z, tMax)) * (1.0f + 2.0f * gammaBound(3));
+    const float tExit = std::min(std::min(tFar.x, tFar.y), std::min(tFar.z, tMax)) * (1.0f + 2.0f * gammaBound(3));
     return tEntry <= tExit;
 }
 

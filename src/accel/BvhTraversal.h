@@ -54,7 +54,7 @@ bool anyHit(const Bvh& bvh, const TriangleSet& mesh, const glm::vec3& origin, co
 
 /// The work of one closest-hit query.
 struct TraversalStats {
-    uint32_t nodesVisited = 0;   ///< nodes whose box was entered and which were then processed
+    uint32_t nodesVisited = 0; ///< nodes whose box was entered and which were then processed
     uint32_t trianglesTested = 0;
 };
 

@@ -62,7 +62,8 @@ MeshData makeUvSphere(uint32_t trianglesAtLeast, glm::vec3 centre, float radius)
             mesh.triangles.emplace_back(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
         }
     }
-    for (uint32_t j = 0; j < slices; ++j) mesh.triangles.emplace_back(south, ring(stacks - 1, j + 1), ring(stacks - 1, j));
+    for (uint32_t j = 0; j < slices; ++j)
+        mesh.triangles.emplace_back(south, ring(stacks - 1, j + 1), ring(stacks - 1, j));
     return mesh;
 }
 
@@ -72,12 +73,12 @@ namespace {
 void icosahedron(std::vector<glm::dvec3>& dirs, std::vector<glm::uvec3>& faces)
 {
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    dirs = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    dirs = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+            {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
     for (glm::dvec3& d : dirs) d = glm::normalize(d);
-    faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-             {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+             {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
 }
 
 /// Splits every face in four at its edges' midpoints (pushed onto the sphere, shared between neighbours).
@@ -203,7 +204,8 @@ namespace {
 class FileWriter {
 public:
     FileWriter(const std::filesystem::path& file, const std::filesystem::path& shownAs)
-        : m_stream(file, std::ios::binary), m_shownAs(shownAs)
+        : m_stream(file, std::ios::binary),
+          m_shownAs(shownAs)
     {
         if (!m_stream) fail();
         m_buffer.reserve(1 << 20);
