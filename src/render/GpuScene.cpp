@@ -238,13 +238,8 @@ std::vector<gpu::BvhNode> refitTopLevel(const TopLevel& top, const glm::dvec3& e
     }
     std::vector<gpu::BvhNode> nodes = top.bvh.nodes;
     for (size_t i = 0; i < nodes.size(); ++i) {
-        if (nodeBoxes[i].empty()) {
-            // Nothing to hit: a box no ray enters.
-            nodes[i].lower = glm::vec3(std::numeric_limits<float>::infinity());
-            nodes[i].upper = glm::vec3(-std::numeric_limits<float>::infinity());
-        } else {
-            roundOutwards(nodeBoxes[i], nodes[i].lower, nodes[i].upper);
-        }
+        // An empty box becomes a point at +infinity, which no ray enters (accel/Bvh.h).
+        roundOutwards(nodeBoxes[i], nodes[i].lower, nodes[i].upper);
     }
     return nodes;
 }
