@@ -84,6 +84,12 @@ const std::vector<glm::vec3> kSquare{{0, 0, 0}, {2, 0, 0}, {2, 3, 0}, {0, 3, 0}}
 
 } // namespace
 
+// Assimp 5.2 leaks the mesh it was building when its PLY reader throws halfway
+// (e.g. on a malformed number), inside libassimp where we cannot free it; the
+// leak checker (ASan builds, the fuzzer) must not count that against vkrt.
+// Leaks with any other origin are still reported.
+extern "C" const char* __lsan_default_suppressions() { return "leak:libassimp.so\n"; }
+
 // ---------------------------------------------------------------------------
 // OBJ
 
@@ -413,6 +419,13 @@ TEST(MeshLoaderBad, PlyIndexOutOfRange)
 {
     const std::string text = plyHeader("ascii", "float", "uchar", "int", 1) + "0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 4\n";
     expectErrorNaming(writeFile(testDir() / "beyond.ply", text), "out of range");
+}
+
+TEST(MeshLoaderBad, MalformedAsciiPlyNumber)
+{
+    // Found by fuzzing: assimp throws halfway through the vertices (and leaks, see above).
+    const std::string text = plyHeader("ascii", "float", "uchar", "int", 1) + "0 0 0\n1 0 0\n$1 1 0\n0 1 0\n3 0 1 2\n";
+    expectErrorNaming(writeFile(testDir() / "number.ply", text), "cannot read the PLY file");
 }
 
 TEST(MeshLoaderBad, TruncatedBinaryPly)
