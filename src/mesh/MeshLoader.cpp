@@ -72,7 +72,8 @@ std::string readText(const fs::path& file)
 // they never decide what the mesh is.
 
 /// Calls visit(lineNumber, keyword, rest) for each line; stops when it returns true.
-template <typename Visit> std::optional<int> findObjLine(std::string_view text, Visit visit)
+template <typename Visit>
+std::optional<int> findObjLine(std::string_view text, Visit visit)
 {
     int lineNumber = 0;
     while (!text.empty()) {
@@ -189,9 +190,9 @@ void rejectPlyTriangleStrips(const fs::path& file)
 // ---------------------------------------------------------------------------
 // Assimp import.
 
-constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure // first: out-of-range indices, broken buffers
-                                  | aiProcess_Triangulate          // polygons -> triangles
-                                  | aiProcess_SortByPType          // one primitive type per mesh
+constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure   // first: out-of-range indices, broken buffers
+                                  | aiProcess_Triangulate           // polygons -> triangles
+                                  | aiProcess_SortByPType           // one primitive type per mesh
                                   | aiProcess_PreTransformVertices; // glTF node transforms, one flat list
 
 [[noreturn]] void failImport(const fs::path& file, const std::string& extension, const std::string& reason)
@@ -216,8 +217,11 @@ const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, con
     const std::string reason = importer.GetErrorString();
     if (reason.find("No meshes remaining") != std::string::npos ||
         reason.find("mNumMeshes is 0") != std::string::npos) {
-        fail(file, "no triangles in " + file.string() + " (only points or lines, or not a " + formatName(extension) +
-                       " file at all)");
+        fail(file, "no triangles in " + file.string() + " (it has only points or lines, or is no mesh file at all)");
+    }
+    if (reason.find("No suitable reader") != std::string::npos) {
+        fail(file,
+             "is not a " + formatName(extension) + " file: the Open Asset Import Library recognises no format in it");
     }
     failImport(file, extension, reason);
 }
@@ -270,8 +274,7 @@ glm::vec3 unitNormal(const MeshCheck& check, size_t mesh, size_t vertex, const a
     return length > 0.0f && std::isfinite(length) ? n / length : glm::vec3(0.0f);
 }
 
-void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const MeshCheck& check, bool normals,
-                    bool uvs)
+void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const MeshCheck& check, bool normals, bool uvs)
 {
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
         const glm::vec3 position = toGlm(mesh.mVertices[v]);

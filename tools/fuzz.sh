@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz) with clang-14 in build-fuzz/ and
+# runs each for SECONDS (default 60) from a seed corpus: the small meshes of
+# ../shared/assets and the scenes of scenes/. Exits non-zero if either finds a
+# crash, a sanitizer report, a leak, a hang or an exception other than
+# InputError; the input that did it is kept in build-fuzz/artifacts/.
+#   tools/fuzz.sh [SECONDS]   environment: JOBS (build jobs, default 2), VKRT_ASSETS_DIR
+set -euo pipefail
+
+seconds=${1:-60}
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=$root/build-fuzz
+assets=${VKRT_ASSETS_DIR:-$root/../shared/assets}
+compiler=${VKRT_FUZZ_CXX:-clang++-14}
+
+started=$(date +%s)
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$compiler" \
+  -DVKRT_FUZZ=ON >/dev/null
+cmake --build "$build" -j"${JOBS:-2}" --target fuzz_mesh_loader fuzz_scene_parser
+echo "fuzz: build took $(($(date +%s) - started)) s"
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mkdir -p "$work/mesh" "$work/scene" "$build/artifacts"
+
+# A mesh seed is one byte choosing the format (tests/fuzz/fuzz_mesh_loader.cpp:
+# 0 OBJ, 1 PLY, 2 glTF, 3 GLB) and then the file. Files over 64 KiB would only
+# slow every execution down, so the large assets stay out.
+seed() { # SELECTOR FILE
+  { printf "\\$(printf '%03o' "$1")"; cat "$2"; } >"$work/mesh/$(basename "$2").seed"
+}
+for file in "$assets"/*.obj "$assets"/*.ply; do
+  [[ -f $file && $(stat -c %s "$file") -le 65536 ]] || continue
+  case $file in *.obj) seed 0 "$file" ;; *.ply) seed 1 "$file" ;; esac
+done
+seed 3 "$assets/gltf/box01.glb"
+# The Cube's .bin as a data: URI, since the fuzzer's file has no neighbours.
+sed "s|\"uri\" *: *\"Cube.bin\"|\"uri\": \"data:application/octet-stream;base64,$(base64 -w0 "$assets/gltf/Cube/Cube.bin")\"|" \
+  "$assets/gltf/Cube/Cube.gltf" >"$work/Cube.gltf"
+seed 2 "$work/Cube.gltf"
+for file in "$assets"/gltf/bad/*.gltf; do seed 2 "$file"; done
+find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
+
+status=0
+run() { # TARGET CORPUS
+  echo "fuzz: running $1 for $seconds s on $(find "$2" -type f | wc -l) seeds"
+  if ! "$build/tests/fuzz/$1" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$build/artifacts/$1-" "$2" >"$work/$1.log" 2>&1; then
+    status=1
+    tail -n 60 "$work/$1.log"
+    echo "fuzz: $1 FAILED; the input is in $build/artifacts/" >&2
+  fi
+  grep -E '^stat::(number_of_executed_units|average_exec_per_sec|new_units_added|peak_rss_mb)' "$work/$1.log" |
+    sed "s/^/fuzz: $1 /" || true
+}
+run fuzz_mesh_loader "$work/mesh"
+run fuzz_scene_parser "$work/scene"
+exit $status
