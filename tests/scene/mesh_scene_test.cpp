@@ -14,6 +14,7 @@ const char* kHeader = R"(
 [camera]
 eye = [0, 0, 5]
 target = [0, 0, 0]
+fov = 40
 [materials.clay]
 type = "lambert"
 )";
@@ -58,7 +59,7 @@ TEST_F(SceneParserMesh, FileIsRelativeToTheSceneAndLoaded)
     EXPECT_EQ(scene.meshes[0].geometry->data.triangles.size(), 1u);
     EXPECT_EQ(scene.meshes[0].material, 0u);
     EXPECT_EQ(scene.meshes[0].emission, Color(0.0));
-    EXPECT_EQ(scene.meshes[0].where.line, 7);
+    EXPECT_EQ(scene.meshes[0].where.line, 8);
 }
 
 TEST_F(SceneParserMesh, ScaleThenRotateThenTranslate)
@@ -112,7 +113,8 @@ TEST_F(SceneParserMesh, ErrorsNameFileLineAndColumn)
         {"", "'file'"},
         {"file = \"missing.obj\"\n", "does not exist"},
         {"file = \"tri.xyz\"\n", "unsupported mesh file"},
-        {"file = \"tri.obj\"\nnormal = \"face\"\n", "normals"},   // did you mean
+        {"file = \"tri.obj\"\nnormal = \"face\"\n", "not used by shape 'mesh'"},
+        {"file = \"tri.obj\"\nnormls = \"face\"\n", "normals"}, // did you mean
         {"file = \"tri.obj\"\nnormals = \"flat\"\n", "expected one of"},
         {"file = \"tri.obj\"\nscale = 0\n", "must not be zero"},
         {"file = \"tri.obj\"\nscale = [1, 0, 1]\n", "must not be zero"},
@@ -138,7 +140,7 @@ TEST_F(SceneParserMesh, BrokenMeshFileIsASceneErrorNamingBoth)
 {
     writeText(m_dir / "broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
     const std::string message = errorOf("file = \"broken.obj\"\n");
-    EXPECT_NE(message.find("scene.toml:10:"), std::string::npos) << message;
+    EXPECT_NE(message.find("scene.toml:11:"), std::string::npos) << message;
     EXPECT_NE(message.find("broken.obj"), std::string::npos) << message;
 }
 
