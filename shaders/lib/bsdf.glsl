@@ -26,8 +26,10 @@ struct BsdfSample {
 vec3 continuationSide(vec3 n, vec3 ns, BsdfSample s)
 {
     vec3 side = s.transmitted ? -n : n;
+#ifdef VKRT_HAS_MESH_NORMALS // only meshes' vertex normals make ns differ from n
     if (ns != n && dot(s.dir, side) < 0.0)
         side = -side;
+#endif
     return side;
 }
 

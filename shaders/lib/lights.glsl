@@ -67,8 +67,10 @@ vec3 transmittanceTo(vec3 point, vec3 origin, vec3 n, MediumStack media)
 // surface (as Mitsuba's spawn_ray does), instead of counting as visible.
 vec3 transmittanceFromSurface(SurfaceHit hit, vec3 n, vec3 ns, vec3 origin, vec3 target, MediumStack media)
 {
+#ifdef VKRT_HAS_MESH_NORMALS // only meshes' vertex normals make ns differ from n
     if (ns != n && dot(target - hit.position, n) < 0.0)
         return transmittanceTo(target, offsetRayOrigin(hit.position, hit.error, -n), -n, media);
+#endif
     return transmittanceTo(target, origin, n, media);
 }
 

@@ -60,8 +60,10 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
             path.radiance += path.throughput * (directFromPointLights(m, hit, n, ns, wo, path.media) +
-                                                directFromTriangleLights(m, hit, n, ns, wo, path.media, rng) +
-                                                directFromEmitters(m, hit, n, ns, wo, path.media, rng));
+                                                directFromTriangleLights(m, hit, n, ns, wo, path.media, rng));
+#ifdef VKRT_HAS_EMITTERS
+            path.radiance += path.throughput * directFromEmitters(m, hit, n, ns, wo, path.media, rng);
+#endif
         }
         if (depth == u.maxDepth)
             break;
