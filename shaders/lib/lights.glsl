@@ -35,7 +35,7 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax, MediumStack media)
         // angle). Fresnel reflectance is the same from either side at that
         // pair of angles, so evaluate it from the less dense side: (1 - F)^2
         // through a slab, and no spurious total internal reflection.
-        float eta = interfaceEta(media, hit.material, hit.front);
+        float eta = surfaceEta(media, hit);
         transmittance *= 1.0 - dielectricReflectance(m.fresnel, abs(dot(dir, hit.normal)), min(eta, 1.0 / eta));
         media = crossInterface(media, hit.material, hit.front);
         vec3 towardsRay = hit.front ? hit.normal : -hit.normal;

@@ -60,11 +60,31 @@ float interfaceEta(MediumStack s, uint material, bool entering)
     float beyond = entering ? materials[material].ior : mediumIor(crossInterface(s, material, false));
     return inside / beyond;
 }
+bool onStack(MediumStack s, uint material)
+{
+    return (s.count > 0u && s.materials[0] == material) || (s.count > 1u && s.materials[1] == material) ||
+           (s.count > 2u && s.materials[2] == material) || (s.count > 3u && s.materials[3] == material);
+}
+
+// n_incident / n_transmitted at a surface hit. A mesh need not be closed:
+// a ray can meet the back of a glass mesh without having entered it
+// (through a hole, as in the Stanford bunny). Like Mitsuba, which decides
+// at each interface by its side alone, such a surface is crossed as if the
+// ray had been inside: from the material's index into the current medium.
+float surfaceEta(MediumStack s, SurfaceHit hit)
+{
+#ifdef VKRT_HAS_MESHES
+    if (hit.shape == SHAPE_MESH && !hit.front && !onStack(s, hit.material))
+        return materials[hit.material].ior / mediumIor(s);
+#endif
+    return interfaceEta(s, hit.material, hit.front);
+}
 #else
 // Without dielectrics a ray is always in air.
 vec3 mediumAbsorption(MediumStack s) { return vec3(0.0); }
 MediumStack crossInterface(MediumStack s, uint material, bool entering) { return s; }
 float interfaceEta(MediumStack s, uint material, bool entering) { return 1.0; }
+float surfaceEta(MediumStack s, SurfaceHit hit) { return 1.0; }
 #endif
 
 #endif

@@ -135,7 +135,7 @@ vec3 tracePath(Ray ray, inout Sampler rng)
                                                 directFromEnvironment(m, hit, n, ns, wo, path.media, rng));
         }
         vec4 u4 = sampleNext4D(rng);
-        float eta = interfaceEta(path.media, hit.material, hit.front);
+        float eta = surfaceEta(path.media, hit);
         BsdfSample s = sampleBsdf(m, ns, wo, eta, u4.xyz);
         if (s.weight == vec3(0.0))
             break;

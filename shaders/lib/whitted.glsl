@@ -67,7 +67,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         }
         if (depth == u.maxDepth)
             break;
-        float eta = interfaceEta(path.media, hit.material, hit.front);
+        float eta = surfaceEta(path.media, hit);
         BsdfSample s = sampleBsdf(m, ns, wo, eta, sampleNext4D(rng).xyz);
         if (s.weight == vec3(0.0))
             break;

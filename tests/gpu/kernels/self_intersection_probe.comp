@@ -80,7 +80,7 @@ void main()
             dir = shadowDir / tMax;
         }
     }
-    HitId second = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true);
+    HitId second = HitId(SHAPE_NONE, 0u, tMax, vec3(0.0), true, 0u);
     bool anyHit = false;
     if (traced) {
         second = findClosest(Ray(origin, dir), tMax);
