@@ -1,6 +1,7 @@
-// libFuzzer target for loadMeshFile: the first byte picks the format, the rest
+// libFuzzer target for the mesh path (loadMeshFile, normals, BVH build): the first byte picks the format, the rest
 // is the file. Any outcome but a MeshData or an InputError (another exception,
 // a crash, a sanitizer report, a hang) is a bug. tools/fuzz.sh runs it.
+#include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "util/Error.h"
 
@@ -44,7 +45,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
     }
     try {
-        vkrt::loadMeshFile(file);
+        // The whole mesh path of a scene: load, smooth normals, BVH, leaf order.
+        vkrt::makeMeshGeometry(file, vkrt::NormalMode::Smooth);
     } catch (const vkrt::InputError&) {
         // the expected outcome for almost every input
     }
