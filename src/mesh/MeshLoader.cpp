@@ -24,6 +24,21 @@
 
 namespace fs = std::filesystem;
 
+// Debian's assimp is built with its internal assertions on (ASSIMP_BUILD_DEBUG),
+// and their handler aborts the process: malformed input that trips one (the
+// fuzzer found a PLY that fails TriangulateProcess's face count) would crash
+// vkrt. This definition replaces the library's (the executable exports it,
+// CMakeLists.txt: --export-dynamic-symbol) and throws instead; importScene
+// turns the exception into an error that names the file.
+namespace Assimp {
+__attribute__((visibility("default"))) void aiAssertViolation(const char* expression, const char* file, int line)
+{
+    throw std::runtime_error("the Open Asset Import Library's internal check failed (" + std::string(expression) +
+                             ", " + std::string(file) + ":" + std::to_string(line) +
+                             "); the file is malformed in a way it does not report");
+}
+} // namespace Assimp
+
 namespace vkrt {
 namespace {
 

@@ -629,3 +629,24 @@ TEST(MeshLoaderNormals, ApplyNormalModeKeepsComputesOrDrops)
     applyNormalMode(none, NormalMode::File);
     EXPECT_TRUE(none.normals.empty());
 }
+
+namespace vkrt::test {
+namespace {
+
+// Found by tools/fuzz.sh: a PLY that trips an internal assertion of
+// Debian's assimp (TriangulateProcess), which would abort the process
+// without src/mesh/MeshLoader.cpp's replacement handler.
+TEST(MeshLoaderBad, AssimpInternalAssertionIsAnErrorNotAnAbort)
+{
+    const std::filesystem::path file =
+        std::filesystem::path(VKRT_TEST_SOURCE_DIR) / "tests" / "fuzz" / "reproducers" / "triangulate-assert.ply";
+    try {
+        loadMeshFile(file);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("triangulate-assert.ply"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace vkrt::test
