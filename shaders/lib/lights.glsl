@@ -62,16 +62,24 @@ vec3 transmittanceTo(vec3 point, vec3 origin, vec3 n, MediumStack media)
 
 // Transmittance to a light sample from a surface with geometric normal n
 // and shading normal ns (both on the side the ray arrived from). With
-// shading normals a light above the shading plane can lie below the
-// geometric one: its shadow ray then starts on that side, through the
-// surface (as Mitsuba's spawn_ray does), instead of counting as visible.
+// shading normals a light above the shading plane can lie behind the
+// geometric one: the surface itself is between them, so it is blocked
+// (where ns == n such a point lies within the surface's error bound and is
+// fully visible, as in transmittanceTo).
 vec3 transmittanceFromSurface(SurfaceHit hit, vec3 n, vec3 ns, vec3 origin, vec3 target, MediumStack media)
 {
+    // transmittanceTo, written out so that the extra case stays inside its
+    // rarely taken branch: kernels without it keep their exact arithmetic.
+    vec3 shadowDir = target - origin;
+    if (dot(shadowDir, n) <= 0.0) {
 #ifdef VKRT_HAS_MESH_NORMALS // only meshes' vertex normals make ns differ from n
-    if (ns != n && dot(target - hit.position, n) < 0.0)
-        return transmittanceTo(target, offsetRayOrigin(hit.position, hit.error, -n), -n, media);
+        if (ns != n)
+            return vec3(0.0);
 #endif
-    return transmittanceTo(target, origin, n, media);
+        return vec3(1.0);
+    }
+    float shadowDist = length(shadowDir);
+    return shadowTransmittance(origin, shadowDir / shadowDist, shadowDist, media);
 }
 
 // A light's contribution to a surface point before visibility, and the point

@@ -67,13 +67,12 @@ vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
     if (f == vec3(0.0))
         return vec3(0.0);
     float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
-    // Through the surface when wi lies below its geometric plane (shading normals; lib/lights.glsl).
 #ifdef VKRT_HAS_MESH_NORMALS
-    vec3 side = (ns != n && dot(wi, n) < 0.0) ? -n : n;
-#else
-    vec3 side = n;
+    // Behind the geometric surface (shading normals): blocked by it (lib/lights.glsl).
+    if (ns != n && dot(wi, n) <= 0.0)
+        return vec3(0.0);
 #endif
-    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, side), wi, FLT_MAX, media);
+    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
     return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
 #else
     return vec3(0.0);
