@@ -319,7 +319,9 @@ TEST_F(WhittedTest, EveryShippedSceneRendersCleanly)
         EXPECT_EQ(counters.rejectedSamples, 0u) << path;
         EXPECT_EQ(counters.budgetExceeded, 0u) << path;
         // Mesh scenes have no static bound (BVH traversal; checked per subgroup where it matters).
-        if (scene.meshes.empty()) EXPECT_LE(counters.maxLoopIterations, worstCaseLoopIterations(scene)) << path;
+        if (scene.meshes.empty()) {
+            EXPECT_LE(counters.maxLoopIterations, worstCaseLoopIterations(scene)) << path;
+        }
         for (float v : renderer.mean().rgb) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << path;
     }
 }
