@@ -13,7 +13,9 @@ namespace vkrt {
 
 /// Loads every mesh of the file (all objects, groups, glTF nodes with their
 /// node transforms applied) as one MeshData; polygons are triangulated,
-/// triangle strips expanded; points and lines are ignored.
+/// points and lines are ignored. PLY triangle strips are refused with an
+/// error: Debian 12's assimp (5.2.5) keeps one triangle per strip (its bug
+/// #2337), and a silently wrong mesh is worse than none.
 MeshData loadMeshFile(const std::filesystem::path& file);
 
 /// The extensions loadMeshFile accepts (lower case, with the dot).
