@@ -1,6 +1,6 @@
 // vkrt-bvh-bench: BVH build time, peak memory and traversal work for
 // procedural meshes (an optional target: `cmake --build build --target vkrt-bvh-bench`).
-//   vkrt-bvh-bench soup|sphere TRIANGLES [THREADS]
+//   vkrt-bvh-bench soup|sphere TRIANGLES [THREADS [TRAVERSAL_COST]]
 // Memory: the growth of the peak resident set during the build (Linux:
 // /proc/self/clear_refs resets the peak first), i.e. the nodes, the order,
 // the centroids and the build's transient arrays, not the mesh or its boxes.
@@ -39,6 +39,8 @@ int main(int argc, char** argv)
     const std::string kind = argv[1];
     const uint32_t triangles = uint32_t(std::strtoul(argv[2], nullptr, 10));
     const uint32_t threads = argc > 3 ? uint32_t(std::strtoul(argv[3], nullptr, 10)) : 0;
+    vkrt::BvhOptions options{.threads = threads};
+    if (argc > 4) options.traversalCost = std::strtod(argv[4], nullptr);
     const vkrt::MeshData mesh =
         kind == "sphere" ? vkrt::makeUvSphere(triangles, glm::vec3(0.0f), 1.0f) : vkrt::makeRandomSoup(triangles, 1);
     const auto start = std::chrono::steady_clock::now();
@@ -46,7 +48,7 @@ int main(int argc, char** argv)
     const double boxSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     resetPeak();
     const long before = statusKiB("VmRSS");
-    const vkrt::Bvh bvh = vkrt::buildBvh(boxes, vkrt::BvhOptions{.threads = threads});
+    const vkrt::Bvh bvh = vkrt::buildBvh(boxes, options);
     const long peak = statusKiB("VmHWM");
 
     // Traversal work: rays from a sphere of radius 3 towards points inside the mesh's cube.
