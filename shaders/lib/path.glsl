@@ -120,14 +120,16 @@ vec3 tracePath(Ray ray, inout Sampler rng)
             path.radiance += path.throughput * emissionOnHit(path, ray, hit);
             break;
         }
+#ifdef VKRT_HAS_EMITTERS
         if (hit.emitter != NO_EMITTER)
             path.radiance += path.throughput * emitterOnHit(path, ray, hit);
+#endif
         if (depth == u.maxDepth + 1u)
             break; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
         vec3 n = hit.front ? hit.normal : -hit.normal;
-        vec3 ns = hit.front ? hit.shading : -hit.shading;
+        vec3 ns = shadingSide(hit, n);
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
             path.radiance += path.throughput * (directFromLightsOneShadowRay(m, hit, n, ns, wo, path.media, rng) +

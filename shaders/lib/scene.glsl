@@ -37,6 +37,18 @@ const uint NO_EMITTER = 0xffffffffu;
 
 bool hitsLight(SurfaceHit hit) { return hit.shape >= SHAPE_LIGHT; }
 
+// The shading normal on the side of n (the geometric normal facing the ray);
+// only meshes with vertex normals have one of their own, and the other
+// variants never read the field.
+vec3 shadingSide(SurfaceHit hit, vec3 n)
+{
+#ifdef VKRT_HAS_MESH_NORMALS
+    return hit.front ? hit.shading : -hit.shading;
+#else
+    return n;
+#endif
+}
+
 // The closest primitive along the ray: its shape kind, index and distance,
 // and what the test learnt on the way: a sphere's hit point relative to its
 // centre, a box's face normal, a triangle's barycentrics (`detail`), and for
@@ -657,14 +669,18 @@ SurfaceHit describeHit(Ray r, HitId id)
     hit.error = gammaBound(3) * (abs(r.origin) + abs(id.t * r.dir));
     hit.normal = -r.dir;
     hit.front = id.front;
+#ifdef VKRT_HAS_MESHES
     hit.emitter = NO_EMITTER;
+#endif
     hit.shape = id.shape;
     hit.index = id.index;
     hit.material = 0u;
     VKRT_SHAPE_KINDS(VKRT_DESCRIBE_SHAPE)
     VKRT_LIGHT_KINDS(VKRT_DESCRIBE_LIGHT)
+#ifdef VKRT_HAS_MESHES
     if (id.shape != SHAPE_MESH)
         hit.shading = hit.normal;
+#endif
     return hit;
 }
 

@@ -56,7 +56,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
         vec3 n = hit.front ? hit.normal : -hit.normal;
-        vec3 ns = hit.front ? hit.shading : -hit.shading;
+        vec3 ns = shadingSide(hit, n);
         vec3 wo = -ray.dir;
         if (!isDeltaMaterial(m.type)) {
             path.radiance += path.throughput * (directFromPointLights(m, hit, n, ns, wo, path.media) +
