@@ -174,9 +174,7 @@ struct SceneUniforms {
     uint cameraMediumCount; // dielectrics containing the eye (lib/media.glsl)
     uvec4 cameraMedia;      // their materials, innermost last
     uint emitterCount;      // Emitter records (emissive mesh triangles)
-    float emitterPower;     // their total power (W), for choosing between emitters and other lights
     uint topNodeCount;      // nodes of the top-level BVH (0: none; the kernel loops over the arrays)
-    uint pad0;
 };
 
 /// Per-batch values (push constants), pushed once per submission: lavapipe

@@ -468,7 +468,6 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
     u.cameraMediumCount = uint32_t(media.size());
     for (size_t i = 0; i < media.size(); ++i) u.cameraMedia[int(i)] = media[i];
     u.emitterCount = uint32_t(data.emitters.size());
-    u.emitterPower = float(fixed.emitters.totalPower);
     u.topNodeCount = uint32_t(data.topNodes.size());
     return data;
 }
