@@ -4,7 +4,9 @@
 # ../shared/assets and the scenes of scenes/. Exits non-zero if either finds a
 # crash, a sanitizer report, a leak, a hang or an exception other than
 # InputError; the input that did it is kept in build-fuzz/artifacts/.
-#   tools/fuzz.sh [SECONDS]   environment: JOBS (build jobs, default 2), VKRT_ASSETS_DIR
+# The mutation seed is fixed (VKRT_FUZZ_SEED, default 1) so that a CI run
+# explores the same inputs each time; set another to search further.
+#   tools/fuzz.sh [SECONDS]   environment: JOBS (build jobs, default 2), VKRT_ASSETS_DIR, VKRT_FUZZ_SEED
 set -euo pipefail
 
 seconds=${1:-60}
@@ -44,7 +46,7 @@ find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
 status=0
 run() { # TARGET CORPUS
   echo "fuzz: running $1 for $seconds s on $(find "$2" -type f | wc -l) seeds"
-  if ! "$build/tests/fuzz/$1" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+  if ! "$build/tests/fuzz/$1" -max_total_time="$seconds" -seed="${VKRT_FUZZ_SEED:-1}" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$build/artifacts/$1-" "$2" >"$work/$1.log" 2>&1; then
     status=1
     tail -n 60 "$work/$1.log"

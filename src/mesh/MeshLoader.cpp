@@ -1,5 +1,7 @@
 #include "mesh/MeshLoader.h"
 
+#include "mesh/PlyHeader.h"
+
 #include "util/Error.h"
 #include "util/Hash.h"
 
@@ -181,25 +183,6 @@ void checkIsMeshFile(const fs::path& file)
         fail(file, "unsupported mesh file extension '" + extension + "' (supported: " + list + ")");
     }
     if (fs::file_size(file, error) == 0 && !error) fail(file, "empty file");
-}
-
-/// Assimp up to at least 5.4 keeps one triangle per `tristrips` element
-/// (assimp issue #2337): refuse such files rather than render a wrong mesh.
-void rejectPlyTriangleStrips(const fs::path& file)
-{
-    std::ifstream in(file, std::ios::binary);
-    std::string header(4096, '\0');
-    in.read(header.data(), static_cast<std::streamsize>(header.size()));
-    header.resize(static_cast<size_t>(in.gcount()));
-    header = header.substr(0, header.find("end_header"));
-    std::istringstream lines(header);
-    for (std::string line; std::getline(lines, line);) {
-        const std::vector<std::string> words = tokens(line);
-        if (words.size() >= 2 && words[0] == "element" && words[1] == "tristrips") {
-            fail(file, "PLY triangle strips (element 'tristrips') are not supported: the Open Asset Import Library "
-                       "loads only one triangle of each strip; convert the strips to faces (e.g. with MeshLab)");
-        }
-    }
 }
 
 // ---------------------------------------------------------------------------
@@ -403,7 +386,7 @@ MeshData loadMeshFile(const fs::path& file)
 {
     checkIsMeshFile(file);
     const std::string extension = lowerExtension(file);
-    if (extension == ".ply") rejectPlyTriangleStrips(file);
+    if (extension == ".ply") checkPlyHeader(file);
     Assimp::Importer importer;
     const aiScene* scene = importScene(importer, file, extension);
     MeshData mesh = convertScene(*scene, MeshCheck{file, extension});

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 namespace fs = std::filesystem;
 using namespace vkrt;
@@ -246,8 +247,61 @@ TEST(MeshLoaderPly, TriangleStripsAreRefusedRatherThanLoadedWrong)
                              "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 2 3\n";
     const fs::path file = writeFile(testDir() / "strip.ply", text);
     const std::string message = loadError(file);
-    EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0u) << message;
+    EXPECT_EQ(message.rfind(file.string() + ":7: ", 0), 0u) << message;
     EXPECT_NE(message.find("tristrips"), std::string::npos) << message;
+}
+
+TEST(MeshLoaderPly, MalformedHeadersAreRefusedWithTheirLine)
+{
+    // Assimp 5.2 trusts the header; each of these made it loop or allocate
+    // for minutes (the first is what tools/fuzz.sh found, trimmed).
+    const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string body = "0 0 0\n1 0 0\n0 1 0\n";
+    const std::vector<std::tuple<std::string, std::string, int, std::string>> cases{
+        {"two-words", "ply\nformat ascii 1.0\n" + vertex + "property floatnd_header\n" + body, 7,
+         "a PLY property line must read"},
+        {"unknown-type", "ply\nformat ascii 1.0\n" + vertex + "property float64x w\n" + body, 7,
+         "unknown PLY type 'float64x'"},
+        {"no-end", "ply\nformat ascii 1.0\n" + vertex, 6, "no 'end_header'"},
+        {"huge-count", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+                       "end_header\n0000",
+         3, "declares 4000000000 instances"},
+        {"ascii-count", "ply\nformat ascii 1.0\nelement vertex 300\nproperty float x\nproperty float y\n"
+                        "property float z\nend_header\n" + body,
+         3, "more than the rest of the file can hold"},
+        {"no-properties", "ply\nformat ascii 1.0\nelement vertex 99\nend_header\n" + body, 3, "no properties"},
+        {"bad-count", "ply\nformat ascii 1.0\nelement vertex -3\n", 3, "not a non-negative integer"},
+        {"bad-line", "ply\nformat ascii 1.0\nvertex 3\n", 3, "unknown PLY header line 'vertex'"},
+        {"bad-format", "ply\nformat ascii 2.0\n", 2, "format line"},
+        {"no-format", "ply\n" + vertex, 2, "no 'format' line"},
+    };
+    const fs::path dir = testDir();
+    for (const auto& [name, text, line, expected] : cases) {
+        SCOPED_TRACE(name);
+        const fs::path file = writeFile(dir / (name + ".ply"), text);
+        const std::string message = loadError(file);
+        const std::string prefix = file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": ";
+        EXPECT_EQ(message.rfind(prefix, 0), 0u) << message;
+        EXPECT_NE(message.find(expected), std::string::npos) << message;
+    }
+}
+
+TEST(MeshLoaderPly, HeaderCheckAcceptsTheCommonSpellings)
+{
+    // CRLF lines, obj_info, comments, int8/float32 names and a list whose
+    // count is all a binary face needs: none of it is refused.
+    std::string text = "ply\r\nformat binary_little_endian 1.0\r\ncomment made by hand\r\nobj_info test\r\n"
+                       "element vertex 3\r\nproperty float32 x\r\nproperty float32 y\r\nproperty float32 z\r\n"
+                       "element face 1\r\nproperty list uint8 int32 vertex_indices\r\nend_header\n";
+    for (const glm::vec3& p : {glm::vec3(0, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)}) {
+        put(text, p.x);
+        put(text, p.y);
+        put(text, p.z);
+    }
+    put(text, uint8_t(3));
+    for (const int32_t index : {0, 1, 2}) put(text, index);
+    const MeshData mesh = loadMeshFile(writeFile(testDir() / "spellings.ply", text));
+    EXPECT_EQ(mesh.triangles.size(), 1u);
 }
 
 // ---------------------------------------------------------------------------
@@ -636,6 +690,19 @@ namespace {
 // Found by tools/fuzz.sh: a PLY that trips an internal assertion of
 // Debian's assimp (TriangulateProcess), which would abort the process
 // without src/mesh/MeshLoader.cpp's replacement handler.
+TEST(MeshLoaderBad, FuzzedPlyHeaderIsAnErrorNotAHang)
+{
+    const std::filesystem::path file =
+        std::filesystem::path(VKRT_TEST_SOURCE_DIR) / "tests" / "fuzz" / "reproducers" / "ply-header-hang.ply";
+    try {
+        loadMeshFile(file);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("ply-header-hang.ply:8: a PLY property line must read"), std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(MeshLoaderBad, AssimpInternalAssertionIsAnErrorNotAnAbort)
 {
     const std::filesystem::path file =
