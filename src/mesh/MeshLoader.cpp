@@ -1,6 +1,6 @@
 #include "mesh/MeshLoader.h"
 
-#include "mesh/PlyHeader.h"
+#include "mesh/PlyReader.h"
 
 #include "util/Error.h"
 #include "util/Hash.h"
@@ -386,7 +386,7 @@ MeshData loadMeshFile(const fs::path& file)
 {
     checkIsMeshFile(file);
     const std::string extension = lowerExtension(file);
-    if (extension == ".ply") checkPlyHeader(file);
+    if (extension == ".ply") return readPlyFile(file); // not assimp: see PlyReader.h
     Assimp::Importer importer;
     const aiScene* scene = importScene(importer, file, extension);
     MeshData mesh = convertScene(*scene, MeshCheck{file, extension});

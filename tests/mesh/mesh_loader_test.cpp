@@ -453,13 +453,14 @@ TEST(MeshLoaderBad, NonFiniteObjCoordinateNamesLineAndVertex)
 TEST(MeshLoaderBad, NonFinitePlyCoordinateNamesVertex)
 {
     std::string bytes = plyHeader("binary_little_endian", "float", "uchar", "int", 1);
+    const size_t thirdVertex = bytes.size() + 2 * 12; // where the message must point
     for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, std::numeric_limits<float>::infinity(), 0.f, 1.f, 1.f, 0.f}) {
         put<float>(bytes, v);
     }
     put<uint8_t>(bytes, 3);
     for (int32_t i : {0, 1, 2}) put<int32_t>(bytes, i);
     const fs::path file = writeFile(testDir() / "inf.ply", bytes);
-    expectErrorNaming(file, "vertex 2 (counting from 0) has a non-finite coordinate (0, inf, 0)");
+    expectErrorNaming(file, "inf.ply: byte " + std::to_string(thirdVertex) + ": vertex 2 (counting from 0) has a non-finite coordinate (0, inf, 0)");
 }
 
 TEST(MeshLoaderBad, ObjIndexOutOfRangeNamesTheLine)
@@ -472,14 +473,14 @@ TEST(MeshLoaderBad, ObjIndexOutOfRangeNamesTheLine)
 TEST(MeshLoaderBad, PlyIndexOutOfRange)
 {
     const std::string text = plyHeader("ascii", "float", "uchar", "int", 1) + "0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 4\n";
-    expectErrorNaming(writeFile(testDir() / "beyond.ply", text), "out of range");
+    expectErrorNaming(writeFile(testDir() / "beyond.ply", text), "beyond.ply:15: face 0 (counting from 0) uses vertex 4 of only 4");
 }
 
 TEST(MeshLoaderBad, MalformedAsciiPlyNumber)
 {
     // Found by fuzzing: assimp throws halfway through the vertices (and leaks, see above).
     const std::string text = plyHeader("ascii", "float", "uchar", "int", 1) + "0 0 0\n1 0 0\n$1 1 0\n0 1 0\n3 0 1 2\n";
-    expectErrorNaming(writeFile(testDir() / "number.ply", text), "cannot read the PLY file");
+    expectErrorNaming(writeFile(testDir() / "number.ply", text), "number.ply:13: vertex 2 (counting from 0) has '$1', not a number");
 }
 
 TEST(MeshLoaderBad, TruncatedBinaryPly)
@@ -699,6 +700,22 @@ TEST(MeshLoaderBad, FuzzedPlyHeaderIsAnErrorNotAHang)
         FAIL() << "expected InputError";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("ply-header-hang.ply:8: a PLY property line must read"), std::string::npos)
+            << e.what();
+    }
+}
+
+// Found by tools/fuzz.sh: an ASCII PLY whose vertex lines run into the face
+// lines; assimp's importer read past its data and died of SIGBUS.
+TEST(MeshLoaderBad, FuzzedTruncatedPlyBodyIsAnErrorNotACrash)
+{
+    const std::filesystem::path file =
+        std::filesystem::path(VKRT_TEST_SOURCE_DIR) / "tests" / "fuzz" / "reproducers" / "ply-truncated-body.ply";
+    try {
+        loadMeshFile(file);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("ply-truncated-body.ply:141: vertex 128 (counting from 0) has fewer"),
+                  std::string::npos)
             << e.what();
     }
 }
