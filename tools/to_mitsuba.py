@@ -784,7 +784,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 r.fail(f"{where}.ior", f"must be in [1, 1e30], got {ior:g}")
             absorption = r.color(m, "absorption", where, 0.0, 0.0)
             bsdf = {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
-            roughness = r.number(m, "roughness", where, 0.0) if mtype == "rough_dielectric" else 0.0
+            roughness = r.number(m, "roughness", where, math.sqrt(0.1)) if mtype == "rough_dielectric" else 0.0
             if roughness > 0:
                 bsdf.update({"type": "roughdielectric", "distribution": "ggx", "sample_visible": True,
                              "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
@@ -810,9 +810,11 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 eta, k = METALS.get(r.string(m, "metal", where), (None, None))
                 if eta is None:
                     r.fail(f"{where}.metal", f"unknown metal '{m['metal']}' (known: {', '.join(sorted(METALS))})")
-            else:
+            elif "eta" in m or "k" in m:
                 eta = r.color(m, "eta", where, None, 0.0)
                 k = r.color(m, "k", where, None, 0.0)
+            else:  # vkrt's default, Mitsuba's material "none"
+                eta, k = [0.0] * 3, [1.0] * 3
             tint = r.color(m, "tint", where, 1.0, 0.0, 1.0)
             inner = {"type": "conductor", "eta": _rgb(eta), "k": _rgb(k), "specular_reflectance": _rgb(tint)}
             if roughness > 0:

@@ -163,11 +163,37 @@ double roughSpecularAlbedo(double mu, double alpha, double eta, int quadratureOr
     return integratePiecewise(azimuthIntegral, 0.0, halfPi, psiBreaks, n);
 }
 
+double roughTransmittance(double mu, double alpha, double eta)
+{
+    checkArguments(alpha, eta);
+    alpha = std::max(alpha, 1e-4);
+    const Ggx ggx{alpha, alpha};
+    const glm::dvec3 w(std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, std::clamp(mu, 1e-6, 1.0));
+    // The expected (1 - F) G1(t, m) over visible normals m, t the refracted direction: Mitsuba 3's
+    // eval_transmittance, with its quadrature (Gauss-Legendre on the square of the visible-normal
+    // sampler's inputs, 32 x 32 nodes for eta > 1, 128 x 128 below), so that its tables are matched.
+    const int n = eta > 1.0 ? 32 : 128;
+    const GaussLegendre& rule = gaussLegendre(n);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+            const glm::dvec3 m = ggx.sampleVisibleNormal(w, 0.5 * rule.nodes[i] + 0.5, 0.5 * rule.nodes[j] + 0.5);
+            const double cosI = glm::dot(w, m);
+            const DielectricFresnel fresnel = fresnelDielectric(cosI, eta);
+            if (fresnel.reflectance >= 1.0) continue;
+            const glm::dvec3 t = -fresnel.etaTI * w + (fresnel.etaTI * cosI - fresnel.cosT) * m;
+            if (t.z * w.z >= 0.0) continue;
+            sum += ggx.g1(t, m) * (1.0 - fresnel.reflectance) * rule.weights[i] * rule.weights[j] * 0.25;
+        }
+    }
+    return sum;
+}
+
 std::array<float, kRoughTransmittanceResolution> roughTransmittanceTable(double alpha, double eta)
 {
     std::array<float, kRoughTransmittanceResolution> table{};
     for (int i = 0; i < kRoughTransmittanceResolution; ++i)
-        table[i] = float(1.0 - roughSpecularAlbedo(roughTransmittanceCosine(i), alpha, eta));
+        table[i] = float(roughTransmittance(roughTransmittanceCosine(i), alpha, eta));
     return table;
 }
 

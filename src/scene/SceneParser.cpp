@@ -241,10 +241,14 @@ void readConductorIor(const TableField& table, Material& material)
         material.k = ior.k;
         return;
     }
+    if (!eta && !k) { // Mitsuba's material "none": eta 0, k 1 reflects everything at every angle
+        material.eta = Color(0.0);
+        material.k = Color(1.0);
+        return;
+    }
     if (!eta || !k) {
-        if (eta || k) table.field().fail(std::string("a conductor with '") + (eta ? "eta" : "k") + "' needs '" +
-                                         (eta ? "k" : "eta") + "' too");
-        table.field().fail("a conductor needs 'metal' (e.g. \"Au\") or 'eta' and 'k'");
+        table.field().fail(std::string("a conductor with '") + (eta ? "eta" : "k") + "' needs '" +
+                           (eta ? "k" : "eta") + "' too");
     }
     material.eta = readRadiance(*eta);
     material.k = readRadiance(*k);
@@ -258,11 +262,12 @@ void readConductor(const TableField& table, Material& material)
     readConductorIor(table, material);
 }
 
-/// Roughness 0 is the smooth dielectric itself: the same kind, kernel and image.
+/// Roughness 0 is the smooth dielectric itself: the same kind, kernel and
+/// image. The default is Mitsuba's roughdielectric alpha = 0.1.
 void readRoughDielectric(const TableField& table, Material& material)
 {
     readDielectric(table, material);
-    material.roughness = readOr(table, "roughness", 0.0, readUnitInterval);
+    material.roughness = readOr(table, "roughness", std::sqrt(0.1), readUnitInterval);
     if (material.roughness == 0.0) material.type = MaterialType::Dielectric;
 }
 
