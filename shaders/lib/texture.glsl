@@ -94,7 +94,7 @@ vec4 sampleTextureLevel(uint textureIndex, vec2 uv, uint level)
 
 /// Trilinear lookup: bilinear in levels floor(lod) and floor(lod) + 1, mixed
 /// by the fraction. `lod` is log2 of the footprint in level-0 texels (see
-/// textureLod), clamped to [0, levels - 1]; NaN counts as 0.
+/// rayConeTextureLod), clamped to [0, levels - 1]; NaN counts as 0.
 vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
 {
     float top = float(textureRecords[textureIndex].levels - 1u);
@@ -109,14 +109,14 @@ vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
 
 /// Mip level from a ray cone (Akenine-Möller et al. 2019, "Texture Level of
 /// Detail Strategies for Real-Time Ray Tracing", Ray Tracing Gems ch. 20,
-/// eq. 34): lod = 0.5 log2(w h * uvArea / worldArea) + log2(coneWidth / |cos|),
+/// ray cones): lod = 0.5 log2(w h * uvArea / worldArea) + log2(coneWidth / |cos|),
 /// where w x h is level 0's size, uvAreaPerWorldArea the triangle's uv area
 /// over its world area (the texel density term Delta), coneWidth the cone's
 /// width at the hit and cosTheta the cosine between the ray and the normal.
 /// |cos| is kept above 1e-4 so a grazing hit gives a large, finite lod; a
 /// degenerate uv mapping (0 area) gives -infinity, which sampleTexture treats
-/// as level 0.
-float textureLod(uint textureIndex, float coneWidth, float cosTheta, float uvAreaPerWorldArea)
+/// as level 0. (Not called textureLod: GLSL has a built-in of that name.)
+float rayConeTextureLod(uint textureIndex, float coneWidth, float cosTheta, float uvAreaPerWorldArea)
 {
     float texels = float(textureRecords[textureIndex].width) * float(textureRecords[textureIndex].height);
     return 0.5 * log2(texels * uvAreaPerWorldArea) + log2(coneWidth / max(abs(cosTheta), 1e-4));

@@ -68,7 +68,10 @@ TEST(MipPyramid, CheckerboardMeanIsKeptAtEveryLevel)
 }
 
 /// Length of [a0, a1) inside [b0, b1).
-double overlap(double a0, double a1, double b0, double b1) { return std::max(0.0, std::min(a1, b1) - std::max(a0, b0)); }
+double overlap(double a0, double a1, double b0, double b1)
+{
+    return std::max(0.0, std::min(a1, b1) - std::max(a0, b0));
+}
 
 // Every level of odd, even and mixed sizes is the exact area average of level
 // 0 over each texel's footprint (computed here by brute force in 2D).

@@ -43,7 +43,7 @@ TEST(TextureImage, EverySrgbCodeDecodesByTheExactFormula)
 {
     std::vector<uint8_t> samples;
     for (int code = 0; code < 256; ++code)
-        for (uint8_t value : {uint8_t(code), uint8_t(code), uint8_t(code), uint8_t(255 - code)}) samples.push_back(value);
+        samples.insert(samples.end(), {uint8_t(code), uint8_t(code), uint8_t(code), uint8_t(255 - code)});
     const fs::path file = write8BitPng(textureTestDir() / "ramp.png", 256, 1, 4, samples);
     const TextureImage image = loadTextureImage(file, false);
     EXPECT_EQ(image.encoding, TexelEncoding::Srgb8);
