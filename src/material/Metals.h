@@ -1,23 +1,23 @@
 #pragma once
-// Named metals for `type = "conductor"`, `metal = "Au"`: complex indices of
-// refraction eta + i k per RGB channel.
-#include "scene/Scene.h"
-
-#include <optional>
+// Named conductors for `type = "conductor"`, `metal = "Au"`: complex indices of refraction per RGB channel.
+#include <array>
+#include <string>
 #include <string_view>
 #include <vector>
 
 namespace vkrt {
 
-struct ConductorIor {
-    Color eta;
-    Color k;
+/// Complex index of refraction eta + i k of a named conductor, per linear sRGB channel.
+struct Metal {
+    std::string_view name;
+    std::array<double, 3> eta;
+    std::array<double, 3> k;
 };
 
-/// The metal called `name` (case-sensitive chemical symbol), if vkrt knows it.
-std::optional<ConductorIor> findMetal(std::string_view name);
+/// The named conductor, or nullptr when there is none of that name (names are case-sensitive, as Mitsuba's).
+const Metal* findMetal(std::string_view name);
 
-/// Every known name, for messages (did-you-mean, the list of choices).
-const std::vector<std::string_view>& metalNames();
+/// Every name findMetal knows, in table order (for "did you mean" messages and docs).
+std::vector<std::string> metalNames();
 
 } // namespace vkrt

@@ -221,29 +221,27 @@ double readUnitInterval(const Field& field) { return readNumberIn(field, NumberR
 /// Anisotropy 1 would give one of the alphas zero width: [0, 1).
 double readAnisotropy(const Field& field) { return readNumberIn(field, NumberRange{0.0, 1.0, false, true}); }
 
-ConductorIor readMetal(const Field& field)
+const Metal& readMetal(const Field& field)
 {
     const std::string name = readString(field);
-    if (const std::optional<ConductorIor> ior = findMetal(name)) return *ior;
-    const std::vector<std::string_view>& names = metalNames();
+    if (const Metal* metal = findMetal(name)) return *metal;
+    const std::vector<std::string> owned = metalNames();
+    const std::vector<std::string_view> names(owned.begin(), owned.end());
     field.fail("unknown metal " + quote(name) + didYouMean(name, names) + " (expected one of: " + joinList(names) +
                ", or give eta and k)");
 }
+
+Color toColor(const std::array<double, 3>& c) { return {c[0], c[1], c[2]}; }
 
 /// A conductor's complex index: a named metal, or eta and k (both, per channel).
 void readConductorIor(const TableField& table, Material& material)
 {
     const std::optional<Field> metal = table.find("metal"), eta = table.find("eta"), k = table.find("k");
     if (metal && (eta || k)) (eta ? *eta : *k).fail("give either 'metal' or 'eta' and 'k', not both");
-    if (metal) {
-        const ConductorIor ior = readMetal(*metal);
-        material.eta = ior.eta;
-        material.k = ior.k;
-        return;
-    }
-    if (!eta && !k) { // Mitsuba's material "none": eta 0, k 1 reflects everything at every angle
-        material.eta = Color(0.0);
-        material.k = Color(1.0);
+    if (!eta && !k) { // the default: Mitsuba's material "none", which reflects everything at every angle
+        const Metal& chosen = metal ? readMetal(*metal) : *findMetal("none");
+        material.eta = toColor(chosen.eta);
+        material.k = toColor(chosen.k);
         return;
     }
     if (!eta || !k) {
