@@ -1,0 +1,82 @@
+// The microfacet BSDFs of lib/bsdf.glsl in the local frame (n = +z), for the
+// sampling-density and energy tests of tests/gpu/microfacet_probe_test.cpp.
+// inputs[0 .. 24]: one Material, member by member in the order of
+// shared/SceneTypes.h (uints as float values); inputs[25 .. 27]: wo;
+// inputs[28]: eta (n_i / n_t of the interface); inputs[29]: mode;
+// inputs[30]: seed; inputs[64 ..]: a rough plastic's coating table
+// (Material::table = 64 points here). Mode 0, invocation i: one sample with
+// uniforms from pcg4d(i, seed): outputs[8i ..] = dir.xyz, weight.xyz,
+// pdfBsdf(dir) (reflection only; 0 for transmitted and delta samples),
+// flags (1 specular, 2 transmitted, 4 no sample). Mode 1: evaluates at
+// wi = inputs[128 + 3i ..]: outputs[8i ..] = evalBsdf(wi).xyz, pdfBsdf(wi).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "probe.glsl"
+#define VKRT_MATERIAL_CONDUCTOR 1
+#define VKRT_MATERIAL_ROUGH_DIELECTRIC 1
+#define VKRT_MATERIAL_PLASTIC 1
+#define VKRT_MATERIAL_PBR 1
+#define VKRT_HAS_MATERIAL_TABLES 1
+#define materialTables inputs
+#include "lib/pcg.glsl"
+#include "lib/fresnel.glsl"
+#include "lib/sampling.glsl"
+#include "lib/microfacet.glsl"
+#include "lib/bsdf.glsl"
+
+Material probeMaterial()
+{
+    Material m;
+    m.diffuse = vec3(inputs[0], inputs[1], inputs[2]);
+    m.type = uint(inputs[3]);
+    m.specular = vec3(inputs[4], inputs[5], inputs[6]);
+    m.exponent = inputs[7];
+    m.absorption = vec3(inputs[8], inputs[9], inputs[10]);
+    m.ior = inputs[11];
+    m.fresnel = uint(inputs[12]);
+    m.alphaX = inputs[13];
+    m.alphaY = inputs[14];
+    m.table = inputs[15] < 0.0 ? NO_MATERIAL_TABLE : uint(inputs[15]);
+    m.eta = vec3(inputs[16], inputs[17], inputs[18]);
+    m.metallic = inputs[19];
+    m.k = vec3(inputs[20], inputs[21], inputs[22]);
+    m.lobeWeight = inputs[23];
+    m.internalReflectance = inputs[24];
+    return m;
+}
+
+void main()
+{
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= invocationCount)
+        return;
+    Material m = probeMaterial();
+    vec3 n = vec3(0.0, 0.0, 1.0);
+    vec3 wo = vec3(inputs[25], inputs[26], inputs[27]);
+    float eta = inputs[28];
+#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
+    m = withInterfaceEta(m, eta);
+#endif
+    if (inputs[29] == 0.0) {
+        uvec4 bits = pcg4d(uvec4(i, uint(inputs[30]), 0x9e3779b9u, 7u));
+        vec3 u = vec3(bits.xyz >> 8u) * (1.0 / 16777216.0);
+        BsdfSample s = sampleBsdf(m, n, wo, eta, u);
+        bool none = s.weight == vec3(0.0);
+        float pdf = (none || s.specular || s.transmitted) ? 0.0 : pdfBsdf(m, n, wo, s.dir);
+        outputs[8 * i + 0] = s.dir.x;
+        outputs[8 * i + 1] = s.dir.y;
+        outputs[8 * i + 2] = s.dir.z;
+        outputs[8 * i + 3] = s.weight.x;
+        outputs[8 * i + 4] = s.weight.y;
+        outputs[8 * i + 5] = s.weight.z;
+        outputs[8 * i + 6] = pdf;
+        outputs[8 * i + 7] = float((s.specular ? 1u : 0u) | (s.transmitted ? 2u : 0u) | (none ? 4u : 0u));
+    } else {
+        vec3 wi = vec3(inputs[128 + 3 * i], inputs[129 + 3 * i], inputs[130 + 3 * i]);
+        vec3 f = evalBsdf(m, n, wo, wi);
+        outputs[8 * i + 0] = f.x;
+        outputs[8 * i + 1] = f.y;
+        outputs[8 * i + 2] = f.z;
+        outputs[8 * i + 3] = pdfBsdf(m, n, wo, wi);
+    }
+}
