@@ -95,13 +95,45 @@ TEST(MicrofacetAlbedo, TableFollowsMitsubasLayoutAndInterpolation)
     EXPECT_DOUBLE_EQ(roughTransmittanceCosine(21), 21.0 / 63.0);
     auto table = roughTransmittanceTable(0.25, 1.5);
     for (int i : {0, 1, 30, 63}) {
-        EXPECT_NEAR(table[i], 1.0 - roughSpecularAlbedo(roughTransmittanceCosine(i), 0.25, 1.5), 1e-7);
+        EXPECT_NEAR(table[i], roughTransmittance(roughTransmittanceCosine(i), 0.25, 1.5), 1e-7);
         EXPECT_NEAR(lerpTransmittance(table, i / 63.0), table[i], 1e-7);
     }
     EXPECT_NEAR(lerpTransmittance(table, 10.5 / 63.0), 0.5 * (table[10] + table[11]), 1e-7);
     // Transmittance grows towards normal incidence for a dielectric seen from outside.
     EXPECT_LT(table[1], table[32]);
     EXPECT_LT(table[32], table[63]);
+}
+
+TEST(MicrofacetAlbedo, TransmittanceLosesWhatMaskingLosesAndHasTheSmoothLimit)
+{
+    for (double alpha : {0.05, 0.3, 1.0}) {
+        for (double mu : {1.0, 0.5, 0.1, 0.02}) {
+            // Transmitted plus reflected energy is at most 1: masking on either side only loses light.
+            const double t = roughTransmittance(mu, alpha, 1.5), r = roughSpecularAlbedo(mu, alpha, 1.5);
+            EXPECT_GT(t, 0.0);
+            EXPECT_LE(t + r, 1.0 + 2e-4) << "alpha " << alpha << " mu " << mu;
+        }
+    }
+    // A nearly smooth interface transmits 1 - F.
+    for (double mu : {1.0, 0.6, 0.2})
+        EXPECT_NEAR(roughTransmittance(mu, 1e-4, 1.5), 1.0 - fresnelDielectric(mu, 1.5).reflectance, 2e-3);
+}
+
+TEST(MicrofacetAlbedo, PlasticTablesMatchMitsubasRoughplastic)
+{
+    // Measured with Mitsuba 3.9.1 (scalar_rgb): roughplastic, ggx, alpha 0.36, int_ior 1.8, diffuse 0.8,
+    // nonlinear false; eval of the diffuse component without its cosine at (cos_i, cos_o):
+    // (1, 1) 0.131043, (0.5, 0.8) 0.118822, (0.2, 0.9) 0.105247.
+    const double alpha = 0.36, eta = 1.8, rho = 0.8;
+    const auto table = roughTransmittanceTable(alpha, eta);
+    const double fdr = internalDiffuseReflectance(alpha, eta);
+    auto diffuse = [&](double ci, double co) {
+        return rho / (1.0 - fdr) / (eta * eta) * lerpTransmittance(table, ci) * lerpTransmittance(table, co) /
+               std::numbers::pi;
+    };
+    EXPECT_NEAR(diffuse(1.0, 1.0), 0.131043, 1e-3 * 0.131043);
+    EXPECT_NEAR(diffuse(0.5, 0.8), 0.118822, 1e-3 * 0.118822);
+    EXPECT_NEAR(diffuse(0.2, 0.9), 0.105247, 1e-3 * 0.105247);
 }
 
 TEST(MicrofacetAlbedo, InternalReflectanceHasTheSmoothLimit)
