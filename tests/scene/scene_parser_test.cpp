@@ -498,6 +498,23 @@ const std::vector<BadScene> kBadScenes = {
     {"UnknownTopLevelKey", "title = 1\n" + kCamera, 1, 1, "unknown top-level key 'title'"},
     {"UnknownMaterialType", kCamera + "[materials.red]\ntype = \"lambret\"\n", 6, 8,
      "materials.red.type: unknown material type 'lambret'; did you mean 'lambert'?"},
+    {"RoughnessAboveOne", kCamera + "[materials.m]\ntype = \"conductor\"\nroughness = 1.5\n", 7, 13,
+     "materials.m.roughness: must be in [0, 1]"},
+    {"RoughnessNegative", kCamera + "[materials.m]\ntype = \"plastic\"\nroughness = -0.1\n", 7, 13,
+     "materials.m.roughness: must be in [0, 1]"},
+    {"UnknownMetal", kCamera + "[materials.m]\ntype = \"conductor\"\nmetal = \"Gold\"\n", 7, 9,
+     "materials.m.metal: unknown metal 'Gold'"},
+    {"UnknownMetalSuggestion", kCamera + "[materials.m]\ntype = \"conductor\"\nmetal = \"Cuu\"\n", 7, 9,
+     "unknown metal 'Cuu'; did you mean 'Cu'?"},
+    {"MetalAndEta", kCamera + "[materials.m]\ntype = \"conductor\"\nmetal = \"Au\"\neta = 1\nk = 2\n", 8, 7,
+     "give either 'metal' or 'eta' and 'k', not both"},
+    {"EtaWithoutK", kCamera + "[materials.m]\ntype = \"conductor\"\neta = 1\n", 5, 1,
+     "a conductor with 'eta' needs 'k' too"},
+    {"AnisotropyOne", kCamera + "[materials.m]\ntype = \"conductor\"\nanisotropy = 1\n", 7, 14,
+     "materials.m.anisotropy: must be in [0, 1)"},
+    {"PlasticIorOne", kCamera + "[materials.m]\ntype = \"plastic\"\nior = 1\n", 7, 7, "must differ from 1"},
+    {"MetallicAboveOne", kCamera + "[materials.m]\ntype = \"pbr\"\nmetallic = 2\n", 7, 12,
+     "materials.m.metallic: must be in [0, 1]"},
     {"KeyOfOtherMaterialType", kCamera + "[materials.red]\ntype = \"lambert\"\nshininess = 3\n", 7, 1,
      "materials.red: key 'shininess' is not used by material type 'lambert'"},
     {"LambertRejectsFresnel", kCamera + "[materials.red]\ntype = \"lambert\"\nfresnel = \"schlick\"\n", 7, 1,
@@ -774,4 +791,28 @@ TEST_F(SceneParserCubemap, UnknownFaceKey)
 }
 
 } // namespace
+TEST(SceneParserMaterials, RoughDielectricOfRoughnessZeroIsTheSmoothDielectric)
+{
+    const Scene scene = sceneFromText(kCamera + "[materials.a]\ntype = \"rough_dielectric\"\nroughness = 0\n"
+                                                "[materials.b]\ntype = \"rough_dielectric\"\n");
+    ASSERT_EQ(scene.materials.size(), 2u);
+    EXPECT_EQ(scene.materials[0].type, MaterialType::Dielectric); // same kind, kernel and image as `dielectric`
+    EXPECT_EQ(scene.materials[1].type, MaterialType::RoughDielectric);
+    EXPECT_NEAR(scene.materials[1].roughness, std::sqrt(0.1), 1e-12); // Mitsuba's default alpha = 0.1
+}
+
+TEST(SceneParserMaterials, NamedMetalsAndDefaults)
+{
+    const Scene scene = sceneFromText(kCamera + "[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\n"
+                                                "[materials.perfect]\ntype = \"conductor\"\n"
+                                                "[materials.gltf]\ntype = \"pbr\"\n");
+    EXPECT_NEAR(scene.materials[0].eta.r, 0.1431, 1e-9);
+    EXPECT_NEAR(scene.materials[0].k.b, 1.6032, 1e-9);
+    EXPECT_EQ(scene.materials[1].eta, Color(0.0)); // Mitsuba's "none": F = 1 at every angle
+    EXPECT_EQ(scene.materials[1].k, Color(1.0));
+    EXPECT_EQ(scene.materials[2].metallic, 1.0); // glTF's defaults
+    EXPECT_EQ(scene.materials[2].roughness, 1.0);
+    EXPECT_EQ(scene.materials[2].diffuse, Color(1.0));
+}
+
 } // namespace vkrt
