@@ -793,7 +793,7 @@ TEST_F(SceneParserCubemap, UnknownFaceKey)
 } // namespace
 TEST(SceneParserMaterials, RoughDielectricOfRoughnessZeroIsTheSmoothDielectric)
 {
-    const Scene scene = sceneFromText(kCamera + "[materials.a]\ntype = \"rough_dielectric\"\nroughness = 0\n"
+    const Scene scene = parseSceneString(kCamera + "[materials.a]\ntype = \"rough_dielectric\"\nroughness = 0\n"
                                                 "[materials.b]\ntype = \"rough_dielectric\"\n");
     ASSERT_EQ(scene.materials.size(), 2u);
     EXPECT_EQ(scene.materials[0].type, MaterialType::Dielectric); // same kind, kernel and image as `dielectric`
@@ -803,7 +803,7 @@ TEST(SceneParserMaterials, RoughDielectricOfRoughnessZeroIsTheSmoothDielectric)
 
 TEST(SceneParserMaterials, NamedMetalsAndDefaults)
 {
-    const Scene scene = sceneFromText(kCamera + "[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\n"
+    const Scene scene = parseSceneString(kCamera + "[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\n"
                                                 "[materials.perfect]\ntype = \"conductor\"\n"
                                                 "[materials.gltf]\ntype = \"pbr\"\n");
     EXPECT_NEAR(scene.materials[0].eta.r, 0.1431, 1e-9);
