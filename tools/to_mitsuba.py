@@ -21,7 +21,10 @@ The conversion follows the semantics of vkrt's path integrator
 * lambert -> `diffuse`; mirror (fresnel = "none") -> `conductor`, material
   "none"; dielectric (exact Fresnel) -> `dielectric` with int_ior = ior and
   ext_ior = 1; absorption κ -> a `homogeneous` interior medium with
-  sigma_t = κ and albedo 0, rendered with `volpath`. vkrt shades both sides of
+  sigma_t = κ and albedo 0, rendered with `volpath`; conductor -> `conductor`
+  (roughness 0) or `roughconductor` (ggx, alpha = roughness², visible-normal
+  sampling) with RGB eta and k; rough_dielectric -> `roughdielectric`;
+  plastic -> `plastic` / `roughplastic` (nonlinear = false). vkrt shades both sides of
   every surface, so diffuse and conductor BSDFs are wrapped in `twosided`;
 * point light -> `point` (intensity, W/sr); triangle light -> a one-triangle
   mesh with an `area` emitter and a black diffuse BSDF; a two-sided light is two
@@ -41,7 +44,7 @@ The conversion follows the semantics of vkrt's path integrator
   emission -> an `area` emitter on the mesh, which keeps its material. glTF
   (Mitsuba has no loader) and two-sided emissive meshes are refused.
 
-What has no Mitsuba equivalent (phong, glossy, Schlick Fresnel, the Whitted
+What has no Mitsuba equivalent (phong, glossy, pbr, anisotropic conductors, Schlick Fresnel, the Whitted
 integrator) is refused with an error naming the scene file, table and key.
 """
 from __future__ import annotations
@@ -58,6 +61,22 @@ from pathlib import Path
 
 DEFAULT_PLANE_HALF_SIZE = 1e4
 ABSORPTION_FLOOR = 1e-7  # see the dielectric case in convert()
+MIN_GGX_ALPHA = 1e-4  # shaders/shared/SceneTypes.h: the narrowest GGX lobe vkrt renders
+# vkrt's named metals (src/material/Metals.cpp), RGB eta and k; tests/tools/test_to_mitsuba.py checks that the tables agree.
+METALS: dict = {
+    "none": ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+    "Ag": ([0.1553, 0.1167, 0.1384], [4.8283, 3.1222, 2.1470]),
+    "Al": ([1.6575, 0.8804, 0.5212], [9.2239, 6.2695, 4.8370]),
+    "Au": ([0.1431, 0.3750, 1.4425], [3.9832, 2.3857, 1.6032]),
+    "Cr": ([4.3697, 2.9167, 1.6547], [5.2064, 4.2314, 3.7549]),
+    "Cu": ([0.2004, 0.9240, 1.1022], [3.9129, 2.4528, 2.1422]),
+    "Hg": ([2.3989, 1.4400, 0.9096], [6.3276, 4.3719, 3.4218]),
+    "Ir": ([3.0864, 2.0822, 1.6179], [5.5922, 4.0672, 3.2673]),
+    "Li": ([0.2658, 0.1956, 0.2209], [3.5402, 2.3111, 1.6686]),
+    "Mo": ([4.4837, 3.5255, 2.7761], [4.1111, 3.4209, 3.1506]),
+    "Rh": ([2.5858, 1.8602, 1.5544], [6.7823, 4.7030, 3.9761]),
+    "W": ([4.3707, 3.3003, 2.9983], [3.5007, 2.6049, 2.2732]),
+}
 FACE_KEYS = ("px", "nx", "py", "ny", "pz", "nz")  # Vulkan face order
 
 
@@ -759,8 +778,9 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
             refl = r.color(m, "reflectance", where, 1.0, 0.0, 1.0)
             bsdf = {"type": "twosided", "bsdf": {"type": "conductor", "material": "none",
                                                  "specular_reflectance": _rgb(refl)}}
-        elif mtype == "dielectric":
-            r.check_keys(m, where, ["type", "ior", "absorption", "fresnel"])
+        elif mtype in ("dielectric", "rough_dielectric"):
+            r.check_keys(m, where, ["type", "ior", "absorption", "fresnel"] +
+                         (["roughness"] if mtype == "rough_dielectric" else []))
             fresnel = r.string(m, "fresnel", where, "exact")
             if fresnel != "exact":
                 r.fail(f"{where}.fresnel", f"dielectric with fresnel = \"{fresnel}\" has no Mitsuba equivalent "
@@ -771,6 +791,10 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 r.fail(f"{where}.ior", f"must be in [1, 1e30], got {ior:g}")
             absorption = r.color(m, "absorption", where, 0.0, 0.0)
             bsdf = {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
+            roughness = r.number(m, "roughness", where, math.sqrt(0.1)) if mtype == "rough_dielectric" else 0.0
+            if roughness > 0:
+                bsdf.update({"type": "roughdielectric", "distribution": "ggx", "sample_visible": True,
+                             "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
             if any(k > 0 for k in absorption):
                 media_ids[name] = f"medium{index}"
                 # volpath turns a channel with sigma_t = 0 and albedo 0 into NaN
@@ -783,6 +807,39 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 scene[media_ids[name]] = {"type": "homogeneous", "id": media_ids[name], "albedo": 0.0,
                                           "sigma_t": _rgb([k / scale for k in sigma_t]), "scale": scale}
                 needs_volpath = True
+        elif mtype == "conductor":
+            r.check_keys(m, where, ["type", "roughness", "anisotropy", "metal", "eta", "k", "tint"])
+            roughness = r.number(m, "roughness", where, 0.0)
+            if r.number(m, "anisotropy", where, 0.0) != 0.0:
+                r.fail(f"{where}.anisotropy", "anisotropic conductors do not convert: vkrt orients the "
+                                              "anisotropy by a frame around the normal, Mitsuba by dp/du")
+            if "metal" in m:
+                eta, k = METALS.get(r.string(m, "metal", where), (None, None))
+                if eta is None:
+                    r.fail(f"{where}.metal", f"unknown metal '{m['metal']}' (known: {', '.join(sorted(METALS))})")
+            elif "eta" in m or "k" in m:
+                eta = r.color(m, "eta", where, None, 0.0)
+                k = r.color(m, "k", where, None, 0.0)
+            else:  # vkrt's default, Mitsuba's material "none"
+                eta, k = [0.0] * 3, [1.0] * 3
+            tint = r.color(m, "tint", where, 1.0, 0.0, 1.0)
+            inner = {"type": "conductor", "eta": _rgb(eta), "k": _rgb(k), "specular_reflectance": _rgb(tint)}
+            if roughness > 0:
+                inner.update({"type": "roughconductor", "distribution": "ggx", "sample_visible": True,
+                              "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
+            bsdf = {"type": "twosided", "bsdf": inner}
+        elif mtype == "plastic":
+            r.check_keys(m, where, ["type", "diffuse", "roughness", "ior"])
+            roughness = r.number(m, "roughness", where, 0.0)
+            inner = {"type": "plastic", "int_ior": r.number(m, "ior", where, 1.49), "ext_ior": 1.0,
+                     "diffuse_reflectance": _rgb(r.color(m, "diffuse", where, 0.5, 0.0, 1.0)), "nonlinear": False}
+            if roughness > 0:
+                inner.update({"type": "roughplastic", "distribution": "ggx", "sample_visible": True,
+                              "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
+            bsdf = {"type": "twosided", "bsdf": inner}
+        elif mtype == "pbr":
+            r.fail(f"{where}.type", "material type 'pbr' (glTF metallic-roughness) has no Mitsuba equivalent: "
+                                    "Mitsuba's principled BSDF is another model")
         elif mtype in ("phong", "glossy"):
             r.fail(f"{where}.type", f"material type '{mtype}' has no Mitsuba equivalent "
                                     f"(used by {used[name]}); only lambert, mirror (fresnel = \"none\") and "
@@ -1042,6 +1099,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
 
 _PLUGIN_TAGS = {
     "twosided": "bsdf", "diffuse": "bsdf", "conductor": "bsdf", "dielectric": "bsdf",
+    "roughconductor": "bsdf", "roughdielectric": "bsdf", "plastic": "bsdf", "roughplastic": "bsdf",
     "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape", "obj": "shape",
     "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter",
     "homogeneous": "medium", "perspective": "sensor", "hdrfilm": "film", "independent": "sampler",

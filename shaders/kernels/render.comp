@@ -19,6 +19,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/accumulate.glsl"
 #include "lib/fresnel.glsl"
 #include "lib/sampling.glsl"
+#include "lib/microfacet.glsl"
 #include "lib/bsdf.glsl"
 #include "lib/environment.glsl"
 #include "lib/media.glsl"

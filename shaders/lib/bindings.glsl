@@ -56,6 +56,9 @@ layout(scalar, binding = BINDING_MESH_NORMALS) readonly buffer MeshNormalBlock {
 #ifdef VKRT_HAS_EMITTERS
 layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitter emitters[]; };
 #endif
+#ifdef VKRT_HAS_MATERIAL_TABLES
+layout(scalar, binding = BINDING_MATERIAL_TABLES) readonly buffer MaterialTableBlock { float materialTables[]; };
+#endif
 #ifdef VKRT_HAS_POINT_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
 #endif

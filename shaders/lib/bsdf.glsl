@@ -38,6 +38,17 @@ bool isDeltaMaterial(uint type) { return false VKRT_MATERIAL_KINDS(VKRT_IS_DELTA
 
 vec3 evalBsdf(Material m, vec3 n, vec3 wo, vec3 wi);
 
+// No light sampling for it: a delta kind, or a conductor of roughness 0 (a
+// mirror with the conductor's Fresnel term).
+bool scattersIntoDeltasOnly(Material m)
+{
+#ifdef VKRT_MATERIAL_CONDUCTOR
+    if (m.type == MATERIAL_CONDUCTOR && m.alphaX == 0.0)
+        return true;
+#endif
+    return isDeltaMaterial(m.type);
+}
+
 BsdfSample noScatter() { return BsdfSample(vec3(0.0, 0.0, 1.0), vec3(0.0), false, false); }
 
 #define VKRT_ABSENT_MATERIAL(Type)                                                                  \
@@ -164,6 +175,280 @@ BsdfSample sampleDielectric(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 }
 #else
 VKRT_ABSENT_MATERIAL(Dielectric)
+#endif
+
+// ------------------------------------------------------ microfacet helpers
+
+#if defined(VKRT_MATERIAL_CONDUCTOR) || defined(VKRT_MATERIAL_ROUGH_DIELECTRIC) || defined(VKRT_MATERIAL_PLASTIC) || \
+    defined(VKRT_MATERIAL_PBR)
+vec2 ggxAlpha(Material m) { return vec2(m.alphaX, m.alphaY); }
+
+// D G / (4 cosO cosI) of the GGX lobe at the half vector h (local frame).
+float ggxSpecular(vec3 lo, vec3 li, vec3 h, vec2 alpha)
+{
+    return ggxD(h, alpha) * ggxG1(lo, h, alpha) * ggxG1(li, h, alpha) / (4.0 * lo.z * li.z);
+}
+
+float pow5(float x)
+{
+    float x2 = x * x;
+    return x2 * x2 * x;
+}
+#endif
+
+// ---------------------------------------------------------------- conductor
+// GGX microfacets with the exact conductor Fresnel term (Mitsuba's
+// roughconductor, ggx, visible-normal sampling): f = tint F(wo.h) D G / (4 cosO cosI).
+
+#ifdef VKRT_MATERIAL_CONDUCTOR
+// alphaX = 0: a smooth conductor, a delta (sampled only).
+vec3 evalConductor(Material m, vec3 n, vec3 wo, vec3 wi)
+{
+    if (m.alphaX == 0.0)
+        return vec3(0.0);
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    vec3 h = normalize(lo + li);
+    return m.specular * fresnelConductor(dot(lo, h), m.eta, m.k) * ggxSpecular(lo, li, h, ggxAlpha(m));
+}
+
+float pdfConductor(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
+{
+    if (m.alphaX == 0.0)
+        return 0.0;
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    return ggxReflectionPdf(lo, normalize(lo + toFrame(f, wi)), ggxAlpha(m));
+}
+
+// Visible normals, reflected: weight = tint F G1(wi, h).
+BsdfSample sampleConductor(Material m, vec3 n, vec3 wo, float eta, vec3 u)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    if (lo.z <= 0.0)
+        return noScatter();
+    if (m.alphaX == 0.0)
+        return BsdfSample(reflect(-wo, n), m.specular * fresnelConductor(lo.z, m.eta, m.k), true, false);
+    vec2 alpha = ggxAlpha(m);
+    vec3 h = sampleGgxVisibleNormal(lo, alpha, u.xy);
+    vec3 li = reflect(-lo, h);
+    if (li.z <= 0.0)
+        return noScatter();
+    vec3 weight = m.specular * fresnelConductor(dot(lo, h), m.eta, m.k) * ggxG1(li, h, alpha);
+    return BsdfSample(fromFrame(f, li), weight, false, false);
+}
+#else
+VKRT_ABSENT_MATERIAL(Conductor)
+#endif
+
+// --------------------------------------------------------- rough dielectric
+// Walter et al. 2007 with visible-normal sampling (Mitsuba's roughdielectric,
+// ggx): reflect with probability F(wo.m), else refract about m. Like the
+// smooth dielectric, refraction carries no radiance scaling by eta^2, so
+// roughness -> 0 tends to its image. Light sampling covers the reflection
+// side only: a refracted sample is marked `specular`, so that a light it
+// reaches counts in full (no light sample competes for that direction).
+// eval and pdf need the interface's eta = n_i / n_t, which only the
+// integrator knows: it stores it in m.exponent (withInterfaceEta).
+
+#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
+Material withInterfaceEta(Material m, float eta)
+{
+    if (m.type == MATERIAL_ROUGH_DIELECTRIC)
+        m.exponent = eta;
+    return m;
+}
+
+vec3 evalRoughDielectric(Material m, vec3 n, vec3 wo, vec3 wi)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    vec3 h = normalize(lo + li);
+    float fresnel = dielectricReflectance(m.fresnel, dot(lo, h), m.exponent);
+    return vec3(fresnel * ggxSpecular(lo, li, h, ggxAlpha(m)));
+}
+
+float pdfRoughDielectric(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    vec3 h = normalize(lo + toFrame(f, wi));
+    return dielectricReflectance(m.fresnel, dot(lo, h), m.exponent) * ggxReflectionPdf(lo, h, ggxAlpha(m));
+}
+
+// Either branch's weight is G1(wi, m): its probability is its Fresnel factor.
+BsdfSample sampleRoughDielectric(Material m, vec3 n, vec3 wo, float eta, vec3 u)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    if (lo.z <= 0.0)
+        return noScatter();
+    vec2 alpha = ggxAlpha(m);
+    vec3 h = sampleGgxVisibleNormal(lo, alpha, u.xy);
+    float fresnel = dielectricReflectance(m.fresnel, dot(lo, h), eta);
+    vec3 refracted = refractDirection(lo, h, eta);
+    if (u.z < fresnel || refracted == vec3(0.0)) {
+        vec3 li = reflect(-lo, h);
+        if (li.z <= 0.0)
+            return noScatter();
+        return BsdfSample(fromFrame(f, li), vec3(ggxG1(li, h, alpha)), false, false);
+    }
+    if (refracted.z >= 0.0)
+        return noScatter();
+    return BsdfSample(fromFrame(f, refracted), vec3(ggxG1(refracted, h, alpha)), true, true);
+}
+#else
+VKRT_ABSENT_MATERIAL(RoughDielectric)
+#endif
+
+// ------------------------------------------------------------------ plastic
+// A Lambert base under a dielectric coating of index ior (Mitsuba's plastic
+// and roughplastic, nonlinear = false):
+//   f = F(wo.h) D G / (4 cosO cosI)                      (rough coating only)
+//     + diffuse / (1 - Fdr) / ior^2 * T(cosO) T(cosI) / pi,
+// T = 1 - F for a smooth coating, else 1 - the rough coating's albedo,
+// tabulated by the host (src/material/MicrofacetAlbedo.h); Fdr is the
+// coating's internal diffuse reflectance. A smooth coating's reflection is a
+// delta: sampled (marked specular), never evaluated.
+
+#ifdef VKRT_MATERIAL_PLASTIC
+float coatingTransmittance(Material m, float mu)
+{
+#ifdef VKRT_HAS_MATERIAL_TABLES
+    if (m.table != NO_MATERIAL_TABLE) {
+        float x = clamp(mu, 0.0, 1.0) * float(MATERIAL_TABLE_SIZE - 1u);
+        uint i = min(uint(x), MATERIAL_TABLE_SIZE - 2u);
+        float w1 = x - float(i);
+        return (1.0 - w1) * materialTables[m.table + i] + w1 * materialTables[m.table + i + 1u];
+    }
+#endif
+    return 1.0 - fresnelExact(mu, 1.0 / m.ior);
+}
+
+bool roughCoating(Material m) { return m.table != NO_MATERIAL_TABLE; }
+
+// Probability of sampling the coating rather than the base (Mitsuba's rule).
+float coatingProbability(Material m, float cosO)
+{
+    float t = coatingTransmittance(m, cosO);
+    float specular = (1.0 - t) * m.lobeWeight;
+    float diffuse = t * (1.0 - m.lobeWeight);
+    return specular + diffuse > 0.0 ? specular / (specular + diffuse) : 0.0;
+}
+
+vec3 plasticBase(Material m, float cosO, float cosI)
+{
+    float transmitted = coatingTransmittance(m, cosO) * coatingTransmittance(m, cosI);
+    return m.diffuse * (INV_PI * transmitted / ((1.0 - m.internalReflectance) * m.ior * m.ior));
+}
+
+vec3 evalPlastic(Material m, vec3 n, vec3 wo, vec3 wi)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    vec3 value = plasticBase(m, lo.z, li.z);
+    if (roughCoating(m)) {
+        vec3 h = normalize(lo + li);
+        value += vec3(fresnelExact(dot(lo, h), 1.0 / m.ior) * ggxSpecular(lo, li, h, ggxAlpha(m)));
+    }
+    return value;
+}
+
+float pdfPlastic(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    float ps = coatingProbability(m, lo.z);
+    float pdf = (1.0 - ps) * li.z * INV_PI;
+    if (roughCoating(m))
+        pdf += ps * ggxReflectionPdf(lo, normalize(lo + li), ggxAlpha(m));
+    return pdf;
+}
+
+BsdfSample samplePlastic(Material m, vec3 n, vec3 wo, float eta, vec3 u)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    if (lo.z <= 0.0)
+        return noScatter();
+    float ps = coatingProbability(m, lo.z);
+    vec3 li;
+    if (u.z < ps) {
+        if (!roughCoating(m)) // the smooth coating's mirror reflection, weight F / ps
+            return BsdfSample(reflect(-wo, n), vec3(fresnelExact(lo.z, 1.0 / m.ior) / ps), true, false);
+        li = reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy));
+    } else {
+        li = toFrame(f, sampleCosineHemisphere(n, u.xy));
+    }
+    if (li.z <= 0.0)
+        return noScatter();
+    vec3 wi = fromFrame(f, li);
+    float pdf = pdfPlastic(m, n, wo, wi, li.z);
+    if (!(pdf > 0.0))
+        return noScatter();
+    return BsdfSample(wi, evalPlastic(m, n, wo, wi) * (li.z / pdf), false, false);
+}
+#else
+VKRT_ABSENT_MATERIAL(Plastic)
+#endif
+
+// ---------------------------------------------------------------------- pbr
+// glTF 2.0 metallic-roughness (the specification's Appendix B):
+//   f = (1 - metallic) [(1 - Fs) base / pi + Fs S] + metallic Fm S,
+// S = D G / (4 cosO cosI), Fs = 0.04 + 0.96 (1 - wo.h)^5 and
+// Fm = base + (1 - base)(1 - wo.h)^5 (Schlick). Sampled as a mixture of the
+// visible-normal lobe and the cosine lobe.
+
+#ifdef VKRT_MATERIAL_PBR
+vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    vec3 h = normalize(lo + li);
+    float s = ggxSpecular(lo, li, h, ggxAlpha(m));
+    float schlick = pow5(1.0 - clamp(dot(lo, h), 0.0, 1.0));
+    float fs = 0.04 + 0.96 * schlick;
+    vec3 fm = m.diffuse + (vec3(1.0) - m.diffuse) * schlick;
+    return (1.0 - m.metallic) * ((1.0 - fs) * m.diffuse * INV_PI + vec3(fs * s)) + m.metallic * fm * s;
+}
+
+// The share of the specular lobe, from Fresnel at the macro-surface angle.
+float pbrSpecularProbability(Material m, float cosO)
+{
+    float fs = 0.04 + 0.96 * pow5(1.0 - clamp(cosO, 0.0, 1.0));
+    float specular = m.metallic + (1.0 - m.metallic) * fs;
+    float diffuse = (1.0 - m.metallic) * (1.0 - fs) * luminance(m.diffuse);
+    return diffuse > 0.0 ? specular / (specular + diffuse) : 1.0;
+}
+
+float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    float ps = pbrSpecularProbability(m, lo.z);
+    return ps * ggxReflectionPdf(lo, normalize(lo + li), ggxAlpha(m)) + (1.0 - ps) * li.z * INV_PI;
+}
+
+BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    if (lo.z <= 0.0)
+        return noScatter();
+    vec3 li = u.z < pbrSpecularProbability(m, lo.z)
+                  ? reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy))
+                  : toFrame(f, sampleCosineHemisphere(n, u.xy));
+    if (li.z <= 0.0)
+        return noScatter();
+    vec3 wi = fromFrame(f, li);
+    float pdf = pdfPbr(m, n, wo, wi, li.z);
+    if (!(pdf > 0.0))
+        return noScatter();
+    return BsdfSample(wi, evalPbr(m, n, wo, wi) * (li.z / pdf), false, false);
+}
+#else
+VKRT_ABSENT_MATERIAL(Pbr)
 #endif
 
 // ------------------------------------------------------------- dispatchers

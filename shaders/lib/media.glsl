@@ -17,7 +17,7 @@ struct MediumStack {
 // The stack the camera starts in (found by the host, innermost last).
 MediumStack cameraMedia() { return MediumStack(min(u.cameraMediumCount, MEDIUM_STACK_DEPTH), u.cameraMedia); }
 
-#ifdef VKRT_MATERIAL_DIELECTRIC
+#if defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_MATERIAL_ROUGH_DIELECTRIC)
 float mediumIor(MediumStack s) { return s.count == 0u ? 1.0 : materials[s.materials[s.count - 1u]].ior; }
 
 vec3 mediumAbsorption(MediumStack s)

@@ -58,7 +58,10 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 ns = shadingSide(hit, n);
         vec3 wo = -ray.dir;
-        if (!isDeltaMaterial(m.type)) {
+#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
+        m = withInterfaceEta(m, surfaceEta(path.media, hit)); // its eval and pdf need the crossing's eta
+#endif
+        if (!scattersIntoDeltasOnly(m)) {
             path.radiance += path.throughput * (directFromPointLights(m, hit, n, ns, wo, path.media) +
                                                 directFromTriangleLights(m, hit, n, ns, wo, path.media, rng));
 #ifdef VKRT_HAS_EMITTERS

@@ -35,7 +35,9 @@ VKRT_CONSTANT(uint, BINDING_MESH_NORMALS, BINDING_ENVIRONMENT + 5)
 VKRT_CONSTANT(uint, BINDING_TOP_NODES, BINDING_ENVIRONMENT + 6)
 VKRT_CONSTANT(uint, BINDING_TOP_REFS, BINDING_ENVIRONMENT + 7)
 VKRT_CONSTANT(uint, BINDING_EMITTERS, BINDING_ENVIRONMENT + 8)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 9)
+// float[]: the rough plastics' coating tables (shared/SceneTypes.h: MATERIAL_TABLE_SIZE)
+VKRT_CONSTANT(uint, BINDING_MATERIAL_TABLES, BINDING_ENVIRONMENT + 9)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 10)
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);
 // the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).

@@ -26,12 +26,16 @@
 #define VKRT_SHARED_KINDS_H
 #include "Interop.h"
 
-#define VKRT_MATERIAL_KINDS(X)         \
-    X(LAMBERT, Lambert, lambert, 0, 0) \
-    X(PHONG, Phong, phong, 1, 0)       \
-    X(MIRROR, Mirror, mirror, 2, 1)    \
-    X(GLOSSY, Glossy, glossy, 3, 0)    \
-    X(DIELECTRIC, Dielectric, dielectric, 4, 1)
+#define VKRT_MATERIAL_KINDS(X)                                  \
+    X(LAMBERT, Lambert, lambert, 0, 0)                          \
+    X(PHONG, Phong, phong, 1, 0)                                \
+    X(MIRROR, Mirror, mirror, 2, 1)                             \
+    X(GLOSSY, Glossy, glossy, 3, 0)                             \
+    X(DIELECTRIC, Dielectric, dielectric, 4, 1)                 \
+    X(CONDUCTOR, Conductor, conductor, 5, 0)                    \
+    X(ROUGH_DIELECTRIC, RoughDielectric, rough_dielectric, 6, 0) \
+    X(PLASTIC, Plastic, plastic, 7, 0)                          \
+    X(PBR, Pbr, pbr, 8, 0)
 
 #define VKRT_SHAPE_KINDS(X)                                                 \
     X(SPHERE, Sphere, sphere, 0, sphere, spheres, SPHERES, 819)             \

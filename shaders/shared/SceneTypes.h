@@ -18,6 +18,23 @@ VKRT_CONSTANT(uint, FRESNEL_NONE, 0)
 VKRT_CONSTANT(uint, FRESNEL_SCHLICK, 1)
 VKRT_CONSTANT(uint, FRESNEL_EXACT, 2)
 
+// Material::table of a plastic without a table (a smooth coating)
+VKRT_CONSTANT(uint, NO_MATERIAL_TABLE, 4294967295u)
+// A rough plastic's table in materialTables (shared/Bindings.h): the rough
+// coating's transmittance 1 - R(mu) at mu = i / (MATERIAL_TABLE_SIZE - 1),
+// i = 0 ... MATERIAL_TABLE_SIZE - 1 (src/material/MicrofacetAlbedo.h).
+VKRT_CONSTANT(uint, MATERIAL_TABLE_SIZE, 64)
+
+// Which members a kind reads (the rest are zero):
+//   lambert: diffuse; phong: diffuse, specular, exponent;
+//   mirror, glossy: specular, exponent (glossy), ior, fresnel;
+//   dielectric: ior, absorption, fresnel;
+//   conductor: specular (tint), alphaX, alphaY, eta, k;
+//   rough_dielectric: ior, absorption, fresnel, alphaX = alphaY;
+//   plastic: diffuse, ior, alphaX = alphaY (0: smooth), table, lobeWeight, internalReflectance;
+//   pbr: diffuse (base colour), metallic, alphaX = alphaY.
+// alpha is the GGX width (perceptual roughness squared), never below
+// MIN_GGX_ALPHA where it is used.
 struct Material {
     vec3 diffuse;
     uint type;
@@ -26,7 +43,20 @@ struct Material {
     vec3 absorption;
     float ior;
     uint fresnel;
+    float alphaX;
+    float alphaY;
+    uint table;
+    vec3 eta;
+    float metallic;
+    vec3 k;
+    float lobeWeight;          // plastic: Mitsuba's specular sampling weight s / (s + d)
+    float internalReflectance; // plastic: diffuse Fresnel reflectance inside the coating
 };
+
+// The narrowest GGX lobe a rough material gets: narrower ones lose float
+// precision in D and the visible-normal sampler (roughness 0 selects the
+// smooth kinds instead).
+VKRT_CONSTANT(float, MIN_GGX_ALPHA, 1e-4)
 
 struct Sphere {
     vec3 center;
@@ -151,7 +181,7 @@ VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
 // maxUniformBufferRange Vulkan allows; src/gpu/SharedTypes.cpp checks the
 // sizes. Bigger scenes use the storage-buffer variant. The shape and light
 // arrays' capacities (UNIFORM_SPHERES, ...) are in the registry, shared/Kinds.h.
-VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 315) // 16384 / 52
+VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 163) // 16384 / 100
 
 // One record count per shape and light array, in registry order:
 // sphereCount, boxCount, triangleCount, planeCount, pointLightCount, ...

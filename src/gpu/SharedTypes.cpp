@@ -11,7 +11,7 @@
 namespace vkrt::gpu {
 
 static_assert(alignof(vec3) == 4 && sizeof(vec3) == 12, "GLM vec3 must be three packed floats");
-static_assert(sizeof(Material) == 52);
+static_assert(sizeof(Material) == 100);
 // The shape and light records' sizes are pinned by their registry capacities
 // below: 16384 / (capacity + 1) < size <= 16384 / capacity admits one size.
 // Each uniform scene array fills at most the 16 KiB every Vulkan device allows.
@@ -36,7 +36,8 @@ constexpr bool bindingsDistinct()
 {
     constexpr uint fixed[] = {BINDING_UNIFORMS,    BINDING_ACCUMULATION,   BINDING_STATS,         BINDING_ENVIRONMENT,
                               BINDING_MOMENTS,     BINDING_ENVIRONMENT_CDF, BINDING_MESH_NODES,   BINDING_MESH_TRIANGLES,
-                              BINDING_MESH_NORMALS, BINDING_TOP_NODES,     BINDING_TOP_REFS,      BINDING_EMITTERS};
+                              BINDING_MESH_NORMALS, BINDING_TOP_NODES,     BINDING_TOP_REFS,      BINDING_EMITTERS,
+                              BINDING_MATERIAL_TABLES};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -61,7 +62,7 @@ static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);
 static_assert(sizeof(MomentPixel) == 36);
 static_assert(offsetof(SceneUniforms, tileStride) == 96);
-static_assert(offsetof(Material, fresnel) == 48);
+static_assert(offsetof(Material, fresnel) == 48 && offsetof(Material, eta) == 64 && offsetof(Material, k) == 80);
 static_assert(offsetof(TriangleLight, radiance) == 44);
 
 } // namespace vkrt::gpu

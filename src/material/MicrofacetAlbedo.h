@@ -19,7 +19,12 @@ double roughTransmittanceCosine(int i);
 /// Gauss-Legendre nodes per dimension of the visible-normal disk; the default meets the 1e-4 bound.
 double roughSpecularAlbedo(double mu, double alpha, double eta, int quadratureOrder = 0);
 
-/// T(mu_i) = 1 - R(mu_i; alpha, eta) at the 64 cosines of roughTransmittanceCosine, for Mitsuba's
+/// The energy a rough interface transmits from a direction at cosine mu above it: the expected
+/// (1 - F(w.m)) G1(t, m) over visible normals m, t the refracted direction. Less than 1 - R(mu): light
+/// masked on the far side is lost (Mitsuba 3's eval_transmittance, which its roughplastic tabulates).
+double roughTransmittance(double mu, double alpha, double eta);
+
+/// T(mu_i) = roughTransmittance(mu_i; alpha, eta) at the 64 cosines of roughTransmittanceCosine, for Mitsuba's
 /// linear interpolation: x = cos * 63, i = min(floor(x), 62), T = lerp(table[i], table[i + 1], x - i).
 std::array<float, kRoughTransmittanceResolution> roughTransmittanceTable(double alpha, double eta);
 

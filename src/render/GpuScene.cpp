@@ -1,5 +1,7 @@
 #include "render/GpuScene.h"
 
+#include "material/MicrofacetAlbedo.h"
+
 #include "mesh/MeshGeometry.h"
 #include "shared/Bindings.h"
 
@@ -23,7 +25,29 @@ struct Relativizer {
     glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3(p - eye); }
 };
 
-gpu::Material convertMaterial(const Material& m, Integrator integrator)
+/// GGX alphas from perceptual roughness (alpha = roughness^2) and anisotropy
+/// (Burley 2012: aspect = sqrt(1 - 0.9 anisotropy), alphaX = alpha / aspect,
+/// alphaY = alpha * aspect), never below MIN_GGX_ALPHA; roughness 0 keeps 0
+/// (the smooth kinds).
+glm::vec2 ggxAlphas(const Material& m)
+{
+    if (m.roughness == 0.0) return glm::vec2(0.0f);
+    const double alpha = m.roughness * m.roughness;
+    const double aspect = std::sqrt(1.0 - 0.9 * m.anisotropy);
+    const double minimum = gpu::MIN_GGX_ALPHA;
+    return glm::vec2(float(std::max(alpha / aspect, minimum)), float(std::max(alpha * aspect, minimum)));
+}
+
+/// Mitsuba's sampling weight of a plastic's coating: s / (s + d), with the
+/// coating's reflectance s = 1 and d the mean of the diffuse colour.
+float coatingLobeWeight(const Material& m)
+{
+    const double diffuseMean = (m.diffuse.r + m.diffuse.g + m.diffuse.b) / 3.0;
+    return float(1.0 / (1.0 + diffuseMean));
+}
+
+gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t tableStart,
+                              float internalReflectance)
 {
     gpu::Material g{};
     g.diffuse = toFloat(m.diffuse);
@@ -42,7 +66,44 @@ gpu::Material convertMaterial(const Material& m, Integrator integrator)
         else g.fresnel = integrator == Integrator::Path ? gpu::FRESNEL_EXACT : gpu::FRESNEL_SCHLICK;
         break;
     }
+    if (m.type == MaterialType::RoughDielectric && m.fresnel == FresnelMode::Default) g.fresnel = gpu::FRESNEL_EXACT;
+    const glm::vec2 alpha = ggxAlphas(m);
+    g.alphaX = alpha.x;
+    g.alphaY = alpha.y;
+    g.eta = toFloat(m.eta);
+    g.k = toFloat(m.k);
+    g.metallic = float(m.metallic);
+    g.table = tableStart;
+    g.internalReflectance = internalReflectance;
+    if (m.type == MaterialType::Plastic) g.lobeWeight = coatingLobeWeight(m);
     return g;
+}
+
+/// Appends a rough plastic's coating table; returns where it starts.
+uint32_t appendCoatingTable(const Material& m, std::vector<float>& tables)
+{
+    const auto start = uint32_t(tables.size());
+    const auto table = roughTransmittanceTable(ggxAlphas(m).x, m.ior);
+    static_assert(table.size() == gpu::MATERIAL_TABLE_SIZE);
+    tables.insert(tables.end(), table.begin(), table.end());
+    return start;
+}
+
+/// The plastics' coating data, once per scene (tens of milliseconds each).
+void prepareMaterialTables(const Scene& scene, GpuSceneStatic& fixed)
+{
+    for (const Material& m : scene.materials) {
+        uint32_t start = gpu::NO_MATERIAL_TABLE;
+        float internal = 0.0f;
+        if (m.type == MaterialType::Plastic && m.roughness > 0.0) {
+            start = appendCoatingTable(m, fixed.materialTables);
+            internal = float(internalDiffuseReflectance(ggxAlphas(m).x, m.ior));
+        } else if (m.type == MaterialType::Plastic) {
+            internal = float(smoothInternalDiffuseReflectance(m.ior));
+        }
+        fixed.materialTableStart.push_back(start);
+        fixed.internalReflectance.push_back(internal);
+    }
 }
 
 // One conversion per shape and light kind (shared/Kinds.h), found by overload.
@@ -361,7 +422,10 @@ uint32_t tileStrideFor(uint32_t tileCount)
 std::vector<uint32_t> mediaAroundCamera(const Scene& scene)
 {
     std::vector<std::pair<double, uint32_t>> around; // (distance to the boundary, material)
-    auto dielectric = [&](uint32_t m) { return scene.materials[m].type == MaterialType::Dielectric; };
+    auto dielectric = [&](uint32_t m) {
+        return scene.materials[m].type == MaterialType::Dielectric ||
+               scene.materials[m].type == MaterialType::RoughDielectric;
+    };
     const glm::dvec3 eye = scene.camera.eye;
     for (size_t i = 0; i < scene.spheres.size(); ++i) {
         const Sphere& s = scene.spheres[i];
@@ -410,6 +474,7 @@ uint64_t emissiveTriangleCount(const Scene& scene)
 GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
 {
     GpuSceneStatic fixed;
+    prepareMaterialTables(scene, fixed);
     if (scene.meshes.empty()) return fixed;
     for (const Mesh& mesh : scene.meshes) {
         const MeshGeometry& g = *mesh.geometry;
@@ -440,7 +505,10 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
 {
     GpuSceneData data;
     Relativizer rel{scene.camera.eye};
-    for (const auto& m : scene.materials) data.materials.push_back(convertMaterial(m, scene.render.integrator));
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        data.materials.push_back(convertMaterial(scene.materials[i], scene.render.integrator,
+                                                 fixed.materialTableStart.at(i), fixed.internalReflectance.at(i)));
+    }
 #define VKRT_CONVERT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity) \
     for (const auto& record : recordsToUpload(scene, scene.array)) data.array.push_back(toGpu(record, rel));
     VKRT_SHAPE_KINDS(VKRT_CONVERT_RECORDS)

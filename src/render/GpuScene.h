@@ -42,6 +42,13 @@ struct EmitterTable {
 /// geometries concatenated (each once, however many instances share it),
 /// the top-level BVH's topology and the emitters' alias table.
 struct GpuSceneStatic {
+    /// The rough plastics' coating tables (gpu::MATERIAL_TABLE_SIZE floats each;
+    /// never empty, so that the buffer can always be bound), and per material
+    /// where its table starts (gpu::NO_MATERIAL_TABLE for none) and its
+    /// coating's internal diffuse reflectance.
+    std::vector<float> materialTables{0.0f};
+    std::vector<uint32_t> materialTableStart;
+    std::vector<float> internalReflectance;
     std::vector<gpu::BvhNode> meshNodes;
     std::vector<gpu::MeshTriangle> meshTriangles;
     std::vector<gpu::MeshNormals> meshNormals;

@@ -42,6 +42,8 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({meshes, "VKRT_HAS_TOP_REFS", int(gpu::BINDING_TOP_REFS), ""});
     list.push_back({meshes && f.meshNormals, "VKRT_HAS_MESH_NORMALS", int(gpu::BINDING_MESH_NORMALS), "mesh-normals"});
     list.push_back({meshes && f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emissive-meshes"});
+    // The rough plastics' coating tables come with the plastic kind.
+    list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});
     list.push_back({f.environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
                     "environment-sampling"});

@@ -252,6 +252,7 @@ void Renderer::uploadSceneBuffers()
     addStorage(gpu::BINDING_TOP_NODES, m_data.topNodes);
     addStorage(gpu::BINDING_TOP_REFS, m_data.topRefs);
     addStorage(gpu::BINDING_EMITTERS, m_data.emitters);
+    addStorage(gpu::BINDING_MATERIAL_TABLES, m_static.materialTables);
 }
 
 void Renderer::reset()

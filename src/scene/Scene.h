@@ -145,6 +145,14 @@ struct Material {
     double ior = 1.5;      ///< dielectric IOR; also Schlick's R0 for mirror/glossy
     Color absorption{0.0}; ///< dielectric Beer–Lambert κ per unit length
     FresnelMode fresnel = FresnelMode::Default;
+    /// conductor, rough_dielectric, plastic, pbr: perceptual roughness in [0, 1]; GGX alpha = roughness²
+    double roughness = 0.0;
+    double anisotropy = 0.0; ///< conductor: in [0, 1); stretches alpha along the frame's tangent
+    Color eta{0.0};          ///< conductor: real part of the complex index of refraction
+    Color k{0.0};            ///< conductor: imaginary part (extinction)
+    double metallic = 0.0;   ///< pbr
+    // Colours reuse the members above: conductor `tint` is specular, plastic
+    // `diffuse` and pbr `base_color` are diffuse; plastic and rough_dielectric use ior.
     SourceLocation where; ///< the [materials.NAME] table
 };
 

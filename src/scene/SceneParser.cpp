@@ -7,6 +7,7 @@
 // reading itself is scene/TomlReader.h; this file knows what a scene holds.
 #include "scene/SceneParser.h"
 
+#include "material/Metals.h"
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "scene/SceneOverrides.h"
@@ -156,6 +157,10 @@ constexpr std::array<std::string_view, 4> phongKeys{"type", "diffuse", "specular
 constexpr std::array<std::string_view, 4> mirrorKeys{"type", "reflectance", "fresnel", "ior"};
 constexpr std::array<std::string_view, 5> glossyKeys{"type", "reflectance", "exponent", "fresnel", "ior"};
 constexpr std::array<std::string_view, 4> dielectricKeys{"type", "ior", "absorption", "fresnel"};
+constexpr std::array<std::string_view, 7> conductorKeys{"type", "roughness", "anisotropy", "metal", "eta", "k", "tint"};
+constexpr std::array<std::string_view, 5> rough_dielectricKeys{"type", "roughness", "ior", "absorption", "fresnel"};
+constexpr std::array<std::string_view, 4> plasticKeys{"type", "diffuse", "roughness", "ior"};
+constexpr std::array<std::string_view, 4> pbrKeys{"type", "base_color", "metallic", "roughness"};
 
 constexpr std::array<EnumName<FresnelMode>, 2> reflectorFresnelModes{
     {{"none", FresnelMode::None}, {"schlick", FresnelMode::Schlick}}};
@@ -209,6 +214,76 @@ void readDielectric(const TableField& table, Material& material)
     material.ior = readOr(table, "ior", 1.5, readIor);
     material.absorption = readOr(table, "absorption", Color(0.0), readRadiance);
     material.fresnel = readOr(table, "fresnel", FresnelMode::Default, readDielectricFresnel);
+}
+
+double readUnitInterval(const Field& field) { return readNumberIn(field, NumberRange{0.0, 1.0}); }
+
+/// Anisotropy 1 would give one of the alphas zero width: [0, 1).
+double readAnisotropy(const Field& field) { return readNumberIn(field, NumberRange{0.0, 1.0, false, true}); }
+
+const Metal& readMetal(const Field& field)
+{
+    const std::string name = readString(field);
+    if (const Metal* metal = findMetal(name)) return *metal;
+    const std::vector<std::string> owned = metalNames();
+    const std::vector<std::string_view> names(owned.begin(), owned.end());
+    field.fail("unknown metal " + quote(name) + didYouMean(name, names) + " (expected one of: " + joinList(names) +
+               ", or give eta and k)");
+}
+
+Color toColor(const std::array<double, 3>& c) { return {c[0], c[1], c[2]}; }
+
+/// A conductor's complex index: a named metal, or eta and k (both, per channel).
+void readConductorIor(const TableField& table, Material& material)
+{
+    const std::optional<Field> metal = table.find("metal"), eta = table.find("eta"), k = table.find("k");
+    if (metal && (eta || k)) (eta ? *eta : *k).fail("give either 'metal' or 'eta' and 'k', not both");
+    if (!eta && !k) { // the default: Mitsuba's material "none", which reflects everything at every angle
+        const Metal& chosen = metal ? readMetal(*metal) : *findMetal("none");
+        material.eta = toColor(chosen.eta);
+        material.k = toColor(chosen.k);
+        return;
+    }
+    if (!eta || !k) {
+        table.field().fail(std::string("a conductor with '") + (eta ? "eta" : "k") + "' needs '" +
+                           (eta ? "k" : "eta") + "' too");
+    }
+    material.eta = readRadiance(*eta);
+    material.k = readRadiance(*k);
+}
+
+void readConductor(const TableField& table, Material& material)
+{
+    material.roughness = readOr(table, "roughness", 0.0, readUnitInterval);
+    material.anisotropy = readOr(table, "anisotropy", 0.0, readAnisotropy);
+    material.specular = readOr(table, "tint", Color(1.0), readUnitColor);
+    readConductorIor(table, material);
+}
+
+/// Roughness 0 is the smooth dielectric itself: the same kind, kernel and
+/// image. The default is Mitsuba's roughdielectric alpha = 0.1.
+void readRoughDielectric(const TableField& table, Material& material)
+{
+    readDielectric(table, material);
+    material.roughness = readOr(table, "roughness", std::sqrt(0.1), readUnitInterval);
+    if (material.roughness == 0.0) material.type = MaterialType::Dielectric;
+}
+
+/// Mitsuba's defaults: polypropylene (1.49), diffuse 0.5; roughness 0 is the smooth coating.
+void readPlastic(const TableField& table, Material& material)
+{
+    material.diffuse = readOr(table, "diffuse", Color(0.5), readUnitColor);
+    material.roughness = readOr(table, "roughness", 0.0, readUnitInterval);
+    material.ior = readOr(table, "ior", 1.49, readIor);
+    if (material.ior == 1.0) table.find("ior")->fail("must differ from 1 (a coating of index 1 is no coating)");
+}
+
+/// glTF 2.0's defaults: base colour 1, metallic 1, roughness 1.
+void readPbr(const TableField& table, Material& material)
+{
+    material.diffuse = readOr(table, "base_color", Color(1.0), readUnitColor);
+    material.metallic = readOr(table, "metallic", 1.0, readUnitInterval);
+    material.roughness = readOr(table, "roughness", 1.0, readUnitInterval);
 }
 
 struct MaterialKind {

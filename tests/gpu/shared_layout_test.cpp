@@ -43,6 +43,14 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(materials, Material, absorption),
         ARRAY_MEMBER(materials, Material, ior),
         ARRAY_MEMBER(materials, Material, fresnel),
+        ARRAY_MEMBER(materials, Material, alphaX),
+        ARRAY_MEMBER(materials, Material, alphaY),
+        ARRAY_MEMBER(materials, Material, table),
+        ARRAY_MEMBER(materials, Material, eta),
+        ARRAY_MEMBER(materials, Material, metallic),
+        ARRAY_MEMBER(materials, Material, k),
+        ARRAY_MEMBER(materials, Material, lobeWeight),
+        ARRAY_MEMBER(materials, Material, internalReflectance),
         ARRAY_MEMBER(spheres, Sphere, center),
         ARRAY_MEMBER(spheres, Sphere, radius),
         ARRAY_MEMBER(spheres, Sphere, material),
@@ -142,7 +150,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     // stride is the struct size in the scalar layout, which static_asserts in
     // src/gpu/SharedTypes.cpp pin. Here check the last member ends the struct.
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
-    EXPECT_EQ(offsets.at("materials[0].fresnel") + 4, int(sizeof(gpu::Material)));
+    EXPECT_EQ(offsets.at("materials[0].internalReflectance") + 4, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].radiance") + 12, int(sizeof(gpu::TriangleLight)));
     EXPECT_EQ(offsets.at("u.topNodeCount") + 4, int(sizeof(gpu::SceneUniforms)));
     EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));

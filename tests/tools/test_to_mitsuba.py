@@ -637,6 +637,16 @@ def test_single_glass_interface_scales_radiance_by_inverse_eta_squared():
     assert abs(img.mean() - (1 - r) / n**2) < 0.01, img.mean()
 
 
+def test_metal_table_matches_vkrts():
+    """to_mitsuba.METALS must hold exactly the numbers of src/material/Metals.cpp."""
+    import re
+    source = (REPO / "src" / "material" / "Metals.cpp").read_text()
+    rows = re.findall(r'\{"(\w+)", \{([^}]*)\}, \{([^}]*)\}\}', source)
+    assert len(rows) >= 5, rows
+    parsed = {name: ([float(x) for x in eta.split(",")], [float(x) for x in k.split(",")]) for name, eta, k in rows}
+    assert parsed == to_mitsuba.METALS, (parsed, to_mitsuba.METALS)
+
+
 if __name__ == "__main__":
     _STANDALONE = True
     failures = 0

@@ -9,6 +9,7 @@
 #define VKRT_MATERIAL_DIELECTRIC 1
 #include "lib/fresnel.glsl"
 #include "lib/sampling.glsl"
+#include "lib/microfacet.glsl"
 #include "lib/bsdf.glsl"
 
 void main()

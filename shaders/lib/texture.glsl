@@ -1,0 +1,125 @@
+// Image texture lookups from the packed texel buffer (shared/TextureTypes.h,
+// src/texture/TextureAtlas.h). Include lib/texture_bindings.glsl first, with
+// VKRT_HAS_TEXTURES defined.
+//
+// Conventions:
+// - uv follows OBJ (and OpenGL): u runs left to right, v from the BOTTOM of the
+//   image as stored in the file up to its top, so uv (0, 0) is the bottom-left
+//   corner of the image and (0, 1) its top-left. glTF's uvs start at the top,
+//   but assimp converts them on import (its glTF importer stores 1 - v; vkrt
+//   does not ask for aiProcess_FlipUVs, src/mesh/MeshLoader.cpp), so every
+//   mesh format arrives in this convention (tests/texture: TextureUv*).
+// - Texel (x, y) of a w x h level (row y = 0 the file's top row) has its
+//   centre at uv ((x + 0.5) / w, 1 - (y + 0.5) / h): every level spans the
+//   same uv square.
+// - Filtering happens on linear values: 8-bit sRGB texels are decoded one by
+//   one (exact piecewise sRGB EOTF) before they are weighted.
+// - Wrap modes apply to texel indices, on each axis separately:
+//   TEXTURE_WRAP_REPEAT (period n), _CLAMP (edge texel continues), _MIRROR
+//   (period 2n, edge texels doubled as in GL_MIRRORED_REPEAT).
+#ifndef VKRT_TEXTURE_GLSL
+#define VKRT_TEXTURE_GLSL
+
+#include "lib/texture_bindings.glsl"
+
+/// The exact sRGB EOTF (IEC 61966-2-1).
+vec3 srgbToLinear(vec3 encoded)
+{
+    vec3 low = encoded / 12.92;
+    vec3 high = pow((encoded + 0.055) / 1.055, vec3(2.4));
+    return mix(high, low, lessThanEqual(encoded, vec3(0.04045)));
+}
+
+/// Texel index i of a side of n texels after the wrap mode; i >= -n - 1 (see
+/// wrapTextureCoordinate). The last clamp keeps even a NaN uv inside the level.
+int wrapTexelIndex(int i, int n, uint wrap)
+{
+    if (wrap == TEXTURE_WRAP_MIRROR) {
+        int j = (i + 2 * n) % (2 * n);
+        i = j < n ? j : 2 * n - 1 - j;
+    } else if (wrap == TEXTURE_WRAP_REPEAT) {
+        i = (i + n) % n;
+    }
+    return clamp(i, 0, n - 1);
+}
+
+/// A texture coordinate (in units of the image, y down) moved by whole
+/// periods of its wrap mode into a small range, so texel indices stay
+/// non-negative after one period is added (GLSL's % is undefined for negative
+/// operands) and never overflow an int; the lookup is unchanged.
+float wrapTextureCoordinate(float s, uint wrap)
+{
+    if (wrap == TEXTURE_WRAP_REPEAT)
+        return s - floor(s);
+    if (wrap == TEXTURE_WRAP_MIRROR)
+        return s - 2.0 * floor(0.5 * s);
+    return clamp(s, -1.0, 2.0);
+}
+
+/// Texel (x, y) of a level starting at word `offset` with rows of `width`, linear RGBA.
+vec4 fetchTexel(uint format, uint offset, uint width, uint x, uint y)
+{
+    uint index = y * width + x;
+    if (format == TEXTURE_FORMAT_RGBA16F) {
+        uint word = offset + 2u * index;
+        return vec4(unpackHalf2x16(textureTexels[word]), unpackHalf2x16(textureTexels[word + 1u]));
+    }
+    vec4 texel = unpackUnorm4x8(textureTexels[offset + index]);
+    if (format == TEXTURE_FORMAT_RGBA8_SRGB)
+        texel.rgb = srgbToLinear(texel.rgb);
+    return texel;
+}
+
+/// Bilinear lookup in one mip level.
+vec4 sampleTextureLevel(uint textureIndex, vec2 uv, uint level)
+{
+    uint format = textureRecords[textureIndex].format;
+    uint offset = textureRecords[textureIndex].levelOffset[level];
+    ivec2 size = ivec2(max(uvec2(1u), uvec2(textureRecords[textureIndex].width, textureRecords[textureIndex].height)
+                                          >> level));
+    uint wrapU = textureRecords[textureIndex].wrapU, wrapV = textureRecords[textureIndex].wrapV;
+    // Continuous texel coordinates, texel centres at integers; y down from the top row.
+    vec2 image = vec2(wrapTextureCoordinate(uv.x, wrapU), wrapTextureCoordinate(1.0 - uv.y, wrapV));
+    vec2 st = image * vec2(size) - 0.5;
+    vec2 base = floor(st);
+    vec2 f = st - base;
+    ivec2 i0 = ivec2(base);
+    uint x0 = uint(wrapTexelIndex(i0.x, size.x, wrapU)), x1 = uint(wrapTexelIndex(i0.x + 1, size.x, wrapU));
+    uint y0 = uint(wrapTexelIndex(i0.y, size.y, wrapV)), y1 = uint(wrapTexelIndex(i0.y + 1, size.y, wrapV));
+    uint w = uint(size.x);
+    vec4 top = mix(fetchTexel(format, offset, w, x0, y0), fetchTexel(format, offset, w, x1, y0), f.x);
+    vec4 bottom = mix(fetchTexel(format, offset, w, x0, y1), fetchTexel(format, offset, w, x1, y1), f.x);
+    return mix(top, bottom, f.y);
+}
+
+/// Trilinear lookup: bilinear in levels floor(lod) and floor(lod) + 1, mixed
+/// by the fraction. `lod` is log2 of the footprint in level-0 texels (see
+/// rayConeTextureLod), clamped to [0, levels - 1]; NaN counts as 0.
+vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
+{
+    float top = float(textureRecords[textureIndex].levels - 1u);
+    lod = lod > 0.0 ? min(lod, top) : 0.0;
+    float level0 = floor(lod);
+    float t = lod - level0;
+    vec4 fine = sampleTextureLevel(textureIndex, uv, uint(level0));
+    if (t == 0.0)
+        return fine;
+    return mix(fine, sampleTextureLevel(textureIndex, uv, uint(level0) + 1u), t);
+}
+
+/// Mip level from a ray cone (Akenine-Möller et al. 2019, "Texture Level of
+/// Detail Strategies for Real-Time Ray Tracing", Ray Tracing Gems ch. 20,
+/// ray cones): lod = 0.5 log2(w h * uvArea / worldArea) + log2(coneWidth / |cos|),
+/// where w x h is level 0's size, uvAreaPerWorldArea the triangle's uv area
+/// over its world area (the texel density term Delta), coneWidth the cone's
+/// width at the hit and cosTheta the cosine between the ray and the normal.
+/// |cos| is kept above 1e-4 so a grazing hit gives a large, finite lod; a
+/// degenerate uv mapping (0 area) gives -infinity, which sampleTexture treats
+/// as level 0. (Not called textureLod: GLSL has a built-in of that name.)
+float rayConeTextureLod(uint textureIndex, float coneWidth, float cosTheta, float uvAreaPerWorldArea)
+{
+    float texels = float(textureRecords[textureIndex].width) * float(textureRecords[textureIndex].height);
+    return 0.5 * log2(texels * uvAreaPerWorldArea) + log2(coneWidth / max(abs(cosTheta), 1e-4));
+}
+
+#endif

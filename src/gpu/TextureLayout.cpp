@@ -1,0 +1,18 @@
+// Host-side checks of shared/TextureTypes.h, in the manner of SharedTypes.cpp:
+// the scalar layout lays TextureRecord out as C++ does while no padding
+// appears; tests/texture/texture_layout_test.cpp compares the offsets with
+// glslang's reflection.
+#include "shared/TextureTypes.h"
+
+#include <cstddef>
+
+namespace vkrt::gpu {
+
+static_assert(sizeof(TextureRecord) == 4 * (6 + TEXTURE_MAX_LEVELS));
+static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, levelOffset) == 24);
+// Level sizes: the largest side has floor(log2(TEXTURE_MAX_SIZE)) + 1 levels.
+static_assert((1u << (TEXTURE_MAX_LEVELS - 1)) == TEXTURE_MAX_SIZE);
+static_assert(BINDING_TEXTURE_TEXELS >= BINDING_COUNT && BINDING_TEXTURE_RECORDS != BINDING_TEXTURE_TEXELS,
+              "texture bindings must not collide with the render kernels' (until they move to Bindings.h)");
+
+} // namespace vkrt::gpu

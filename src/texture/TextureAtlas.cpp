@@ -1,0 +1,157 @@
+#include "texture/TextureAtlas.h"
+
+#include "texture/MipPyramid.h"
+
+#include <Imath/half.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace vkrt {
+
+namespace fs = std::filesystem;
+
+uint32_t encodeRgba8(const float* linearRgba, bool srgb)
+{
+    uint32_t word = 0;
+    for (int c = 0; c < 4; ++c) {
+        double value = std::clamp(double(linearRgba[c]), 0.0, 1.0);
+        if (srgb && c < 3) value = linearToSrgb(value);
+        word |= uint32_t(std::lround(value * 255.0)) << (8 * c);
+    }
+    return word;
+}
+
+void encodeRgba16f(const float* linearRgba, uint32_t words[2])
+{
+    auto bits = [](float value) { return uint32_t(Imath::half(std::clamp(value, -65504.0f, 65504.0f)).bits()); };
+    words[0] = bits(linearRgba[0]) | bits(linearRgba[1]) << 16;
+    words[1] = bits(linearRgba[2]) | bits(linearRgba[3]) << 16;
+}
+
+namespace {
+
+uint32_t formatOf(TexelEncoding encoding)
+{
+    switch (encoding) {
+    case TexelEncoding::Srgb8: return gpu::TEXTURE_FORMAT_RGBA8_SRGB;
+    case TexelEncoding::Unorm8: return gpu::TEXTURE_FORMAT_RGBA8_UNORM;
+    case TexelEncoding::Half: return gpu::TEXTURE_FORMAT_RGBA16F;
+    }
+    throw InternalError("unknown texel encoding");
+}
+
+void appendLevel(const RgbaImage& level, uint32_t format, std::vector<uint32_t>& words)
+{
+    for (size_t i = 0; i < level.texelCount(); ++i) {
+        const float* texel = &level.rgba[i * 4];
+        if (format == gpu::TEXTURE_FORMAT_RGBA16F) {
+            uint32_t pair[2];
+            encodeRgba16f(texel, pair);
+            words.insert(words.end(), pair, pair + 2);
+        } else {
+            words.push_back(encodeRgba8(texel, format == gpu::TEXTURE_FORMAT_RGBA8_SRGB));
+        }
+    }
+}
+
+std::string mebibytes(uint64_t bytes)
+{
+    std::ostringstream text;
+    text.precision(bytes < (10u << 20) ? 2 : 0);
+    text << std::fixed << double(bytes) / double(1u << 20) << " MiB";
+    return text.str();
+}
+
+std::string fileKey(const fs::path& file)
+{
+    std::error_code error;
+    const fs::path canonical = fs::weakly_canonical(file, error);
+    return (error ? file : canonical).string();
+}
+
+} // namespace
+
+uint32_t TextureAtlas::addImage(const TextureImage& image, const std::string& name)
+{
+    StoredImage stored;
+    stored.name = name;
+    stored.width = image.pixels.width;
+    stored.height = image.pixels.height;
+    stored.format = formatOf(image.encoding);
+    for (const RgbaImage& level : buildMipPyramid(image.pixels)) {
+        stored.levelWords.push_back(stored.words.size());
+        appendLevel(level, stored.format, stored.words);
+    }
+    stored.levels = uint32_t(stored.levelWords.size());
+    VKRT_CHECK(stored.levels <= gpu::TEXTURE_MAX_LEVELS);
+    stored.firstWord = m_words;
+    m_words += stored.words.size();
+    m_images.push_back(std::move(stored));
+    return uint32_t(m_images.size() - 1);
+}
+
+uint32_t TextureAtlas::addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV)
+{
+    const auto record = std::make_tuple(image, wrapU, wrapV);
+    const auto found = std::find(m_records.begin(), m_records.end(), record);
+    if (found != m_records.end()) return uint32_t(found - m_records.begin());
+    m_records.push_back(record);
+    return uint32_t(m_records.size() - 1);
+}
+
+uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& where)
+{
+    const auto key = std::make_pair(fileKey(request.file), request.linear);
+    auto found = m_imageByFile.find(key);
+    if (found == m_imageByFile.end()) {
+        uint32_t image = 0;
+        try {
+            image = addImage(loadTextureImage(request.file, request.linear), request.file.string());
+        } catch (const SceneError&) {
+            throw;
+        } catch (const InputError& error) {
+            if (where.file.empty()) throw;
+            throw SceneError(where, error.what());
+        }
+        found = m_imageByFile.emplace(key, image).first;
+    }
+    return addRecord(found->second, request.wrapU, request.wrapV);
+}
+
+uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV)
+{
+    VKRT_CHECK(image.pixels.width >= 1 && image.pixels.width <= gpu::TEXTURE_MAX_SIZE);
+    VKRT_CHECK(image.pixels.height >= 1 && image.pixels.height <= gpu::TEXTURE_MAX_SIZE);
+    return addRecord(addImage(image, name), wrapU, wrapV);
+}
+
+TextureBuffers TextureAtlas::pack(uint64_t maxStorageBufferRange) const
+{
+    if (texelBytes() > maxStorageBufferRange) {
+        const auto largest = std::max_element(m_images.begin(), m_images.end(), [](const auto& a, const auto& b) {
+            return a.words.size() < b.words.size();
+        });
+        throw InputError("textures need " + mebibytes(texelBytes()) + " of GPU storage (all mip levels), more than " +
+                         "this device's limit of " + mebibytes(maxStorageBufferRange) +
+                         " for one storage buffer (maxStorageBufferRange); the largest is " + largest->name + " (" +
+                         std::to_string(largest->width) + "x" + std::to_string(largest->height) + ", " +
+                         mebibytes(largest->words.size() * 4) + ")");
+    }
+    TextureBuffers buffers;
+    buffers.texels.reserve(m_words);
+    for (const StoredImage& image : m_images)
+        buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
+    for (const auto& [imageIndex, wrapU, wrapV] : m_records) {
+        const StoredImage& image = m_images[imageIndex];
+        gpu::TextureRecord record{image.width, image.height, image.levels, image.format,
+                                  uint32_t(wrapU), uint32_t(wrapV), {}};
+        for (uint32_t level = 0; level < image.levels; ++level)
+            record.levelOffset[level] = uint32_t(image.firstWord + image.levelWords[level]);
+        buffers.records.push_back(record);
+    }
+    return buffers;
+}
+
+} // namespace vkrt

@@ -1,0 +1,85 @@
+#pragma once
+// Every texture of a scene, all mip levels, packed into one buffer of 32-bit
+// words plus a table of gpu::TextureRecord (shared/TextureTypes.h) that
+// lib/texture.glsl reads. One buffer means no descriptor-count limit; its size
+// is checked against the device's maxStorageBufferRange instead.
+#include "shared/TextureTypes.h"
+#include "texture/TextureImage.h"
+#include "util/Error.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace vkrt {
+
+enum class TextureWrap : uint32_t {
+    Repeat = gpu::TEXTURE_WRAP_REPEAT,
+    Clamp = gpu::TEXTURE_WRAP_CLAMP,
+    Mirror = gpu::TEXTURE_WRAP_MIRROR,
+};
+
+/// A texture as a scene names it.
+struct TextureRequest {
+    std::filesystem::path file; ///< already resolved against the scene file's folder
+    bool linear = false;        ///< 8/16-bit data that is not sRGB (roughness, normal maps)
+    TextureWrap wrapU = TextureWrap::Repeat;
+    TextureWrap wrapV = TextureWrap::Repeat;
+};
+
+/// What the kernels bind: BINDING_TEXTURE_TEXELS and BINDING_TEXTURE_RECORDS.
+struct TextureBuffers {
+    std::vector<uint32_t> texels;
+    std::vector<gpu::TextureRecord> records;
+};
+
+class TextureAtlas {
+public:
+    /// Loads the file (once per (file, linear) pair) and returns the index of
+    /// its record (one per distinct pair and wrap modes). Load errors are
+    /// InputErrors naming the file; given a location (the scene's `texture`
+    /// key), a SceneError starting "file:line:column: ".
+    uint32_t add(const TextureRequest& request, const SourceLocation& where = {});
+
+    /// An image made in memory (procedural textures, tests); `name` is used in messages.
+    uint32_t add(const TextureImage& image, const std::string& name, TextureWrap wrapU = TextureWrap::Repeat,
+                 TextureWrap wrapV = TextureWrap::Repeat);
+
+    size_t recordCount() const { return m_records.size(); }
+    /// Distinct images loaded (each with its mip chain).
+    size_t imageCount() const { return m_images.size(); }
+    /// Bytes of texel storage so far.
+    uint64_t texelBytes() const { return m_words * 4; }
+
+    /// The buffers to upload. Throws InputError when the texels exceed
+    /// `maxStorageBufferRange` bytes (VkPhysicalDeviceLimits), naming the largest texture.
+    TextureBuffers pack(uint64_t maxStorageBufferRange) const;
+
+private:
+    struct StoredImage {
+        std::string name;
+        uint32_t width = 0, height = 0, levels = 0, format = 0;
+        uint64_t firstWord = 0;           ///< in the packed buffer
+        std::vector<uint64_t> levelWords; ///< each level's start, relative to firstWord
+        std::vector<uint32_t> words;      ///< every level, encoded
+    };
+    uint32_t addImage(const TextureImage& image, const std::string& name);
+    uint32_t addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV);
+
+    std::vector<StoredImage> m_images;
+    std::vector<std::tuple<uint32_t, TextureWrap, TextureWrap>> m_records; ///< image, wrap u, wrap v
+    std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile;        ///< (canonical path, linear)
+    uint64_t m_words = 0;
+};
+
+/// Texel encodings (exposed for tests): RGBA8 words (unpackUnorm4x8 order)
+/// and half-float pairs (packHalf2x16 order). Linear values to sRGB 8-bit round
+/// to nearest, so an 8-bit sRGB level 0 keeps its file's codes exactly;
+/// half floats clamp to +-65504 (no infinity from a bright EXR).
+uint32_t encodeRgba8(const float* linearRgba, bool srgb);
+void encodeRgba16f(const float* linearRgba, uint32_t words[2]);
+
+} // namespace vkrt

@@ -1,0 +1,154 @@
+#include "texture/TextureImage.h"
+
+#include "io/ExrFile.h"
+#include "shared/TextureTypes.h"
+#include "util/Error.h"
+
+// stb_image's implementation is compiled once, in the system's libstb (the `stb` target).
+#include <stb/stb_image.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <memory>
+
+namespace vkrt {
+
+namespace fs = std::filesystem;
+
+double srgbToLinear(double encoded)
+{
+    return encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4);
+}
+
+double linearToSrgb(double linear)
+{
+    return linear <= 0.0031308 ? linear * 12.92 : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+namespace {
+
+[[noreturn]] void fail(const fs::path& file, const std::string& reason)
+{
+    throw InputError(file.string() + ": " + reason);
+}
+
+std::vector<unsigned char> readBytes(const fs::path& file)
+{
+    std::error_code error;
+    const fs::file_status status = fs::status(file, error);
+    if (!fs::exists(status)) fail(file, "texture file not found");
+    if (fs::is_directory(status)) fail(file, "is a directory, not an image file");
+    std::ifstream in(file, std::ios::binary);
+    if (!in) fail(file, "cannot open texture file");
+    std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (bytes.empty()) fail(file, "empty file, not an image");
+    return bytes;
+}
+
+bool isExr(const std::vector<unsigned char>& bytes)
+{
+    return bytes.size() >= 4 && bytes[0] == 0x76 && bytes[1] == 0x2f && bytes[2] == 0x31 && bytes[3] == 0x01;
+}
+
+void checkSize(const fs::path& file, uint64_t width, uint64_t height)
+{
+    if (width == 0 || height == 0)
+        fail(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) + " pixels");
+    if (width > gpu::TEXTURE_MAX_SIZE || height > gpu::TEXTURE_MAX_SIZE)
+        fail(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) +
+                       " pixels (textures may have at most " + std::to_string(gpu::TEXTURE_MAX_SIZE) +
+                       " pixels a side)");
+}
+
+std::string stbReason()
+{
+    const char* reason = stbi_failure_reason();
+    return reason ? reason : "unknown reason";
+}
+
+/// stb_image results, freed with stbi_image_free.
+template <typename T>
+using StbPixels = std::unique_ptr<T, void (*)(void*)>;
+
+TextureImage loadExr(const fs::path& file)
+{
+    const Image rgb = readExr(file).image; // R, G, B; alpha is 1
+    checkSize(file, rgb.width, rgb.height);
+    TextureImage texture{RgbaImage(rgb.width, rgb.height), TexelEncoding::Half};
+    for (uint32_t y = 0; y < rgb.height; ++y) {
+        for (uint32_t x = 0; x < rgb.width; ++x) {
+            const float* in = rgb.at(x, y);
+            float* out = texture.pixels.at(x, y);
+            for (int c = 0; c < 3; ++c) {
+                if (!std::isfinite(in[c]))
+                    fail(file, "non-finite texel (" + std::string(std::isnan(in[c]) ? "NaN" : "infinity") +
+                                   ") at pixel x=" + std::to_string(x) + ", y=" + std::to_string(y) +
+                                   " (from the top left)");
+                out[c] = in[c];
+            }
+            out[3] = 1.0f;
+        }
+    }
+    return texture;
+}
+
+/// Decodes `count` channel values quantized to `maxCode` into linear floats.
+template <typename T>
+void decodeChannels(const T* codes, RgbaImage& image, double maxCode, bool linear)
+{
+    for (size_t i = 0; i < image.rgba.size(); ++i) {
+        const double value = double(codes[i]) / maxCode;
+        const bool colour = i % 4 != 3; // alpha is always linear
+        image.rgba[i] = float(colour && !linear ? srgbToLinear(value) : value);
+    }
+}
+
+TextureImage loadStb(const fs::path& file, const std::vector<unsigned char>& bytes, bool linear)
+{
+    const auto* data = bytes.data();
+    const int length = int(bytes.size());
+    int width = 0, height = 0, channels = 0;
+    if (bytes.size() > size_t(INT32_MAX)) fail(file, "unsupported image: larger than 2 GiB");
+    if (!stbi_info_from_memory(data, length, &width, &height, &channels)) {
+        // stbi_info tries every format in turn and reports the last one's
+        // complaint ("unknown image type"); a decode attempt stops at the
+        // format whose signature matches and says what is wrong with it.
+        StbPixels<stbi_uc> pixels(stbi_load_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
+        const std::string reason = pixels ? "its header cannot be read" : stbReason();
+        if (reason == "unknown image type") fail(file, "not an image file (stb_image: " + reason + ")");
+        fail(file, "unsupported or damaged image (stb_image: " + reason + ")");
+    }
+    checkSize(file, uint64_t(width), uint64_t(height));
+    TextureImage texture{RgbaImage(uint32_t(width), uint32_t(height)), TexelEncoding::Half};
+    // Four channels requested: grey becomes (g, g, g, 1), grey + alpha (g, g, g, a), RGB gets alpha 1.
+    if (stbi_is_hdr_from_memory(data, length)) {
+        StbPixels<float> pixels(stbi_loadf_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
+        if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
+        std::copy_n(pixels.get(), texture.pixels.rgba.size(), texture.pixels.rgba.begin());
+    } else if (stbi_is_16_bit_from_memory(data, length)) {
+        StbPixels<stbi_us> pixels(stbi_load_16_from_memory(data, length, &width, &height, &channels, 4),
+                                  stbi_image_free);
+        if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
+        decodeChannels(pixels.get(), texture.pixels, 65535.0, linear);
+    } else {
+        StbPixels<stbi_uc> pixels(stbi_load_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
+        if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
+        decodeChannels(pixels.get(), texture.pixels, 255.0, linear);
+        texture.encoding = linear ? TexelEncoding::Unorm8 : TexelEncoding::Srgb8;
+    }
+    return texture;
+}
+
+} // namespace
+
+TextureImage loadTextureImage(const fs::path& file, bool linear)
+{
+    const std::vector<unsigned char> bytes = readBytes(file);
+    if (isExr(bytes)) return loadExr(file); // EXR is linear whatever `linear` says
+    return loadStb(file, bytes, linear);
+}
+
+} // namespace vkrt

@@ -1,0 +1,32 @@
+#pragma once
+// Test images written by code: 8-bit files through stb_image_write, and PNGs
+// stb_image_write cannot make (16-bit, odd bit depths, bare headers) by a
+// minimal encoder (stored, uncompressed deflate blocks).
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace vkrt::test {
+
+/// A fresh directory named after the running test.
+std::filesystem::path textureTestDir();
+
+/// Writes raw bytes to a file.
+std::filesystem::path writeBytes(const std::filesystem::path& path, const std::string& bytes);
+
+/// An 8-bit PNG of `channels` channels (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA), rows top to bottom.
+std::filesystem::path write8BitPng(const std::filesystem::path& path, uint32_t width, uint32_t height, int channels,
+                                   const std::vector<uint8_t>& samples);
+
+/// A PNG with samples of `bitDepth` bits (stored big-endian as PNG wants) and
+/// PNG colour type `colourType` (0 grey, 2 RGB, 4 grey + alpha, 6 RGBA).
+/// Only depths 8 and 16 get pixel data; any other depth writes the header
+/// with no image data (enough for stb_image to refuse it).
+std::filesystem::path writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, int bitDepth,
+                               int colourType, const std::vector<uint16_t>& samples);
+
+/// The shared third-party assets: ../shared/assets beside the checkout, or $VKRT_ASSETS_DIR.
+std::filesystem::path assetsDir();
+
+} // namespace vkrt::test

@@ -1,0 +1,142 @@
+// Packing textures into one buffer (src/texture/TextureAtlas.h): records,
+// level offsets, encodings, de-duplication, located errors and the device limit.
+#include "texture/MipPyramid.h"
+#include "texture/TextureAtlas.h"
+#include "texture/TextureTestFiles.h"
+
+#include <Imath/half.h>
+
+#include <gtest/gtest.h>
+
+namespace vkrt::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+TextureImage solid(uint32_t width, uint32_t height, TexelEncoding encoding, float value = 0.5f)
+{
+    TextureImage image{RgbaImage(width, height), encoding};
+    std::fill(image.pixels.rgba.begin(), image.pixels.rgba.end(), value);
+    return image;
+}
+
+TEST(TextureAtlas, RecordsPointAtEveryLevel)
+{
+    TextureAtlas atlas;
+    EXPECT_EQ(atlas.add(solid(5, 3, TexelEncoding::Srgb8), "a", TextureWrap::Clamp, TextureWrap::Mirror), 0u);
+    EXPECT_EQ(atlas.add(solid(4, 4, TexelEncoding::Half), "b"), 1u);
+    const TextureBuffers buffers = atlas.pack(1u << 20);
+    ASSERT_EQ(buffers.records.size(), 2u);
+    const gpu::TextureRecord& a = buffers.records[0];
+    EXPECT_EQ(a.width, 5u);
+    EXPECT_EQ(a.height, 3u);
+    EXPECT_EQ(a.levels, 3u); // 5x3, 2x1, 1x1
+    EXPECT_EQ(a.format, gpu::TEXTURE_FORMAT_RGBA8_SRGB);
+    EXPECT_EQ(a.wrapU, gpu::TEXTURE_WRAP_CLAMP);
+    EXPECT_EQ(a.wrapV, gpu::TEXTURE_WRAP_MIRROR);
+    EXPECT_EQ(a.levelOffset[0], 0u);
+    EXPECT_EQ(a.levelOffset[1], 15u);
+    EXPECT_EQ(a.levelOffset[2], 17u);
+    EXPECT_EQ(a.levelOffset[3], 0u);
+    const gpu::TextureRecord& b = buffers.records[1];
+    EXPECT_EQ(b.format, gpu::TEXTURE_FORMAT_RGBA16F);
+    EXPECT_EQ(b.levels, 3u); // 4x4, 2x2, 1x1, two words a texel
+    EXPECT_EQ(b.levelOffset[0], 18u);
+    EXPECT_EQ(b.levelOffset[1], 18u + 32u);
+    EXPECT_EQ(b.levelOffset[2], 18u + 40u);
+    EXPECT_EQ(buffers.texels.size(), 18u + 42u);
+    EXPECT_EQ(atlas.texelBytes(), 4u * 60u);
+}
+
+TEST(TextureAtlas, EightBitSrgbKeepsTheFileCodes)
+{
+    std::vector<uint8_t> samples;
+    for (int code = 0; code < 256; ++code)
+        for (int c = 0; c < 4; ++c) samples.push_back(uint8_t(code + 50 * c)); // wraps mod 256
+    const fs::path file = write8BitPng(textureTestDir() / "codes.png", 256, 1, 4, samples);
+    TextureAtlas atlas;
+    atlas.add(TextureRequest{file});
+    const TextureBuffers buffers = atlas.pack(1u << 20);
+    for (uint32_t x = 0; x < 256; ++x) {
+        const uint32_t word = buffers.texels[x];
+        for (int c = 0; c < 4; ++c) EXPECT_EQ((word >> (8 * c)) & 0xffu, samples[x * 4 + c]) << x << " " << c;
+    }
+}
+
+TEST(TextureAtlas, HalfFloatsPackAsPackHalf2x16)
+{
+    const float texel[4] = {1.0f, -2.5f, 1e6f, 0.333f};
+    uint32_t words[2];
+    encodeRgba16f(texel, words);
+    EXPECT_EQ(words[0] & 0xffffu, 0x3c00u); // 1.0 in the low half, as packHalf2x16's x
+    EXPECT_EQ(words[0] >> 16, 0xc100u);     // -2.5
+    EXPECT_EQ(words[1] & 0xffffu, 0x7bffu); // clamped to 65504, not infinity
+    Imath::half third;
+    third.setBits(uint16_t(words[1] >> 16));
+    EXPECT_NEAR(float(third), 0.333f, 0.333f / 1024);
+}
+
+TEST(TextureAtlas, LinearEightBitIsUnorm)
+{
+    const float texel[4] = {0.5f, 0.0f, 1.0f, 0.2f};
+    EXPECT_EQ(encodeRgba8(texel, false), 128u | 0u << 8 | 255u << 16 | 51u << 24);
+    // sRGB: 0.5 linear encodes to 188 (0.7354 * 255 = 187.5 rounds up), alpha stays linear.
+    EXPECT_EQ(encodeRgba8(texel, true), 188u | 0u << 8 | 255u << 16 | 51u << 24);
+}
+
+TEST(TextureAtlas, SameFileIsLoadedOnce)
+{
+    const fs::path dir = textureTestDir();
+    const fs::path file = write8BitPng(dir / "wood.png", 4, 2, 3, std::vector<uint8_t>(24, 77));
+    fs::create_directories(dir / "sub");
+    TextureAtlas atlas;
+    const uint32_t first = atlas.add(TextureRequest{file});
+    EXPECT_EQ(atlas.add(TextureRequest{dir / "sub" / ".." / "wood.png"}), first);
+    const uint32_t clamped = atlas.add(TextureRequest{file, false, TextureWrap::Clamp, TextureWrap::Clamp});
+    const uint32_t linear = atlas.add(TextureRequest{file, true});
+    EXPECT_NE(clamped, first);
+    EXPECT_NE(linear, first);
+    EXPECT_EQ(atlas.imageCount(), 2u); // (file, sRGB) and (file, linear)
+    EXPECT_EQ(atlas.recordCount(), 3u);
+    const TextureBuffers buffers = atlas.pack(1u << 20);
+    EXPECT_EQ(buffers.records[clamped].levelOffset[0], buffers.records[first].levelOffset[0]);
+    EXPECT_NE(buffers.records[linear].levelOffset[0], buffers.records[first].levelOffset[0]);
+    EXPECT_EQ(buffers.records[linear].format, gpu::TEXTURE_FORMAT_RGBA8_UNORM);
+}
+
+TEST(TextureAtlas, LoadErrorCarriesTheSceneLocation)
+{
+    const fs::path file = textureTestDir() / "missing.png";
+    TextureAtlas atlas;
+    try {
+        atlas.add(TextureRequest{file}, SourceLocation{"scene.toml", 12, 20});
+        FAIL() << "no error";
+    } catch (const SceneError& error) {
+        EXPECT_EQ(std::string(error.what()), "scene.toml:12:20: " + file.string() + ": texture file not found");
+        EXPECT_EQ(error.where().line, 12);
+    }
+    EXPECT_THROW(atlas.add(TextureRequest{file}), InputError); // no location: the loader's own error
+    EXPECT_EQ(atlas.imageCount(), 0u);
+}
+
+TEST(TextureAtlas, OverTheBufferLimitIsRefusedNamingTheLargest)
+{
+    TextureAtlas atlas;
+    atlas.add(solid(16, 16, TexelEncoding::Srgb8), "small.png");
+    atlas.add(solid(64, 32, TexelEncoding::Half), "big.exr");
+    atlas.add(solid(8, 8, TexelEncoding::Half), "tiny.exr");
+    const uint64_t bytes = atlas.texelBytes();
+    EXPECT_NO_THROW(atlas.pack(bytes)); // exactly at the limit fits
+    try {
+        atlas.pack(bytes - 4);
+        FAIL() << "no error";
+    } catch (const InputError& error) {
+        const std::string message = error.what();
+        EXPECT_NE(message.find("more than this device's limit"), std::string::npos) << message;
+        EXPECT_NE(message.find("maxStorageBufferRange"), std::string::npos) << message;
+        EXPECT_NE(message.find("the largest is big.exr (64x32, "), std::string::npos) << message;
+    }
+}
+
+} // namespace
+} // namespace vkrt::test
