@@ -95,13 +95,32 @@ TEST(MicrofacetAlbedo, TableFollowsMitsubasLayoutAndInterpolation)
     EXPECT_DOUBLE_EQ(roughTransmittanceCosine(21), 21.0 / 63.0);
     auto table = roughTransmittanceTable(0.25, 1.5);
     for (int i : {0, 1, 30, 63}) {
-        EXPECT_NEAR(table[i], 1.0 - roughSpecularAlbedo(roughTransmittanceCosine(i), 0.25, 1.5), 1e-7);
+        EXPECT_NEAR(table[i], roughTransmittance(roughTransmittanceCosine(i), 0.25, 1.5), 1e-7);
         EXPECT_NEAR(lerpTransmittance(table, i / 63.0), table[i], 1e-7);
     }
     EXPECT_NEAR(lerpTransmittance(table, 10.5 / 63.0), 0.5 * (table[10] + table[11]), 1e-7);
     // Transmittance grows towards normal incidence for a dielectric seen from outside.
     EXPECT_LT(table[1], table[32]);
     EXPECT_LT(table[32], table[63]);
+}
+
+TEST(MicrofacetAlbedo, TransmittanceIsWhatReflectionAndMaskingLeave)
+{
+    for (double alpha : {1e-4, 0.04, 0.25, 1.0})
+        for (double eta : {1.5, 1.0 / 1.5, 3.0})
+            for (double mu : {0.05, 0.2, 0.5, 1.0}) {
+                double t = roughTransmittance(mu, alpha, eta), r = roughSpecularAlbedo(mu, alpha, eta);
+                EXPECT_GE(t, 0.0);
+                // Light masked on the far side is lost, never gained: T + R <= 1.
+                EXPECT_LE(t + r, 1.0 + 2e-4) << "alpha " << alpha << " eta " << eta << " mu " << mu;
+            }
+    // A smooth interface transmits 1 - F(mu) (outside above the critical angle from inside).
+    for (double eta : {1.5, 1.0 / 1.5})
+        for (double mu : {0.8, 0.9, 1.0})
+            EXPECT_NEAR(roughTransmittance(mu, 1e-4, eta), 1.0 - fresnelDielectric(mu, eta).reflectance, 2e-3)
+                << "eta " << eta << " mu " << mu;
+    // Rough interfaces lose energy to masking: at alpha = 1 and normal incidence T + R is well below 1.
+    EXPECT_LT(roughTransmittance(1.0, 1.0, 1.5) + roughSpecularAlbedo(1.0, 1.0, 1.5), 0.95);
 }
 
 TEST(MicrofacetAlbedo, InternalReflectanceHasTheSmoothLimit)
