@@ -16,7 +16,7 @@ double roughTransmittanceCosine(int i);
 /// specular reflection f_s = F D G / (4 cosO cosI) (separable Smith G, exact dielectric Fresnel of
 /// relative index eta = n_below / n_above) for a direction at cosine mu (0 < mu <= 1) above an isotropic
 /// interface of roughness alpha (clamped to >= 1e-4, as Mitsuba does). quadratureOrder is the number of
-/// Gauss-Legendre nodes per dimension of the visible-normal disk; the default meets the 1e-4 bound.
+/// Gauss-Legendre nodes per smooth segment of each dimension (0: chosen by mu to meet the 1e-4 bound).
 double roughSpecularAlbedo(double mu, double alpha, double eta, int quadratureOrder = 0);
 
 /// The energy a rough interface transmits from a direction at cosine mu above it: the expected

@@ -16,7 +16,7 @@ using DirectionPdf = std::function<double(const glm::dvec3&)>;
 struct ChiSquareOptions {
     int thetaBins = 20;          ///< cells in cos(theta) over [-1, 1]; phi gets twice as many over [0, 2 pi)
     int subCells = 4;            ///< initial Simpson panels per cell and axis before adaptive refinement
-    double tolerance = 1e-9;     ///< absolute error allowed in each cell's probability
+    double countTolerance = 0.1;  ///< error allowed in each cell's expected count (sets the integration tolerance)
     double minExpected = 5.0;    ///< cells expecting fewer samples are pooled together
     int worstCellsShown = 8;     ///< rows in the printable table
 };
