@@ -4,6 +4,7 @@
 // sampleDielectric (bsdf.glsl) and the uniform triangle sampler
 // (sampling.glsl, driven by the render kernels' random.glsl), with statistical
 // tests that are shown to reject a deliberately wrong sampler.
+#include "support/ChiSquare.h"
 #include "support/ProbeKernel.h"
 #include "support/TestSupport.h"
 
@@ -381,40 +382,6 @@ TEST_F(SnellProbe, RefractionObeysSnellOrReflectsBeyondCriticalAngle)
 
 // ---------------------------------------------------------------------------
 // 6. Uniform triangle sampling
-
-/// Regularized upper incomplete gamma Q(a, x) = Gamma(a, x) / Gamma(a): a series for
-/// x < a + 1, else a Lentz continued fraction (Numerical Recipes, section 6.2).
-double upperIncompleteGammaQ(double a, double x)
-{
-    if (x <= 0.0) return 1.0;
-    double logPrefix = a * std::log(x) - x - std::lgamma(a);
-    if (x < a + 1.0) {
-        double term = 1.0 / a, sum = term;
-        for (int n = 1; n < 100000 && std::abs(term) > std::abs(sum) * 1e-16; ++n) {
-            term *= x / (a + n);
-            sum += term;
-        }
-        return std::max(0.0, 1.0 - sum * std::exp(logPrefix));
-    }
-    constexpr double tiny = 1e-300;
-    double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-    for (int i = 1; i < 100000; ++i) {
-        double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (std::abs(d) < tiny) d = tiny;
-        c = b + an / c;
-        if (std::abs(c) < tiny) c = tiny;
-        d = 1.0 / d;
-        double delta = d * c;
-        h *= delta;
-        if (std::abs(delta - 1.0) < 1e-15) break;
-    }
-    return std::exp(logPrefix) * h;
-}
-
-/// P(X >= chiSquare) for X chi-square distributed with `dof` degrees of freedom.
-double chiSquarePValue(double chiSquare, int dof) { return upperIncompleteGammaQ(0.5 * dof, 0.5 * chiSquare); }
 
 struct Triangle {
     glm::dvec3 a, b, c;

@@ -1,38 +1,13 @@
 #include "support/ProbeKernel.h"
 
-#include "gpu/Buffer.h"
-#include "gpu/ComputeKernel.h"
-#include "support/TestSupport.h"
-
-#include <algorithm>
+#include "support/ProbeBuffers.h"
 
 namespace vkrt::test {
 
 std::vector<float> runProbe(const std::string& kernel, const std::vector<float>& input, size_t outputFloats,
                             uint32_t invocations, const std::vector<Define>& defines)
 {
-    const VulkanContext& context = gpu();
-    // Kernels live beside the tests; includes still resolve from shaders/.
-    KernelSource source{defaultShaderRoot(), "../tests/gpu/kernels/" + kernel + ".comp", defines};
-    std::vector<uint32_t> spirv = compileGlsl(source);
-    constexpr vk::BufferUsageFlags kUsage = vk::BufferUsageFlagBits::eStorageBuffer;
-    Buffer in = makeBufferFrom(context, input.empty() ? std::vector<float>{0.0f} : input, kUsage);
-    Buffer out(context, std::max<size_t>(1, outputFloats) * sizeof(float),
-               kUsage | vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst,
-               MemoryUse::Device);
-    out.clear(context);
-    ComputeKernel probe(context, spirv,
-                        {{0, vk::DescriptorType::eStorageBuffer}, {1, vk::DescriptorType::eStorageBuffer}},
-                        sizeof(uint32_t));
-    probe.bind(0, in);
-    probe.bind(1, out);
-    context.submitAndWait([&](vk::CommandBuffer cmd) {
-        probe.recordDispatch(cmd, std::as_bytes(std::span(&invocations, 1)), vk::Extent2D((invocations + 63) / 64, 1));
-    });
-    auto bytes = out.download(context);
-    std::vector<float> result(outputFloats);
-    std::memcpy(result.data(), bytes.data(), outputFloats * sizeof(float));
-    return result;
+    return runProbeWithBuffers(kernel, input, outputFloats, invocations, {}, defines);
 }
 
 } // namespace vkrt::test
