@@ -21,6 +21,9 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/sampling.glsl"
 #include "lib/microfacet.glsl"
 #include "lib/bsdf.glsl"
+#ifdef VKRT_HAS_TEXTURES
+#include "lib/material_textures.glsl"
+#endif
 #include "lib/environment.glsl"
 #include "lib/media.glsl"
 #include "lib/lights.glsl"

@@ -59,6 +59,27 @@ layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitte
 #ifdef VKRT_HAS_MATERIAL_TABLES
 layout(scalar, binding = BINDING_MATERIAL_TABLES) readonly buffer MaterialTableBlock { float materialTables[]; };
 #endif
+#ifdef VKRT_HAS_TEXTURES
+// The texel and record buffers are declared by lib/texture_bindings.glsl.
+#include "shared/TextureTypes.h"
+layout(scalar, binding = BINDING_MATERIAL_TEXTURES) readonly buffer MaterialTextureBlock
+{
+    MaterialTextures materialTextures[];
+};
+#endif
+#ifdef VKRT_HAS_MESH_UVS
+layout(scalar, binding = BINDING_MESH_UVS) readonly buffer MeshUvBlock { MeshUvs meshUvs[]; };
+#endif
+#ifdef VKRT_HAS_MESH_TANGENTS
+layout(scalar, binding = BINDING_MESH_TANGENTS) readonly buffer MeshTangentBlock { MeshTangents meshTangents[]; };
+#endif
+#ifdef VKRT_HAS_MESH_MATERIALS
+layout(scalar, binding = BINDING_MESH_MATERIALS) readonly buffer MeshMaterialBlock { uint meshMaterials[]; };
+#endif
+// Shading normals differ from geometric ones with meshes' vertex normals or normal maps.
+#if defined(VKRT_HAS_MESH_NORMALS) || defined(VKRT_HAS_NORMAL_MAPS)
+#define VKRT_HAS_SHADING_NORMALS
+#endif
 #ifdef VKRT_HAS_POINT_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
 #endif

@@ -26,7 +26,7 @@ struct BsdfSample {
 vec3 continuationSide(vec3 n, vec3 ns, BsdfSample s)
 {
     vec3 side = s.transmitted ? -n : n;
-#ifdef VKRT_HAS_MESH_NORMALS // only meshes' vertex normals make ns differ from n
+#ifdef VKRT_HAS_SHADING_NORMALS // only vertex normals and normal maps make ns differ from n
     if (ns != n && dot(s.dir, side) < 0.0)
         side = -side;
 #endif

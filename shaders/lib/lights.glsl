@@ -72,7 +72,7 @@ vec3 transmittanceFromSurface(SurfaceHit hit, vec3 n, vec3 ns, vec3 origin, vec3
     // rarely taken branch: kernels without it keep their exact arithmetic.
     vec3 shadowDir = target - origin;
     if (dot(shadowDir, n) <= 0.0) {
-#ifdef VKRT_HAS_MESH_NORMALS // only meshes' vertex normals make ns differ from n
+#ifdef VKRT_HAS_SHADING_NORMALS // only vertex normals and normal maps make ns differ from n
         if (ns != n)
             return vec3(0.0);
 #endif

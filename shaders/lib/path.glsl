@@ -67,7 +67,7 @@ vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
     if (f == vec3(0.0))
         return vec3(0.0);
     float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
-#ifdef VKRT_HAS_MESH_NORMALS
+#ifdef VKRT_HAS_SHADING_NORMALS
     // Behind the geometric surface (shading normals): blocked by it (lib/lights.glsl).
     if (ns != n && dot(wi, n) <= 0.0)
         return vec3(0.0);
@@ -107,6 +107,9 @@ bool survivesRoulette(inout PathVertexState path, uint depth, float u)
 vec3 tracePath(Ray ray, inout Sampler rng)
 {
     PathVertexState path = PathVertexState(vec3(0.0), vec3(1.0), cameraMedia(), true, 0.0);
+#ifdef VKRT_HAS_TEXTURES
+    float pathLength = 0.0; // from the camera, for the textures' ray cones
+#endif
     for (uint depth = 1u; depth <= u.maxDepth + 1u; ++depth) {
         ++g_loopIterations;
         SurfaceHit hit;
@@ -128,6 +131,10 @@ vec3 tracePath(Ray ray, inout Sampler rng)
             break; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
+#ifdef VKRT_HAS_TEXTURES
+        pathLength += hit.t;
+        m = texturedMaterial(m, hit, ray.dir, pathLength);
+#endif
         vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 ns = shadingSide(hit, n);
         vec3 wo = -ray.dir;

@@ -31,6 +31,15 @@ struct SurfaceHit {
     int shape;
     uint index;
     uint emitter; // the Emitter this surface is (emissive meshes), else NO_EMITTER
+#ifdef VKRT_HAS_TEXTURES
+    // Texture coordinates (docs/scene-format.md, "Texture coordinates"), the
+    // uv area per world area there (the ray cone's texel density), and the
+    // world direction of increasing u with the bitangent's handedness
+    // (bitangent = tangent.w cross(shading, tangent.xyz)) for normal maps.
+    vec2 uv;
+    float uvDensity;
+    vec4 tangent;
+#endif
 };
 
 const uint NO_EMITTER = 0xffffffffu;
@@ -42,7 +51,7 @@ bool hitsLight(SurfaceHit hit) { return hit.shape >= SHAPE_LIGHT; }
 // variants never read the field.
 vec3 shadingSide(SurfaceHit hit, vec3 n)
 {
-#ifdef VKRT_HAS_MESH_NORMALS
+#ifdef VKRT_HAS_SHADING_NORMALS
     return hit.front ? hit.shading : -hit.shading;
 #else
     return n;
@@ -61,6 +70,83 @@ struct HitId {
     bool front;
     uint primitive; // a mesh's triangle (its leaf slot); 0 for other kinds
 };
+
+// ------------------------------------------------------ texture coordinates
+// Every shape's uv, texel density and tangent (docs/scene-format.md,
+// "Texture coordinates"). The tangent is dp/du's direction, w the sign that
+// makes w cross(n, tangent) point along dp/dv.
+
+#ifdef VKRT_HAS_TEXTURES
+// Spheres: longitude and latitude about the world y axis, u = 0.5 at +z and
+// growing towards +x, v from 0 at the bottom pole to 1 at the top.
+// du dv / dA = 1 / (2 pi^2 r^2 cos(latitude)).
+void sphereUv(vec3 n, float radius, inout SurfaceHit hit)
+{
+    float cosLatitude = sqrt(max(1.0 - n.y * n.y, 0.0));
+    hit.uv = vec2(0.5 + atan(n.x, n.z) * (0.5 * INV_PI), 0.5 + asin(clamp(n.y, -1.0, 1.0)) * INV_PI);
+    hit.uvDensity = 1.0 / (2.0 * PI * PI * radius * radius * max(cosLatitude, 1e-3));
+    vec3 east = vec3(n.z, 0.0, -n.x);
+    hit.tangent = vec4(cosLatitude > 1e-6 ? east / cosLatitude : vec3(1.0, 0.0, 0.0), 1.0);
+}
+
+// Boxes: each face's uv spans [0, 1]^2 over the face, upright seen from
+// outside (v up along +y on the side faces; on the top v grows towards -z,
+// on the bottom towards +z).
+void boxUv(Box b, vec3 faceNormal, vec3 p, inout SurfaceHit hit)
+{
+    vec3 extent = b.upper - b.lower;
+    vec3 f = (p - b.lower) / extent; // 0 ... 1 across the box
+    if (faceNormal.x != 0.0) {
+        float s = faceNormal.x;
+        hit.uv = vec2(s > 0.0 ? 1.0 - f.z : f.z, f.y);
+        hit.uvDensity = 1.0 / (extent.z * extent.y);
+        hit.tangent = vec4(0.0, 0.0, -s, 1.0);
+    } else if (faceNormal.y != 0.0) {
+        float s = faceNormal.y;
+        hit.uv = vec2(f.x, s > 0.0 ? 1.0 - f.z : f.z);
+        hit.uvDensity = 1.0 / (extent.x * extent.z);
+        hit.tangent = vec4(1.0, 0.0, 0.0, 1.0);
+    } else {
+        float s = faceNormal.z;
+        hit.uv = vec2(s > 0.0 ? f.x : 1.0 - f.x, f.y);
+        hit.uvDensity = 1.0 / (extent.x * extent.y);
+        hit.tangent = vec4(s, 0.0, 0.0, 1.0);
+    }
+}
+
+// Planes: world distances from the plane's point along two axes in it, one
+// uv unit per scene unit: tangent = normalize(cross(+y, n)) (+x for
+// horizontal planes), bitangent = cross(n, tangent).
+void planeUv(Plane pl, vec3 p, inout SurfaceHit hit)
+{
+    vec3 side = cross(vec3(0.0, 1.0, 0.0), pl.normal);
+    float len = length(side);
+    vec3 t = len > 1e-6 ? side / len : vec3(1.0, 0.0, 0.0);
+    vec3 b = cross(pl.normal, t);
+    vec3 d = p - pl.point;
+    hit.uv = vec2(dot(d, t), dot(d, b));
+    hit.uvDensity = 1.0;
+    hit.tangent = vec4(t, 1.0);
+}
+
+// Triangles with uvs uv0..uv2 at world edges e1 = v1 - v0, e2 = v2 - v0:
+// uv by barycentrics, density from the two areas, the tangent from the uv
+// derivatives (Lengyel 2001) when no vertex tangents are given.
+void triangleUv(vec3 bary, vec2 uv0, vec2 uv1, vec2 uv2, vec3 e1, vec3 e2, inout SurfaceHit hit)
+{
+    hit.uv = bary.x * uv0 + bary.y * uv1 + bary.z * uv2;
+    vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+    float uvCross = d1.x * d2.y - d1.y * d2.x;
+    vec3 worldCross = cross(e1, e2);
+    float worldArea = length(worldCross);
+    hit.uvDensity = worldArea > 0.0 ? abs(uvCross) / worldArea : 0.0;
+    vec3 dpdu = (d2.y * e1 - d1.y * e2) * sign(uvCross);
+    vec3 dpdv = (d1.x * e2 - d2.x * e1) * sign(uvCross);
+    float len = length(dpdu);
+    hit.tangent = vec4(len > 0.0 && !isinf(len) ? dpdu / len : normalize(e1),
+                       dot(cross(worldCross, dpdu), dpdv) < 0.0 ? -1.0 : 1.0);
+}
+#endif
 
 // ------------------------------------------------------------------ spheres
 
@@ -121,6 +207,9 @@ void describeSphere(Ray r, HitId id, inout SurfaceHit hit)
     hit.position = s.center + local;
     hit.error = gammaBound(6) * (abs(s.center) + abs(local));
     hit.material = s.material;
+#ifdef VKRT_HAS_TEXTURES
+    sphereUv(hit.normal, s.radius, hit);
+#endif
 #endif
 }
 
@@ -177,6 +266,9 @@ void describeBox(Ray r, HitId id, inout SurfaceHit hit)
     hit.position[axis] = id.detail[axis] > 0.0 ? b.upper[axis] : b.lower[axis];
     hit.error[axis] = 0.0;
     hit.material = b.material;
+#ifdef VKRT_HAS_TEXTURES
+    boxUv(b, id.detail, hit.position, hit);
+#endif
 #endif
 }
 
@@ -236,6 +328,9 @@ void describeTriangle(Ray r, HitId id, inout SurfaceHit hit)
     hit.error = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2));
     hit.front = dot(hit.normal, r.dir) < 0.0;
     hit.material = tri.material;
+#ifdef VKRT_HAS_TEXTURES
+    triangleUv(id.detail, vec2(0.0), vec2(1.0, 0.0), vec2(0.0, 1.0), tri.v1 - tri.v0, tri.v2 - tri.v0, hit);
+#endif
 #endif
 }
 
@@ -276,6 +371,9 @@ void describePlane(Ray r, HitId id, inout SurfaceHit hit)
     hit.error = gammaBound(6) * (abs(hit.position) + abs(p.point));
     hit.front = dot(hit.normal, r.dir) < 0.0;
     hit.material = p.material;
+#ifdef VKRT_HAS_TEXTURES
+    planeUv(p, hit.position, hit);
+#endif
 #endif
 }
 
@@ -409,6 +507,35 @@ bool anyHitMesh(Ray r, float tMax)
     return false;
 }
 
+#ifdef VKRT_HAS_MESH_UVS
+vec3 objectToWorldVector(Mesh mesh, vec3 v)
+{
+    return vec3(dot(mesh.toWorld0.xyz, v), dot(mesh.toWorld1.xyz, v), dot(mesh.toWorld2.xyz, v));
+}
+
+// A mesh triangle's uv, density and tangent: the file's uvs (zero without),
+// the vertex tangents interpolated where the geometry has them.
+void describeMeshUv(Mesh mesh, HitId id, MeshTriangle tri, inout SurfaceHit hit)
+{
+    uint index = mesh.firstTriangle + id.primitive;
+    MeshUvs uvs = (mesh.flags & MESH_FLAG_UVS) != 0u ? meshUvs[index] : MeshUvs(vec2(0.0), vec2(0.0), vec2(0.0));
+    triangleUv(id.detail, uvs.uv0, uvs.uv1, uvs.uv2, objectToWorldVector(mesh, tri.v1 - tri.v0),
+               objectToWorldVector(mesh, tri.v2 - tri.v0), hit);
+#ifdef VKRT_HAS_MESH_TANGENTS
+    if ((mesh.flags & MESH_FLAG_TANGENTS) != 0u) {
+        MeshTangents t = meshTangents[index];
+        vec3 object = id.detail.x * t.t0.xyz + id.detail.y * t.t1.xyz + id.detail.z * t.t2.xyz;
+        vec3 world = objectToWorldVector(mesh, object);
+        float len = length(world);
+        // A mirroring transform flips the bitangent's handedness.
+        float mirror = dot(cross(mesh.toWorld0.xyz, mesh.toWorld1.xyz), mesh.toWorld2.xyz) < 0.0 ? -1.0 : 1.0;
+        if (len > 0.0 && !isinf(len))
+            hit.tangent = vec4(world / len, (t.t0.w < 0.0 ? -1.0 : 1.0) * mirror);
+    }
+#endif
+}
+#endif
+
 void describeMesh(Ray r, HitId id, inout SurfaceHit hit)
 {
 #ifdef VKRT_HAS_MESHES
@@ -442,6 +569,13 @@ void describeMesh(Ray r, HitId id, inout SurfaceHit hit)
     }
 #endif
     hit.material = mesh.material;
+#ifdef VKRT_HAS_MESH_MATERIALS
+    if ((mesh.flags & MESH_FLAG_MATERIALS) != 0u)
+        hit.material = meshMaterials[mesh.firstTriangle + id.primitive];
+#endif
+#ifdef VKRT_HAS_MESH_UVS
+    describeMeshUv(mesh, id, tri, hit);
+#endif
 #ifdef VKRT_HAS_EMITTERS
     if ((mesh.flags & MESH_FLAG_EMISSIVE) != 0u)
         hit.emitter = mesh.firstEmitter + id.primitive;
@@ -675,12 +809,18 @@ SurfaceHit describeHit(Ray r, HitId id)
     hit.shape = id.shape;
     hit.index = id.index;
     hit.material = 0u;
+#ifdef VKRT_HAS_TEXTURES
+    hit.uv = vec2(0.0);
+    hit.uvDensity = 0.0;
+    hit.tangent = vec4(1.0, 0.0, 0.0, 1.0);
+#endif
     VKRT_SHAPE_KINDS(VKRT_DESCRIBE_SHAPE)
     VKRT_LIGHT_KINDS(VKRT_DESCRIBE_LIGHT)
+    // Meshes set their own shading normal; normal maps may change it later.
 #ifdef VKRT_HAS_MESHES
     if (id.shape != SHAPE_MESH)
-        hit.shading = hit.normal;
 #endif
+        hit.shading = hit.normal;
     return hit;
 }
 

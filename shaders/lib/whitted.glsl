@@ -42,6 +42,9 @@ void addEmitterRadiance(inout PathState path, Ray ray, SurfaceHit hit)
 vec3 traceWhitted(Ray ray, inout Sampler rng)
 {
     PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true);
+#ifdef VKRT_HAS_TEXTURES
+    float pathLength = 0.0; // from the camera, for the textures' ray cones
+#endif
     for (uint depth = 1u; depth <= u.maxDepth; ++depth) {
         ++g_loopIterations;
         SurfaceHit hit;
@@ -55,6 +58,10 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         addEmitterRadiance(path, ray, hit);
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
+#ifdef VKRT_HAS_TEXTURES
+        pathLength += hit.t;
+        m = texturedMaterial(m, hit, ray.dir, pathLength);
+#endif
         vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 ns = shadingSide(hit, n);
         vec3 wo = -ray.dir;

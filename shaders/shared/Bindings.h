@@ -37,7 +37,19 @@ VKRT_CONSTANT(uint, BINDING_TOP_REFS, BINDING_ENVIRONMENT + 7)
 VKRT_CONSTANT(uint, BINDING_EMITTERS, BINDING_ENVIRONMENT + 8)
 // float[]: the rough plastics' coating tables (shared/SceneTypes.h: MATERIAL_TABLE_SIZE)
 VKRT_CONSTANT(uint, BINDING_MATERIAL_TABLES, BINDING_ENVIRONMENT + 9)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 10)
+// Image textures (shared/TextureTypes.h, variants with textures only): every
+// texel of every texture in one buffer of words, the TextureRecord table, and
+// per material its MaterialTextures.
+VKRT_CONSTANT(uint, BINDING_TEXTURE_TEXELS, BINDING_ENVIRONMENT + 10)
+VKRT_CONSTANT(uint, BINDING_TEXTURE_RECORDS, BINDING_ENVIRONMENT + 11)
+VKRT_CONSTANT(uint, BINDING_MATERIAL_TEXTURES, BINDING_ENVIRONMENT + 12)
+// Per mesh triangle, in leaf order beside meshTriangles: texture coordinates
+// (MeshUvs, variants with textures), tangents (MeshTangents, normal maps) and
+// the scene material of each triangle (uint, meshes with file materials).
+VKRT_CONSTANT(uint, BINDING_MESH_UVS, BINDING_ENVIRONMENT + 13)
+VKRT_CONSTANT(uint, BINDING_MESH_TANGENTS, BINDING_ENVIRONMENT + 14)
+VKRT_CONSTANT(uint, BINDING_MESH_MATERIALS, BINDING_ENVIRONMENT + 15)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 16)
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);
 // the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).

@@ -87,6 +87,9 @@ struct Plane {
 VKRT_CONSTANT(uint, MESH_FLAG_NORMALS, 1)   // meshNormals holds shading normals for its triangles
 VKRT_CONSTANT(uint, MESH_FLAG_EMISSIVE, 2)  // its triangles are emitters firstEmitter, ...
 VKRT_CONSTANT(uint, MESH_FLAG_TWO_SIDED, 4) // they emit on both sides
+VKRT_CONSTANT(uint, MESH_FLAG_UVS, 8)        // meshUvs holds its triangles' texture coordinates
+VKRT_CONSTANT(uint, MESH_FLAG_TANGENTS, 16)  // meshTangents holds its triangles' tangents
+VKRT_CONSTANT(uint, MESH_FLAG_MATERIALS, 32) // meshMaterials holds each triangle's material (file materials)
 
 /// One instance of a mesh (src/scene/Scene.h: Mesh). The matrices are the
 /// object -> camera-relative world transform and its inverse, as three rows
@@ -113,6 +116,23 @@ struct MeshNormals {
     vec3 n0;
     vec3 n1;
     vec3 n2;
+};
+
+/// Texture coordinates at a mesh triangle's three vertices, stored beside its
+/// MeshTriangle (same index: firstTriangle + leaf slot).
+struct MeshUvs {
+    vec2 uv0;
+    vec2 uv1;
+    vec2 uv2;
+};
+
+/// Tangents at a mesh triangle's three vertices (object space): xyz along
+/// increasing u, w = +-1 with bitangent = w cross(normal, tangent). Same index
+/// as MeshUvs.
+struct MeshTangents {
+    vec4 t0;
+    vec4 t1;
+    vec4 t2;
 };
 
 /// One emissive mesh triangle as a light, camera-relative world space. Lights

@@ -32,10 +32,10 @@ VKRT_CONSTANT(uint, TEXTURE_FORMAT_RGBA16F, 2)
 VKRT_CONSTANT(uint, TEXTURE_MAX_SIZE, 16384)
 VKRT_CONSTANT(uint, TEXTURE_MAX_LEVELS, 15)
 
-// Placeholder binding indices just past the render kernels' own: the lead
-// moves them into shared/Bindings.h when the render kernels bind textures.
-VKRT_CONSTANT(uint, BINDING_TEXTURE_TEXELS, BINDING_COUNT)      // uint textureTexels[]
-VKRT_CONSTANT(uint, BINDING_TEXTURE_RECORDS, BINDING_COUNT + 1) // TextureRecord textureRecords[]
+// The bindings (BINDING_TEXTURE_TEXELS: uint textureTexels[],
+// BINDING_TEXTURE_RECORDS: TextureRecord textureRecords[],
+// BINDING_MATERIAL_TEXTURES: MaterialTextures materialTextures[]) are in
+// shared/Bindings.h.
 
 /// One texture as the kernels see it. Level l is max(1, width >> l) x
 /// max(1, height >> l) texels starting at word levelOffset[l] of textureTexels
@@ -48,6 +48,33 @@ struct TextureRecord {
     uint wrapU;
     uint wrapV;
     uint levelOffset[TEXTURE_MAX_LEVELS];
+};
+
+// A material parameter without a texture.
+VKRT_CONSTANT(uint, NO_TEXTURE, 4294967295u)
+
+/// One textured parameter of a material: texture `record`, looked up at
+/// uv * scale. Colours use the texel's rgb, scalars its component `channel`
+/// (0 = r ... 3 = a). The texel multiplies the material's constant (which the
+/// scene sets to 1, and a glTF file to its factor).
+struct TextureSlot {
+    uint record; // NO_TEXTURE: the constant alone
+    uint channel;
+    vec2 scale;
+};
+
+// MaterialTextures::slots, by parameter:
+VKRT_CONSTANT(uint, TEXTURE_SLOT_COLOR, 0)     // diffuse / albedo / base_color (Material::diffuse)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR, 1)  // specular / reflectance / tint (Material::specular)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_ROUGHNESS, 2) // perceptual roughness: alpha scales by texel^2
+VKRT_CONSTANT(uint, TEXTURE_SLOT_METALLIC, 3)  // pbr metallic
+VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 4)    // tangent-space normal map (rgb = (n + 1) / 2)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 5)
+
+/// The textures of one material (one per Material, same index).
+struct MaterialTextures {
+    TextureSlot slots[TEXTURE_SLOT_COUNT];
+    float normalStrength; // a normal map's tangent-plane components scale by this (glTF normalTexture.scale)
 };
 
 VKRT_END_NAMESPACE

@@ -37,7 +37,9 @@ constexpr bool bindingsDistinct()
     constexpr uint fixed[] = {BINDING_UNIFORMS,    BINDING_ACCUMULATION,   BINDING_STATS,         BINDING_ENVIRONMENT,
                               BINDING_MOMENTS,     BINDING_ENVIRONMENT_CDF, BINDING_MESH_NODES,   BINDING_MESH_TRIANGLES,
                               BINDING_MESH_NORMALS, BINDING_TOP_NODES,     BINDING_TOP_REFS,      BINDING_EMITTERS,
-                              BINDING_MATERIAL_TABLES};
+                              BINDING_MATERIAL_TABLES, BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
+                              BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS, BINDING_MESH_TANGENTS,
+                              BINDING_MESH_MATERIALS};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -57,6 +59,8 @@ static_assert(sizeof(BvhNode) == 32);
 static_assert(sizeof(MeshTriangle) == 36);
 static_assert(sizeof(MeshNormals) == 36);
 static_assert(sizeof(Emitter) == 68);
+static_assert(sizeof(MeshUvs) == 24);
+static_assert(sizeof(MeshTangents) == 48);
 static_assert(offsetof(Mesh, emission) == 96 && offsetof(Mesh, firstEmitter) == 128);
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);

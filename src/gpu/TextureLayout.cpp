@@ -12,7 +12,7 @@ static_assert(sizeof(TextureRecord) == 4 * (6 + TEXTURE_MAX_LEVELS));
 static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, levelOffset) == 24);
 // Level sizes: the largest side has floor(log2(TEXTURE_MAX_SIZE)) + 1 levels.
 static_assert((1u << (TEXTURE_MAX_LEVELS - 1)) == TEXTURE_MAX_SIZE);
-static_assert(BINDING_TEXTURE_TEXELS >= BINDING_COUNT && BINDING_TEXTURE_RECORDS != BINDING_TEXTURE_TEXELS,
-              "texture bindings must not collide with the render kernels' (until they move to Bindings.h)");
+static_assert(sizeof(TextureSlot) == 16);
+static_assert(sizeof(MaterialTextures) == 16 * TEXTURE_SLOT_COUNT + 4);
 
 } // namespace vkrt::gpu

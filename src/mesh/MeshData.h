@@ -19,6 +19,8 @@ struct MeshData {
     std::vector<glm::vec3> normals; ///< unit vertex normals, or empty
     std::vector<glm::vec2> uvs;     ///< texture coordinates, or empty
     std::vector<glm::uvec3> triangles;
+    std::vector<glm::vec4> tangents;         ///< per vertex: xyz along +u, w = +-1 (bitangent = w cross(n, t)), or empty
+    std::vector<uint32_t> triangleMaterials; ///< per triangle: the file material it uses, or empty
 };
 
 /// How a mesh's shading normals are chosen (scene format `normals = ...`).

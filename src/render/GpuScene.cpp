@@ -3,6 +3,7 @@
 #include "material/MicrofacetAlbedo.h"
 
 #include "mesh/MeshGeometry.h"
+#include "scene/FeatureSet.h"
 #include "shared/Bindings.h"
 
 #include <chrono>
@@ -38,16 +39,50 @@ glm::vec2 ggxAlphas(const Material& m)
     return glm::vec2(float(std::max(alpha / aspect, minimum)), float(std::max(alpha * aspect, minimum)));
 }
 
+/// The mean of a material's diffuse colour, over its texture when it has one
+/// (what Mitsuba's Texture::mean() gives for a bitmap).
+double meanDiffuse(const Material& m, const TextureAtlas* textures)
+{
+    Color mean = m.diffuse;
+    if (const auto& texture = m.texture(TextureSlot::Color)) {
+        VKRT_CHECK(textures != nullptr);
+        const auto texel = textures->meanOf(texture->record);
+        mean *= Color(texel[0], texel[1], texel[2]);
+    }
+    return (mean.r + mean.g + mean.b) / 3.0;
+}
+
 /// Mitsuba's sampling weight of a plastic's coating: s / (s + d), with the
 /// coating's reflectance s = 1 and d the mean of the diffuse colour.
-float coatingLobeWeight(const Material& m)
+float coatingLobeWeight(const Material& m, const TextureAtlas* textures)
 {
-    const double diffuseMean = (m.diffuse.r + m.diffuse.g + m.diffuse.b) / 3.0;
-    return float(1.0 / (1.0 + diffuseMean));
+    return float(1.0 / (1.0 + meanDiffuse(m, textures)));
+}
+
+gpu::MaterialTextures convertMaterialTextures(const Material& m)
+{
+    gpu::MaterialTextures g{};
+    for (size_t slot = 0; slot < kTextureSlotCount; ++slot) {
+        g.slots[slot] = gpu::TextureSlot{gpu::NO_TEXTURE, 0u, glm::vec2(1.0f)};
+        if (const auto& texture = m.textures[slot])
+            g.slots[slot] = gpu::TextureSlot{texture->record, texture->channel, glm::vec2(texture->scale)};
+    }
+    g.normalStrength = float(m.normalStrength);
+    return g;
+}
+
+/// The textures' buffers, never empty (the uber kernel binds them for any scene).
+TextureBuffers packTextures(const Scene& scene, uint64_t maxBytes)
+{
+    TextureBuffers buffers;
+    if (scene.textures) buffers = scene.textures->pack(maxBytes);
+    if (buffers.texels.empty()) buffers.texels.push_back(0u);
+    if (buffers.records.empty()) buffers.records.push_back(gpu::TextureRecord{});
+    return buffers;
 }
 
 gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t tableStart,
-                              float internalReflectance)
+                              float internalReflectance, const TextureAtlas* textures)
 {
     gpu::Material g{};
     g.diffuse = toFloat(m.diffuse);
@@ -75,7 +110,7 @@ gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t
     g.metallic = float(m.metallic);
     g.table = tableStart;
     g.internalReflectance = internalReflectance;
-    if (m.type == MaterialType::Plastic) g.lobeWeight = coatingLobeWeight(m);
+    if (m.type == MaterialType::Plastic) g.lobeWeight = coatingLobeWeight(m, textures);
     return g;
 }
 
@@ -152,7 +187,19 @@ glm::dmat4 toCameraRelative(const Mesh& mesh, const glm::dvec3& eye)
 
 double meanOf(const Color& c) { return (c.r + c.g + c.b) / 3.0; }
 
-bool isEmissive(const Mesh& mesh) { return mesh.emission != Color(0.0); }
+/// The scene material of a mesh triangle (leaf slot).
+const Material& triangleMaterial(const Scene& scene, const Mesh& mesh, uint32_t slot)
+{
+    if (mesh.fileMaterials.empty()) return scene.materials[mesh.material];
+    return scene.materials[mesh.fileMaterials[mesh.geometry->data.triangleMaterials[slot]]];
+}
+
+/// A mesh triangle's emitted radiance: the mesh's own `emission`, else its material's.
+Color triangleEmission(const Scene& scene, const Mesh& mesh, uint32_t slot)
+{
+    if (mesh.emission != Color(0.0)) return mesh.emission;
+    return triangleMaterial(scene, mesh, slot).emission;
+}
 
 std::array<glm::dvec3, 3> worldVertices(const Mesh& mesh, const MeshGeometry& g, uint32_t slot, const glm::dvec3& eye)
 {
@@ -202,13 +249,14 @@ EmitterTable emitterTableOf(const Scene& scene)
 {
     std::vector<double> power;
     for (const Mesh& mesh : scene.meshes) {
-        if (!isEmissive(mesh)) continue;
+        if (!meshEmits(scene, mesh)) continue;
         const MeshGeometry& g = *mesh.geometry;
         const double sides = mesh.twoSided ? 2.0 : 1.0;
         for (uint32_t slot = 0; slot < g.data.triangles.size(); ++slot) {
             const double area = triangleArea(worldVertices(mesh, g, slot, glm::dvec3(0.0)));
             const bool emits = area > 0.0 && float(area) > 0.0 && std::isfinite(area);
-            power.push_back(emits ? meanOf(mesh.emission) * area * sides * glm::pi<double>() : 0.0);
+            const double radiance = meanOf(triangleEmission(scene, mesh, slot));
+            power.push_back(emits ? radiance * area * sides * glm::pi<double>() : 0.0);
         }
     }
     return aliasTable(power);
@@ -341,11 +389,15 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
         record.root = at.root;
         record.firstTriangle = at.firstTriangle;
         record.firstNormals = at.firstNormals;
-        record.flags = (at.normals ? gpu::MESH_FLAG_NORMALS : 0u) | (isEmissive(mesh) ? gpu::MESH_FLAG_EMISSIVE : 0u) |
-                       (mesh.twoSided ? gpu::MESH_FLAG_TWO_SIDED : 0u);
+        const bool emissive = meshEmits(scene, mesh);
+        record.flags = (at.normals ? gpu::MESH_FLAG_NORMALS : 0u) | (emissive ? gpu::MESH_FLAG_EMISSIVE : 0u) |
+                       (mesh.twoSided ? gpu::MESH_FLAG_TWO_SIDED : 0u) |
+                       (!g.data.uvs.empty() ? gpu::MESH_FLAG_UVS : 0u) |
+                       (!g.data.tangents.empty() ? gpu::MESH_FLAG_TANGENTS : 0u) |
+                       (!mesh.fileMaterials.empty() ? gpu::MESH_FLAG_MATERIALS : 0u);
         record.firstEmitter = firstEmitter;
         data.meshes.push_back(record);
-        if (!isEmissive(mesh)) continue;
+        if (!emissive) continue;
         for (uint32_t slot = 0; slot < g.data.triangles.size(); ++slot, ++firstEmitter) {
             const auto v = worldVertices(mesh, g, slot, eye);
             gpu::Emitter e{};
@@ -355,7 +407,7 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
             e.area = float(triangleArea(v));
             e.twoSided = mesh.twoSided ? 1u : 0u;
             e.pdf = float(fixed.emitters.pdf[firstEmitter]);
-            e.radiance = toFloat(mesh.emission);
+            e.radiance = toFloat(triangleEmission(scene, mesh, slot));
             e.aliasThreshold = fixed.emitters.threshold[firstEmitter];
             e.alias = fixed.emitters.alias[firstEmitter];
             data.emitters.push_back(e);
@@ -467,18 +519,51 @@ uint64_t emissiveTriangleCount(const Scene& scene)
 {
     uint64_t total = 0;
     for (const Mesh& m : scene.meshes)
-        if (isEmissive(m)) total += m.geometry->data.triangles.size();
+        if (meshEmits(scene, m)) total += m.geometry->data.triangles.size();
     return total;
+}
+
+/// One geometry's per-triangle texture coordinates, tangents and materials
+/// (in leaf order, beside its MeshTriangles), for the features that need them.
+void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features,
+                              GpuSceneStatic& fixed)
+{
+    const MeshData& d = mesh.geometry->data;
+    if (features.textures) {
+        for (const glm::uvec3& t : d.triangles)
+            fixed.meshUvs.push_back(d.uvs.empty() ? gpu::MeshUvs{} : gpu::MeshUvs{d.uvs[t.x], d.uvs[t.y], d.uvs[t.z]});
+    }
+    if (features.normalMaps) {
+        for (const glm::uvec3& t : d.triangles) {
+            fixed.meshTangents.push_back(d.tangents.empty()
+                                             ? gpu::MeshTangents{}
+                                             : gpu::MeshTangents{d.tangents[t.x], d.tangents[t.y], d.tangents[t.z]});
+        }
+    }
+    if (features.fileMaterials) {
+        for (uint32_t slot = 0; slot < d.triangles.size(); ++slot)
+            fixed.meshMaterials.push_back(mesh.fileMaterials.empty() ? mesh.material
+                                                                     : mesh.fileMaterials[d.triangleMaterials[slot]]);
+    }
 }
 
 GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
 {
     GpuSceneStatic fixed;
     prepareMaterialTables(scene, fixed);
+    for (const Material& m : scene.materials) fixed.materialTextures.push_back(convertMaterialTextures(m));
+    if (fixed.materialTextures.empty()) fixed.materialTextures.push_back(gpu::MaterialTextures{});
+    fixed.textures = packTextures(scene, maxBytes);
     if (scene.meshes.empty()) return fixed;
+    const FeatureSet features = featuresOf(scene);
+    // The per-triangle attributes start at index 0 beside meshTriangles: drop the placeholders.
+    if (features.textures) fixed.meshUvs.clear();
+    if (features.normalMaps) fixed.meshTangents.clear();
+    if (features.fileMaterials) fixed.meshMaterials.clear();
     for (const Mesh& mesh : scene.meshes) {
         const MeshGeometry& g = *mesh.geometry;
         if (fixed.offsets.count(&g)) continue;
+        appendTriangleAttributes(mesh, features, fixed);
         GeometryOffsets at{uint32_t(fixed.meshNodes.size()), uint32_t(fixed.meshTriangles.size()),
                            uint32_t(fixed.meshNormals.size()), !g.data.normals.empty()};
         fixed.offsets[&g] = at;
@@ -493,6 +578,11 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     checkBufferSize(fixed.meshNodes.size() * sizeof(gpu::BvhNode), maxBytes, "BVH nodes", scene);
     checkBufferSize(fixed.meshTriangles.size() * sizeof(gpu::MeshTriangle), maxBytes, "mesh triangles", scene);
     checkBufferSize(fixed.meshNormals.size() * sizeof(gpu::MeshNormals), maxBytes, "mesh normals", scene);
+    checkBufferSize(fixed.meshUvs.size() * sizeof(gpu::MeshUvs), maxBytes, "mesh texture coordinates", scene);
+    checkBufferSize(fixed.meshTangents.size() * sizeof(gpu::MeshTangents), maxBytes, "mesh tangents", scene);
+    if (fixed.meshUvs.empty()) fixed.meshUvs.push_back(gpu::MeshUvs{});
+    if (fixed.meshTangents.empty()) fixed.meshTangents.push_back(gpu::MeshTangents{});
+    if (fixed.meshMaterials.empty()) fixed.meshMaterials.push_back(0u);
     const auto start = std::chrono::steady_clock::now();
     fixed.top = buildTopLevel(scene);
     fixed.topBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -507,7 +597,8 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
     Relativizer rel{scene.camera.eye};
     for (size_t i = 0; i < scene.materials.size(); ++i) {
         data.materials.push_back(convertMaterial(scene.materials[i], scene.render.integrator,
-                                                 fixed.materialTableStart.at(i), fixed.internalReflectance.at(i)));
+                                                 fixed.materialTableStart.at(i), fixed.internalReflectance.at(i),
+                                                 scene.textures.get()));
     }
 #define VKRT_CONVERT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity) \
     for (const auto& record : recordsToUpload(scene, scene.array)) data.array.push_back(toGpu(record, rel));

@@ -5,6 +5,8 @@
 #include "accel/Bvh.h"
 #include "scene/Scene.h"
 #include "shared/SceneTypes.h"
+#include "shared/TextureTypes.h"
+#include "texture/TextureAtlas.h"
 
 #include <map>
 #include <optional>
@@ -52,6 +54,16 @@ struct GpuSceneStatic {
     std::vector<gpu::BvhNode> meshNodes;
     std::vector<gpu::MeshTriangle> meshTriangles;
     std::vector<gpu::MeshNormals> meshNormals;
+    /// Beside meshTriangles (same index), filled only when the scene's
+    /// features need them (textures, normal maps, file materials); each has
+    /// at least one record so the buffer can always be bound.
+    std::vector<gpu::MeshUvs> meshUvs{gpu::MeshUvs{}};
+    std::vector<gpu::MeshTangents> meshTangents{gpu::MeshTangents{}};
+    std::vector<uint32_t> meshMaterials{0u};
+    /// Every texture's texels and records (one zero record and word without
+    /// textures), and per material its texture slots.
+    TextureBuffers textures;
+    std::vector<gpu::MaterialTextures> materialTextures;
     std::map<const MeshGeometry*, GeometryOffsets> offsets;
     std::optional<TopLevel> top; ///< only for scenes with meshes
     EmitterTable emitters;

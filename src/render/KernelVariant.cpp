@@ -42,6 +42,18 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({meshes, "VKRT_HAS_TOP_REFS", int(gpu::BINDING_TOP_REFS), ""});
     list.push_back({meshes && f.meshNormals, "VKRT_HAS_MESH_NORMALS", int(gpu::BINDING_MESH_NORMALS), "mesh-normals"});
     list.push_back({meshes && f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emissive-meshes"});
+    // Textures: the texel buffer, the texture records and each material's slots;
+    // meshes add their triangles' uvs, tangents for normal maps, and each
+    // triangle's material when they use their file's materials.
+    list.push_back({f.textures, "VKRT_HAS_TEXTURES", int(gpu::BINDING_TEXTURE_TEXELS), "textures"});
+    list.push_back({f.textures, "VKRT_HAS_TEXTURE_RECORDS", int(gpu::BINDING_TEXTURE_RECORDS), ""});
+    list.push_back({f.textures, "VKRT_HAS_MATERIAL_TEXTURES", int(gpu::BINDING_MATERIAL_TEXTURES), ""});
+    list.push_back({f.textures && f.normalMaps, "VKRT_HAS_NORMAL_MAPS", -1, "normal-maps"});
+    list.push_back({meshes && f.textures, "VKRT_HAS_MESH_UVS", int(gpu::BINDING_MESH_UVS), ""});
+    list.push_back({meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS),
+                    ""});
+    list.push_back(
+        {meshes && f.fileMaterials, "VKRT_HAS_MESH_MATERIALS", int(gpu::BINDING_MESH_MATERIALS), "file-materials"});
     // The rough plastics' coating tables come with the plastic kind.
     list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});

@@ -203,10 +203,17 @@ void Renderer::uploadMeshBuffers()
         m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage));
         m_kernel.bind(binding, m_meshBuffers.back());
     };
-    m_meshBuffers.reserve(3); // bind() keeps references: no reallocation
+    m_meshBuffers.reserve(9); // bind() keeps references: no reallocation
     addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
     addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles);
     addBuffer(gpu::BINDING_MESH_NORMALS, m_static.meshNormals);
+    addBuffer(gpu::BINDING_MESH_UVS, m_static.meshUvs);
+    addBuffer(gpu::BINDING_MESH_TANGENTS, m_static.meshTangents);
+    addBuffer(gpu::BINDING_MESH_MATERIALS, m_static.meshMaterials);
+    // Textures never change with the camera either: uploaded once, here.
+    addBuffer(gpu::BINDING_TEXTURE_TEXELS, m_static.textures.texels);
+    addBuffer(gpu::BINDING_TEXTURE_RECORDS, m_static.textures.records);
+    addBuffer(gpu::BINDING_MATERIAL_TEXTURES, m_static.materialTextures);
 }
 
 void Renderer::bindEnvironment()

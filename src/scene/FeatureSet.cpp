@@ -35,23 +35,43 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.environmentSampling = integrator == Integrator::Path;
     all.meshNormals = true;
     all.emitters = true;
+    all.textures = true;
+    all.normalMaps = true;
+    all.fileMaterials = true;
     all.integrator = integrator;
     return all;
 }
 
 namespace {
 
-/// Marks the material of every record of the scene's shape arrays as used.
+/// Marks the material of every record of the scene's shape arrays (and every
+/// file material of a mesh) as used, with its textures.
 void markMaterialsUsed(const Scene& scene, FeatureSet& set)
 {
-    auto markUsed = [&](uint32_t material) { set.materialTypes[size_t(scene.materials[material].type)] = true; };
+    auto markUsed = [&](uint32_t index) {
+        const Material& material = scene.materials[index];
+        set.materialTypes[size_t(material.type)] = true;
+        set.textures = set.textures || material.hasTextures();
+        set.normalMaps = set.normalMaps || material.hasNormalMap();
+    };
 #define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity) \
     for (const auto& shape : scene.array) markUsed(shape.material);
     VKRT_SHAPE_KINDS(VKRT_MARK_SHAPE_MATERIALS)
 #undef VKRT_MARK_SHAPE_MATERIALS
+    for (const Mesh& mesh : scene.meshes)
+        for (uint32_t index : mesh.fileMaterials) markUsed(index);
 }
 
 } // namespace
+
+bool meshEmits(const Scene& scene, const Mesh& mesh)
+{
+    if (mesh.emission != Color(0.0)) return true;
+    if (scene.materials[mesh.material].emission != Color(0.0)) return true;
+    for (uint32_t index : mesh.fileMaterials)
+        if (scene.materials[index].emission != Color(0.0)) return true;
+    return false;
+}
 
 FeatureSet featuresOf(const Scene& scene)
 {
@@ -63,7 +83,8 @@ FeatureSet featuresOf(const Scene& scene)
     set.integrator = scene.render.integrator;
     for (const Mesh& mesh : scene.meshes) {
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();
-        set.emitters = set.emitters || mesh.emission != Color(0.0);
+        set.emitters = set.emitters || meshEmits(scene, mesh);
+        set.fileMaterials = set.fileMaterials || !mesh.fileMaterials.empty();
     }
     markMaterialsUsed(scene, set);
     return set;

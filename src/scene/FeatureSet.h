@@ -18,6 +18,9 @@ struct FeatureSet {
     bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
     bool meshNormals = false;         ///< some mesh has per-vertex shading normals
     bool emitters = false;            ///< some mesh emits (its triangles are lights)
+    bool textures = false;            ///< some material in use has a texture
+    bool normalMaps = false;          ///< ... a normal map
+    bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).
@@ -32,6 +35,9 @@ struct FeatureSet {
 };
 
 FeatureSet featuresOf(const Scene& scene);
+
+/// Whether some triangle of the mesh emits: its own `emission`, or an emissive material.
+bool meshEmits(const Scene& scene, const Mesh& mesh);
 
 std::string integratorName(Integrator integrator);
 std::string materialTypeName(MaterialType type);

@@ -4,6 +4,7 @@
 // render/GpuScene. A Scene is only ever produced by parseScene*, which has
 // already checked every value, so consumers need not re-validate.
 #include "shared/Kinds.h"
+#include "shared/TextureTypes.h"
 #include "util/Error.h"
 
 #include <glm/glm.hpp>
@@ -19,6 +20,7 @@
 namespace vkrt {
 
 struct MeshGeometry; // mesh/MeshGeometry.h
+class TextureAtlas;  // texture/TextureAtlas.h
 
 using Color = glm::dvec3; ///< linear RGB
 
@@ -136,6 +138,25 @@ VKRT_LIGHT_KINDS(VKRT_CHECK_LIGHT_VALUE)
 /// (Whitted: Schlick for dielectrics, none otherwise; path: exact for dielectrics).
 enum class FresnelMode { Default, None, Schlick, Exact };
 
+/// A material parameter's texture (scene `albedo = { texture = ... }`, glTF
+/// texture references): a record of the scene's TextureAtlas, looked up at
+/// uv * scale; scalars read component `channel` (0 = r ... 3 = a).
+struct MaterialTexture {
+    uint32_t record = 0;
+    uint32_t channel = 0;
+    glm::dvec2 scale{1.0};
+};
+
+/// Which parameter a texture drives (gpu::TEXTURE_SLOT_*).
+enum class TextureSlot : uint32_t {
+    Color = gpu::TEXTURE_SLOT_COLOR,         ///< diffuse / albedo / base_color
+    Specular = gpu::TEXTURE_SLOT_SPECULAR,   ///< specular / reflectance / tint
+    Roughness = gpu::TEXTURE_SLOT_ROUGHNESS, ///< perceptual roughness
+    Metallic = gpu::TEXTURE_SLOT_METALLIC,   ///< pbr metallic
+    Normal = gpu::TEXTURE_SLOT_NORMAL,       ///< tangent-space normal map
+};
+inline constexpr size_t kTextureSlotCount = gpu::TEXTURE_SLOT_COUNT;
+
 struct Material {
     std::string name;
     MaterialType type = MaterialType::Lambert;
@@ -151,10 +172,26 @@ struct Material {
     Color eta{0.0};          ///< conductor: real part of the complex index of refraction
     Color k{0.0};            ///< conductor: imaginary part (extinction)
     double metallic = 0.0;   ///< pbr
+    Color emission{0.0};     ///< pbr: emitted radiance (meshes only: their triangles become lights)
+    /// Textured parameters; a texel multiplies the parameter's constant above
+    /// (1 for the scene's textures, a glTF file's factor for its own).
+    std::array<std::optional<MaterialTexture>, kTextureSlotCount> textures{};
+    double normalStrength = 1.0; ///< scales a normal map's tangent-plane components (glTF normalTexture.scale)
     // Colours reuse the members above: conductor `tint` is specular, plastic
     // `diffuse` and pbr `base_color` are diffuse; plastic and rough_dielectric use ior.
     SourceLocation where; ///< the [materials.NAME] table
+
+    const std::optional<MaterialTexture>& texture(TextureSlot slot) const { return textures[size_t(slot)]; }
+    bool hasTextures() const;
+    bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
 };
+
+inline bool Material::hasTextures() const
+{
+    for (const auto& t : textures)
+        if (t) return true;
+    return false;
+}
 
 struct Sphere {
     glm::dvec3 center;
@@ -190,6 +227,9 @@ struct Mesh {
     std::shared_ptr<const MeshGeometry> geometry;
     glm::dmat4 objectToWorld{1.0};
     uint32_t material = 0;
+    /// `material = "file"`: triangle t uses Scene::materials[fileMaterials[geometry's triangleMaterials[t]]]
+    /// (empty: every triangle uses `material`).
+    std::vector<uint32_t> fileMaterials;
     Color emission{0.0};
     bool twoSided = false;
     SourceLocation where; ///< the [[objects]] table
@@ -233,6 +273,11 @@ struct Scene {
     VKRT_LIGHT_KINDS(VKRT_SCENE_ARRAY_MEMBER)
 #undef VKRT_SCENE_ARRAY_MEMBER
     Background background;
+    /// Every texture the materials use (null without textures).
+    std::shared_ptr<const TextureAtlas> textures;
+    /// What the scene asks for that vkrt cannot honour exactly, each located
+    /// ("file:line:column: ..."); the commands print them as warnings.
+    std::vector<std::string> warnings;
 
     size_t primitiveCount() const;
     /// Records of one kind (triangle lights: before zero-area ones are dropped).

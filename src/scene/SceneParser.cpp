@@ -10,8 +10,10 @@
 #include "material/Metals.h"
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
+#include "scene/FileMaterialImport.h"
 #include "scene/SceneOverrides.h"
 
+#include "scene/TextureParameters.h"
 #include "scene/TomlReader.h"
 #include "util/Hash.h"
 
@@ -152,15 +154,59 @@ Camera readCamera(const TableField& table)
 
 // ----------------------------------------------------------------- materials
 
-constexpr std::array<std::string_view, 2> lambertKeys{"type", "albedo"};
-constexpr std::array<std::string_view, 4> phongKeys{"type", "diffuse", "specular", "shininess"};
-constexpr std::array<std::string_view, 4> mirrorKeys{"type", "reflectance", "fresnel", "ior"};
-constexpr std::array<std::string_view, 5> glossyKeys{"type", "reflectance", "exponent", "fresnel", "ior"};
-constexpr std::array<std::string_view, 4> dielectricKeys{"type", "ior", "absorption", "fresnel"};
-constexpr std::array<std::string_view, 7> conductorKeys{"type", "roughness", "anisotropy", "metal", "eta", "k", "tint"};
-constexpr std::array<std::string_view, 5> rough_dielectricKeys{"type", "roughness", "ior", "absorption", "fresnel"};
-constexpr std::array<std::string_view, 4> plasticKeys{"type", "diffuse", "roughness", "ior"};
-constexpr std::array<std::string_view, 4> pbrKeys{"type", "base_color", "metallic", "roughness"};
+// Every kind takes `normal_map` (a tangent-space normal map; TextureParameters.h).
+constexpr std::array<std::string_view, 3> lambertKeys{"type", "albedo", "normal_map"};
+constexpr std::array<std::string_view, 5> phongKeys{"type", "diffuse", "specular", "shininess", "normal_map"};
+constexpr std::array<std::string_view, 5> mirrorKeys{"type", "reflectance", "fresnel", "ior", "normal_map"};
+constexpr std::array<std::string_view, 6> glossyKeys{"type", "reflectance", "exponent", "fresnel", "ior", "normal_map"};
+constexpr std::array<std::string_view, 5> dielectricKeys{"type", "ior", "absorption", "fresnel", "normal_map"};
+constexpr std::array<std::string_view, 8> conductorKeys{"type", "roughness", "anisotropy", "metal",
+                                                        "eta",  "k",         "tint",       "normal_map"};
+constexpr std::array<std::string_view, 6> rough_dielectricKeys{"type",       "roughness", "ior",
+                                                               "absorption", "fresnel",   "normal_map"};
+constexpr std::array<std::string_view, 5> plasticKeys{"type", "diffuse", "roughness", "ior", "normal_map"};
+constexpr std::array<std::string_view, 6> pbrKeys{"type",     "base_color", "metallic",
+                                                  "roughness", "emission",  "normal_map"};
+
+/// The textures of the scene being parsed (set by parseSceneString for the duration of a parse).
+thread_local TextureAtlas* t_textures = nullptr;
+
+/// A colour parameter: a value, or a texture table whose texel is the colour
+/// (the constant becomes 1, which the texel multiplies on the GPU).
+Color readColorParameter(const TableField& table, std::string_view key, Color fallback, Material& material,
+                         TextureSlot slot)
+{
+    const std::optional<Field> field = table.find(key);
+    if (!field) return fallback;
+    if (!isTextureTable(*field)) return readUnitColor(*field);
+    VKRT_CHECK(t_textures != nullptr);
+    material.textures[size_t(slot)] = readTextureTable(*field, TextureUse::Color, *t_textures);
+    return Color(1.0);
+}
+
+/// A parameter in [0, 1] (roughness, metallic): a value or a texture table.
+double readUnitParameter(const TableField& table, std::string_view key, double fallback, Material& material,
+                         TextureSlot slot)
+{
+    const std::optional<Field> field = table.find(key);
+    if (!field) return fallback;
+    if (!isTextureTable(*field)) return readNumberIn(*field, NumberRange{0.0, 1.0});
+    VKRT_CHECK(t_textures != nullptr);
+    material.textures[size_t(slot)] = readTextureTable(*field, TextureUse::Scalar, *t_textures);
+    return 1.0;
+}
+
+void readNormalMap(const TableField& table, Material& material)
+{
+    const std::optional<Field> field = table.find("normal_map");
+    if (!field) return;
+    if (!isTextureTable(*field))
+        field->fail("expected a texture table ({ texture = \"normals.png\", ... }), got " +
+                    describeType(field->node()));
+    VKRT_CHECK(t_textures != nullptr);
+    material.textures[size_t(TextureSlot::Normal)] =
+        readTextureTable(*field, TextureUse::NormalMap, *t_textures, &material.normalStrength);
+}
 
 constexpr std::array<EnumName<FresnelMode>, 2> reflectorFresnelModes{
     {{"none", FresnelMode::None}, {"schlick", FresnelMode::Schlick}}};
@@ -177,15 +223,18 @@ FresnelMode readDielectricFresnel(const Field& field)
     return readChoice(field, "fresnel mode", dielectricFresnelModes).value;
 }
 
+/// `material = "file"` on a mesh: the file's own materials (glTF).
+constexpr std::string_view kFileMaterial = "file";
+
 void readLambert(const TableField& table, Material& material)
 {
-    material.diffuse = readOr(table, "albedo", Color(0.8), readUnitColor);
+    material.diffuse = readColorParameter(table, "albedo", Color(0.8), material, TextureSlot::Color);
 }
 
 void readPhong(const TableField& table, Material& material)
 {
-    material.diffuse = readOr(table, "diffuse", Color(0.8), readUnitColor);
-    material.specular = readOr(table, "specular", Color(0.0), readUnitColor);
+    material.diffuse = readColorParameter(table, "diffuse", Color(0.8), material, TextureSlot::Color);
+    material.specular = readColorParameter(table, "specular", Color(0.0), material, TextureSlot::Specular);
     material.exponent = readOr(table, "shininess", 32.0, readNonNegative);
 }
 
@@ -198,13 +247,13 @@ void readReflectorFresnelTerm(const TableField& table, Material& material)
 
 void readMirror(const TableField& table, Material& material)
 {
-    material.specular = readOr(table, "reflectance", Color(1.0), readUnitColor);
+    material.specular = readColorParameter(table, "reflectance", Color(1.0), material, TextureSlot::Specular);
     readReflectorFresnelTerm(table, material);
 }
 
 void readGlossy(const TableField& table, Material& material)
 {
-    material.specular = readOr(table, "reflectance", Color(1.0), readUnitColor);
+    material.specular = readColorParameter(table, "reflectance", Color(1.0), material, TextureSlot::Specular);
     material.exponent = readOr(table, "exponent", 100.0, readNonNegative);
     readReflectorFresnelTerm(table, material);
 }
@@ -254,9 +303,9 @@ void readConductorIor(const TableField& table, Material& material)
 
 void readConductor(const TableField& table, Material& material)
 {
-    material.roughness = readOr(table, "roughness", 0.0, readUnitInterval);
+    material.roughness = readUnitParameter(table, "roughness", 0.0, material, TextureSlot::Roughness);
     material.anisotropy = readOr(table, "anisotropy", 0.0, readAnisotropy);
-    material.specular = readOr(table, "tint", Color(1.0), readUnitColor);
+    material.specular = readColorParameter(table, "tint", Color(1.0), material, TextureSlot::Specular);
     readConductorIor(table, material);
 }
 
@@ -265,14 +314,17 @@ void readConductor(const TableField& table, Material& material)
 void readRoughDielectric(const TableField& table, Material& material)
 {
     readDielectric(table, material);
-    material.roughness = readOr(table, "roughness", std::sqrt(0.1), readUnitInterval);
-    if (material.roughness == 0.0) material.type = MaterialType::Dielectric;
+    material.roughness = readUnitParameter(table, "roughness", std::sqrt(0.1), material, TextureSlot::Roughness);
+    if (material.roughness == 0.0) material.type = MaterialType::Dielectric; // never with a texture (its constant is 1)
 }
 
 /// Mitsuba's defaults: polypropylene (1.49), diffuse 0.5; roughness 0 is the smooth coating.
 void readPlastic(const TableField& table, Material& material)
 {
-    material.diffuse = readOr(table, "diffuse", Color(0.5), readUnitColor);
+    material.diffuse = readColorParameter(table, "diffuse", Color(0.5), material, TextureSlot::Color);
+    if (const auto roughness = table.find("roughness"); roughness && isTextureTable(*roughness))
+        roughness->fail("a plastic's roughness cannot be a texture: its coating's energy table is computed per "
+                        "material (use a constant, or a conductor or pbr material)");
     material.roughness = readOr(table, "roughness", 0.0, readUnitInterval);
     material.ior = readOr(table, "ior", 1.49, readIor);
     if (material.ior == 1.0) table.find("ior")->fail("must differ from 1 (a coating of index 1 is no coating)");
@@ -281,9 +333,10 @@ void readPlastic(const TableField& table, Material& material)
 /// glTF 2.0's defaults: base colour 1, metallic 1, roughness 1.
 void readPbr(const TableField& table, Material& material)
 {
-    material.diffuse = readOr(table, "base_color", Color(1.0), readUnitColor);
-    material.metallic = readOr(table, "metallic", 1.0, readUnitInterval);
-    material.roughness = readOr(table, "roughness", 1.0, readUnitInterval);
+    material.diffuse = readColorParameter(table, "base_color", Color(1.0), material, TextureSlot::Color);
+    material.metallic = readUnitParameter(table, "metallic", 1.0, material, TextureSlot::Metallic);
+    material.roughness = readUnitParameter(table, "roughness", 1.0, material, TextureSlot::Roughness);
+    material.emission = readOr(table, "emission", Color(0.0), readRadiance);
 }
 
 struct MaterialKind {
@@ -322,7 +375,11 @@ Material readMaterial(std::string_view name, const TableField& table)
     material.name = name;
     material.type = kind.type;
     material.where = table.field().location();
+    if (name == kFileMaterial)
+        table.field().fail("the material name \"file\" is reserved: `material = \"file\"` gives a mesh its "
+                           "file's own materials");
     kind.read(table, material);
+    readNormalMap(table, material);
     return material;
 }
 
@@ -425,6 +482,28 @@ constexpr std::array<std::string_view, 2> rotateKeys{"axis", "angle"};
 /// The geometries of the scene being parsed, so that instances of one file
 /// share one (set by parseSceneString for the duration of a parse).
 thread_local MeshGeometryCache* t_meshCache = nullptr;
+/// The scene materials made from each geometry's file materials, so that instances share them.
+thread_local std::map<const MeshGeometry*, std::vector<uint32_t>>* t_fileMaterials = nullptr;
+
+/// readMesh's material for `material = "file"`.
+constexpr uint32_t kFileMaterialIndex = UINT32_MAX;
+
+std::vector<uint32_t> fileMaterialsOf(const MeshGeometry& geometry, const Field& materialField, Scene& scene)
+{
+    VKRT_CHECK(t_fileMaterials != nullptr && t_textures != nullptr);
+    const auto known = t_fileMaterials->find(&geometry);
+    if (known != t_fileMaterials->end()) return known->second;
+    std::vector<uint32_t> indices;
+    try {
+        indices = importFileMaterials(geometry, materialField.location(), *t_textures, scene.materials, scene.warnings);
+    } catch (const SceneError&) {
+        throw;
+    } catch (const InputError& error) {
+        materialField.fail(error.what());
+    }
+    t_fileMaterials->emplace(&geometry, indices);
+    return indices;
+}
 
 /// `scale`: one number or three, none zero (a negative one mirrors).
 glm::dvec3 readScale(const Field& field)
@@ -505,6 +584,27 @@ std::filesystem::path readMeshPath(const Field& field)
     return path;
 }
 
+/// Every material a mesh instance uses.
+std::vector<uint32_t> materialsOf(const Mesh& mesh)
+{
+    return mesh.fileMaterials.empty() ? std::vector<uint32_t>{mesh.material} : mesh.fileMaterials;
+}
+
+/// Textures need the file's texture coordinates; an emissive material needs no `emission` of the mesh's own.
+void checkMeshMaterials(const Mesh& mesh, const Field& materialField, const Scene& scene)
+{
+    for (uint32_t index : materialsOf(mesh)) {
+        const Material& m = scene.materials[index];
+        if (m.hasTextures() && mesh.geometry->data.uvs.empty())
+            materialField.fail("material " + quote(m.name) + " has textures, but the mesh file " +
+                               quote(mesh.geometry->file.string()) +
+                               " has no texture coordinates (export it with uvs)");
+        if (m.emission != Color(0.0) && mesh.emission != Color(0.0))
+            materialField.fail("material " + quote(m.name) +
+                               " emits already; give the mesh either `emission` or an emissive material");
+    }
+}
+
 void readMesh(const TableField& table, uint32_t material, Scene& scene)
 {
     Mesh mesh;
@@ -529,6 +629,12 @@ void readMesh(const TableField& table, uint32_t material, Scene& scene)
     } catch (const InputError& error) {
         fileField.fail(std::string("cannot load the mesh: ") + error.what());
     }
+    const Field materialField = table.require("material");
+    if (material == kFileMaterialIndex) {
+        mesh.fileMaterials = fileMaterialsOf(*mesh.geometry, materialField, scene);
+        mesh.material = mesh.fileMaterials.front();
+    }
+    checkMeshMaterials(mesh, materialField, scene);
     scene.meshes.push_back(std::move(mesh));
 }
 
@@ -548,7 +654,14 @@ void readObject(const TableField& table, const MaterialIndex& materials, Scene& 
 {
     const ShapeReader kind = readChoice(table.require("shape"), "shape", shapeKinds);
     table.rejectUnknownKeys(kind.keys, allShapeKeys, "shape " + quote(kind.name));
-    kind.read(table, materials.resolve(table.require("material")), scene);
+    const Field materialField = table.require("material");
+    const bool mesh = kind.read == readMesh;
+    if (mesh && readString(materialField) == kFileMaterial) return readMesh(table, kFileMaterialIndex, scene);
+    const uint32_t material = materials.resolve(materialField);
+    if (!mesh && scene.materials[material].emission != Color(0.0))
+        materialField.fail("material " + quote(scene.materials[material].name) +
+                           " emits; only meshes can use an emissive material (use a mesh, or a [[lights]] entry)");
+    kind.read(table, material, scene);
 }
 
 // -------------------------------------------------------------------- lights
@@ -664,19 +777,34 @@ Scene readScene(const TableField& top)
 
 } // namespace
 
+/// Points a thread-local at `value` for one parse, restoring what it held before.
+template <class T>
+class ParseState {
+public:
+    ParseState(T*& slot, T* value) : m_slot(slot), m_previous(slot) { slot = value; }
+    ~ParseState() { m_slot = m_previous; }
+    ParseState(const ParseState&) = delete;
+    ParseState& operator=(const ParseState&) = delete;
+
+private:
+    T*& m_slot;
+    T* m_previous;
+};
+
 Scene parseSceneString(std::string_view text, const std::string& path)
 {
     MeshGeometryCache meshes;
-    struct CacheInUse {
-        explicit CacheInUse(MeshGeometryCache* cache) : previous(t_meshCache) { t_meshCache = cache; }
-        ~CacheInUse() { t_meshCache = previous; }
-        MeshGeometryCache* previous;
-    } inUse(&meshes);
+    auto textures = std::make_shared<TextureAtlas>();
+    std::map<const MeshGeometry*, std::vector<uint32_t>> fileMaterials;
+    const ParseState meshState(t_meshCache, &meshes);
+    const ParseState textureState(t_textures, textures.get());
+    const ParseState fileMaterialState(t_fileMaterials, &fileMaterials);
     const TomlSource source{path, fs::path(path).parent_path()};
     const toml::table root = parseToml(text, source);
     Scene scene = readScene(TableField(Field(source, root, "")));
     scene.path = path;
     scene.fileHash = fnv1a64(text);
+    if (textures->recordCount() > 0) scene.textures = std::move(textures);
     return scene;
 }
 

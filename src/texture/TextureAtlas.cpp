@@ -80,6 +80,9 @@ uint32_t TextureAtlas::addImage(const TextureImage& image, const std::string& na
     stored.width = image.pixels.width;
     stored.height = image.pixels.height;
     stored.format = formatOf(image.encoding);
+    for (size_t i = 0; i < image.pixels.texelCount(); ++i)
+        for (int c = 0; c < 4; ++c) stored.mean[c] += image.pixels.rgba[i * 4 + c];
+    for (double& m : stored.mean) m /= double(image.pixels.texelCount());
     for (const RgbaImage& level : buildMipPyramid(image.pixels)) {
         stored.levelWords.push_back(stored.words.size());
         appendLevel(level, stored.format, stored.words);
@@ -90,6 +93,18 @@ uint32_t TextureAtlas::addImage(const TextureImage& image, const std::string& na
     m_words += stored.words.size();
     m_images.push_back(std::move(stored));
     return uint32_t(m_images.size() - 1);
+}
+
+std::array<double, 4> TextureAtlas::meanOf(uint32_t record) const
+{
+    VKRT_CHECK(record < m_records.size());
+    return m_images[std::get<0>(m_records[record])].mean;
+}
+
+const std::string& TextureAtlas::nameOf(uint32_t record) const
+{
+    VKRT_CHECK(record < m_records.size());
+    return m_images[std::get<0>(m_records[record])].name;
 }
 
 uint32_t TextureAtlas::addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV)

@@ -7,6 +7,7 @@
 #include "texture/TextureImage.h"
 #include "util/Error.h"
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -53,6 +54,11 @@ public:
     size_t imageCount() const { return m_images.size(); }
     /// Bytes of texel storage so far.
     uint64_t texelBytes() const { return m_words * 4; }
+    /// The mean linear RGBA of a record's image (level 0), as Mitsuba's
+    /// Texture::mean() gives for a bitmap: what a plastic's sampling weight uses.
+    std::array<double, 4> meanOf(uint32_t record) const;
+    /// The name (file) of a record's image, for messages.
+    const std::string& nameOf(uint32_t record) const;
 
     /// The buffers to upload. Throws InputError when the texels exceed
     /// `maxStorageBufferRange` bytes (VkPhysicalDeviceLimits), naming the largest texture.
@@ -65,6 +71,7 @@ private:
         uint64_t firstWord = 0;           ///< in the packed buffer
         std::vector<uint64_t> levelWords; ///< each level's start, relative to firstWord
         std::vector<uint32_t> words;      ///< every level, encoded
+        std::array<double, 4> mean{};     ///< level 0's mean linear RGBA
     };
     uint32_t addImage(const TextureImage& image, const std::string& name);
     uint32_t addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV);

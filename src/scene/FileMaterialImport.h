@@ -1,0 +1,23 @@
+#pragma once
+// Mesh files' own materials (`material = "file"` on a glTF mesh) as scene
+// materials: glTF 2.0 metallic-roughness becomes the `pbr` kind, its
+// textures enter the scene's TextureAtlas, and whatever vkrt cannot honour
+// (extensions, alpha modes, emissive textures, ...) becomes a warning that
+// names it, located at the mesh's `material` key.
+#include "scene/Scene.h"
+#include "texture/TextureAtlas.h"
+
+#include <string>
+#include <vector>
+
+namespace vkrt {
+
+/// Appends one Material per material of the geometry's file to `materials`
+/// and returns their indices, in the order of the file's materials (the
+/// geometry's triangleMaterials index this list). Throws SceneError at
+/// `where` when the file has no materials or a texture cannot be loaded.
+std::vector<uint32_t> importFileMaterials(const MeshGeometry& geometry, const SourceLocation& where,
+                                          TextureAtlas& atlas, std::vector<Material>& materials,
+                                          std::vector<std::string>& warnings);
+
+} // namespace vkrt
