@@ -56,29 +56,30 @@ vec3 normalMapped(SurfaceHit hit, vec3 texel, float strength)
 // from the camera to this hit.
 Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float pathLength)
 {
-    MaterialTextures t = materialTextures[hit.material];
+    // Slots are read one by one: copying the whole MaterialTextures (a struct
+    // with an array) out of the buffer makes glslang emit invalid SPIR-V.
     float coneWidth = pixelSpreadAngle() * pathLength;
     float cosTheta = dot(dir, hit.normal);
-    TextureSlot slot = t.slots[TEXTURE_SLOT_COLOR];
+    TextureSlot slot = materialTextures[hit.material].slots[TEXTURE_SLOT_COLOR];
     if (slot.record != NO_TEXTURE)
         m.diffuse *= clamp(lookupSlot(slot, hit, coneWidth, cosTheta).rgb, 0.0, 1.0);
-    slot = t.slots[TEXTURE_SLOT_SPECULAR];
+    slot = materialTextures[hit.material].slots[TEXTURE_SLOT_SPECULAR];
     if (slot.record != NO_TEXTURE)
         m.specular *= clamp(lookupSlot(slot, hit, coneWidth, cosTheta).rgb, 0.0, 1.0);
-    slot = t.slots[TEXTURE_SLOT_ROUGHNESS];
+    slot = materialTextures[hit.material].slots[TEXTURE_SLOT_ROUGHNESS];
     if (slot.record != NO_TEXTURE) {
         // alpha = roughness^2: the texel's roughness scales both alphas by its square.
         float r = channelOf(lookupSlot(slot, hit, coneWidth, cosTheta), slot.channel);
         m.alphaX = max(m.alphaX * r * r, MIN_GGX_ALPHA);
         m.alphaY = max(m.alphaY * r * r, MIN_GGX_ALPHA);
     }
-    slot = t.slots[TEXTURE_SLOT_METALLIC];
+    slot = materialTextures[hit.material].slots[TEXTURE_SLOT_METALLIC];
     if (slot.record != NO_TEXTURE)
         m.metallic *= channelOf(lookupSlot(slot, hit, coneWidth, cosTheta), slot.channel);
 #ifdef VKRT_HAS_NORMAL_MAPS
-    slot = t.slots[TEXTURE_SLOT_NORMAL];
+    slot = materialTextures[hit.material].slots[TEXTURE_SLOT_NORMAL];
     if (slot.record != NO_TEXTURE)
-        hit.shading = normalMapped(hit, lookupSlot(slot, hit, coneWidth, cosTheta).rgb, t.normalStrength);
+        hit.shading = normalMapped(hit, lookupSlot(slot, hit, coneWidth, cosTheta).rgb, materialTextures[hit.material].normalStrength);
 #endif
     return m;
 }

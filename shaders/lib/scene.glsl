@@ -518,8 +518,14 @@ vec3 objectToWorldVector(Mesh mesh, vec3 v)
 void describeMeshUv(Mesh mesh, HitId id, MeshTriangle tri, inout SurfaceHit hit)
 {
     uint index = mesh.firstTriangle + id.primitive;
-    MeshUvs uvs = (mesh.flags & MESH_FLAG_UVS) != 0u ? meshUvs[index] : MeshUvs(vec2(0.0), vec2(0.0), vec2(0.0));
-    triangleUv(id.detail, uvs.uv0, uvs.uv1, uvs.uv2, objectToWorldVector(mesh, tri.v1 - tri.v0),
+    // (No ?: between a buffer's struct and a local one: glslang emits invalid SPIR-V for it.)
+    vec2 uv0 = vec2(0.0), uv1 = vec2(0.0), uv2 = vec2(0.0);
+    if ((mesh.flags & MESH_FLAG_UVS) != 0u) {
+        uv0 = meshUvs[index].uv0;
+        uv1 = meshUvs[index].uv1;
+        uv2 = meshUvs[index].uv2;
+    }
+    triangleUv(id.detail, uv0, uv1, uv2, objectToWorldVector(mesh, tri.v1 - tri.v0),
                objectToWorldVector(mesh, tri.v2 - tri.v0), hit);
 #ifdef VKRT_HAS_MESH_TANGENTS
     if ((mesh.flags & MESH_FLAG_TANGENTS) != 0u) {

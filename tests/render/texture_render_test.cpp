@@ -1,0 +1,249 @@
+// Textured materials on the GPU, each checked against an answer worked out
+// here from the documented conventions (docs/scene-format.md, "Textures" and
+// "Texture coordinates"), not from the texture code:
+// - a Lambert surface under a uniform white sky, one bounce, shows exactly
+//   its albedo, so a textured albedo shows the texel: the image appears
+//   upright on planes, box faces, spheres and meshes;
+// - a distant one-texel checker is filtered to its linear mean (mip-mapping
+//   by ray cones), while a near one keeps its contrast;
+// - a constant normal map tilts a plane's shading normal in its tangent
+//   frame, which changes a point light's Lambert term to a closed form.
+#include "render/Renderer.h"
+#include "scene/SceneParser.h"
+#include "support/TestSupport.h"
+#include "texture/TextureImage.h"
+#include "texture/TextureTestFiles.h"
+
+#include <glm/glm.hpp>
+
+#include <cmath>
+#include <fstream>
+
+namespace vkrt::test {
+namespace {
+
+class TextureRender : public GpuTest {};
+
+constexpr uint32_t kSide = 33; // odd: the centre pixel looks along the view axis
+
+Image renderCentres(const Scene& scene, uint32_t frames = 1)
+{
+    Renderer renderer(gpu(), scene, pixelCentreOptions());
+    renderer.renderFrames(frames);
+    EXPECT_EQ(renderer.counters().rejectedSamples, 0u);
+    return renderer.mean();
+}
+
+// ------------------------------------------------- orientation on every shape
+
+/// 16 x 16 sRGB texels in four uniform quadrants (rows top to bottom as in the file).
+struct Quadrants {
+    static constexpr uint8_t topLeft[3] = {255, 0, 0};
+    static constexpr uint8_t topRight[3] = {0, 255, 0};
+    static constexpr uint8_t bottomLeft[3] = {0, 0, 255};
+    static constexpr uint8_t bottomRight[3] = {128, 128, 128};
+};
+
+std::filesystem::path writeQuadrantTexture(const std::filesystem::path& dir)
+{
+    std::vector<uint8_t> samples;
+    for (uint32_t y = 0; y < 16; ++y)
+        for (uint32_t x = 0; x < 16; ++x) {
+            const uint8_t* c = y < 8 ? (x < 8 ? Quadrants::topLeft : Quadrants::topRight)
+                                     : (x < 8 ? Quadrants::bottomLeft : Quadrants::bottomRight);
+            samples.insert(samples.end(), c, c + 3);
+        }
+    return write8BitPng(dir / "quadrants.png", 16, 16, 3, samples);
+}
+
+/// A camera on +z looking at the origin whose view at z = 0 is exactly [-0.5, 0.5]^2.
+std::string frontCamera()
+{
+    const double fov = 2.0 * std::atan(0.5 / 3.0) * 180.0 / 3.14159265358979323846;
+    return "[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = " +
+           std::to_string(fov) + "\nwidth = " + std::to_string(kSide) + "\nheight = " + std::to_string(kSide) +
+           "\n[background]\ncolor = [1, 1, 1]\n"
+           "[materials.textured]\ntype = \"lambert\"\nalbedo = { texture = \"quadrants.png\", wrap = \"clamp\" }\n";
+}
+
+void expectTexel(const Image& image, uint32_t x, uint32_t y, const uint8_t (&srgb)[3], const std::string& what)
+{
+    for (int c = 0; c < 3; ++c) {
+        const double expected = srgbToLinear(srgb[c] / 255.0);
+        EXPECT_NEAR(image.at(x, y)[c], expected, 2e-4) << what << " got " << image.at(x, y)[0] << " " << image.at(x, y)[1] << " " << image.at(x, y)[2] << ": pixel (" << x << ", " << y << ") channel " << c;
+    }
+}
+
+/// The pixels at the quadrants' centres show the quadrants of the image, upright.
+void expectUpright(const Image& image, const std::string& what)
+{
+    const uint32_t low = kSide / 4, high = kSide - 1 - kSide / 4;
+    expectTexel(image, low, low, Quadrants::topLeft, what + ", top left");
+    expectTexel(image, high, low, Quadrants::topRight, what + ", top right");
+    expectTexel(image, low, high, Quadrants::bottomLeft, what + ", bottom left");
+    expectTexel(image, high, high, Quadrants::bottomRight, what + ", bottom right");
+}
+
+TEST_F(TextureRender, ImageAppearsUprightOnPlanesBoxesSpheresAndMeshes)
+{
+    const auto dir = freshTempDir("texture-upright");
+    writeQuadrantTexture(dir);
+    {
+        std::ofstream(dir / "quad.obj") << "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\n"
+                                           "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+    }
+    const std::string scenePath = (dir / "scene.toml").string();
+    // A plane facing +z: u along +x, v along +y, one unit per scene unit from its point.
+    const std::string plane = "[[objects]]\nshape = \"plane\"\npoint = [-0.5, -0.5, 0]\nnormal = [0, 0, 1]\n"
+                              "material = \"textured\"\n";
+    // A box's +z face spans [0, 1]^2 over the face.
+    const std::string box = "[[objects]]\nshape = \"box\"\nmin = [-0.5, -0.5, -1]\nmax = [0.5, 0.5, 0]\n"
+                            "material = \"textured\"\n";
+    // A mesh quad with the OBJ's uvs (0, 0) at its bottom-left corner.
+    const std::string mesh = "[[objects]]\nshape = \"mesh\"\nfile = \"quad.obj\"\nmaterial = \"textured\"\n";
+    // A sphere seen from +z: u = 0.5 at +z, growing towards +x; v = 0.5 at the
+    // equator, 1 at the top. Small enough that the quadrants' centres in the
+    // image see uvs well inside the texture's quadrants.
+    const std::string sphere = "[[objects]]\nshape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.4\n"
+                               "material = \"textured\"\n";
+    expectUpright(renderCentres(parseSceneString(frontCamera() + plane, scenePath)), "plane");
+    expectUpright(renderCentres(parseSceneString(frontCamera() + box, scenePath)), "box");
+    expectUpright(renderCentres(parseSceneString(frontCamera() + mesh, scenePath)), "mesh");
+    expectUpright(renderCentres(parseSceneString(frontCamera() + sphere, scenePath)), "sphere");
+}
+
+// ----------------------------------------------------------- mip-mapping
+
+std::filesystem::path writeChecker(const std::filesystem::path& dir, uint32_t side)
+{
+    std::vector<uint8_t> samples;
+    for (uint32_t y = 0; y < side; ++y)
+        for (uint32_t x = 0; x < side; ++x) samples.push_back((x + y) % 2 ? 255 : 0);
+    return write8BitPng(dir / "checker.png", side, side, 1, samples);
+}
+
+/// A floor under a white sky seen from 1 unit above it, with a one-texel checker at uv scale `scale`.
+Image renderCheckerFloor(const std::filesystem::path& dir, double scale)
+{
+    const std::string text = "[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 1, 0]\n"
+                             "target = [0, 0.2, -4]\nfov = 40\nwidth = " +
+                             std::to_string(kSide) + "\nheight = " + std::to_string(kSide) +
+                             "\n[background]\ncolor = [1, 1, 1]\n[materials.floor]\ntype = \"lambert\"\n"
+                             "albedo = { texture = \"checker.png\", scale = " +
+                             std::to_string(scale) +
+                             " }\n[[objects]]\nshape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n"
+                             "material = \"floor\"\n";
+    return renderCentres(parseSceneString(text, (dir / "scene.toml").string()));
+}
+
+TEST_F(TextureRender, DistantCheckerIsFilteredToItsLinearMeanNearOneKeepsItsContrast)
+{
+    const auto dir = freshTempDir("texture-mips");
+    writeChecker(dir, 64);
+    // Minified: every pixel's footprint covers hundreds of texels. Point
+    // samples of the checker would read 0 or 1; its mip levels average to
+    // 0.5 in linear light (an average of the sRGB codes would give 0.21).
+    const Image far = renderCheckerFloor(dir, 512.0);
+    // Magnified: each texel spans several pixels, so level 0 is used and the
+    // pixels read black, white and bilinear blends of the two.
+    const Image near = renderCheckerFloor(dir, 0.05);
+    double farMin = 1e9, farMax = -1e9, nearMin = 1e9, nearMax = -1e9, farSum = 0;
+    size_t floorPixels = 0;
+    for (uint32_t y = 0; y < kSide; ++y)
+        for (uint32_t x = 0; x < kSide; ++x) {
+            if (far.at(x, y)[0] == 1.0f && far.at(x, y)[2] == 1.0f && y < kSide / 3) continue; // the sky
+            const double f = far.at(x, y)[0], n = near.at(x, y)[0];
+            farMin = std::min(farMin, f), farMax = std::max(farMax, f), farSum += f;
+            nearMin = std::min(nearMin, n), nearMax = std::max(nearMax, n);
+            ++floorPixels;
+        }
+    ASSERT_GT(floorPixels, kSide * kSide / 2) << "the floor should fill most of the image";
+    EXPECT_NEAR(farSum / double(floorPixels), 0.5, 0.01);
+    EXPECT_GT(farMin, 0.45) << "a distant pixel was not filtered (aliasing)";
+    EXPECT_LT(farMax, 0.55) << "a distant pixel was not filtered (aliasing)";
+    EXPECT_LT(nearMin, 0.05) << "the near checker lost its black texels: blurred although magnified";
+    EXPECT_GT(nearMax, 0.95) << "the near checker lost its white texels: blurred although magnified";
+}
+
+// ------------------------------------------------------------ normal maps
+
+/// A 4 x 4 linear normal map of one tangent-space normal, given as 8-bit codes.
+void writeConstantNormalMap(const std::filesystem::path& file, const std::array<uint8_t, 3>& code)
+{
+    std::vector<uint8_t> samples;
+    for (int i = 0; i < 16; ++i) samples.insert(samples.end(), code.begin(), code.end());
+    write8BitPng(file, 4, 4, 3, samples);
+}
+
+/// The tangent-space normal a texel of `code` stands for (rgb = (n + 1) / 2), normalised.
+glm::dvec3 decodeNormal(const std::array<uint8_t, 3>& code)
+{
+    return glm::normalize(glm::dvec3(code[0], code[1], code[2]) * (2.0 / 255.0) - 1.0);
+}
+
+/// Looking straight down at the floor's origin; albedo 0.5; a point light of intensity 10 at `light`.
+std::string normalMapScene(const std::string& integrator, const glm::dvec3& light, const std::string& floor)
+{
+    auto vec = [](const glm::dvec3& v) {
+        return "[" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + "]";
+    };
+    return "[render]\nintegrator = \"" + integrator + "\"\nmax_depth = 1\n[camera]\neye = [0, 3, 0]\n"
+           "target = [0, 0, 0]\nup = [0, 0, -1]\nfov = 20\nwidth = " + std::to_string(kSide) + "\nheight = " +
+           std::to_string(kSide) +
+           "\n[materials.bumpy]\ntype = \"lambert\"\nalbedo = 0.5\n"
+           "normal_map = { texture = \"normals.png\" }\n[[lights]]\ntype = \"point\"\nposition = " + vec(light) +
+           "\nintensity = [10, 10, 10]\n" + floor;
+}
+
+/// Radiance at the floor's origin: albedo / pi * I * cos(mapped normal, light) / d^2.
+double expectedRadiance(const glm::dvec3& mappedNormal, const glm::dvec3& light)
+{
+    const double cosine = std::max(0.0, glm::dot(mappedNormal, glm::normalize(light)));
+    return 0.5 / 3.14159265358979323846 * 10.0 * cosine / glm::dot(light, light);
+}
+
+TEST_F(TextureRender, ConstantNormalMapTiltsTheShadingNormalInTheTangentFrame)
+{
+    const auto dir = freshTempDir("texture-normal-map");
+    {
+        // Corners CCW seen from above (normal +y), uv: u along +x, v along -z.
+        std::ofstream(dir / "floor.obj") << "v -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\n"
+                                            "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+    }
+    // The floor's tangent frame by the documented conventions: tangent +x
+    // (increasing u), bitangent -z (increasing v), normal +y, for the plane
+    // (tangent = cross(+y, n), else +x; bitangent = cross(n, tangent)), the
+    // box's top face and the mesh's uvs alike.
+    const glm::dvec3 tangent(1, 0, 0), bitangent(0, 0, -1), normal(0, 1, 0);
+    const std::vector<std::pair<std::string, std::string>> floors = {
+        {"plane", "[[objects]]\nshape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nmaterial = \"bumpy\"\n"},
+        {"box", "[[objects]]\nshape = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 0, 1]\nmaterial = \"bumpy\"\n"},
+        {"mesh", "[[objects]]\nshape = \"mesh\"\nfile = \"floor.obj\"\nmaterial = \"bumpy\"\n"},
+    };
+    // Tilted 30 degrees towards +tangent, then towards +bitangent; each lit
+    // from the side it tilts to, where the wrong sign would give a far smaller cosine.
+    const std::vector<std::pair<std::array<uint8_t, 3>, glm::dvec3>> cases = {
+        {{191, 128, 238}, glm::dvec3(2, 2, 0)},
+        {{128, 191, 238}, glm::dvec3(0, 2, -2)},
+    };
+    for (const auto& [code, light] : cases) {
+        writeConstantNormalMap(dir / "normals.png", code);
+        const glm::dvec3 local = decodeNormal(code);
+        const glm::dvec3 mapped = glm::normalize(local.x * tangent + local.y * bitangent + local.z * normal);
+        const double expected = expectedRadiance(mapped, light);
+        const double unmapped = expectedRadiance(normal, light);
+        ASSERT_GT(expected, 1.2 * unmapped) << "the case does not tell a tilted normal from a flat one";
+        for (const auto& [name, floor] : floors)
+            for (const std::string integrator : {"path", "whitted"}) {
+                const Scene scene = parseSceneString(normalMapScene(integrator, light, floor),
+                                                     (dir / "scene.toml").string());
+                const Image image = renderCentres(scene);
+                EXPECT_NEAR(image.at(kSide / 2, kSide / 2)[0], expected, 2e-3 * expected)
+                    << name << ", " << integrator << ", normal map code " << int(code[0]) << " " << int(code[1])
+                    << " " << int(code[2]) << " (flat normal would give " << unmapped << ")";
+            }
+    }
+}
+
+} // namespace
+} // namespace vkrt::test

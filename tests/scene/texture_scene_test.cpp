@@ -1,0 +1,152 @@
+// Textured material parameters in scene files (docs/scene-format.md,
+// "Textures"): what a texture table sets, and every way one can be wrong,
+// each with its position in the file.
+#include "scene/FeatureSet.h"
+#include "scene/SceneParser.h"
+#include "texture/TextureAtlas.h"
+#include "texture/TextureTestFiles.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+namespace vkrt::test {
+namespace {
+
+const std::string kCamera = "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov = 45\n";
+
+class SceneParserTextures : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        m_dir = textureTestDir();
+        write8BitPng(m_dir / "grey.png", 2, 2, 3, std::vector<uint8_t>(12, 128));
+        std::ofstream(m_dir / "notes.png") << "not an image at all\n";
+        writePng(m_dir / "four-bit.png", 2, 2, 4, 0, {});
+        std::ofstream(m_dir / "no-uvs.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    }
+
+    Scene parse(const std::string& body) const { return parseSceneString(kCamera + body, scenePath()); }
+    std::string scenePath() const { return (m_dir / "scene.toml").string(); }
+
+    /// The message of the SceneError `body` raises (empty if none).
+    std::string errorOf(const std::string& body) const
+    {
+        try {
+            parse(body);
+        } catch (const SceneError& e) {
+            return e.what();
+        }
+        return "";
+    }
+
+    std::filesystem::path m_dir;
+};
+
+const std::string kSphere = "[[objects]]\nshape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
+
+TEST_F(SceneParserTextures, ATextureTableSetsTheSlotAndReplacesTheConstant)
+{
+    const Scene scene = parse("[materials.m]\ntype = \"lambert\"\n"
+                              "albedo = { texture = \"grey.png\", scale = [4, 2], wrap = [\"clamp\", \"mirror\"] }\n" +
+                              kSphere);
+    const Material& m = scene.materials[0];
+    ASSERT_TRUE(m.texture(TextureSlot::Color).has_value());
+    EXPECT_EQ(m.diffuse, Color(1.0)) << "the texel is the albedo: the constant it multiplies is 1";
+    EXPECT_EQ(m.texture(TextureSlot::Color)->scale, glm::dvec2(4, 2));
+    ASSERT_TRUE(scene.textures);
+    const TextureBuffers buffers = scene.textures->pack(~0ull);
+    ASSERT_EQ(buffers.records.size(), 1u);
+    EXPECT_EQ(buffers.records[0].wrapU, gpu::TEXTURE_WRAP_CLAMP);
+    EXPECT_EQ(buffers.records[0].wrapV, gpu::TEXTURE_WRAP_MIRROR);
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.textures);
+    EXPECT_FALSE(features.normalMaps);
+}
+
+TEST_F(SceneParserTextures, ScalarTexturesPickTheirChannelAndKeepRoughKinds)
+{
+    const Scene scene = parse("[materials.m]\ntype = \"rough_dielectric\"\n"
+                              "roughness = { texture = \"grey.png\", channel = \"b\", linear = true }\n"
+                              "[materials.n]\ntype = \"pbr\"\nmetallic = { texture = \"grey.png\", channel = \"a\" }\n"
+                              "normal_map = { texture = \"grey.png\", strength = 0.5 }\n" +
+                              kSphere + "[[objects]]\nshape = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n"
+                                        "material = \"n\"\n");
+    const Material& glass = scene.materials[0];
+    EXPECT_EQ(glass.type, MaterialType::RoughDielectric) << "a textured roughness is never the smooth kind";
+    EXPECT_EQ(glass.roughness, 1.0);
+    ASSERT_TRUE(glass.texture(TextureSlot::Roughness).has_value());
+    EXPECT_EQ(glass.texture(TextureSlot::Roughness)->channel, 2u);
+    const Material& pbr = scene.materials[1];
+    EXPECT_EQ(pbr.texture(TextureSlot::Metallic)->channel, 3u);
+    EXPECT_EQ(pbr.normalStrength, 0.5);
+    EXPECT_TRUE(featuresOf(scene).normalMaps);
+    // The same file as sRGB and as linear data are two images; the normal map reuses the linear one.
+    EXPECT_EQ(scene.textures->imageCount(), 2u);
+}
+
+TEST_F(SceneParserTextures, SceneWithoutTexturesHasNoAtlasAndNoTextureFeature)
+{
+    const Scene scene = parse("[materials.m]\ntype = \"lambert\"\nalbedo = 0.5\n" + kSphere);
+    EXPECT_FALSE(scene.textures);
+    EXPECT_FALSE(featuresOf(scene).textures);
+}
+
+struct BadTexture {
+    const char* name;
+    std::string body;
+    std::string location; ///< "line:column"
+    std::string message;
+};
+
+class SceneParserTexturesBad : public SceneParserTextures, public ::testing::WithParamInterface<BadTexture> {};
+
+TEST_P(SceneParserTexturesBad, ReportsMessageAndPosition)
+{
+    const BadTexture& bad = GetParam();
+    const std::string error = errorOf(bad.body);
+    ASSERT_FALSE(error.empty()) << bad.name << ": no error";
+    EXPECT_NE(error.find(scenePath() + ":" + bad.location + ": "), std::string::npos) << error;
+    EXPECT_NE(error.find(bad.message), std::string::npos) << error;
+}
+
+const std::string kLambert = "[materials.m]\ntype = \"lambert\"\n";
+
+const BadTexture kBadTextures[] = {
+    {"MissingFile", kLambert + "albedo = { texture = \"absent.png\" }\n" + kSphere, "7:22", "absent.png"},
+    {"NotAnImage", kLambert + "albedo = { texture = \"notes.png\" }\n" + kSphere, "7:22", "notes.png"},
+    {"UnsupportedDepth", kLambert + "albedo = { texture = \"four-bit.png\" }\n" + kSphere, "7:22", "four-bit.png"},
+    {"NoTextureKey", kLambert + "albedo = { scale = 2 }\n" + kSphere, "7:10", "'texture'"},
+    {"MisspeltKey", kLambert + "albedo = { texure = \"grey.png\" }\n" + kSphere, "7:12",
+     "unknown key 'texure'; did you mean 'texture'?"},
+    {"ChannelOnAColour", kLambert + "albedo = { texture = \"grey.png\", channel = \"r\" }\n" + kSphere, "7:34",
+     "unknown key 'channel'"},
+    {"UnknownChannel",
+     "[materials.m]\ntype = \"conductor\"\nroughness = { texture = \"grey.png\", channel = \"x\" }\n" + kSphere,
+     "7:47", "unknown channel 'x'"},
+    {"UnknownWrapMode", kLambert + "albedo = { texture = \"grey.png\", wrap = \"repet\" }\n" + kSphere, "7:41",
+     "unknown wrap mode 'repet'; did you mean 'repeat'?"},
+    {"ZeroScale", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 0] }\n" + kSphere, "7:46",
+     "must not be zero"},
+    {"ScaleTriple", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 2, 3] }\n" + kSphere, "7:42",
+     "a pair [su, sv]"},
+    {"TexturedPlasticRoughness",
+     "[materials.m]\ntype = \"plastic\"\nroughness = { texture = \"grey.png\" }\n" + kSphere, "7:13",
+     "a plastic's roughness cannot be a texture"},
+    {"NormalMapNotATable", kLambert + "normal_map = \"grey.png\"\n" + kSphere, "7:14", "expected a texture table"},
+    {"NormalMapLinearKey", kLambert + "normal_map = { texture = \"grey.png\", linear = true }\n" + kSphere, "7:38",
+     "unknown key 'linear'"},
+    {"TexturedMeshWithoutUvs",
+     kLambert + "albedo = { texture = \"grey.png\" }\n[[objects]]\nshape = \"mesh\"\nfile = \"no-uvs.obj\"\n"
+                "material = \"m\"\n",
+     "11:12", "has no texture coordinates"},
+    {"EmissiveMaterialOnASphere", "[materials.m]\ntype = \"pbr\"\nemission = [1, 1, 1]\n" + kSphere, "12:12",
+     "only meshes can use an emissive material"},
+    {"ReservedMaterialName", "[materials.file]\ntype = \"lambert\"\n", "5:1", "reserved"},
+};
+
+INSTANTIATE_TEST_SUITE_P(AllCases, SceneParserTexturesBad, ::testing::ValuesIn(kBadTextures),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+} // namespace
+} // namespace vkrt::test
