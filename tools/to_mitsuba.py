@@ -413,7 +413,7 @@ class _Texture:
     alpha = roughness² Mitsuba needs as a one-channel image."""
 
     def __init__(self, file: Path, scale, linear: bool, wrap: str, channel: int, where: str, alpha: bool):
-        self.file = file
+        self.file = file  # where: "scene.toml: materials.x.key"
         self.scale = scale
         self.linear = linear
         self.wrap = wrap
@@ -476,8 +476,8 @@ def read_texture(r: _Reader, data: dict, key: str, where: str, scene_dir: Path, 
     channel = r.string(t, "channel", tw, "r")
     if channel not in TEXTURE_CHANNELS:
         r.fail(f"{tw}.channel", f"unknown channel '{channel}' (expected one of: {', '.join(TEXTURE_CHANNELS)})")
-    return _Texture(file, scale, r.boolean(t, "linear", tw, False), wrap, TEXTURE_CHANNELS.index(channel), tw,
-                    alpha)
+    return _Texture(file, scale, r.boolean(t, "linear", tw, False), wrap, TEXTURE_CHANNELS.index(channel),
+                    f"{r.path}: {tw}", alpha)
 
 
 def uv_transform_matrix(scale):
@@ -491,11 +491,57 @@ def uv_transform_matrix(scale):
     return [[su, 0.0, 0.0], [0.0, sv, 1.0 - sv], [0.0, 0.0, 1.0]]
 
 
-def _alpha_texture_file(mi, tex: _Texture, out: Path) -> None:
-    """A one-channel float EXR of GGX alpha = max(texel², MIN_GGX_ALPHA) from
-    the chosen channel (Mitsuba's bitmap cannot select a channel, and its alpha
-    is not the roughness). The texel is decoded as vkrt decodes it: sRGB
-    colour channels linearised unless linear, alpha channel as stored."""
+ALPHA_UPSAMPLING = 7  # odd: see _alpha_texture_file
+ALPHA_MAX_SIDE = 2048
+
+
+def wrap_texel_index(i, n: int, wrap: str):
+    """Texel index i (numpy ints) of a side of n texels after vkrt's wrap mode
+    (shaders/lib/texture.glsl: repeat has period n, mirror period 2n with the
+    edge texels doubled, clamp continues the edge texel)."""
+    import numpy as np
+
+    if wrap == "repeat":
+        return np.mod(i, n)
+    if wrap == "mirror":
+        j = np.mod(i, 2 * n)
+        return np.where(j < n, j, 2 * n - 1 - j)
+    return np.clip(i, 0, n - 1)
+
+
+def upsample_bilinear(image, factor: int, wrap: str):
+    """vkrt's bilinear lookup of `image` (h x w, row 0 at the top) at the texel
+    centres of an image `factor` times larger on each side, which spans the
+    same uv square: fine texel j of side k n has its centre at coarse texel
+    coordinate (j + 0.5) / k - 0.5."""
+    import numpy as np
+
+    for axis in (0, 1):
+        n = image.shape[axis]
+        x = (np.arange(factor * n) + 0.5) / factor - 0.5
+        i0 = np.floor(x).astype(np.int64)
+        f = (x - i0).reshape((-1, 1) if axis == 0 else (1, -1))
+        lo = np.take(image, wrap_texel_index(i0, n, wrap), axis)
+        hi = np.take(image, wrap_texel_index(i0 + 1, n, wrap), axis)
+        image = lo * (1 - f) + hi * f
+    return image
+
+
+def _alpha_texture_file(mi, tex: _Texture, out: Path) -> int:
+    """Write a one-channel float EXR of GGX alpha = max(roughness², MIN_GGX_ALPHA)
+    for the chosen channel (Mitsuba's bitmap cannot select a channel, and its
+    alpha is not the roughness); return the upsampling factor. The texel is
+    decoded as vkrt decodes it: sRGB colour channels linearised unless linear,
+    the alpha channel as stored.
+
+    vkrt interpolates the roughness and squares it, Mitsuba interpolates alpha:
+    at texel resolution the two differ between texel centres by up to
+    (Δr)²/4 for neighbouring roughnesses r and r + Δr. The image is therefore
+    first resampled with vkrt's bilinear filter and wrap mode to k = 7 times
+    its size (less where a side would exceed 2048), which cuts that bound to
+    about (Δr)²/(4 k²): the squares are exact at the fine texel centres, and k
+    is odd so that every coarse texel centre (where vkrt's interpolated
+    roughness has a kink) is a fine one."""
     import numpy as np
 
     try:
@@ -506,8 +552,12 @@ def _alpha_texture_file(mi, tex: _Texture, out: Path) -> None:
         bmp.set_srgb_gamma(False)  # the stored values are the texels
     rgba = bmp.convert(mi.Bitmap.PixelFormat.RGBA, mi.Struct.Type.Float32, False)
     texel = np.array(rgba, dtype=np.float64).reshape(rgba.height(), rgba.width(), 4)[..., tex.channel]
-    alpha = np.maximum(texel * texel, MIN_GGX_ALPHA).astype(np.float32)
+    factor = max(1, min(ALPHA_UPSAMPLING, ALPHA_MAX_SIDE // max(texel.shape)))
+    factor -= 1 - factor % 2  # odd
+    roughness = upsample_bilinear(texel, factor, tex.wrap)
+    alpha = np.maximum(roughness * roughness, MIN_GGX_ALPHA).astype(np.float32)
     mi.Bitmap(alpha[..., None], mi.Bitmap.PixelFormat.Y).write(str(out))
+    return factor
 
 
 def _bitmap_texture(mi, tex: _Texture, files_dir: Path, name: str) -> dict:
@@ -515,7 +565,9 @@ def _bitmap_texture(mi, tex: _Texture, files_dir: Path, name: str) -> dict:
     one-channel alpha EXR written to files_dir/<name>.exr for a roughness."""
     if tex.alpha:
         file = files_dir / f"{name}.exr"
-        _alpha_texture_file(mi, tex, file)
+        factor = _alpha_texture_file(mi, tex, file)
+        _note(f"{tex.where}: roughness texture written as GGX alpha = roughness² to {file} "
+              f"({factor}x the resolution of {tex.file.name}, resampled bilinearly as vkrt filters it)")
         raw = True
     else:
         file, raw = tex.file, tex.is_linear
@@ -1072,6 +1124,15 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         scene[bsdf_id] = bsdf
         bsdf_ids[name] = bsdf_id
 
+    # Only meshes have texture coordinates Mitsuba shares with vkrt.
+    for i, o in enumerate(objects):
+        shape, mat = o.get("shape"), o["material"]
+        if mat in textured and shape != "mesh":
+            r.fail(f"objects[{i}].shape", f"material '{mat}' has textures ({', '.join(textured[mat])}), but a "
+                                          f"{shape} has no texture coordinates that Mitsuba shares with vkrt "
+                                          "(vkrt's parametrisation of spheres, boxes, planes and triangles is "
+                                          "its own); use a mesh with uvs for a Mitsuba reference")
+
     # Everything above is plain Python: scenes that cannot be converted are
     # refused without Mitsuba.
     mi = _mitsuba()
@@ -1175,11 +1236,6 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         shape = r.string(o, "shape", where)
         mat = o["material"]
         shape_dict = None
-        if mat in textured and shape != "mesh":
-            r.fail(f"{where}.shape", f"material '{mat}' has textures ({', '.join(textured[mat])}), but a {shape} "
-                                     "has no texture coordinates that Mitsuba shares with vkrt (vkrt's "
-                                     "parametrisation of spheres, boxes, planes and triangles is its own); "
-                                     "use a mesh with uvs for a Mitsuba reference")
         if shape == "sphere":
             r.check_keys(o, where, ["shape", "material", "center", "radius"])
             c = r.vector(o, "center", where)
