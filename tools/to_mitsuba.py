@@ -44,8 +44,25 @@ The conversion follows the semantics of vkrt's path integrator
   emission -> an `area` emitter on the mesh, which keeps its material. glTF
   (Mitsuba has no loader) and two-sided emissive meshes are refused.
 
+* textures (`albedo = { texture = "wood.png", scale = [su, sv], linear = false,
+  wrap = "repeat" }` for lambert albedo, mirror reflectance, conductor tint,
+  plastic diffuse; `roughness = { ..., channel = "r" }` for conductor and
+  rough_dielectric) -> `bitmap` textures, bilinear, one `wrap_mode`, `raw`
+  for linear data (linear = true, or EXR), `to_uv` for the uv scale. The
+  meshes get flip_tex_coords = true (Mitsuba's PLY loader does not flip v by
+  default, its OBJ loader does), so that uv (0, 0) is the image's bottom-left
+  corner as in vkrt. A colour texture is the scene's own image file. A
+  roughness texture becomes a one-channel float EXR of GGX alpha =
+  roughness², made from the chosen channel and resampled 7x with vkrt's
+  filter (Mitsuba can neither select a channel nor square a texture); it is
+  written into the folder next to the XML (<stem>_files/<bsdf>_..._alpha.exr,
+  or the temporary folder of --print-dict and convert()). Only meshes with
+  texture coordinates on every face corner can carry textured materials.
+
 What has no Mitsuba equivalent (phong, glossy, pbr, anisotropic conductors, Schlick Fresnel, the Whitted
-integrator) is refused with an error naming the scene file, table and key.
+integrator, normal maps, plastic roughness textures, different wrap modes for u and v, textured materials on
+spheres, boxes, planes and triangles, whose uvs are vkrt's own) is refused with an error naming the scene
+file, table and key.
 """
 from __future__ import annotations
 
@@ -1479,8 +1496,9 @@ def main(argv=None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="vkrt scene (.toml)")
     out = ap.add_mutually_exclusive_group(required=True)
-    out.add_argument("-o", "--output", help="Mitsuba XML file to write; meshes and the environment map go "
-                                            "into a folder next to it named after it (<stem>_files/)")
+    out.add_argument("-o", "--output", help="Mitsuba XML file to write; meshes, the environment map and "
+                                            "roughness (alpha) textures go into a folder next to it named "
+                                            "after it (<stem>_files/)")
     out.add_argument("--print-dict", action="store_true",
                      help="print the Mitsuba scene dict (its PLY and EXR files live in a temporary folder "
                           "that is removed on exit)")
