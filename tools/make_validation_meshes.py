@@ -21,6 +21,18 @@ Stanford bunny of the shared assets. Re-running it rewrites the same bytes.
   triangle fans at the poles, quads between), without normals or texture
   coordinates, every vertex stored once (the seam and the poles are shared),
   so that smooth normals computed from the triangles are continuous.
+* textured-floor.obj: the square [-1, 1]^2 in y = 0 facing +y, with texture
+  coordinates: u runs along +x, v along -z (away from a camera at +z), so
+  uv (0, 0) is the front-left corner and the image stands upright seen from
+  the front; one normal (0, 1, 0).
+* textured-panel.obj: the unit square [-0.5, 0.5] x [0, 1] in z = 0 facing +z,
+  u along +x, v along +y (the image upright seen from +z); normal (0, 0, 1).
+* uv-sphere-textured.obj: a unit UV sphere of 24 slices and 12 stacks with
+  texture coordinates u = phi / 2 pi (increasing to the right seen from
+  outside), v = 1 - theta / pi (1 at the north pole) and exact unit normals
+  (`vn`); the positions are shared, the seam (u = 0 and u = 1) and the pole
+  triangles (u at the middle of their slice) have their own texture
+  coordinates.
 """
 from __future__ import annotations
 
@@ -120,6 +132,71 @@ def uv_sphere_text(slices: int = 12, stacks: int = 10) -> str:
     return "".join(lines)
 
 
+def textured_quad_text(corners, uvs, normal, group: str) -> str:
+    """One quad with a texture coordinate per corner and one normal."""
+    lines = [HEADER, f"g {group}\n"] + [_vertex(p) for p in corners]
+    lines += ["vt " + " ".join(_num(c) for c in uv) + "\n" for uv in uvs]
+    lines.append("vn " + " ".join(_num(c) for c in normal) + "\n")
+    lines.append("f " + " ".join(f"{k}/{k}/1" for k in range(1, 5)) + "\n")
+    return "".join(lines)
+
+
+def textured_floor_text() -> str:
+    # The corners of the Cornell floor, counter-clockwise seen from above.
+    corners = [(-1, 0, -1), (-1, 0, 1), (1, 0, 1), (1, 0, -1)]
+    uvs = [((x + 1) / 2, (1 - z) / 2) for x, _, z in corners]
+    return textured_quad_text(corners, uvs, (0, 1, 0), "floor")
+
+
+def textured_panel_text() -> str:
+    corners = [(-0.5, 0, 0), (0.5, 0, 0), (0.5, 1, 0), (-0.5, 1, 0)]  # counter-clockwise seen from +z
+    return textured_quad_text(corners, [(x + 0.5, y) for x, y, _ in corners], (0, 0, 1), "panel")
+
+
+def textured_uv_sphere_text(slices: int = 24, stacks: int = 12) -> str:
+    """Positions and normals: north pole, (stacks - 1) rings of `slices`, south
+    pole (as uv_sphere_text). Texture coordinates: (stacks - 1) rings of
+    slices + 1 (the last repeats the first at u = 1), then `slices` for each pole."""
+    positions = [(0.0, 1.0, 0.0)]
+    for j in range(1, stacks):
+        theta = math.pi * j / stacks
+        for i in range(slices):
+            phi = 2 * math.pi * i / slices
+            positions.append((math.sin(theta) * math.cos(phi), math.cos(theta), -math.sin(theta) * math.sin(phi)))
+    positions.append((0.0, -1.0, 0.0))
+    lines = [HEADER, "g sphere\n"] + [_vertex(p) for p in positions]
+    lines += ["vn " + " ".join(_num(c) for c in p) + "\n" for p in positions]
+    for j in range(1, stacks):
+        lines += [f"vt {_num(i / slices)} {_num(1 - j / stacks)}\n" for i in range(slices + 1)]
+    for v in (1, 0):
+        lines += [f"vt {_num((i + 0.5) / slices)} {v}\n" for i in range(slices)]
+    south = 2 + (stacks - 1) * slices
+    ring_uvs = (stacks - 1) * (slices + 1)
+
+    def ring(j, i):  # position (and normal) index of ring j, slice i (mod slices)
+        return 2 + (j - 1) * slices + i % slices
+
+    def ring_uv(j, i):  # texture coordinate of ring j, slice i in 0..slices
+        return 1 + (j - 1) * (slices + 1) + i
+
+    def corner(v, t):
+        return f"{v}/{t}/{v}"
+
+    for i in range(slices):
+        lines.append(f"f {corner(1, ring_uvs + 1 + i)} {corner(ring(1, i), ring_uv(1, i))} "
+                     f"{corner(ring(1, i + 1), ring_uv(1, i + 1))}\n")
+    for j in range(1, stacks - 1):
+        for i in range(slices):
+            lines.append(f"f {corner(ring(j, i), ring_uv(j, i))} {corner(ring(j + 1, i), ring_uv(j + 1, i))} "
+                         f"{corner(ring(j + 1, i + 1), ring_uv(j + 1, i + 1))} "
+                         f"{corner(ring(j, i + 1), ring_uv(j, i + 1))}\n")
+    for i in range(slices):
+        lines.append(f"f {corner(ring(stacks - 1, i), ring_uv(stacks - 1, i))} "
+                     f"{corner(south, ring_uvs + slices + 1 + i)} "
+                     f"{corner(ring(stacks - 1, i + 1), ring_uv(stacks - 1, i + 1))}\n")
+    return "".join(lines)
+
+
 def all_files() -> dict[str, str]:
     files = {}
     for material, walls in cornell_walls().items():
@@ -129,6 +206,9 @@ def all_files() -> dict[str, str]:
     files["cube.obj"] = obj_text([("cube", cube())])
     files["light.obj"] = obj_text([("light", [light_quad()])])
     files["uv-sphere.obj"] = uv_sphere_text()
+    files["textured-floor.obj"] = textured_floor_text()
+    files["textured-panel.obj"] = textured_panel_text()
+    files["uv-sphere-textured.obj"] = textured_uv_sphere_text()
     return files
 
 

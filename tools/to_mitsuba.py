@@ -44,8 +44,25 @@ The conversion follows the semantics of vkrt's path integrator
   emission -> an `area` emitter on the mesh, which keeps its material. glTF
   (Mitsuba has no loader) and two-sided emissive meshes are refused.
 
+* textures (`albedo = { texture = "wood.png", scale = [su, sv], linear = false,
+  wrap = "repeat" }` for lambert albedo, mirror reflectance, conductor tint,
+  plastic diffuse; `roughness = { ..., channel = "r" }` for conductor and
+  rough_dielectric) -> `bitmap` textures, bilinear, one `wrap_mode`, `raw`
+  for linear data (linear = true, or EXR), `to_uv` for the uv scale. The
+  meshes get flip_tex_coords = true (Mitsuba's PLY loader does not flip v by
+  default, its OBJ loader does), so that uv (0, 0) is the image's bottom-left
+  corner as in vkrt. A colour texture is the scene's own image file. A
+  roughness texture becomes a one-channel float EXR of GGX alpha =
+  roughness², made from the chosen channel and resampled 7x with vkrt's
+  filter (Mitsuba can neither select a channel nor square a texture); it is
+  written into the folder next to the XML (<stem>_files/<bsdf>_..._alpha.exr,
+  or the temporary folder of --print-dict and convert()). Only meshes with
+  texture coordinates on every face corner can carry textured materials.
+
 What has no Mitsuba equivalent (phong, glossy, pbr, anisotropic conductors, Schlick Fresnel, the Whitted
-integrator) is refused with an error naming the scene file, table and key.
+integrator, normal maps, plastic roughness textures, different wrap modes for u and v, textured materials on
+spheres, boxes, planes and triangles, whose uvs are vkrt's own) is refused with an error naming the scene
+file, table and key.
 """
 from __future__ import annotations
 
@@ -396,6 +413,198 @@ def _matrix_transform(mi, m):
 
 
 # ----------------------------------------------------------------------------
+# Textures (a parameter given as { texture = "file.png", ... })
+# ----------------------------------------------------------------------------
+
+TEXTURE_WRAPS = ("repeat", "clamp", "mirror")
+TEXTURE_CHANNELS = ("r", "g", "b", "a")
+COLOR_TEXTURE_KEYS = ["texture", "scale", "linear", "wrap"]
+SCALAR_TEXTURE_KEYS = COLOR_TEXTURE_KEYS + ["channel"]
+TEXTURE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".exr")
+
+
+class _Texture:
+    """A texture table of the scene: the texel is the parameter's value. It
+    stands in the scene dict until convert() has Mitsuba and turns it into a
+    `bitmap` (_bitmap_texture). `alpha`: the texel is a GGX roughness, whose
+    alpha = roughness² Mitsuba needs as a one-channel image."""
+
+    def __init__(self, file: Path, scale, linear: bool, wrap: str, channel: int, where: str, alpha: bool):
+        self.file = file  # where: "scene.toml: materials.x.key"
+        self.scale = scale
+        self.linear = linear
+        self.wrap = wrap
+        self.channel = channel
+        self.where = where
+        self.alpha = alpha
+
+    @property
+    def is_linear(self) -> bool:
+        """vkrt decodes PNG and JPEG as sRGB unless linear = true; EXR is linear."""
+        return self.linear or self.file.suffix.lower() == ".exr"
+
+
+def is_texture_table(data: dict, key: str) -> bool:
+    return isinstance(data.get(key), dict)
+
+
+def _read_wrap(r: _Reader, value, where: str) -> str:
+    """`wrap`: a mode, or [u, v] modes; Mitsuba's bitmap has one mode for both axes."""
+    modes = value if isinstance(value, list) else [value]
+    if len(modes) not in (1, 2) or not all(isinstance(m, str) for m in modes):
+        r.fail(where, f"expected a wrap mode or a pair [u, v] of them, got {value!r}")
+    for i, m in enumerate(modes):
+        if m not in TEXTURE_WRAPS:
+            r.fail(where if len(modes) == 1 else f"{where}[{i}]",
+                   f"unknown wrap mode '{m}' (expected one of: {', '.join(TEXTURE_WRAPS)})")
+    if len(set(modes)) != 1:
+        r.fail(where, f"wrap = {value!r} has no Mitsuba equivalent: Mitsuba's bitmap texture has one "
+                      "wrap_mode for both axes (use the same mode for u and v)")
+    return modes[0]
+
+
+def _read_uv_scale(r: _Reader, value, where: str):
+    """`scale`: one number or [su, sv], finite and non-zero (negative mirrors)."""
+    items = value if isinstance(value, list) else [value, value]
+    if len(items) != 2:
+        r.fail(where, f"expected a number or a pair [su, sv], got {value!r}")
+    for x in items:
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) or x == 0:
+            r.fail(where, f"expected finite, non-zero numbers, got {value!r}")
+    return [float(items[0]), float(items[1])]
+
+
+def read_texture(r: _Reader, data: dict, key: str, where: str, scene_dir: Path, *, scalar: bool,
+                 alpha: bool = False) -> _Texture:
+    """The texture table data[key] (docs/scene-format.md, "Textures"), checked
+    as vkrt checks it: `channel` only for scalar parameters."""
+    tw = f"{where}.{key}"
+    t = data[key]
+    r.check_keys(t, tw, SCALAR_TEXTURE_KEYS if scalar else COLOR_TEXTURE_KEYS)
+    file = Path(r.string(t, "texture", tw))
+    if not file.is_absolute():
+        file = scene_dir / file
+    if file.suffix.lower() not in TEXTURE_EXTENSIONS:
+        r.fail(f"{tw}.texture", f"'{file}': expected a .png, .jpg, .jpeg or .exr file")
+    if not file.is_file():
+        r.fail(f"{tw}.texture", f"'{file}' does not exist or is not a regular file")
+    scale = _read_uv_scale(r, t["scale"], f"{tw}.scale") if "scale" in t else [1.0, 1.0]
+    wrap = _read_wrap(r, t["wrap"], f"{tw}.wrap") if "wrap" in t else "repeat"
+    channel = r.string(t, "channel", tw, "r")
+    if channel not in TEXTURE_CHANNELS:
+        r.fail(f"{tw}.channel", f"unknown channel '{channel}' (expected one of: {', '.join(TEXTURE_CHANNELS)})")
+    return _Texture(file, scale, r.boolean(t, "linear", tw, False), wrap, TEXTURE_CHANNELS.index(channel),
+                    f"{r.path}: {tw}", alpha)
+
+
+def uv_transform_matrix(scale):
+    """Mitsuba's bitmap `to_uv` (3 x 3) for vkrt's uv scale [su, sv], on meshes
+    loaded with flip_tex_coords = true (Mitsuba's uv = (u, 1 - v) of the
+    file's (u, v); its bitmap puts uv.y = 0 at the image's top row). vkrt
+    reads the image at (su u, sv v) with v up from the bottom row, i.e. at
+    Mitsuba image coordinates (su u, 1 - sv v) = (su u', (1 - sv) + sv v') for
+    u' = u, v' = 1 - v."""
+    su, sv = scale
+    return [[su, 0.0, 0.0], [0.0, sv, 1.0 - sv], [0.0, 0.0, 1.0]]
+
+
+ALPHA_UPSAMPLING = 7  # odd: see _alpha_texture_file
+ALPHA_MAX_SIDE = 2048
+
+
+def wrap_texel_index(i, n: int, wrap: str):
+    """Texel index i (numpy ints) of a side of n texels after vkrt's wrap mode
+    (shaders/lib/texture.glsl: repeat has period n, mirror period 2n with the
+    edge texels doubled, clamp continues the edge texel)."""
+    import numpy as np
+
+    if wrap == "repeat":
+        return np.mod(i, n)
+    if wrap == "mirror":
+        j = np.mod(i, 2 * n)
+        return np.where(j < n, j, 2 * n - 1 - j)
+    return np.clip(i, 0, n - 1)
+
+
+def upsample_bilinear(image, factor: int, wrap: str):
+    """vkrt's bilinear lookup of `image` (h x w, row 0 at the top) at the texel
+    centres of an image `factor` times larger on each side, which spans the
+    same uv square: fine texel j of side k n has its centre at coarse texel
+    coordinate (j + 0.5) / k - 0.5."""
+    import numpy as np
+
+    for axis in (0, 1):
+        n = image.shape[axis]
+        x = (np.arange(factor * n) + 0.5) / factor - 0.5
+        i0 = np.floor(x).astype(np.int64)
+        f = (x - i0).reshape((-1, 1) if axis == 0 else (1, -1))
+        lo = np.take(image, wrap_texel_index(i0, n, wrap), axis)
+        hi = np.take(image, wrap_texel_index(i0 + 1, n, wrap), axis)
+        image = lo * (1 - f) + hi * f
+    return image
+
+
+def _alpha_texture_file(mi, tex: _Texture, out: Path) -> int:
+    """Write a one-channel float EXR of GGX alpha = max(roughness², MIN_GGX_ALPHA)
+    for the chosen channel (Mitsuba's bitmap cannot select a channel, and its
+    alpha is not the roughness); return the upsampling factor. The texel is
+    decoded as vkrt decodes it: sRGB colour channels linearised unless linear,
+    the alpha channel as stored.
+
+    vkrt interpolates the roughness and squares it, Mitsuba interpolates alpha:
+    at texel resolution the two differ between texel centres by up to
+    (Δr)²/4 for neighbouring roughnesses r and r + Δr. The image is therefore
+    first resampled with vkrt's bilinear filter and wrap mode to k = 7 times
+    its size (less where a side would exceed 2048), which cuts that bound to
+    about (Δr)²/(4 k²): the squares are exact at the fine texel centres, and k
+    is odd so that every coarse texel centre (where vkrt's interpolated
+    roughness has a kink) is a fine one."""
+    import numpy as np
+
+    try:
+        bmp = mi.Bitmap(str(tex.file))
+    except Exception as e:  # noqa: BLE001 (Mitsuba raises RuntimeError and friends)
+        raise ConversionError(f"{tex.where}.texture: cannot read '{tex.file}': {e}") from e
+    if tex.is_linear:
+        bmp.set_srgb_gamma(False)  # the stored values are the texels
+    rgba = bmp.convert(mi.Bitmap.PixelFormat.RGBA, mi.Struct.Type.Float32, False)
+    texel = np.array(rgba, dtype=np.float64).reshape(rgba.height(), rgba.width(), 4)[..., tex.channel]
+    factor = max(1, min(ALPHA_UPSAMPLING, ALPHA_MAX_SIDE // max(texel.shape)))
+    factor -= 1 - factor % 2  # odd
+    roughness = upsample_bilinear(texel, factor, tex.wrap)
+    alpha = np.maximum(roughness * roughness, MIN_GGX_ALPHA).astype(np.float32)
+    mi.Bitmap(alpha[..., None], mi.Bitmap.PixelFormat.Y).write(str(out))
+    return factor
+
+
+def _bitmap_texture(mi, tex: _Texture, files_dir: Path, name: str) -> dict:
+    """The `bitmap` texture for `tex`: the scene's own image for a colour, a
+    one-channel alpha EXR written to files_dir/<name>.exr for a roughness."""
+    if tex.alpha:
+        file = files_dir / f"{name}.exr"
+        factor = _alpha_texture_file(mi, tex, file)
+        _note(f"{tex.where}: roughness texture written as GGX alpha = roughness² to {file} "
+              f"({factor}x the resolution of {tex.file.name}, resampled bilinearly as vkrt filters it)")
+        raw = True
+    else:
+        file, raw = tex.file, tex.is_linear
+    bitmap = {"type": "bitmap", "filename": str(Path(file).resolve()), "raw": raw, "filter_type": "bilinear",
+              "wrap_mode": tex.wrap}
+    if tex.scale != [1.0, 1.0]:
+        bitmap["to_uv"] = mi.ScalarTransform3f(mi.ScalarMatrix3f(uv_transform_matrix(tex.scale)))
+    return bitmap
+
+
+def _resolve_textures(mi, value, files_dir: Path, name: str):
+    """`value` with every _Texture in it replaced by its bitmap dict (names from the path of keys)."""
+    if isinstance(value, _Texture):
+        return _bitmap_texture(mi, value, files_dir, name)
+    if isinstance(value, dict):
+        return {k: _resolve_textures(mi, v, files_dir, f"{name}_{k}") for k, v in value.items()}
+    return value
+
+
+# ----------------------------------------------------------------------------
 # Mesh files (shape = "mesh")
 # ----------------------------------------------------------------------------
 
@@ -412,13 +621,21 @@ class _MeshFileError(Exception):
 class _MeshFile:
     """What the converter needs of a mesh file: object-space positions (float64,
     N x 3), triangles (M x 3 vertex indices, polygons fanned from their first
-    corner as Mitsuba's and assimp's loaders do) and whether the file gives
-    every triangle corner a vertex normal."""
+    corner as Mitsuba's and assimp's loaders do), whether the file gives
+    every triangle corner a vertex normal, and the texture coordinates if
+    every corner has one: `uvs` (K x 2, the file's values) and `corner_uvs`
+    (M x 3 indices into `uvs`), else both None."""
 
-    def __init__(self, positions, triangles, has_normals: bool):
+    def __init__(self, positions, triangles, has_normals: bool, uvs=None, corner_uvs=None):
         self.positions = positions
         self.triangles = triangles
         self.has_normals = has_normals
+        self.uvs = uvs
+        self.corner_uvs = corner_uvs
+
+    @property
+    def has_uvs(self) -> bool:
+        return self.uvs is not None
 
 
 def _fan(polygon):
@@ -428,8 +645,8 @@ def _fan(polygon):
 def _read_obj(path: Path) -> _MeshFile:
     import numpy as np
 
-    positions, triangles = [], []
-    corners = with_normal = 0
+    positions, triangles, uvs, corner_uvs = [], [], [], []
+    corners = with_normal = with_uv = 0
     with open(path, encoding="utf-8", errors="replace") as f:
         for line_no, line in enumerate(f, 1):
             parts = line.split()
@@ -442,27 +659,52 @@ def _read_obj(path: Path) -> _MeshFile:
                     raise _MeshFileError(f"{path}:{line_no}: bad vertex: {e}") from e
                 if len(positions[-1]) != 3:
                     raise _MeshFileError(f"{path}:{line_no}: a vertex needs three coordinates")
+            elif parts[0] == "vt":
+                try:
+                    uvs.append([float(x) for x in parts[1:3]])
+                except ValueError as e:
+                    raise _MeshFileError(f"{path}:{line_no}: bad texture coordinate: {e}") from e
+                if len(uvs[-1]) != 2:
+                    raise _MeshFileError(f"{path}:{line_no}: a texture coordinate needs u and v")
             elif parts[0] == "f":
-                polygon = []
+                polygon, polygon_uvs = [], []
                 for corner in parts[1:]:
                     fields = corner.split("/")
                     try:
                         index = int(fields[0])
+                        uv = int(fields[1]) if len(fields) >= 2 and fields[1] != "" else None
                     except ValueError as e:
                         raise _MeshFileError(f"{path}:{line_no}: bad face corner '{corner}'") from e
                     index = index - 1 if index > 0 else len(positions) + index
                     if not 0 <= index < len(positions):
                         raise _MeshFileError(f"{path}:{line_no}: vertex index {fields[0]} out of range")
+                    if uv is not None:
+                        uv = uv - 1 if uv > 0 else len(uvs) + uv
+                        if not 0 <= uv < len(uvs):
+                            raise _MeshFileError(f"{path}:{line_no}: texture coordinate index {fields[1]} "
+                                                 "out of range")
+                        with_uv += 1
                     polygon.append(index)
+                    polygon_uvs.append(uv if uv is not None else -1)
                     corners += 1
                     with_normal += len(fields) >= 3 and fields[2] != ""
                 triangles += _fan(polygon)
+                corner_uvs += _fan(polygon_uvs)
     if with_normal not in (0, corners):
         # assimp and Mitsuba fill the missing normals differently.
         raise _MeshFileError(f"{path}: only {with_normal} of {corners} face corners have a normal index "
                              "(give all or none normals)")
+    # vkrt takes uvs only when every corner has one (MeshLoader.cpp); so do we.
+    all_uvs = corners > 0 and with_uv == corners
     return _MeshFile(np.array(positions, float).reshape(-1, 3), np.array(triangles, np.int64).reshape(-1, 3),
-                     corners > 0 and with_normal == corners)
+                     corners > 0 and with_normal == corners,
+                     np.array(uvs, float).reshape(-1, 2) if all_uvs else None,
+                     np.array(corner_uvs, np.int64).reshape(-1, 3) if all_uvs else None)
+
+
+# vkrt's PlyReader.cpp: the first of these names present is u (resp. v).
+_PLY_U_NAMES = ("u", "s", "texture_u", "texture_s")
+_PLY_V_NAMES = ("v", "t", "texture_v", "texture_t")
 
 
 _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
@@ -562,7 +804,16 @@ def _read_ply(path: Path) -> _MeshFile:
     triangles = np.array(triangles, np.int64).reshape(-1, 3)
     if triangles.size and (triangles.min() < 0 or triangles.max() >= len(positions)):
         raise _MeshFileError(f"{path}: vertex index out of range")
-    return _MeshFile(positions, triangles, all(k in vertex_props for k in ("nx", "ny", "nz")))
+    u_name = next((k for k in _PLY_U_NAMES if k in vertex_props), None)
+    v_name = next((k for k in _PLY_V_NAMES if k in vertex_props), None)
+    uvs = None
+    if u_name and v_name:
+        if isinstance(vertices, list):
+            uvs = np.array([[v[u_name], v[v_name]] for v in vertices], float)
+        else:
+            uvs = np.stack([vertices[u_name].astype(float), vertices[v_name].astype(float)], -1)
+    return _MeshFile(positions, triangles, all(k in vertex_props for k in ("nx", "ny", "nz")),
+                     uvs, triangles if uvs is not None else None)
 
 
 def read_mesh_file(path: Path) -> _MeshFile:
@@ -597,15 +848,26 @@ def area_weighted_normals(positions, triangles):
     return np.where(length > 0, normals / np.maximum(length, 1e-300), 0.0)
 
 
-def write_ply_with_normals(path: Path, positions, normals, triangles) -> None:
-    """Binary little-endian PLY with float32 positions and vertex normals."""
+def write_ply_with_normals(path: Path, positions, normals, triangles, uvs=None, corner_uvs=None) -> None:
+    """Binary little-endian PLY with float32 positions and vertex normals, and
+    texture coordinates u, v (the file's values, unflipped) when `uvs` and
+    `corner_uvs` are given: a vertex is then split wherever its corners have
+    different uvs (a uv seam), each copy keeping the vertex's normal."""
     import numpy as np
 
+    props = ["x", "y", "z", "nx", "ny", "nz"]
+    columns = [positions, normals]
+    if uvs is not None:
+        pairs = np.stack([triangles.ravel(), corner_uvs.ravel()], -1)
+        unique, inverse = np.unique(pairs, axis=0, return_inverse=True)
+        columns = [positions[unique[:, 0]], normals[unique[:, 0]], uvs[unique[:, 1]]]
+        triangles = inverse.reshape(-1, 3)
+        props += ["u", "v"]
+    vertex = np.concatenate(columns, 1).astype("<f4")
     header = ("ply\nformat binary_little_endian 1.0\ncomment written by vkrt tools/to_mitsuba.py\n"
-              f"element vertex {len(positions)}\n"
-              + "".join(f"property float {k}\n" for k in ("x", "y", "z", "nx", "ny", "nz"))
+              f"element vertex {len(vertex)}\n"
+              + "".join(f"property float {k}\n" for k in props)
               + f"element face {len(triangles)}\nproperty list uchar int vertex_indices\nend_header\n")
-    vertex = np.concatenate([positions, normals], 1).astype("<f4")
     faces = np.zeros(len(triangles), dtype=[("n", "u1"), ("i", "<i4", 3)])
     faces["n"] = 3
     faces["i"] = triangles
@@ -757,7 +1019,30 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
     scene: dict = {"type": "scene"}
     bsdf_ids: dict[str, str] = {}
     media_ids: dict[str, str] = {}
+    textured: dict[str, list[str]] = {}  # material -> its keys given as textures
     needs_volpath = False
+
+    def color_param(m, key, where, default, name):
+        """An rgb value, or a _Texture for a texture table (its texel replaces the constant)."""
+        if is_texture_table(m, key):
+            textured.setdefault(name, []).append(key)
+            return read_texture(r, m, key, where, path.parent, scalar=False)
+        return _rgb(r.color(m, key, where, default, 0.0, 1.0))
+
+    def roughness_param(m, where, default, name):
+        """The roughness as a number, or a _Texture whose texel is the roughness."""
+        if is_texture_table(m, "roughness"):
+            textured.setdefault(name, []).append("roughness")
+            return read_texture(r, m, "roughness", where, path.parent, scalar=True, alpha=True)
+        return r.number(m, "roughness", where, default)
+
+    def ggx(roughness):
+        """Mitsuba's microfacet keys for a roughness (number or texture) > 0."""
+        alpha = roughness if isinstance(roughness, _Texture) else max(roughness * roughness, MIN_GGX_ALPHA)
+        return {"distribution": "ggx", "sample_visible": True, "alpha": alpha}
+
+    def is_rough(roughness):
+        return isinstance(roughness, _Texture) or roughness > 0
     for index, (name, m) in enumerate(materials.items()):
         where = f"materials.{_quote(name)}"
         mtype = m["type"]
@@ -765,19 +1050,24 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
             _note(f"{path}: {where}: not used by any object; skipped")
             continue
         bsdf_id = f"mat{index}"
+        if "normal_map" in m:
+            r.fail(f"{where}.normal_map", "normal maps are not converted: Mitsuba's normalmap BSDF builds its "
+                                          "tangent frame from each triangle's dp/du, vkrt from its own vertex "
+                                          "tangents, and the two treat shading normals that face away from "
+                                          "the light differently (remove normal_map for a Mitsuba reference)")
         if mtype == "lambert":
             r.check_keys(m, where, ["type", "albedo"])
-            albedo = r.color(m, "albedo", where, 0.8, 0.0, 1.0)
-            bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": _rgb(albedo)}}
+            albedo = color_param(m, "albedo", where, 0.8, name)
+            bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": albedo}}
         elif mtype == "mirror":
             r.check_keys(m, where, ["type", "reflectance", "fresnel", "ior"])
             fresnel = r.string(m, "fresnel", where, "none")
             if fresnel != "none":
                 r.fail(f"{where}.fresnel", f"mirror with fresnel = \"{fresnel}\" has no Mitsuba equivalent "
                                            "(only fresnel = \"none\" converts, to a conductor with material = \"none\")")
-            refl = r.color(m, "reflectance", where, 1.0, 0.0, 1.0)
+            refl = color_param(m, "reflectance", where, 1.0, name)
             bsdf = {"type": "twosided", "bsdf": {"type": "conductor", "material": "none",
-                                                 "specular_reflectance": _rgb(refl)}}
+                                                 "specular_reflectance": refl}}
         elif mtype in ("dielectric", "rough_dielectric"):
             r.check_keys(m, where, ["type", "ior", "absorption", "fresnel"] +
                          (["roughness"] if mtype == "rough_dielectric" else []))
@@ -791,10 +1081,9 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 r.fail(f"{where}.ior", f"must be in [1, 1e30], got {ior:g}")
             absorption = r.color(m, "absorption", where, 0.0, 0.0)
             bsdf = {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
-            roughness = r.number(m, "roughness", where, math.sqrt(0.1)) if mtype == "rough_dielectric" else 0.0
-            if roughness > 0:
-                bsdf.update({"type": "roughdielectric", "distribution": "ggx", "sample_visible": True,
-                             "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
+            roughness = roughness_param(m, where, math.sqrt(0.1), name) if mtype == "rough_dielectric" else 0.0
+            if is_rough(roughness):
+                bsdf.update({"type": "roughdielectric", **ggx(roughness)})
             if any(k > 0 for k in absorption):
                 media_ids[name] = f"medium{index}"
                 # volpath turns a channel with sigma_t = 0 and albedo 0 into NaN
@@ -809,7 +1098,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 needs_volpath = True
         elif mtype == "conductor":
             r.check_keys(m, where, ["type", "roughness", "anisotropy", "metal", "eta", "k", "tint"])
-            roughness = r.number(m, "roughness", where, 0.0)
+            roughness = roughness_param(m, where, 0.0, name)
             if r.number(m, "anisotropy", where, 0.0) != 0.0:
                 r.fail(f"{where}.anisotropy", "anisotropic conductors do not convert: vkrt orients the "
                                               "anisotropy by a frame around the normal, Mitsuba by dp/du")
@@ -822,20 +1111,22 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 k = r.color(m, "k", where, None, 0.0)
             else:  # vkrt's default, Mitsuba's material "none"
                 eta, k = [0.0] * 3, [1.0] * 3
-            tint = r.color(m, "tint", where, 1.0, 0.0, 1.0)
-            inner = {"type": "conductor", "eta": _rgb(eta), "k": _rgb(k), "specular_reflectance": _rgb(tint)}
-            if roughness > 0:
-                inner.update({"type": "roughconductor", "distribution": "ggx", "sample_visible": True,
-                              "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
+            tint = color_param(m, "tint", where, 1.0, name)
+            inner = {"type": "conductor", "eta": _rgb(eta), "k": _rgb(k), "specular_reflectance": tint}
+            if is_rough(roughness):
+                inner.update({"type": "roughconductor", **ggx(roughness)})
             bsdf = {"type": "twosided", "bsdf": inner}
         elif mtype == "plastic":
             r.check_keys(m, where, ["type", "diffuse", "roughness", "ior"])
+            if is_texture_table(m, "roughness"):
+                r.fail(f"{where}.roughness", "a plastic's roughness cannot be a texture (vkrt refuses it too: "
+                                             "its coating's energy table, like Mitsuba's roughplastic's, is "
+                                             "computed for one roughness)")
             roughness = r.number(m, "roughness", where, 0.0)
             inner = {"type": "plastic", "int_ior": r.number(m, "ior", where, 1.49), "ext_ior": 1.0,
-                     "diffuse_reflectance": _rgb(r.color(m, "diffuse", where, 0.5, 0.0, 1.0)), "nonlinear": False}
+                     "diffuse_reflectance": color_param(m, "diffuse", where, 0.5, name), "nonlinear": False}
             if roughness > 0:
-                inner.update({"type": "roughplastic", "distribution": "ggx", "sample_visible": True,
-                              "alpha": max(roughness * roughness, MIN_GGX_ALPHA)})
+                inner.update({"type": "roughplastic", **ggx(roughness)})
             bsdf = {"type": "twosided", "bsdf": inner}
         elif mtype == "pbr":
             r.fail(f"{where}.type", "material type 'pbr' (glTF metallic-roughness) has no Mitsuba equivalent: "
@@ -850,6 +1141,15 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         scene[bsdf_id] = bsdf
         bsdf_ids[name] = bsdf_id
 
+    # Only meshes have texture coordinates Mitsuba shares with vkrt.
+    for i, o in enumerate(objects):
+        shape, mat = o.get("shape"), o["material"]
+        if mat in textured and shape != "mesh":
+            r.fail(f"objects[{i}].shape", f"material '{mat}' has textures ({', '.join(textured[mat])}), but a "
+                                          f"{shape} has no texture coordinates that Mitsuba shares with vkrt "
+                                          "(vkrt's parametrisation of spheres, boxes, planes and triangles is "
+                                          "its own); use a mesh with uvs for a Mitsuba reference")
+
     # Everything above is plain Python: scenes that cannot be converted are
     # refused without Mitsuba.
     mi = _mitsuba()
@@ -858,6 +1158,8 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         atexit.register(shutil.rmtree, files_dir, True)
     files_dir = Path(files_dir)
     files_dir.mkdir(parents=True, exist_ok=True)
+    for bsdf_id in bsdf_ids.values():
+        scene[bsdf_id] = _resolve_textures(mi, scene[bsdf_id], files_dir, bsdf_id)
 
     def ref(i):
         return {"type": "ref", "id": i}
@@ -883,8 +1185,9 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         mesh_count += 1
         return {"type": "ply", "filename": str(file.resolve()), "face_normals": True}
 
-    def mesh_object(o, where):
-        """A `shape = "mesh"` object as an obj/ply shape (material and medium are added by the caller)."""
+    def mesh_object(o, where, texture_keys):
+        """A `shape = "mesh"` object as an obj/ply shape (material and medium are added by the caller).
+        `texture_keys`: the material's textured keys (empty for none)."""
         import numpy as np
 
         r.check_keys(o, where, MESH_KEYS)
@@ -914,19 +1217,27 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
             geometry = read_mesh_file(file)
         except _MeshFileError as e:
             r.fail(f"{where}.file", str(e))
+        if texture_keys and not geometry.has_uvs:
+            r.fail(f"{where}.file", f"'{file}' has no texture coordinates (on every face corner), but its "
+                                    f"material '{o['material']}' has textures ({', '.join(texture_keys)})")
         shape_dict = {"type": suffix[1:], "filename": str(file.resolve())}
         if normals == "smooth":
             # Mitsuba's recomputed vertex normals are angle-weighted and it
             # prefers the file's own; vkrt's are area-weighted from the
             # triangles alone: write them into a PLY of our own.
             smooth = files_dir / f"{where.replace('[', '').replace(']', '')}_smooth.ply"
+            uvs = (geometry.uvs, geometry.corner_uvs) if texture_keys else (None, None)
             write_ply_with_normals(smooth, geometry.positions,
                                    area_weighted_normals(geometry.positions, geometry.triangles),
-                                   geometry.triangles)
+                                   geometry.triangles, *uvs)
             shape_dict = {"type": "ply", "filename": str(smooth.resolve())}
         elif normals == "face" or not geometry.has_normals:
             # vkrt: no file normals means face normals; Mitsuba would compute smooth ones.
             shape_dict["face_normals"] = True
+        if texture_keys:
+            # Mitsuba's OBJ loader flips v by default, its PLY loader does not;
+            # flipped, its bitmaps show the image as vkrt does (uv_transform_matrix).
+            shape_dict["flip_tex_coords"] = True
         shape_dict["to_world"] = _matrix_transform(mi, m4)
         if emission is not None and any(c > 0 for c in emission):
             shape_dict["emitter"] = {"type": "area", "radiance": _rgb(emission)}
@@ -970,7 +1281,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
             shape_dict = mesh([v], f"object{i}")
             extent_points += v
         elif shape == "mesh":
-            shape_dict, points = mesh_object(o, where)
+            shape_dict, points = mesh_object(o, where, textured.get(mat, []))
             extent_points += points
         elif shape == "plane":
             r.check_keys(o, where, ["shape", "material", "point", "normal"])
@@ -1100,7 +1411,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
 _PLUGIN_TAGS = {
     "twosided": "bsdf", "diffuse": "bsdf", "conductor": "bsdf", "dielectric": "bsdf",
     "roughconductor": "bsdf", "roughdielectric": "bsdf", "plastic": "bsdf", "roughplastic": "bsdf",
-    "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape", "obj": "shape",
+    "bitmap": "texture", "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape", "obj": "shape",
     "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter",
     "homogeneous": "medium", "perspective": "sensor", "hdrfilm": "film", "independent": "sampler",
     "box": "rfilter", "path": "integrator", "volpath": "integrator",
@@ -1147,10 +1458,17 @@ def _xml_element(name, value, indent: str, base: Path) -> list[str]:
     if isinstance(value, list) and len(value) == 3:
         x, y, z = (_xml_number(v) for v in value)
         return [f"{indent}<point name={q(name)} x=\"{x}\" y=\"{y}\" z=\"{z}\"/>"]
-    if hasattr(value, "matrix"):  # ScalarTransform4f: write the full matrix, row-major
+    if hasattr(value, "matrix"):  # ScalarTransform4f or 3f: write the full matrix, row-major
         import numpy as np
 
-        m = np.array(value.matrix, dtype=np.float64).reshape(4, 4)
+        m = np.array(value.matrix, dtype=np.float64)
+        if m.size == 9:
+            # A 2D (uv) transform. Mitsuba's XML reads 9 values as the linear part of a 4 x 4 matrix
+            # and drops the translation (checked), but takes rows/columns 0, 1 and 3 of a 4 x 4.
+            m3 = m.reshape(3, 3)
+            m = np.eye(4)
+            m[np.ix_([0, 1, 3], [0, 1, 3])] = m3
+        m = m.reshape(4, 4)
         values = " ".join(_xml_number(v) for v in m.ravel())
         return [f"{indent}<transform name={q(name)}>", f"{indent}    <matrix value=\"{values}\"/>",
                 f"{indent}</transform>"]
@@ -1178,8 +1496,9 @@ def main(argv=None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="vkrt scene (.toml)")
     out = ap.add_mutually_exclusive_group(required=True)
-    out.add_argument("-o", "--output", help="Mitsuba XML file to write; meshes and the environment map go "
-                                            "into a folder next to it named after it (<stem>_files/)")
+    out.add_argument("-o", "--output", help="Mitsuba XML file to write; meshes, the environment map and "
+                                            "roughness (alpha) textures go into a folder next to it named "
+                                            "after it (<stem>_files/)")
     out.add_argument("--print-dict", action="store_true",
                      help="print the Mitsuba scene dict (its PLY and EXR files live in a temporary folder "
                           "that is removed on exit)")

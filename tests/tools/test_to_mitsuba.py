@@ -647,6 +647,347 @@ def test_metal_table_matches_vkrts():
     assert parsed == to_mitsuba.METALS, (parsed, to_mitsuba.METALS)
 
 
+# ----------------------------------------------------------------------------
+# Textures
+# ----------------------------------------------------------------------------
+
+def _srgb_to_linear(c):
+    """The exact sRGB EOTF (IEC 61966-2-1), as shaders/lib/texture.glsl decodes."""
+    c = np.asarray(c, np.float64)
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _vkrt_wrap(i, n, wrap):
+    """wrapTexelIndex of shaders/lib/texture.glsl."""
+    if wrap == "mirror":
+        j = (i + 2 * n * 1000) % (2 * n)
+        return np.where(j < n, j, 2 * n - 1 - j)
+    if wrap == "repeat":
+        return i % n
+    return np.clip(i, 0, n - 1)
+
+
+def _vkrt_lookup(texels, uv, scale=(1.0, 1.0), wrap="repeat"):
+    """vkrt's level-0 bilinear lookup (sampleTextureLevel) of linear texels
+    (h x w x c, row 0 the file's top row) at uv[..., 2] times the uv scale;
+    v runs up from the bottom row."""
+    h, w = texels.shape[:2]
+    u = uv[..., 0] * scale[0]
+    v = uv[..., 1] * scale[1]
+    sx, sy = u * w - 0.5, (1.0 - v) * h - 0.5
+    x0, y0 = np.floor(sx).astype(np.int64), np.floor(sy).astype(np.int64)
+    fx, fy = (sx - x0)[..., None], (sy - y0)[..., None]
+    xs = [_vkrt_wrap(x0, w, wrap), _vkrt_wrap(x0 + 1, w, wrap)]
+    ys = [_vkrt_wrap(y0, h, wrap), _vkrt_wrap(y0 + 1, h, wrap)]
+    top = (1 - fx) * texels[ys[0], xs[0]] + fx * texels[ys[0], xs[1]]
+    bottom = (1 - fx) * texels[ys[1], xs[0]] + fx * texels[ys[1], xs[1]]
+    return (1 - fy) * top + fy * bottom
+
+
+# A unit quad in z = 0 facing +z whose uvs run from UV_LO to UV_HI, so that
+# lookups leave [0, 1] and the wrap modes show. Mesh uv = UV_LO + (x, y) * (UV_HI - UV_LO).
+UV_LO, UV_HI = np.array([-0.7, -0.4]), np.array([1.6, 1.9])
+
+
+def _uv_quad_obj():
+    corners = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    uvs = [UV_LO + np.array(c) * (UV_HI - UV_LO) for c in corners]
+    return ("".join(f"v {x} {y} 0\n" for x, y in corners) + "".join(f"vt {float(u)!r} {float(v)!r}\n" for u, v in uvs)
+            + "f 1/1 2/2 3/3 4/4\n")
+
+
+def _uv_quad_ply():
+    corners = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    rows = "".join(f"{x} {y} 0 {float(uv[0])!r} {float(uv[1])!r}\n"
+                   for (x, y), uv in ((c, UV_LO + np.array(c) * (UV_HI - UV_LO)) for c in corners))
+    return ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+            "property float u\nproperty float v\nelement face 2\nproperty list uchar int vertex_indices\n"
+            "end_header\n" + rows + "3 0 1 2\n3 0 2 3\n")
+
+
+def _texture_scene(tmp: Path, material: str, mesh_file: str = "quad.obj", shape: str = "mesh") -> Path:
+    obj = (f'shape = "mesh"\nfile = "{mesh_file}"\n' if shape == "mesh" else
+           'shape = "sphere"\ncenter = [0.0, 0.0, 0.0]\nradius = 1\n' if shape == "sphere" else
+           'shape = "box"\nmin = [0.0, 0.0, -1.0]\nmax = [1.0, 1.0, 0.0]\n' if shape == "box" else
+           'shape = "triangle"\nvertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\n')
+    return _write(tmp, HEADER + "[materials.tex]\n" + textwrap.dedent(material) + "[[objects]]\n" + obj
+                  + 'material = "tex"\n')
+
+
+def _write_texture(path: Path, texels, linear_png=False):
+    """Random test images: EXR as float, PNG as 8-bit (RGB or RGBA)."""
+    if path.suffix == ".exr":
+        mi.Bitmap(texels.astype(np.float32)).write(str(path))
+    else:
+        mi.Bitmap(texels.astype(np.uint8)).write(str(path))
+
+
+def _hit_quad(scene, points):
+    """Surface interactions of rays from z = 1 straight down onto quad points (x, y)."""
+    si = []
+    for x, y in points:
+        ray = mi.Ray3f(mi.Point3f(float(x), float(y), 1.0), mi.Vector3f(0.0, 0.0, -1.0))
+        hit = scene.ray_intersect(ray)
+        assert hit.is_valid(), (x, y)
+        si.append(hit)
+    return si
+
+
+def _quad_points(n=200, seed=3):
+    return np.random.default_rng(seed).uniform(0.02, 0.98, (n, 2))
+
+
+def test_texture_refusals():
+    """Refused before Mitsuba is needed: textured materials on non-mesh shapes,
+    per-axis wraps, keys vkrt does not take, plastic roughness textures, normal maps."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "t.png").write_bytes(b"")  # existence is all the refusals below need
+        (tmp / "quad.obj").write_text(_uv_quad_obj())
+
+        def refused(material, key, shape="mesh", fragment=""):
+            path = _texture_scene(tmp, material, shape=shape)
+            try:
+                to_mitsuba.convert(path, files_dir=tmp / "files")
+            except to_mitsuba.ConversionError as e:
+                message = str(e)
+            else:
+                raise AssertionError(f"converted: {material} on a {shape}")
+            assert str(path) in message and key in message and fragment in message, message
+            return message
+
+        lambert = 'type = "lambert"\nalbedo = { texture = "t.png" }\n'
+        for shape in ("sphere", "box", "triangle"):
+            message = refused(lambert, "objects[0].shape", shape=shape, fragment=f"a {shape}")
+            assert "'tex'" in message and "albedo" in message, message
+        refused('type = "lambert"\nalbedo = { texture = "t.png", wrap = ["repeat", "clamp"] }\n',
+                "materials.tex.albedo.wrap", fragment="one")
+        refused('type = "lambert"\nalbedo = { texture = "t.png", wrap = "border" }\n', "materials.tex.albedo.wrap")
+        refused('type = "lambert"\nalbedo = { texture = "t.png", channel = "g" }\n',
+                "materials.tex.albedo.channel", fragment="unknown key")
+        refused('type = "lambert"\nalbedo = { texture = "t.png", scale = [1, 0] }\n', "materials.tex.albedo.scale")
+        refused('type = "lambert"\nalbedo = { texture = "missing.png" }\n', "materials.tex.albedo.texture",
+                fragment="missing.png")
+        refused('type = "lambert"\nalbedo = { texture = "quad.obj" }\n', "materials.tex.albedo.texture")
+        refused('type = "conductor"\nroughness = { texture = "t.png", channel = "x" }\n',
+                "materials.tex.roughness.channel")
+        refused('type = "plastic"\nroughness = { texture = "t.png" }\n', "materials.tex.roughness",
+                fragment="cannot be a texture")
+        refused('type = "lambert"\nnormal_map = { texture = "t.png" }\n', "materials.tex.normal_map")
+
+
+def test_texture_on_mesh_without_uvs_is_refused():
+    _need(mi, "mitsuba")
+    png = np.zeros((2, 2, 3), np.uint8)
+    lambert = '[materials.clay]\ntype = "lambert"\nalbedo = { texture = "t.png" }\n'
+    mesh = '[[objects]]\nshape = "mesh"\nmaterial = "clay"\n'
+    for name, text in (("quad.obj", QUAD_OBJ), ("pyramid.ply", PYRAMID_PLY),
+                       ("half.obj", _uv_quad_obj().replace("f 1/1 2/2 3/3 4/4", "f 1/1 2/2 3/3\nf 1 3 4"))):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            _write_texture(tmp / "t.png", png)
+            (tmp / name).write_text(text)
+            path = _write(tmp, HEADER + lambert + mesh + f'file = "{name}"\n')
+            try:
+                to_mitsuba.convert(path, files_dir=tmp / "files")
+            except to_mitsuba.ConversionError as e:
+                message = str(e)
+            else:
+                raise AssertionError(f"converted {name} without uvs")
+        assert "objects[0].file" in message and "texture coordinates" in message and "'clay'" in message, message
+
+
+def test_texture_becomes_a_bitmap():
+    """The bitmap's keys: the scene's own file, raw for linear data, bilinear,
+    the wrap mode; flip_tex_coords on the mesh."""
+    _need(mi, "mitsuba")
+    tmp = Path(tempfile.mkdtemp(prefix="vkrt-texture-test-"))
+    atexit.register(shutil.rmtree, tmp, True)
+    (tmp / "quad.obj").write_text(_uv_quad_obj())
+    _write_texture(tmp / "t.png", np.zeros((2, 2, 3)))
+    _write_texture(tmp / "t.exr", np.zeros((2, 2, 3)))
+    cases = [('{ texture = "t.png" }', False, "repeat"), ('{ texture = "t.png", linear = true }', True, "repeat"),
+             ('{ texture = "t.exr", wrap = "clamp" }', True, "clamp"),
+             ('{ texture = "t.png", wrap = ["mirror", "mirror"] }', False, "mirror")]
+    for table, raw, wrap in cases:
+        d = to_mitsuba.convert(_texture_scene(tmp, f'type = "lambert"\nalbedo = {table}\n'), files_dir=tmp / "f")
+        bitmap = d["mat0"]["bsdf"]["reflectance"]
+        name = "t.exr" if ".exr" in table else "t.png"
+        assert bitmap["type"] == "bitmap" and bitmap["filename"] == str((tmp / name).resolve()), bitmap
+        assert bitmap["raw"] is raw and bitmap["wrap_mode"] == wrap and bitmap["filter_type"] == "bilinear", bitmap
+        assert "to_uv" not in bitmap  # scale [1, 1]
+        assert d["object0"]["flip_tex_coords"] is True
+    d = to_mitsuba.convert(_texture_scene(tmp, 'type = "conductor"\ntint = { texture = "t.png", scale = 3 }\n'
+                                               'roughness = 0.2\n'), files_dir=tmp / "f")
+    tint = d["mat0"]["bsdf"]["specular_reflectance"]
+    # vkrt reads (3u, 3v); Mitsuba sees v' = 1 - v and needs image y = 1 - 3v = -2 + 3v'.
+    assert np.allclose(np.array(tint["to_uv"].matrix), [[3, 0, 0], [0, 3, -2], [0, 0, 1]]), tint["to_uv"]
+
+
+def _check_lookups(tmp, mesh_file, table, texels, scale, wrap, tol, via_xml=False):
+    d = to_mitsuba.convert(_texture_scene(tmp, f'type = "lambert"\nalbedo = {table}\n', mesh_file),
+                           files_dir=tmp / "files")
+    if via_xml:
+        to_mitsuba.write_xml(d, tmp / "scene.xml")
+        scene = mi.load_file(str(tmp / "scene.xml"))
+    else:
+        scene = mi.load_dict(d)
+    points = _quad_points()
+    got = np.array([np.array(si.bsdf().eval_diffuse_reflectance(si)).ravel() for si in _hit_quad(scene, points)])
+    expected = _vkrt_lookup(texels, UV_LO + points * (UV_HI - UV_LO), scale, wrap)
+    err = np.abs(got - expected).max()
+    assert err < tol, (mesh_file, table, err)
+
+
+def test_texture_lookup_matches_vkrts_convention():
+    """Mitsuba's bitmap on the converted mesh returns what vkrt's lookup does
+    (texture.glsl: bilinear, texel centres, wrap, v up from the bottom row, uv
+    scale), for OBJ (which Mitsuba flips by default) and PLY (which it does
+    not), every wrap mode, scales that are negative and fractional, float EXR
+    and 8-bit sRGB PNG."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    rng = np.random.default_rng(11)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "quad.obj").write_text(_uv_quad_obj())
+        (tmp / "quad.ply").write_text(_uv_quad_ply())
+        texels = rng.uniform(0, 1, (3, 5, 3))  # non-square, odd sizes: a flipped axis shows
+        _write_texture(tmp / "t.exr", texels)
+        png = rng.integers(0, 256, (4, 3, 3))
+        _write_texture(tmp / "t.png", png)
+        for mesh_file in ("quad.obj", "quad.ply"):
+            for wrap in ("repeat", "clamp", "mirror"):
+                for scale in ((1.0, 1.0), (2.0, 3.0), (-1.5, 0.75)):
+                    table = f'{{ texture = "t.exr", wrap = "{wrap}", scale = [{scale[0]}, {scale[1]}] }}'
+                    _check_lookups(tmp, mesh_file, table, texels, scale, wrap, 1e-5)
+        _check_lookups(tmp, "quad.obj", '{ texture = "t.png", scale = [2, -2] }', _srgb_to_linear(png / 255.0),
+                       (2.0, -2.0), "repeat", 2e-3)
+        _check_lookups(tmp, "quad.obj", '{ texture = "t.png", linear = true, wrap = "mirror" }', png / 255.0,
+                       (1.0, 1.0), "mirror", 1e-5)
+        _check_lookups(tmp, "quad.ply", '{ texture = "t.exr", wrap = "mirror", scale = [2, 0.5] }', texels,
+                       (2.0, 0.5), "mirror", 1e-5, via_xml=True)
+
+
+def test_roughness_texture_becomes_an_alpha_bitmap():
+    """A roughness texture: the chosen channel, decoded as vkrt decodes it,
+    interpolated as vkrt interpolates roughness, then squared (GGX alpha)."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    rng = np.random.default_rng(5)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "quad.obj").write_text(_uv_quad_obj())
+        rgba = rng.integers(0, 256, (4, 6, 4))
+        _write_texture(tmp / "r.png", rgba)
+        cases = [('channel = "g", linear = true', rgba[..., 1] / 255.0),
+                 ('channel = "b"', _srgb_to_linear(rgba[..., 2] / 255.0)),
+                 ('channel = "a"', rgba[..., 3] / 255.0),  # alpha is never sRGB
+                 ('', _srgb_to_linear(rgba[..., 0] / 255.0))]  # default channel "r"
+        for wrap in ("repeat", "clamp", "mirror"):
+            for keys, roughness in cases:
+                for mtype in ("conductor", "rough_dielectric"):
+                    extra = f', {keys}' if keys else ""
+                    table = f'{{ texture = "r.png", wrap = "{wrap}", scale = [1.5, 2]{extra} }}'
+                    d = to_mitsuba.convert(_texture_scene(tmp, f'type = "{mtype}"\nroughness = {table}\n'),
+                                           files_dir=tmp / "files")
+                    bsdf = d["mat0"]["bsdf"] if mtype == "conductor" else d["mat0"]
+                    assert bsdf["type"] in ("roughconductor", "roughdielectric"), bsdf
+                    alpha = mi.load_dict(bsdf["alpha"])
+                    assert alpha.is_spatially_varying()
+                    uv = rng.uniform(-1, 2, (300, 2))
+                    got = []
+                    for u, v in uv:
+                        si = mi.SurfaceInteraction3f()
+                        si.uv = mi.Point2f(float(u), 1.0 - float(v))  # as Mitsuba's flipped OBJ delivers
+                        got.append(float(np.array(alpha.eval_1(si)).ravel()[0]))
+                    r = _vkrt_lookup(roughness[..., None], uv, (1.5, 2.0), wrap)[..., 0]
+                    expected = np.maximum(r * r, 1e-4)
+                    # Exact at the 7x finer texel centres; in between about (dr)^2 / (4 * 49).
+                    dr = np.abs(np.diff(roughness, axis=0)).max() + np.abs(np.diff(roughness, axis=1)).max()
+                    tol = dr * dr / 196 + 1e-6
+                    err = np.abs(np.array(got) - expected).max()
+                    assert err < tol, (wrap, keys, mtype, err, tol)
+
+
+def test_smooth_textured_mesh_keeps_its_uvs():
+    """normals = "smooth": the converter's own PLY carries the uvs, split at
+    the seam (one position, two uvs), with one normal per position."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    # Two triangles folded along the shared edge 1-3 (a roof), whose shared
+    # vertices have different uvs on either side.
+    obj = ("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\n"
+           "vt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0.6 0\nvt 0.6 1\nvt 1 1\n"
+           "f 1/1 2/2 4/3\nf 2/4 3/6 4/5\n")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "roof.obj").write_text(obj)
+        _write_texture(tmp / "t.exr", np.zeros((2, 2, 3)))
+        path = _write(tmp, HEADER + '[materials.clay]\ntype = "lambert"\nalbedo = { texture = "t.exr" }\n'
+                      '[[objects]]\nshape = "mesh"\nfile = "roof.obj"\nmaterial = "clay"\nnormals = "smooth"\n')
+        d = to_mitsuba.convert(path, files_dir=tmp / "files")
+        shape = d["object0"]
+        assert shape["type"] == "ply" and shape["flip_tex_coords"] is True
+        mesh = mi.load_dict({"type": "ply", "filename": shape["filename"], "flip_tex_coords": False})
+        p = np.array(mesh.vertex_positions_buffer()).reshape(-1, 3)
+        uv = np.array(mesh.vertex_texcoords_buffer()).reshape(-1, 2)
+        n = np.array(mesh.vertex_normals_buffer()).reshape(-1, 3)
+    assert len(p) == 6  # vertices 2 and 4 split at the seam
+    by_uv = {(round(float(a), 3), round(float(b), 3)): (tuple(float(x) for x in q), m)
+             for a, b, q, m in zip(uv[:, 0], uv[:, 1], p, n)}
+    assert by_uv[(0.5, 0.0)][0] == by_uv[(0.6, 0.0)][0] == (1.0, 0.0, 0.0)
+    assert by_uv[(0.5, 1.0)][0] == by_uv[(0.6, 1.0)][0] == (0.0, 1.0, 1.0)
+    # Both copies of a split vertex keep the one smooth normal of its position.
+    assert np.allclose(by_uv[(0.5, 0.0)][1], by_uv[(0.6, 0.0)][1])
+    # Face cross products cross((1, 0, 0), (0, 1, 1)) = (0, -1, 1) and cross((0, 1, 0), (-1, 1, 1)) = (1, 0, 1).
+    assert np.allclose(by_uv[(0.5, 0.0)][1], np.array([1, -1, 2]) / np.sqrt(6), atol=1e-6)
+
+
+def test_textured_quad_renders_upright():
+    """Render check of the orientation: a texture of 2 x 2 coloured blocks on a
+    quad facing the camera under a white background (a lambert surface then
+    shows its albedo) appears as in the file: top-left block at the top left."""
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    colours = np.array([[[0.8, 0.1, 0.1], [0.1, 0.8, 0.1]], [[0.1, 0.1, 0.8], [0.8, 0.8, 0.1]]])  # row 0 = top
+    quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "quad.obj").write_text(quad)
+        _write_texture(tmp / "t.exr", np.kron(colours, np.ones((2, 2, 1))))  # 4 x 4 texels
+        img = _render(tmp, """
+            [render]
+            integrator = "path"
+            max_depth = 1
+            [camera]
+            eye = [0.0, 0.0, 2.0]
+            target = [0.0, 0.0, 0.0]
+            fov = 40
+            width = 8
+            height = 8
+            [materials.t]
+            type = "lambert"
+            albedo = { texture = "t.exr", wrap = "clamp" }
+            [[objects]]
+            shape = "mesh"
+            file = "quad.obj"
+            material = "t"
+            [background]
+            color = 1.0
+            """, 1024)
+    # The quad fills the view (2 tan 20 deg < 1); pixels 0, 1 and 6, 7 of each axis see
+    # |x|, |y| > 0.36, beyond the texel centres at +-0.25 where the bilinear filter blends blocks.
+    for row, rows in enumerate(((0, 2), (6, 8))):
+        for col, cols in enumerate(((0, 2), (6, 8))):
+            mean = img[rows[0]:rows[1], cols[0]:cols[1]].mean((0, 1))
+            assert np.allclose(mean, colours[row, col], atol=0.03), (row, col, mean)
+
+
 if __name__ == "__main__":
     _STANDALONE = True
     failures = 0
