@@ -3,6 +3,7 @@
 #include "app/Commands.h"
 #include "mesh/MeshGeometry.h"
 #include "render/RenderSession.h"
+#include "texture/TextureAtlas.h"
 
 #include <CLI/CLI.hpp>
 
@@ -56,6 +57,13 @@ void printMeshes(const Scene& scene, const GpuSceneStatic& meshData, double pars
     std::printf("mesh memory:    %.1f MiB on the GPU\n", bytes / (1024.0 * 1024.0));
 }
 
+/// Distinct images, records (image and wrap modes) and texel memory.
+void printTextures(const TextureAtlas& textures)
+{
+    std::printf("textures:       %zu images, %zu records, %.1f MiB of texels (all mip levels)\n",
+                textures.imageCount(), textures.recordCount(), double(textures.texelBytes()) / (1024.0 * 1024.0));
+}
+
 int runInfo(const InfoOptions& options)
 {
     const auto parseStart = std::chrono::steady_clock::now();
@@ -98,6 +106,7 @@ int runInfo(const InfoOptions& options)
                     context.loopCap().capped() ? "; each subgroup's count is checked against the cap as it renders"
                                                : "");
     if (!scene.meshes.empty()) printMeshes(scene, session.renderer().meshData(), parseSeconds);
+    if (scene.textures) printTextures(*scene.textures);
     std::printf("device:         %s\n", context.deviceInfo().name.c_str());
     return kExitOk;
 }

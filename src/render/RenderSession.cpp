@@ -4,6 +4,7 @@
 #include "util/Hash.h"
 
 #include <chrono>
+#include <cstdio>
 #include <csignal>
 
 namespace vkrt {
@@ -35,6 +36,8 @@ Scene loadScene(const std::string& path, const ResolutionOverride& resolution)
 {
     Scene scene = parseSceneFile(path);
     applyResolution(scene.camera, resolution);
+    // What the scene asks for that vkrt cannot honour exactly (glTF extensions, ...): said, never silent.
+    for (const std::string& warning : scene.warnings) std::fprintf(stderr, "vkrt: warning: %s\n", warning.c_str());
     return scene;
 }
 

@@ -46,6 +46,27 @@ std::vector<KernelBinding> kernelBindingsOf(const KernelVariant& variant)
     return bindings;
 }
 
+/// Refuses a variant that binds more buffers of a type than the device allows
+/// one shader stage (textures never add to the count: they share one buffer).
+std::vector<KernelBinding> checkedKernelBindings(const VulkanContext& context, const Scene& scene,
+                                                 const KernelVariant& variant)
+{
+    std::vector<KernelBinding> bindings = kernelBindingsOf(variant);
+    const vk::PhysicalDeviceLimits limits = context.physicalDevice().getProperties().limits;
+    auto count = [&](vk::DescriptorType type) {
+        return uint32_t(std::count_if(bindings.begin(), bindings.end(), [&](const auto& b) { return b.type == type; }));
+    };
+    auto check = [&](vk::DescriptorType type, uint32_t limit, const char* what) {
+        if (count(type) > limit)
+            throw InputError(scene.path + ": the scene's kernel needs " + std::to_string(count(type)) + " " + what +
+                             ", more than the device's limit of " + std::to_string(limit) +
+                             " per shader stage (" + variant.describe() + ")");
+    };
+    check(vk::DescriptorType::eStorageBuffer, limits.maxPerStageDescriptorStorageBuffers, "storage buffers");
+    check(vk::DescriptorType::eUniformBuffer, limits.maxPerStageDescriptorUniformBuffers, "uniform buffers");
+    return bindings;
+}
+
 /// A scene array's GPU buffer: padded to the block's fixed capacity when it
 /// is a uniform buffer, so the bound range covers the whole declared block.
 template <typename T>
@@ -174,7 +195,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, kernelBindingsOf(m_variant), sizeof(gpu::FrameConstants)),
+      m_kernel(context, m_compiled.spirv, checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants)),
       m_cubemap(scene.background.cubemap)
 {
     m_accumulation.clear(context);
