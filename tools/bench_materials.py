@@ -6,11 +6,14 @@ rough_dielectric, plastic and pbr material replaced by a lambert of albedo
 
     tools/bench_materials.py [--runs 5] [--spp 256] [--vkrt build/vkrt] [SCENE ...]
 
-Default scenes: scenes/validation/{conductor,plastic,rough-glass}.toml.
-Both versions of a scene are rendered alternately RUNS times each (the same
-seed), so drift on a shared machine hits both alike; kernels are compiled
-before timing. Prints one row per scene: median Msamples/s of each and the
-ratio Lambert / materials (the slowdown the materials cost)."""
+Default scenes: scenes/validation/{conductor,plastic,rough-glass,textured}.toml.
+A scene with textures gets a third version: the same materials with every
+texture replaced by the constant 0.5 and without normal maps (the cost of the
+textures alone). The versions of a scene are rendered alternately RUNS times
+each (the same seed), so drift on a shared machine hits them alike; kernels
+are compiled before timing. Prints one row per scene: median Msamples/s of
+each and the ratios Lambert / materials (the slowdown the materials cost)
+and constants / textured."""
 from __future__ import annotations
 
 import argparse
@@ -49,6 +52,15 @@ def lambert_only(text: str) -> str:
     return "".join(out)
 
 
+TEXTURE_VALUE = re.compile(r"^(\s*\w+\s*=\s*)\{[^}]*\btexture\s*=[^}]*\}", re.M)
+
+
+def untextured(text: str) -> str:
+    """The scene with every texture table replaced by the constant 0.5 and normal maps removed."""
+    text = re.sub(r"^\s*normal_map\s*=\s*\{[^}]*\}\s*\n", "", text, flags=re.M)
+    return TEXTURE_VALUE.sub(lambda m: m.group(1) + "0.5", text)
+
+
 def samples_per_second(vkrt: str, scene: Path, spp: int, out: Path) -> float:
     result = subprocess.run([vkrt, "render", str(scene), "--spp", str(spp), "--seed", "1", "-o", str(out)],
                             capture_output=True, text=True, check=True)
@@ -65,24 +77,39 @@ def main() -> None:
     parser.add_argument("--spp", type=int, default=256)
     parser.add_argument("--vkrt", default=str(ROOT / "build" / "vkrt"))
     args = parser.parse_args()
-    scenes = args.scenes or [ROOT / "scenes" / "validation" / f"{n}.toml" for n in ("conductor", "plastic", "rough-glass")]
-    print(f"{'scene':14s} {'materials Ms/s':>15s} {'lambert Ms/s':>13s} {'ratio':>6s}")
+    names = ("conductor", "plastic", "rough-glass", "textured")
+    scenes = args.scenes or [ROOT / "scenes" / "validation" / f"{n}.toml" for n in names]
+    print(f"{'scene':14s} {'materials Ms/s':>15s} {'lambert Ms/s':>13s} {'ratio':>6s} "
+          f"{'constants Ms/s':>15s} {'ratio':>6s}")
     with tempfile.TemporaryDirectory() as tmp:
         for scene in scenes:
-            plain = scene.parent / f".{scene.stem}-lambert.toml"  # beside it: relative paths keep working
-            plain.write_text(lambert_only(scene.read_text()))
+            text = scene.read_text()
+            # Beside the scene: its relative paths keep working.
+            versions = {"lambert": (scene.parent / f".{scene.stem}-lambert.toml", untextured(lambert_only(text)))}
+            if untextured(text) != text:
+                versions["constants"] = (scene.parent / f".{scene.stem}-constants.toml", untextured(text))
+            for path, body in versions.values():
+                path.write_text(body)
             try:
                 out = Path(tmp) / "out.exr"
-                for s in (scene, plain):  # compile both kernels before timing
-                    samples_per_second(args.vkrt, s, 1, out)
-                rich, flat = [], []
+                files = [scene] + [path for path, _ in versions.values()]
+                for f in files:  # compile every kernel before timing
+                    samples_per_second(args.vkrt, f, 1, out)
+                rates = {f: [] for f in files}
                 for _ in range(args.runs):
-                    rich.append(samples_per_second(args.vkrt, scene, args.spp, out))
-                    flat.append(samples_per_second(args.vkrt, plain, args.spp, out))
+                    for f in files:
+                        rates[f].append(samples_per_second(args.vkrt, f, args.spp, out))
             finally:
-                plain.unlink()
-            a, b = statistics.median(rich), statistics.median(flat)
-            print(f"{scene.stem:14s} {a:15.3f} {b:13.3f} {b / a:6.2f}")
+                for path, _ in versions.values():
+                    path.unlink()
+            median = {f: statistics.median(r) for f, r in rates.items()}
+            a = median[scene]
+            b = median[versions["lambert"][0]]
+            row = f"{scene.stem:14s} {a:15.3f} {b:13.3f} {b / a:6.2f}"
+            if "constants" in versions:
+                c = median[versions["constants"][0]]
+                row += f" {c:15.3f} {c / a:6.2f}"
+            print(row)
 
 
 if __name__ == "__main__":
