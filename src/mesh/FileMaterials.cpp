@@ -459,6 +459,74 @@ std::string readGltfJson(const fs::path& file)
     return bytes.substr(20, size_t(length));
 }
 
+namespace {
+
+/// A non-negative integer field, or `fallback` when absent or of another type.
+uint64_t sizeField(const json& object, const char* key, uint64_t fallback)
+{
+    const json* value = member(object, key);
+    return value && value->is_number_unsigned() ? value->get<uint64_t>() : fallback;
+}
+
+/// Bytes of one accessor element (matrix column padding ignored: it only makes the need larger).
+uint64_t elementBytes(const json& accessor)
+{
+    const uint64_t component = [&]() -> uint64_t {
+        switch (sizeField(accessor, "componentType", 0)) {
+        case 5120: case 5121: return 1;
+        case 5122: case 5123: return 2;
+        case 5125: case 5126: return 4;
+        default: return 0;
+        }
+    }();
+    const json* type = member(accessor, "type");
+    const std::string name = type && type->is_string() ? type->get<std::string>() : "";
+    const std::pair<const char*, uint64_t> counts[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
+                                                       {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
+    for (const auto& [typeName, count] : counts)
+        if (name == typeName) return component * count;
+    return 0;
+}
+
+} // namespace
+
+void checkGltfBufferBounds(const fs::path& file)
+{
+    const json doc = json::parse(readGltfJson(file), nullptr, /*allow_exceptions=*/false);
+    if (doc.is_discarded() || !doc.is_object()) return; // assimp reports the syntax error
+    const json* buffers = arrayMember(doc, "buffers");
+    const json* views = arrayMember(doc, "bufferViews");
+    constexpr uint64_t kHuge = uint64_t(1) << 40; // no sum or product below overflows
+    if (views) {
+        for (uint32_t v = 0; v < views->size(); ++v) {
+            const json& view = (*views)[v];
+            const json* buffer = element(buffers, uint32_t(std::min<uint64_t>(sizeField(view, "buffer", 0), UINT32_MAX)));
+            if (!buffer) continue;
+            const uint64_t end = std::min(sizeField(view, "byteOffset", 0), kHuge) + std::min(sizeField(view, "byteLength", 0), kHuge);
+            const uint64_t length = sizeField(*buffer, "byteLength", 0);
+            if (end > length)
+                fail(file, "bufferView " + std::to_string(v) + " ends at byte " + std::to_string(end) +
+                               " of a buffer of " + std::to_string(length) + " bytes");
+        }
+    }
+    const json* accessors = arrayMember(doc, "accessors");
+    if (!accessors) return;
+    for (uint32_t a = 0; a < accessors->size(); ++a) {
+        const json& accessor = (*accessors)[a];
+        const auto viewIndex = uintMember(accessor, "bufferView");
+        const json* view = viewIndex ? element(views, *viewIndex) : nullptr;
+        const uint64_t count = std::min(sizeField(accessor, "count", 0), kHuge);
+        const uint64_t bytes = elementBytes(accessor);
+        if (!view || count == 0 || bytes == 0) continue;
+        const uint64_t stride = std::min(std::max(sizeField(*view, "byteStride", bytes), bytes), uint64_t(1) << 16);
+        const uint64_t end = std::min(sizeField(accessor, "byteOffset", 0), kHuge) + (count - 1) * stride + bytes;
+        const uint64_t length = sizeField(*view, "byteLength", 0);
+        if (end > length)
+            fail(file, "accessor " + std::to_string(a) + " needs " + std::to_string(end) + " bytes of bufferView " +
+                           std::to_string(*viewIndex) + ", which has " + std::to_string(length));
+    }
+}
+
 std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path& file)
 {
     const json doc = parseJson(file);

@@ -71,4 +71,11 @@ std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const std::fil
 /// The glTF JSON of a .gltf file or of a .glb's first chunk; throws InputError naming `file`.
 std::string readGltfJson(const std::filesystem::path& file);
 
+/// Checks, before assimp reads the file, that every accessor lies inside its
+/// bufferView and every bufferView inside its buffer's byteLength: assimp
+/// 5.2.5 copies accessor data without that check (a heap overflow the
+/// fuzzer found). Throws InputError naming `file` and the accessor or view.
+/// Fields of the wrong type are left to assimp, which reports them.
+void checkGltfBufferBounds(const std::filesystem::path& file);
+
 } // namespace vkrt

@@ -458,6 +458,7 @@ MeshData loadMeshFile(const fs::path& file)
     checkIsMeshFile(file);
     const std::string extension = lowerExtension(file);
     if (extension == ".ply") return readPlyFile(file); // not assimp: see PlyReader.h
+    if (extension == ".gltf" || extension == ".glb") checkGltfBufferBounds(file); // before assimp trusts them
     Assimp::Importer importer;
     const aiScene* scene = importScene(importer, file, extension);
     MeshData mesh = convertScene(*scene, MeshCheck{file, extension});

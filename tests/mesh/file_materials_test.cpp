@@ -424,3 +424,29 @@ TEST(TextureImageDecode, BadBytesNameTheImage)
     const std::string truncated = error(png.substr(0, png.size() / 2));
     EXPECT_EQ(truncated.rfind(prefix, 0), 0u) << truncated;
 }
+
+// ---------------------------------------------------------------------------
+// Buffer bounds, checked before assimp (whose glTF reader copies past them)
+
+TEST(MeshFileMaterials, AccessorBeyondItsBufferViewIsAnErrorNotAnOverflow)
+{
+    // The fuzzer's find: 6 VEC3 floats (72 bytes) from byte 72 of a 108-byte view.
+    std::string buffer(108, '\0');
+    const std::string json = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) + R"(", "byteLength": 108}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 108}],
+  "accessors": [{"bufferView": 0, "byteOffset": 72, "componentType": 5126, "count": 6, "type": "VEC3"}]})";
+    const fs::path file = writeFile(testDir() / "overflow.gltf", json);
+    const std::string message = loadError(file);
+    EXPECT_EQ(message.rfind(file.string() + ": accessor 0 needs 144 bytes of bufferView 0, which has 108", 0), 0u)
+        << message;
+
+    std::string view = json;
+    const std::string viewLength = R"("byteOffset": 0, "byteLength": 108})";
+    view.replace(view.find(viewLength), viewLength.size(), R"("byteOffset": 0, "byteLength": 200})");
+    const fs::path viewFile = writeFile(testDir() / "view.gltf", view);
+    const std::string viewMessage = loadError(viewFile);
+    EXPECT_EQ(viewMessage.rfind(viewFile.string() + ": bufferView 0 ends at byte 200 of a buffer of 108 bytes", 0), 0u)
+        << viewMessage;
+}
