@@ -79,6 +79,38 @@ std::vector<std::string> stringList(const json& doc, const char* key)
     return strings;
 }
 
+/// Bytes above 0x7f as '?'. They can only stand inside JSON strings;
+/// assimp's rapidjson takes them without checking their encoding and
+/// nlohmann's parser refuses bad UTF-8, so both see one structure only when
+/// they are masked (names are compared masked too).
+std::string masked(std::string text)
+{
+    for (char& c : text)
+        if (static_cast<unsigned char>(c) > 0x7f) c = '?';
+    return text;
+}
+
+/// The file's JSON as assimp reads it. Duplicate keys are refused: rapidjson
+/// takes the first, nlohmann the last, and bounds checked on one value
+/// would not protect reads of the other.
+json parseJson(const fs::path& file)
+{
+    std::vector<std::set<std::string>> keys;
+    std::string duplicate;
+    const json::parser_callback_t noteKeys = [&](int, json::parse_event_t event, json& parsed) {
+        if (event == json::parse_event_t::object_start) keys.emplace_back();
+        if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+        if (event == json::parse_event_t::key && !keys.empty() && parsed.is_string() &&
+            !keys.back().insert(parsed.get<std::string>()).second && duplicate.empty())
+            duplicate = parsed.get<std::string>();
+        return true;
+    };
+    json doc = json::parse(masked(readGltfJson(file)), noteKeys, /*allow_exceptions=*/false);
+    if (doc.is_discarded() || !doc.is_object()) fail(file, "the glTF JSON cannot be parsed");
+    if (!duplicate.empty()) fail(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
+    return doc;
+}
+
 // ---------------------------------------------------------------------------
 // Which file material is which aiMaterial. Assimp 5.2.5's glTF2 reader
 // creates objects lazily, in the order the default scene reaches them
@@ -401,13 +433,6 @@ std::string describeMaterial(bool isDefault, int fileIndex, const std::string& n
     return std::to_string(fileIndex) + (quoted.empty() ? "" : " " + quoted);
 }
 
-json parseJson(const fs::path& file)
-{
-    const std::string text = readGltfJson(file);
-    json doc = json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (doc.is_discarded() || !doc.is_object()) fail(file, "the glTF JSON cannot be parsed");
-    return doc;
-}
 
 bool isGltf2(const json& doc)
 {
@@ -427,7 +452,7 @@ bool orderMatches(const aiScene& scene, const std::vector<uint32_t>& order, cons
         scene.mMaterials[i]->Get(AI_MATKEY_NAME, name);
         const json* fileName = member(*material, "name");
         const std::string expected = fileName && fileName->is_string() ? fileName->get<std::string>() : "";
-        if (expected != name.C_Str()) return false;
+        if (expected != masked(name.C_Str())) return false;
     }
     return true;
 }
@@ -492,8 +517,7 @@ uint64_t elementBytes(const json& accessor)
 
 void checkGltfBufferBounds(const fs::path& file)
 {
-    const json doc = json::parse(readGltfJson(file), nullptr, /*allow_exceptions=*/false);
-    if (doc.is_discarded() || !doc.is_object()) return; // assimp reports the syntax error
+    const json doc = parseJson(file);
     const json* buffers = arrayMember(doc, "buffers");
     const json* views = arrayMember(doc, "bufferViews");
     constexpr uint64_t kHuge = uint64_t(1) << 40; // no sum or product below overflows

@@ -74,8 +74,10 @@ std::string readGltfJson(const std::filesystem::path& file);
 /// Checks, before assimp reads the file, that every accessor lies inside its
 /// bufferView and every bufferView inside its buffer's byteLength: assimp
 /// 5.2.5 copies accessor data without that check (a heap overflow the
-/// fuzzer found). Throws InputError naming `file` and the accessor or view.
-/// Fields of the wrong type are left to assimp, which reports them.
+/// fuzzer found). Throws InputError naming `file` and the accessor or view,
+/// or for JSON that cannot be parsed or repeats a key in an object (which
+/// assimp's parser and ours would read differently). Fields of the wrong
+/// type are left to assimp, which reports them.
 void checkGltfBufferBounds(const std::filesystem::path& file);
 
 } // namespace vkrt

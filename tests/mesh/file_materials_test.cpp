@@ -450,3 +450,17 @@ TEST(MeshFileMaterials, AccessorBeyondItsBufferViewIsAnErrorNotAnOverflow)
     EXPECT_EQ(viewMessage.rfind(viewFile.string() + ": bufferView 0 ends at byte 200 of a buffer of 108 bytes", 0), 0u)
         << viewMessage;
 }
+
+TEST(MeshFileMaterials, NonAsciiNamesMatchAndDuplicateKeysAreRefused)
+{
+    const std::string named = "\"materials\": [{\"name\": \"Mat\xc3\xa9riau\"}]"; // UTF-8 bytes in the file
+    const MeshData mesh = loadMeshFile(writeFile(testDir() / "utf8.gltf", triangleGltf(named)));
+    ASSERT_EQ(mesh.materials.size(), 1u);
+    EXPECT_EQ(mesh.materials[0].fileIndex, 0); // matched by name although the name is not ASCII
+    EXPECT_EQ(mesh.materials[0].name, "Mat\xc3\xa9riau");
+
+    const std::string twice = R"("materials": [{"alphaMode": "BLEND", "alphaMode": "OPAQUE"}])";
+    const fs::path file = writeFile(testDir() / "twice.gltf", triangleGltf(twice));
+    const std::string message = loadError(file);
+    EXPECT_EQ(message.rfind(file.string() + ": the glTF JSON has the key 'alphaMode' twice", 0), 0u) << message;
+}
