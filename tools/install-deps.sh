@@ -24,8 +24,8 @@ packages=(
   # glslang-tools because glslang-dev's CMake package refers to glslangValidator
   # and find_package fails without it (it is only a Recommends, not installed here)
   glslang-dev glslang-tools libglm-dev libglfw3-dev libopenexr-dev libtomlplusplus-dev libcli11-dev libstb-dev libboost-dev libgtest-dev
-  # mesh files: OBJ, PLY and glTF through one API
-  libassimp-dev
+  # mesh files: OBJ, PLY and glTF through one API; glTF's JSON for what assimp does not report (extensions)
+  libassimp-dev nlohmann-json3-dev
   # tools/fuzz.sh: libFuzzer needs clang (clang++-14) and its runtime
   clang-14 libclang-rt-14-dev
   # a real X display for the viewer's tests

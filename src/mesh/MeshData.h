@@ -1,11 +1,18 @@
 #pragma once
 // A triangle mesh as read from a file: object-space float32 vertices (what
-// every mesh format stores), optional per-vertex normals and texture
-// coordinates, and triangles as vertex-index triples. Produced only by
+// every mesh format stores), optional per-vertex normals, texture
+// coordinates and tangents, triangles as vertex-index triples, and the
+// file's materials (glTF) with one per triangle. Produced only by
 // loadMeshFile (MeshLoader.h) or the procedural generators (Procedural.h),
-// which guarantee: every index < positions.size(); normals and uvs are empty
-// or have one entry per position; every coordinate is finite; at least one
-// triangle. Degenerate (zero-area) triangles are kept: they are never hit.
+// which guarantee: every index < positions.size(); normals, uvs and
+// tangents are empty or have one entry per position; tangents only where
+// there are uvs; every coordinate is finite; at least one triangle;
+// triangleMaterials is empty exactly when materials is, else has one entry
+// per triangle, each < materials.size(). Normals are unit or (0, 0, 0) (use
+// the face normal); tangents are unit with w = +1 or -1. Degenerate
+// (zero-area) triangles are kept: they are never hit.
+#include "mesh/FileMaterials.h"
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -18,9 +25,16 @@ struct MeshData {
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals; ///< unit vertex normals, or empty
     std::vector<glm::vec2> uvs;     ///< texture coordinates, or empty
+    /// Per vertex, or empty: xyz the unit tangent along increasing u (dp/du),
+    /// perpendicular to the vertex normal (to the smooth normal where the
+    /// mesh has none); w = +1 or -1 so that w * cross(normal, xyz) is the
+    /// bitangent, along increasing v. From the file (glTF TANGENT) or computeTangents.
+    std::vector<glm::vec4> tangents;
     std::vector<glm::uvec3> triangles;
-    std::vector<glm::vec4> tangents;         ///< per vertex: xyz along +u, w = +-1 (bitangent = w cross(n, t)), or empty
-    std::vector<uint32_t> triangleMaterials; ///< per triangle: the file material it uses, or empty
+    /// Per triangle, its index into `materials`; empty when `materials` is.
+    std::vector<uint32_t> triangleMaterials;
+    /// The file's materials that its triangles use (glTF 2.0 only; OBJ and PLY leave it empty).
+    std::vector<FileMaterial> materials;
 };
 
 /// How a mesh's shading normals are chosen (scene format `normals = ...`).
@@ -37,7 +51,29 @@ enum class NormalMode {
 /// normal (its normal is stored as (0, 0, 0)).
 void computeSmoothNormals(MeshData& mesh);
 
-/// Applies `mode`: File keeps what the file gave, Smooth computes, Face drops normals.
+/// Applies `mode`: File keeps what the file gave, Smooth computes, Face drops
+/// normals. Tangents are made perpendicular to the new normals again (to the
+/// smooth normals for Face), keeping their handedness w.
 void applyNormalMode(MeshData& mesh, NormalMode mode);
+
+/// Fills mesh.tangents from the uvs (which it needs; no uvs: no tangents),
+/// MikkTSpace's construction as far as shading sees it: each triangle's
+/// tangent and bitangent from its uv derivatives, each made perpendicular to
+/// the corner's vertex normal (the smooth normal where the mesh has none or
+/// the vertex's is (0, 0, 0)), normalised and summed weighted by the corner's
+/// angle; w from the side of cross(normal, tangent) the summed bitangent is
+/// on. Vertices with the same position, normal and uv share one sum; vertices
+/// at one position with different uvs (a seam) do not. Triangles whose uvs
+/// are degenerate (zero uv area) contribute nothing. Unlike MikkTSpace, a
+/// vertex where mirrored triangles meet is not split: its w is the
+/// majority's. A vertex that receives no tangent gets the one of a fixed
+/// orthonormal frame around its normal (perpendicularTo), w = +1, so that no
+/// tangent is ever NaN or zero.
+void computeTangents(MeshData& mesh);
+
+/// A unit vector perpendicular to the unit vector n: the first axis of Duff et
+/// al.'s frame (2017, "Building an orthonormal basis, revisited"), continuous
+/// in n except where n.z changes sign. The tangent of last resort.
+glm::vec3 perpendicularTo(glm::vec3 n);
 
 } // namespace vkrt

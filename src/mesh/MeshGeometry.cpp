@@ -10,13 +10,23 @@ namespace vkrt {
 
 namespace {
 
-/// Puts the triangles (and what belongs to them) in the BVH's leaf order, so
-/// that a leaf's triangles are contiguous on the GPU.
+/// Puts `perTriangle` in the BVH's leaf order: slot i gets triangle order[i]'s entry.
+template <typename T>
+void reorder(std::vector<T>& perTriangle, const std::vector<uint32_t>& order)
+{
+    if (perTriangle.empty()) return;
+    std::vector<T> reordered(order.size());
+    for (size_t slot = 0; slot < order.size(); ++slot) reordered[slot] = perTriangle[order[slot]];
+    perTriangle = std::move(reordered);
+}
+
+/// Puts the triangles (and what belongs to them: their materials; per-vertex
+/// arrays follow through the indices) in the BVH's leaf order, so that a
+/// leaf's triangles are contiguous on the GPU.
 void reorderTriangles(MeshData& data, const std::vector<uint32_t>& order)
 {
-    std::vector<glm::uvec3> reordered(order.size());
-    for (size_t slot = 0; slot < order.size(); ++slot) reordered[slot] = data.triangles[order[slot]];
-    data.triangles = std::move(reordered);
+    reorder(data.triangles, order);
+    reorder(data.triangleMaterials, order);
 }
 
 Aabb boundsOf(const MeshData& data)
@@ -33,6 +43,10 @@ size_t MeshGeometry::gpuBytes() const
 {
     size_t bytes = bvh.nodes.size() * sizeof(gpu::BvhNode) + data.triangles.size() * sizeof(gpu::MeshTriangle);
     if (!data.normals.empty()) bytes += data.triangles.size() * sizeof(gpu::MeshNormals);
+    // Uploaded per triangle corner in leaf order: a vec2 uv and a vec4 tangent each, one material index per triangle.
+    if (!data.uvs.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec2);
+    if (!data.tangents.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec4);
+    if (!data.triangleMaterials.empty()) bytes += data.triangles.size() * sizeof(uint32_t);
     return bytes;
 }
 
@@ -42,6 +56,8 @@ std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode n
     geometry->file = std::move(name);
     geometry->normals = normals;
     applyNormalMode(data, normals);
+    // After the normal mode: generated tangents are perpendicular to the normals the mesh keeps.
+    if (!data.uvs.empty() && data.tangents.empty()) computeTangents(data);
     const std::vector<Aabb> boxes = triangleBoxes(data.positions, data.triangles);
     geometry->bvh = buildBvh(boxes);
     if (geometry->bvh.depth > gpu::BVH_STACK_SIZE)

@@ -19,11 +19,12 @@ struct MeshGeometry {
     Bvh bvh;
     Aabb bounds; ///< object space
     double loadSeconds = 0.0;
-    /// Bytes this geometry occupies on the GPU (nodes, triangles, normals).
+    /// Bytes this geometry occupies on the GPU (nodes, triangles, normals, uvs, tangents, materials).
     size_t gpuBytes() const;
 };
 
-/// Loads, applies the normal mode, builds the BVH and reorders the triangles.
+/// Loads, applies the normal mode, computes tangents where there are uvs and
+/// the file gave none, builds the BVH and reorders the triangles.
 std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path& file, NormalMode normals);
 /// The same from data already in memory (procedural meshes, tests).
 std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode normals, std::filesystem::path name);

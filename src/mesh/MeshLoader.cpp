@@ -1,5 +1,6 @@
 #include "mesh/MeshLoader.h"
 
+#include "mesh/FileMaterials.h"
 #include "mesh/PlyReader.h"
 
 #include "util/Error.h"
@@ -232,6 +233,8 @@ struct MeshCheck {
     std::string extension;
     size_t meshCount = 0;
 
+    bool isGltf() const { return extension == ".gltf" || extension == ".glb"; }
+
     std::string where(size_t mesh, size_t vertex) const
     {
         return (meshCount > 1 ? "mesh " + std::to_string(mesh) + ", " : "") + "vertex " + std::to_string(vertex) +
@@ -272,13 +275,43 @@ glm::vec3 unitNormal(const MeshCheck& check, size_t mesh, size_t vertex, const a
     return length > 0.0f && std::isfinite(length) ? n / length : glm::vec3(0.0f);
 }
 
-void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const MeshCheck& check, bool normals, bool uvs)
+/// A file tangent (assimp: tangent and bitangent) as MeshData keeps it: unit,
+/// w from the side of cross(normal, tangent) the bitangent is on. glTF's v
+/// runs down the image and assimp flips it (v = 1 - v_file) while glTF's
+/// bitangent follows v_file (MikkTSpace over the file's uvs; Cube.gltf's data
+/// says so too): relative to MeshData's v that side is the other one.
+glm::vec4 fileTangent(const MeshCheck& check, size_t mesh, size_t vertex, const glm::vec3& normal,
+                      const aiVector3D& tangent, const aiVector3D& bitangent)
 {
+    const glm::vec3 t = toGlm(tangent), b = toGlm(bitangent);
+    if (!allFinite(t) || !allFinite(b))
+        fail(check.file, check.where(mesh, vertex) + " has a non-finite tangent " + describe(t));
+    const float length = glm::length(t);
+    if (!(length > 0.0f) || !std::isfinite(length)) {
+        // No direction to keep: the tangent of last resort (MeshData.h).
+        return glm::vec4(normal == glm::vec3(0.0f) ? glm::vec3(1.0f, 0.0f, 0.0f) : perpendicularTo(normal), 1.0f);
+    }
+    const float side = glm::dot(glm::cross(normal, t), b) < 0.0f ? -1.0f : 1.0f;
+    return glm::vec4(t / length, check.isGltf() ? -side : side);
+}
+
+struct VertexAttributes {
+    bool normals = false, uvs = false, tangents = false;
+};
+
+void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const MeshCheck& check,
+                    VertexAttributes attributes)
+{
+    const auto [normals, uvs, tangents] = attributes;
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
         const glm::vec3 position = toGlm(mesh.mVertices[v]);
         if (!allFinite(position)) check.nonFinitePosition(meshIndex, v, position);
         out.positions.push_back(position);
         if (normals) out.normals.push_back(unitNormal(check, meshIndex, v, mesh.mNormals[v]));
+        if (tangents) {
+            out.tangents.push_back(fileTangent(check, meshIndex, v, out.normals.back(), mesh.mTangents[v],
+                                               mesh.mBitangents[v]));
+        }
         if (uvs) {
             const glm::vec2 uv(mesh.mTextureCoords[0][v].x, mesh.mTextureCoords[0][v].y);
             if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
@@ -289,7 +322,7 @@ void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const M
     }
 }
 
-void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const MeshCheck& check)
+void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const MeshCheck& check, bool materials)
 {
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
         const aiFace& face = mesh.mFaces[f];
@@ -304,7 +337,35 @@ void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const Mes
             triangle[corner] = base + face.mIndices[corner];
         }
         out.triangles.push_back(triangle);
+        if (materials) out.triangleMaterials.push_back(mesh.mMaterialIndex);
     }
+}
+
+/// The glTF materials, one per aiScene material; empty for OBJ (and glTF 1.0).
+std::vector<FileMaterial> sceneMaterials(const aiScene& scene, const MeshCheck& check)
+{
+    if (!check.isGltf()) return {};
+    std::vector<FileMaterial> materials = readGltfMaterials(scene, check.file);
+    if (materials.size() != scene.mNumMaterials) return {};
+    return materials;
+}
+
+/// Keeps the materials the triangles use, in order (assimp's default
+/// material only when a primitive has none), and renumbers the triangles'.
+void keepUsedMaterials(MeshData& out, std::vector<FileMaterial> all, const MeshCheck& check)
+{
+    std::vector<uint32_t> renumbered(all.size(), UINT32_MAX);
+    for (uint32_t& material : out.triangleMaterials) {
+        if (material >= all.size()) fail(check.file, "a mesh uses material " + std::to_string(material) +
+                                                          " of only " + std::to_string(all.size()));
+        renumbered[material] = 0;
+    }
+    for (size_t i = 0; i < all.size(); ++i) {
+        if (renumbered[i] == UINT32_MAX) continue;
+        renumbered[i] = uint32_t(out.materials.size());
+        out.materials.push_back(std::move(all[i]));
+    }
+    for (uint32_t& material : out.triangleMaterials) material = renumbered[material];
 }
 
 MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
@@ -313,18 +374,25 @@ MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
     MeshCheck check = baseCheck;
     check.meshCount = meshes.size();
     // Attributes only where every sub-mesh has them: a partial set would need a per-vertex "absent" marker.
-    const bool normals = std::all_of(meshes.begin(), meshes.end(), [](const aiMesh* m) { return m->HasNormals(); });
-    const bool uvs = std::all_of(meshes.begin(), meshes.end(), [](const aiMesh* m) { return m->HasTextureCoords(0); });
+    const auto every = [&](auto has) { return std::all_of(meshes.begin(), meshes.end(), has); };
+    VertexAttributes attributes;
+    attributes.normals = every([](const aiMesh* m) { return m->HasNormals(); });
+    attributes.uvs = every([](const aiMesh* m) { return m->HasTextureCoords(0); });
+    // Tangents belong to uvs and are oriented by normals (glTF has them only with both).
+    attributes.tangents = attributes.normals && attributes.uvs &&
+                          every([](const aiMesh* m) { return m->HasTangentsAndBitangents(); });
+    std::vector<FileMaterial> materials = sceneMaterials(scene, check);
     MeshData out;
     for (size_t i = 0; i < meshes.size(); ++i) {
         if (out.positions.size() + meshes[i]->mNumVertices > std::numeric_limits<uint32_t>::max()) {
             fail(check.file, "more than 2^32 vertices");
         }
         const auto base = static_cast<uint32_t>(out.positions.size());
-        appendVertices(out, *meshes[i], i, check, normals, uvs);
-        appendTriangles(out, *meshes[i], base, check);
+        appendVertices(out, *meshes[i], i, check, attributes);
+        appendTriangles(out, *meshes[i], base, check, !materials.empty());
     }
     if (out.triangles.empty()) fail(check.file, "no triangles in " + check.file.string());
+    if (!materials.empty()) keepUsedMaterials(out, std::move(materials), check);
     return out;
 }
 
@@ -368,8 +436,11 @@ void joinIdenticalCorners(MeshData& mesh)
         joined.positions.push_back(mesh.positions[vertex]);
         if (!mesh.normals.empty()) joined.normals.push_back(mesh.normals[vertex]);
         if (!mesh.uvs.empty()) joined.uvs.push_back(mesh.uvs[vertex]);
+        if (!mesh.tangents.empty()) joined.tangents.push_back(mesh.tangents[vertex]);
     }
     joined.triangles = std::move(mesh.triangles);
+    joined.triangleMaterials = std::move(mesh.triangleMaterials);
+    joined.materials = std::move(mesh.materials);
     for (glm::uvec3& triangle : joined.triangles) triangle = {remap[triangle.x], remap[triangle.y], remap[triangle.z]};
     mesh = std::move(joined);
 }
@@ -387,6 +458,7 @@ MeshData loadMeshFile(const fs::path& file)
     checkIsMeshFile(file);
     const std::string extension = lowerExtension(file);
     if (extension == ".ply") return readPlyFile(file); // not assimp: see PlyReader.h
+    if (extension == ".gltf" || extension == ".glb") checkGltfBufferBounds(file); // before assimp trusts them
     Assimp::Importer importer;
     const aiScene* scene = importScene(importer, file, extension);
     MeshData mesh = convertScene(*scene, MeshCheck{file, extension});

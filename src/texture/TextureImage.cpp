@@ -4,12 +4,19 @@
 #include "shared/TextureTypes.h"
 #include "util/Error.h"
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+
 // stb_image's implementation is compiled once, in the system's libstb (the `stb` target).
 #include <stb/stb_image.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -30,10 +37,10 @@ double linearToSrgb(double linear)
 
 namespace {
 
-[[noreturn]] void fail(const fs::path& file, const std::string& reason)
-{
-    throw InputError(file.string() + ": " + reason);
-}
+/// Every message starts with the file, or the name an in-memory image was given.
+[[noreturn]] void fail(const std::string& name, const std::string& reason) { throw InputError(name + ": " + reason); }
+
+[[noreturn]] void fail(const fs::path& file, const std::string& reason) { fail(file.string(), reason); }
 
 std::vector<unsigned char> readBytes(const fs::path& file)
 {
@@ -48,12 +55,12 @@ std::vector<unsigned char> readBytes(const fs::path& file)
     return bytes;
 }
 
-bool isExr(const std::vector<unsigned char>& bytes)
+bool isExr(std::span<const uint8_t> bytes)
 {
     return bytes.size() >= 4 && bytes[0] == 0x76 && bytes[1] == 0x2f && bytes[2] == 0x31 && bytes[3] == 0x01;
 }
 
-void checkSize(const fs::path& file, uint64_t width, uint64_t height)
+void checkSize(const std::string& file, uint64_t width, uint64_t height)
 {
     if (width == 0 || height == 0)
         fail(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) + " pixels");
@@ -73,9 +80,9 @@ std::string stbReason()
 template <typename T>
 using StbPixels = std::unique_ptr<T, void (*)(void*)>;
 
-TextureImage loadExr(const fs::path& file)
+/// An EXR's R, G, B (alpha 1) as a texture, refusing non-finite texels.
+TextureImage exrTexture(const Image& rgb, const std::string& file)
 {
-    const Image rgb = readExr(file).image; // R, G, B; alpha is 1
     checkSize(file, rgb.width, rgb.height);
     TextureImage texture{RgbaImage(rgb.width, rgb.height), TexelEncoding::Half};
     for (uint32_t y = 0; y < rgb.height; ++y) {
@@ -95,6 +102,55 @@ TextureImage loadExr(const fs::path& file)
     return texture;
 }
 
+/// OpenEXR reading from memory (an image embedded in a mesh file).
+class MemoryStream : public Imf::IStream {
+public:
+    MemoryStream(std::span<const uint8_t> bytes, const std::string& name) : Imf::IStream(name.c_str()), m_bytes(bytes) {}
+
+    bool read(char c[], int n) override
+    {
+        if (n < 0 || m_position + uint64_t(n) > m_bytes.size()) throw std::runtime_error("unexpected end of data");
+        std::memcpy(c, m_bytes.data() + m_position, size_t(n));
+        m_position += uint64_t(n);
+        return m_position < m_bytes.size();
+    }
+    uint64_t tellg() override { return m_position; }
+    void seekg(uint64_t position) override { m_position = position; }
+
+private:
+    std::span<const uint8_t> m_bytes;
+    uint64_t m_position = 0;
+};
+
+/// io/ExrFile's reading of R, G and B (the same messages), from memory, the
+/// size checked before anything is allocated.
+TextureImage decodeExr(std::span<const uint8_t> bytes, const std::string& name)
+{
+    try {
+        MemoryStream stream(bytes, name);
+        Imf::InputFile file(stream);
+        const Imath::Box2i window = file.header().dataWindow();
+        checkSize(name, uint64_t(int64_t(window.max.x) - window.min.x + 1), uint64_t(int64_t(window.max.y) - window.min.y + 1));
+        Image rgb(uint32_t(window.max.x - window.min.x + 1), uint32_t(window.max.y - window.min.y + 1));
+        Imf::FrameBuffer frame;
+        const char* const channels[3] = {"R", "G", "B"};
+        for (int c = 0; c < 3; ++c) {
+            if (!file.header().channels().findChannel(channels[c]))
+                fail(name, "no channel '" + std::string(channels[c]) + "'");
+            char* base = reinterpret_cast<char*>(rgb.rgb.data() + c) -
+                         (int64_t(window.min.x) + int64_t(window.min.y) * int64_t(rgb.width)) * int64_t(sizeof(float) * 3);
+            frame.insert(channels[c], Imf::Slice(Imf::FLOAT, base, sizeof(float) * 3, sizeof(float) * 3 * rgb.width));
+        }
+        file.setFrameBuffer(frame);
+        file.readPixels(window.min.y, window.max.y);
+        return exrTexture(rgb, name);
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::exception& e) {
+        fail(name, std::string("not a readable EXR file: ") + e.what());
+    }
+}
+
 /// Decodes `count` channel values quantized to `maxCode` into linear floats.
 template <typename T>
 void decodeChannels(const T* codes, RgbaImage& image, double maxCode, bool linear)
@@ -106,7 +162,7 @@ void decodeChannels(const T* codes, RgbaImage& image, double maxCode, bool linea
     }
 }
 
-TextureImage loadStb(const fs::path& file, const std::vector<unsigned char>& bytes, bool linear)
+TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, bool linear)
 {
     const auto* data = bytes.data();
     const int length = int(bytes.size());
@@ -146,9 +202,14 @@ TextureImage loadStb(const fs::path& file, const std::vector<unsigned char>& byt
 
 TextureImage loadTextureImage(const fs::path& file, bool linear)
 {
-    const std::vector<unsigned char> bytes = readBytes(file);
-    if (isExr(bytes)) return loadExr(file); // EXR is linear whatever `linear` says
-    return loadStb(file, bytes, linear);
+    return decodeTextureImage(readBytes(file), file.string(), linear);
+}
+
+TextureImage decodeTextureImage(std::span<const uint8_t> bytes, const std::string& name, bool linear)
+{
+    if (bytes.empty()) fail(name, "empty file, not an image");
+    if (isExr(bytes)) return decodeExr(bytes, name); // EXR is linear whatever `linear` says
+    return decodeStb(bytes, name, linear);
 }
 
 } // namespace vkrt

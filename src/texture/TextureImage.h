@@ -4,6 +4,7 @@
 // sRGB unless the caller says the data is linear; EXR is always linear.
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,11 @@ struct TextureImage {
 /// non-finite texel. Callers that know where the file was named catch it and
 /// rethrow with the location (TextureAtlas::add does).
 TextureImage loadTextureImage(const std::filesystem::path& file, bool linear);
+
+/// The same from the bytes of an image file already in memory (an image
+/// embedded in a .glb or a data: URI): the same checks and messages, with
+/// `name` where they name the file.
+TextureImage decodeTextureImage(std::span<const uint8_t> bytes, const std::string& name, bool linear);
 
 /// The exact sRGB EOTF (IEC 61966-2-1, piecewise), `encoded` in [0, 1].
 double srgbToLinear(double encoded);

@@ -1,0 +1,589 @@
+#include "mesh/FileMaterials.h"
+
+#include "util/Error.h"
+
+#include <assimp/GltfMaterial.h>
+#include <assimp/material.h>
+#include <assimp/scene.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <set>
+#include <sstream>
+
+namespace vkrt {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+[[noreturn]] void fail(const fs::path& file, const std::string& message)
+{
+    throw InputError(file.string() + ": " + message);
+}
+
+// ---------------------------------------------------------------------------
+// JSON access that never throws on a wrong type: the file is whatever bytes
+// it is, and assimp has accepted it, which says little about its other fields.
+
+const json* member(const json& object, const char* key)
+{
+    if (!object.is_object()) return nullptr;
+    const auto found = object.find(key);
+    return found == object.end() ? nullptr : &*found;
+}
+
+const json* arrayMember(const json& object, const char* key)
+{
+    const json* value = member(object, key);
+    return value && value->is_array() ? value : nullptr;
+}
+
+/// rapidjson's IsUint, which assimp's FindUInt uses: a non-negative integer below 2^32.
+std::optional<uint32_t> uintMember(const json& object, const char* key)
+{
+    const json* value = member(object, key);
+    if (!value || !value->is_number_unsigned()) return std::nullopt;
+    const uint64_t number = value->get<uint64_t>();
+    if (number > std::numeric_limits<uint32_t>::max()) return std::nullopt;
+    return uint32_t(number);
+}
+
+const json* element(const json* array, uint32_t index)
+{
+    return array && index < array->size() ? &(*array)[index] : nullptr;
+}
+
+/// The names of an object's "extensions" members.
+std::vector<std::string> extensionNames(const json& object)
+{
+    std::vector<std::string> names;
+    if (const json* extensions = member(object, "extensions"); extensions && extensions->is_object())
+        for (const auto& [name, value] : extensions->items()) names.push_back(name);
+    return names;
+}
+
+std::vector<std::string> stringList(const json& doc, const char* key)
+{
+    std::vector<std::string> strings;
+    if (const json* list = arrayMember(doc, key))
+        for (const json& each : *list)
+            if (each.is_string()) strings.push_back(each.get<std::string>());
+    return strings;
+}
+
+/// Bytes above 0x7f as '?'. They can only stand inside JSON strings;
+/// assimp's rapidjson takes them without checking their encoding and
+/// nlohmann's parser refuses bad UTF-8, so both see one structure only when
+/// they are masked (names are compared masked too).
+std::string masked(std::string text)
+{
+    for (char& c : text)
+        if (static_cast<unsigned char>(c) > 0x7f) c = '?';
+    return text;
+}
+
+/// The file's JSON as assimp reads it. Duplicate keys are refused: rapidjson
+/// takes the first, nlohmann the last, and bounds checked on one value
+/// would not protect reads of the other.
+json parseJson(const fs::path& file)
+{
+    std::vector<std::set<std::string>> keys;
+    std::string duplicate;
+    const json::parser_callback_t noteKeys = [&](int, json::parse_event_t event, json& parsed) {
+        if (event == json::parse_event_t::object_start) keys.emplace_back();
+        if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+        if (event == json::parse_event_t::key && !keys.empty() && parsed.is_string() &&
+            !keys.back().insert(parsed.get<std::string>()).second && duplicate.empty())
+            duplicate = parsed.get<std::string>();
+        return true;
+    };
+    json doc = json::parse(masked(readGltfJson(file)), noteKeys, /*allow_exceptions=*/false);
+    if (doc.is_discarded() || !doc.is_object()) fail(file, "the glTF JSON cannot be parsed");
+    if (!duplicate.empty()) fail(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
+    return doc;
+}
+
+// ---------------------------------------------------------------------------
+// Which file material is which aiMaterial. Assimp 5.2.5's glTF2 reader
+// creates objects lazily, in the order the default scene reaches them
+// (Asset::Load: scenes[scene] -> nodes, children before a node's own mesh
+// -> meshes -> primitives' materials; then every skin's joints; then every
+// animation channel's target node), and its aiMaterial i is the i-th material
+// so reached, not the file's i-th. This walk repeats that order.
+
+class MaterialOrder {
+public:
+    explicit MaterialOrder(const json& doc) : m_doc(doc) {}
+
+    std::vector<uint32_t> walk()
+    {
+        const uint32_t sceneIndex = uintMember(m_doc, "scene").value_or(0);
+        if (const json* scene = element(arrayMember(m_doc, "scenes"), sceneIndex))
+            visitNodeList(arrayMember(*scene, "nodes"));
+        if (const json* skins = arrayMember(m_doc, "skins"))
+            for (const json& skin : *skins) visitNodeList(arrayMember(skin, "joints"));
+        if (const json* animations = arrayMember(m_doc, "animations"))
+            for (const json& animation : *animations) visitChannels(animation);
+        return m_materials;
+    }
+
+private:
+    void visitNodeList(const json* list)
+    {
+        if (!list) return;
+        for (const json& node : *list)
+            if (node.is_number_unsigned() && node.get<uint64_t>() <= std::numeric_limits<uint32_t>::max())
+                visitNode(uint32_t(node.get<uint64_t>()));
+    }
+
+    void visitChannels(const json& animation)
+    {
+        if (const json* channels = arrayMember(animation, "channels"))
+            for (const json& channel : *channels)
+                if (const json* target = member(channel, "target"); target && target->is_object())
+                    if (const auto node = uintMember(*target, "node")) visitNode(*node);
+    }
+
+    /// Depth first, a node's children before its mesh, without recursion (a
+    /// file may nest nodes deeply; assimp refuses cycles before we get here).
+    void visitNode(uint32_t root)
+    {
+        struct Pending {
+            uint32_t node;
+            size_t nextChild;
+        };
+        std::vector<Pending> stack;
+        if (enter(root)) stack.push_back({root, 0});
+        while (!stack.empty()) {
+            Pending& top = stack.back();
+            const json* node = element(arrayMember(m_doc, "nodes"), top.node);
+            const json* children = node ? arrayMember(*node, "children") : nullptr;
+            if (children && top.nextChild < children->size()) {
+                const json& child = (*children)[top.nextChild++];
+                if (child.is_number_unsigned() && child.get<uint64_t>() <= std::numeric_limits<uint32_t>::max() &&
+                    enter(uint32_t(child.get<uint64_t>())))
+                    stack.push_back({uint32_t(child.get<uint64_t>()), 0});
+                continue;
+            }
+            if (node)
+                if (const auto mesh = uintMember(*node, "mesh")) visitMesh(*mesh);
+            stack.pop_back();
+        }
+    }
+
+    bool enter(uint32_t node) { return m_nodes.insert(node).second; }
+
+    void visitMesh(uint32_t index)
+    {
+        if (!m_meshes.insert(index).second) return;
+        const json* mesh = element(arrayMember(m_doc, "meshes"), index);
+        const json* primitives = mesh ? arrayMember(*mesh, "primitives") : nullptr;
+        if (!primitives) return;
+        for (const json& primitive : *primitives)
+            if (const auto material = uintMember(primitive, "material"))
+                if (m_seen.insert(*material).second) m_materials.push_back(*material);
+    }
+
+    const json& m_doc;
+    std::set<uint32_t> m_nodes, m_meshes, m_seen;
+    std::vector<uint32_t> m_materials;
+};
+
+// ---------------------------------------------------------------------------
+// What vkrt will not honour, from the JSON (assimp keeps no list of the
+// extensions it read, and drops those it does not know).
+
+struct TextureSlot {
+    const char* name;  ///< as glTF names it
+    bool inPbr;        ///< under pbrMetallicRoughness
+    bool honoured;     ///< false: occlusionTexture (FileMaterials.h)
+};
+
+constexpr TextureSlot kTextureSlots[] = {
+    {"baseColorTexture", true, true}, {"metallicRoughnessTexture", true, true}, {"normalTexture", false, true},
+    {"emissiveTexture", false, true}, {"occlusionTexture", false, false},
+};
+
+const json* textureInfo(const json& material, const TextureSlot& slot)
+{
+    const json* owner = slot.inPbr ? member(material, "pbrMetallicRoughness") : &material;
+    const json* info = owner ? member(*owner, slot.name) : nullptr;
+    return info && info->is_object() ? info : nullptr;
+}
+
+/// Every extension a material or its texture references names.
+std::set<std::string> materialExtensions(const json& material)
+{
+    std::set<std::string> names;
+    for (const std::string& name : extensionNames(material)) names.insert(name);
+    if (const json* pbr = member(material, "pbrMetallicRoughness"))
+        for (const std::string& name : extensionNames(*pbr)) names.insert(name);
+    for (const TextureSlot& slot : kTextureSlots)
+        if (const json* info = textureInfo(material, slot))
+            for (const std::string& name : extensionNames(*info)) names.insert(name);
+    return names;
+}
+
+void listTextureProblems(const json& material, std::vector<std::string>& out)
+{
+    for (const TextureSlot& slot : kTextureSlots) {
+        const json* info = textureInfo(material, slot);
+        if (!info || !slot.honoured) continue;
+        for (const std::string& name : extensionNames(*info))
+            out.push_back(name + " on " + slot.name + ": not applied");
+        if (const json* texCoord = member(*info, "texCoord");
+            texCoord && texCoord->is_number_integer() && texCoord->get<int64_t>() != 0)
+            out.push_back(std::string(slot.name) + " reads TEXCOORD_" + std::to_string(texCoord->get<int64_t>()) +
+                          ": vkrt reads only TEXCOORD_0");
+    }
+}
+
+/// The unsupported list of one file material (before the file's own extensions).
+std::vector<std::string> materialProblems(const json& material)
+{
+    std::vector<std::string> out;
+    for (const std::string& name : extensionNames(material)) out.push_back(name + ": material extension not supported");
+    if (const json* pbr = member(material, "pbrMetallicRoughness"))
+        for (const std::string& name : extensionNames(*pbr))
+            out.push_back(name + " on pbrMetallicRoughness: not supported");
+    listTextureProblems(material, out);
+    if (const json* mode = member(material, "alphaMode"); mode && mode->is_string() && *mode != "OPAQUE")
+        out.push_back("alphaMode " + mode->get<std::string>() + ": rendered opaque");
+    return out;
+}
+
+/// Extensions the file uses or requires that no material names (lights,
+/// mesh compression, ...): every material lists them, so none is silent.
+std::vector<std::string> fileProblems(const json& doc)
+{
+    std::set<std::string> inMaterials;
+    if (const json* materials = arrayMember(doc, "materials"))
+        for (const json& material : *materials) inMaterials.merge(materialExtensions(material));
+    std::set<std::string> fileLevel;
+    for (const char* key : {"extensionsRequired", "extensionsUsed"})
+        for (const std::string& name : stringList(doc, key))
+            if (!inMaterials.count(name)) fileLevel.insert(name);
+    std::vector<std::string> out;
+    for (const std::string& name : fileLevel) out.push_back(name + ": file extension not supported");
+    return out;
+}
+
+// ---------------------------------------------------------------------------
+// aiMaterial -> FileMaterial: the values, as assimp 5.2.5's glTF2 importer
+// stores them (ImportMaterial: BASE_COLOR, METALLIC_FACTOR, ROUGHNESS_FACTOR,
+// textures under aiTextureType_BASE_COLOR, METALNESS (the metallicRoughness
+// image, also under DIFFUSE_ROUGHNESS and UNKNOWN), NORMALS, EMISSIVE).
+
+struct MaterialReader {
+    const aiScene& scene;
+    const fs::path& file;
+    std::string materialName; ///< for messages
+
+    [[noreturn]] void malformed(const std::string& what) const
+    {
+        fail(file, "material " + materialName + ": " + what);
+    }
+
+    float factor(const aiMaterial& m, const char* key, unsigned type, unsigned index, float fallback,
+                 const char* gltfName) const
+    {
+        float value = fallback;
+        if (m.Get(key, type, index, value) != AI_SUCCESS) return fallback;
+        if (!std::isfinite(value) || value < 0.0f || value > 1.0f)
+            malformed(std::string(gltfName) + " " + std::to_string(value) + " is outside [0, 1]");
+        return value;
+    }
+
+    glm::vec4 colour(const aiMaterial& m, const char* key, unsigned type, unsigned index, glm::vec4 fallback,
+                     const char* gltfName, bool unbounded) const
+    {
+        aiColor4D c;
+        if (m.Get(key, type, index, c) != AI_SUCCESS) return fallback;
+        const glm::vec4 value(c.r, c.g, c.b, c.a);
+        for (int i = 0; i < 4; ++i)
+            if (!std::isfinite(value[i]) || value[i] < 0.0f || (!unbounded && value[i] > 1.0f))
+                malformed(std::string(gltfName) + " has a component " + std::to_string(value[i]) +
+                          (unbounded ? " that is negative or not finite" : " outside [0, 1]"));
+        return value;
+    }
+
+    std::optional<FileTexture> texture(const aiMaterial& m, aiTextureType type) const
+    {
+        aiString path;
+        if (m.GetTextureCount(type) == 0 || m.Get(AI_MATKEY_TEXTURE(type, 0), path) != AI_SUCCESS) return std::nullopt;
+        FileTexture texture;
+        const std::string uri(path.C_Str(), path.length);
+        if (!uri.empty() && uri[0] == '*') {
+            embed(texture, uri);
+        } else {
+            if (uri.empty()) malformed("an image has neither a file nor base64 data");
+            texture.file = file.parent_path() / percentDecoded(uri);
+            texture.name = texture.file.string();
+        }
+        texture.wrapU = wrap(m, AI_MATKEY_MAPPINGMODE_U(type, 0));
+        texture.wrapV = wrap(m, AI_MATKEY_MAPPINGMODE_V(type, 0));
+        return texture;
+    }
+
+    /// "*N": assimp's reference to its embedded texture N (a .glb's bufferView or a data: URI).
+    void embed(FileTexture& texture, const std::string& reference) const
+    {
+        unsigned index = 0;
+        const auto [end, error] = std::from_chars(reference.data() + 1, reference.data() + reference.size(), index);
+        if (error != std::errc() || end != reference.data() + reference.size() || index >= scene.mNumTextures ||
+            !scene.mTextures[index])
+            malformed("names embedded image '" + reference + "', which the file does not have");
+        const aiTexture& image = *scene.mTextures[index];
+        // glTF images are always compressed (PNG, JPEG): assimp then gives the bytes, mHeight 0, mWidth bytes.
+        if (image.mHeight != 0 || !image.pcData) malformed("embedded image " + std::to_string(index) + " has no data");
+        const auto* bytes = reinterpret_cast<const uint8_t*>(image.pcData);
+        texture.embedded.assign(bytes, bytes + image.mWidth);
+        texture.name = file.string() + " (embedded image " + std::to_string(index) + ")";
+    }
+
+    static TextureWrap wrap(const aiMaterial& m, const char* key, unsigned type, unsigned index)
+    {
+        int mode = aiTextureMapMode_Wrap;
+        m.Get(key, type, index, mode);
+        if (mode == aiTextureMapMode_Clamp) return TextureWrap::Clamp;
+        if (mode == aiTextureMapMode_Mirror) return TextureWrap::Mirror;
+        return TextureWrap::Repeat; // glTF's default sampler
+    }
+
+    /// glTF URIs are RFC 3986: "my%20wood.png" is the file "my wood.png".
+    static std::string percentDecoded(const std::string& uri)
+    {
+        std::string out;
+        for (size_t i = 0; i < uri.size(); ++i) {
+            unsigned code = 0;
+            if (uri[i] == '%' && i + 2 < uri.size()) {
+                const auto [end, error] = std::from_chars(uri.data() + i + 1, uri.data() + i + 3, code, 16);
+                if (error == std::errc() && end == uri.data() + i + 3) {
+                    out.push_back(char(code));
+                    i += 2;
+                    continue;
+                }
+            }
+            out.push_back(uri[i]);
+        }
+        return out;
+    }
+
+    AlphaMode alphaMode(const aiMaterial& m) const
+    {
+        aiString mode;
+        if (m.Get(AI_MATKEY_GLTF_ALPHAMODE, mode) != AI_SUCCESS) return AlphaMode::Opaque;
+        const std::string text = mode.C_Str();
+        if (text == "MASK") return AlphaMode::Mask;
+        if (text == "BLEND") return AlphaMode::Blend;
+        return AlphaMode::Opaque;
+    }
+
+    float positive(const aiMaterial& m, const char* key, unsigned type, unsigned index, float fallback,
+                   const char* gltfName) const
+    {
+        float value = fallback;
+        if (m.Get(key, type, index, value) != AI_SUCCESS) return fallback;
+        if (!std::isfinite(value) || value < 0.0f) malformed(std::string(gltfName) + " " + std::to_string(value) + " is negative or not finite");
+        return value;
+    }
+
+    FileMaterial convert(const aiMaterial& m) const
+    {
+        FileMaterial out;
+        aiString name;
+        if (m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) out.name = name.C_Str();
+        out.baseColorFactor =
+            colour(m, AI_MATKEY_BASE_COLOR, out.baseColorFactor, "baseColorFactor", /*unbounded=*/false);
+        out.baseColorTexture = texture(m, aiTextureType_BASE_COLOR);
+        if (!out.baseColorTexture) out.baseColorTexture = texture(m, aiTextureType_DIFFUSE);
+        out.metallicFactor = factor(m, AI_MATKEY_METALLIC_FACTOR, out.metallicFactor, "metallicFactor");
+        out.roughnessFactor = factor(m, AI_MATKEY_ROUGHNESS_FACTOR, out.roughnessFactor, "roughnessFactor");
+        out.metallicRoughnessTexture = texture(m, aiTextureType_METALNESS);
+        if (!out.metallicRoughnessTexture) out.metallicRoughnessTexture = texture(m, aiTextureType_UNKNOWN);
+        out.normalTexture = texture(m, aiTextureType_NORMALS);
+        out.normalScale = 1.0f;
+        if (m.Get(AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0), out.normalScale) == AI_SUCCESS &&
+            !std::isfinite(out.normalScale))
+            malformed("normalTexture scale is not finite");
+        out.emissiveFactor = glm::vec3(colour(m, AI_MATKEY_COLOR_EMISSIVE, glm::vec4(0.0f), "emissiveFactor",
+                                              /*unbounded=*/true));
+        out.emissiveTexture = texture(m, aiTextureType_EMISSIVE);
+        out.alphaMode = alphaMode(m);
+        out.alphaCutoff = positive(m, AI_MATKEY_GLTF_ALPHACUTOFF, out.alphaCutoff, "alphaCutoff");
+        m.Get(AI_MATKEY_TWOSIDED, out.doubleSided);
+        return out;
+    }
+};
+
+/// "0 'Cube'", "2", "'Cube'" (index unknown) or "(glTF's default)": how messages name a material.
+std::string describeMaterial(bool isDefault, int fileIndex, const std::string& name)
+{
+    if (isDefault) return "(glTF's default)";
+    const std::string quoted = name.empty() ? "" : "'" + name + "'";
+    if (fileIndex < 0) return quoted.empty() ? "(unnamed)" : quoted;
+    return std::to_string(fileIndex) + (quoted.empty() ? "" : " " + quoted);
+}
+
+
+bool isGltf2(const json& doc)
+{
+    const json* asset = member(doc, "asset");
+    const json* version = asset ? member(*asset, "version") : nullptr;
+    return version && version->is_string() && version->get<std::string>().rfind("2", 0) == 0;
+}
+
+/// Whether `order` (the walk's file indices) fits assimp's materials: as many, and the same names.
+bool orderMatches(const aiScene& scene, const std::vector<uint32_t>& order, const json* materials)
+{
+    if (scene.mNumMaterials == 0 || order.size() != scene.mNumMaterials - 1) return false;
+    for (size_t i = 0; i < order.size(); ++i) {
+        const json* material = element(materials, order[i]);
+        if (!material || !scene.mMaterials[i]) return false;
+        aiString name;
+        scene.mMaterials[i]->Get(AI_MATKEY_NAME, name);
+        const json* fileName = member(*material, "name");
+        const std::string expected = fileName && fileName->is_string() ? fileName->get<std::string>() : "";
+        if (expected != masked(name.C_Str())) return false;
+    }
+    return true;
+}
+
+void appendUnique(std::vector<std::string>& list, const std::vector<std::string>& more)
+{
+    for (const std::string& each : more)
+        if (std::find(list.begin(), list.end(), each) == list.end()) list.push_back(each);
+}
+
+} // namespace
+
+std::string readGltfJson(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    if (!in) fail(file, "cannot open the glTF file");
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (bytes.compare(0, 4, "glTF") != 0) return bytes;
+    // .glb: a 12-byte header (magic, version, length), then chunks of (length, type, data); JSON comes first.
+    const auto word = [&](size_t offset) {
+        uint32_t value = 0;
+        if (offset + 4 <= bytes.size()) std::memcpy(&value, bytes.data() + offset, 4);
+        return value;
+    };
+    constexpr uint32_t kJsonChunk = 0x4E4F534A; // "JSON", little endian
+    const uint64_t length = word(12);
+    if (bytes.size() < 20 || word(16) != kJsonChunk || 20 + length > bytes.size())
+        fail(file, "the binary glTF's first chunk is not a whole JSON chunk");
+    return bytes.substr(20, size_t(length));
+}
+
+namespace {
+
+/// A non-negative integer field, or `fallback` when absent or of another type.
+uint64_t sizeField(const json& object, const char* key, uint64_t fallback)
+{
+    const json* value = member(object, key);
+    return value && value->is_number_unsigned() ? value->get<uint64_t>() : fallback;
+}
+
+/// Bytes of one accessor element (matrix column padding ignored: it only makes the need larger).
+uint64_t elementBytes(const json& accessor)
+{
+    const uint64_t component = [&]() -> uint64_t {
+        switch (sizeField(accessor, "componentType", 0)) {
+        case 5120: case 5121: return 1;
+        case 5122: case 5123: return 2;
+        case 5125: case 5126: return 4;
+        default: return 0;
+        }
+    }();
+    const json* type = member(accessor, "type");
+    const std::string name = type && type->is_string() ? type->get<std::string>() : "";
+    const std::pair<const char*, uint64_t> counts[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
+                                                       {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
+    for (const auto& [typeName, count] : counts)
+        if (name == typeName) return component * count;
+    return 0;
+}
+
+} // namespace
+
+void checkGltfBufferBounds(const fs::path& file)
+{
+    const json doc = parseJson(file);
+    const json* buffers = arrayMember(doc, "buffers");
+    const json* views = arrayMember(doc, "bufferViews");
+    constexpr uint64_t kHuge = uint64_t(1) << 40; // no sum or product below overflows
+    if (views) {
+        for (uint32_t v = 0; v < views->size(); ++v) {
+            const json& view = (*views)[v];
+            const json* buffer = element(buffers, uint32_t(std::min<uint64_t>(sizeField(view, "buffer", 0), UINT32_MAX)));
+            if (!buffer) continue;
+            const uint64_t end = std::min(sizeField(view, "byteOffset", 0), kHuge) + std::min(sizeField(view, "byteLength", 0), kHuge);
+            const uint64_t length = sizeField(*buffer, "byteLength", 0);
+            if (end > length)
+                fail(file, "bufferView " + std::to_string(v) + " ends at byte " + std::to_string(end) +
+                               " of a buffer of " + std::to_string(length) + " bytes");
+        }
+    }
+    const json* accessors = arrayMember(doc, "accessors");
+    if (!accessors) return;
+    for (uint32_t a = 0; a < accessors->size(); ++a) {
+        const json& accessor = (*accessors)[a];
+        const auto viewIndex = uintMember(accessor, "bufferView");
+        const json* view = viewIndex ? element(views, *viewIndex) : nullptr;
+        const uint64_t count = std::min(sizeField(accessor, "count", 0), kHuge);
+        const uint64_t bytes = elementBytes(accessor);
+        if (!view || count == 0 || bytes == 0) continue;
+        const uint64_t stride = std::min(std::max(sizeField(*view, "byteStride", bytes), bytes), uint64_t(1) << 16);
+        const uint64_t end = std::min(sizeField(accessor, "byteOffset", 0), kHuge) + (count - 1) * stride + bytes;
+        const uint64_t length = sizeField(*view, "byteLength", 0);
+        if (end > length)
+            fail(file, "accessor " + std::to_string(a) + " needs " + std::to_string(end) + " bytes of bufferView " +
+                           std::to_string(*viewIndex) + ", which has " + std::to_string(length));
+    }
+}
+
+std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path& file)
+{
+    const json doc = parseJson(file);
+    if (!isGltf2(doc) || scene.mNumMaterials == 0) return {};
+    const json* fileMaterials = arrayMember(doc, "materials");
+    const std::vector<uint32_t> order = MaterialOrder(doc).walk();
+    const bool matched = orderMatches(scene, order, fileMaterials);
+    const std::vector<std::string> fileLevel = fileProblems(doc);
+    // Unmatched (an assimp whose order differs from 5.2.5's): every material
+    // lists what any file material uses, so that nothing is silent.
+    std::vector<std::string> anyMaterial;
+    if (!matched && fileMaterials)
+        for (const json& material : *fileMaterials) appendUnique(anyMaterial, materialProblems(material));
+
+    std::vector<FileMaterial> materials;
+    for (unsigned i = 0; i < scene.mNumMaterials; ++i) {
+        const bool isDefault = i + 1 == scene.mNumMaterials;
+        const int fileIndex = matched && !isDefault ? int(order[i]) : -1;
+        std::string name;
+        if (scene.mMaterials[i]) {
+            aiString aiName;
+            scene.mMaterials[i]->Get(AI_MATKEY_NAME, aiName);
+            name = aiName.C_Str();
+        }
+        const MaterialReader reader{scene, file, describeMaterial(isDefault, fileIndex, name)};
+        FileMaterial material = scene.mMaterials[i] ? reader.convert(*scene.mMaterials[i]) : FileMaterial{};
+        material.fileIndex = fileIndex;
+        if (fileIndex >= 0) material.unsupported = materialProblems(*element(fileMaterials, uint32_t(fileIndex)));
+        if (!isDefault) appendUnique(material.unsupported, anyMaterial);
+        appendUnique(material.unsupported, fileLevel);
+        materials.push_back(std::move(material));
+    }
+    return materials;
+}
+
+} // namespace vkrt
