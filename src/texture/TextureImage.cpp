@@ -48,6 +48,8 @@ std::vector<unsigned char> readBytes(const fs::path& file)
     const fs::file_status status = fs::status(file, error);
     if (!fs::exists(status)) fail(file, "texture file not found");
     if (fs::is_directory(status)) fail(file, "is a directory, not an image file");
+    // A device or pipe (/dev/zero, a FIFO) could block or never end.
+    if (!fs::is_regular_file(status)) fail(file, "is not a regular file");
     std::ifstream in(file, std::ios::binary);
     if (!in) fail(file, "cannot open texture file");
     std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

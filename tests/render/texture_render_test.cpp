@@ -10,6 +10,7 @@
 //   frame, which changes a point light's Lambert term to a closed form.
 #include "render/Renderer.h"
 #include "scene/SceneParser.h"
+#include "support/GltfTestFiles.h"
 #include "support/TestSupport.h"
 #include "texture/TextureImage.h"
 #include "texture/TextureTestFiles.h"
@@ -243,6 +244,119 @@ TEST_F(TextureRender, ConstantNormalMapTiltsTheShadingNormalInTheTangentFrame)
                     << " " << int(code[2]) << " (flat normal would give " << unmapped << ")";
             }
     }
+}
+
+// ------------------------------------------------------------ kernel variants
+
+// The textured variant and the all-features kernel compute the same image,
+// bit for bit (Whitted, whose samples do not depend on the optional features).
+TEST_F(TextureRender, TexturedSceneRendersAsWithTheUberKernel)
+{
+    const auto dir = freshTempDir("texture-uber");
+    writeChecker(dir, 8);
+    writeConstantNormalMap(dir / "normals.png", {191, 128, 238});
+    const std::string text = R"([render]
+integrator = "whitted"
+max_depth = 3
+[camera]
+eye = [0, 1.5, 4]
+target = [0, 0.5, 0]
+fov = 40
+width = 40
+height = 30
+[materials.floor]
+type = "lambert"
+albedo = { texture = "checker.png", scale = 2 }
+[materials.ball]
+type = "phong"
+diffuse = { texture = "checker.png", wrap = "mirror" }
+specular = 0.3
+normal_map = { texture = "normals.png" }
+[materials.metal]
+type = "conductor"
+metal = "Cu"
+roughness = { texture = "checker.png", linear = true }
+[[objects]]
+shape = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+[[objects]]
+shape = "sphere"
+center = [-0.7, 0.6, 0]
+radius = 0.6
+material = "ball"
+[[objects]]
+shape = "box"
+min = [0.3, 0, -0.5]
+max = [1.3, 1, 0.5]
+material = "metal"
+[[lights]]
+type = "point"
+position = [2, 4, 3]
+intensity = [30, 30, 30]
+)";
+    const Scene scene = parseSceneString(text, (dir / "scene.toml").string());
+    RenderOptions specializedOptions = pixelCentreOptions(), uberOptions = pixelCentreOptions();
+    uberOptions.uber = true;
+    Renderer specialized(gpu(), scene, specializedOptions), uber(gpu(), scene, uberOptions);
+    specialized.renderFrames(2);
+    uber.renderFrames(2);
+    const Image a = specialized.mean(), b = uber.mean();
+    size_t differing = 0, lit = 0;
+    for (size_t i = 0; i < a.rgb.size(); ++i) {
+        differing += a.rgb[i] != b.rgb[i];
+        lit += a.rgb[i] > 0.0f;
+    }
+    EXPECT_EQ(differing, 0u);
+    EXPECT_GT(lit, a.rgb.size() / 2) << "most of the image should be lit";
+}
+
+// --------------------------------------------------------- glTF file materials
+
+/// Two quads side by side in the plane z = 0 facing +z (left x in [-1, 0],
+/// right x in [0, 1], y in [-0.5, 0.5]), each a primitive of its own material.
+std::string twoQuadGltf(const std::string& materials)
+{
+    std::string buffer;
+    for (float x0 : {-1.0f, 0.0f}) {
+        const float x1 = x0 + 1.0f;
+        for (float v : {x0, -0.5f, 0.f, x1, -0.5f, 0.f, x1, 0.5f, 0.f, x0, -0.5f, 0.f, x1, 0.5f, 0.f, x0, 0.5f, 0.f})
+            put(buffer, v);
+    }
+    return R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0},
+                             {"attributes": {"POSITION": 1}, "material": 1}]}],
+  "materials": )" + materials + R"(,
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) + R"(", "byteLength": 144}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 144}],
+  "accessors": [
+    {"bufferView": 0, "byteOffset": 0, "componentType": 5126, "count": 6, "type": "VEC3", "min": [-1, -0.5, 0], "max": [0, 0.5, 0]},
+    {"bufferView": 0, "byteOffset": 72, "componentType": 5126, "count": 6, "type": "VEC3", "min": [0, -0.5, 0], "max": [1, 0.5, 0]}]})";
+}
+
+// Each triangle takes its own file material: two emissive glTF materials on
+// one mesh show their own emission on their own halves, seen directly (black
+// surroundings, black base colour, so nothing else adds to it).
+TEST_F(TextureRender, GltfMaterialsApplyPerTriangleWithTheirEmission)
+{
+    const auto dir = freshTempDir("texture-gltf-emission");
+    std::ofstream(dir / "quads.gltf") << twoQuadGltf(
+        R"([{"name": "Red", "emissiveFactor": [1, 0, 0], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}},
+            {"name": "Green", "emissiveFactor": [0, 0.5, 0], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}}])");
+    const std::string text = "[render]\nintegrator = \"path\"\nmax_depth = 2\n[camera]\neye = [0, 0, 3]\n"
+                             "target = [0, 0, 0]\nfov = 30\nwidth = " + std::to_string(kSide) + "\nheight = " +
+                             std::to_string(kSide) +
+                             "\n[[objects]]\nshape = \"mesh\"\nfile = \"quads.gltf\"\nmaterial = \"file\"\n";
+    const Scene scene = parseSceneString(text, (dir / "scene.toml").string());
+    const Image image = renderCentres(scene);
+    const float* left = image.at(kSide / 2 - 4, kSide / 2);
+    const float* right = image.at(kSide / 2 + 4, kSide / 2);
+    EXPECT_NEAR(left[0], 1.0, 1e-5);
+    EXPECT_NEAR(left[1], 0.0, 1e-5);
+    EXPECT_NEAR(right[0], 0.0, 1e-5);
+    EXPECT_NEAR(right[1], 0.5, 1e-5);
+    EXPECT_NEAR(image.at(0, 0)[0] + image.at(0, 0)[1], 0.0, 1e-6) << "outside the quads the image is black";
 }
 
 } // namespace

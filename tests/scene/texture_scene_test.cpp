@@ -1,8 +1,10 @@
 // Textured material parameters in scene files (docs/scene-format.md,
 // "Textures"): what a texture table sets, and every way one can be wrong,
 // each with its position in the file.
+#include "mesh/MeshGeometry.h"
 #include "scene/FeatureSet.h"
 #include "scene/SceneParser.h"
+#include "support/GltfTestFiles.h"
 #include "texture/TextureAtlas.h"
 #include "texture/TextureTestFiles.h"
 
@@ -90,6 +92,84 @@ TEST_F(SceneParserTextures, SceneWithoutTexturesHasNoAtlasAndNoTextureFeature)
     const Scene scene = parse("[materials.m]\ntype = \"lambert\"\nalbedo = 0.5\n" + kSphere);
     EXPECT_FALSE(scene.textures);
     EXPECT_FALSE(featuresOf(scene).textures);
+}
+
+// ------------------------------------------------------ file materials (glTF)
+
+std::string cubeObjects(int count)
+{
+    std::string text;
+    for (int i = 0; i < count; ++i)
+        text += "[[objects]]\nshape = \"mesh\"\nfile = \"" + (assetsDir() / "gltf" / "Cube" / "Cube.gltf").string() +
+                "\"\nmaterial = \"file\"\ntranslate = [" + std::to_string(3 * i) + ", 0, 0]\n";
+    return text;
+}
+
+TEST_F(SceneParserTextures, GltfCubeGetsItsTexturedMetallicRoughnessMaterialOncePerFile)
+{
+    const Scene scene = parse("[materials.m]\ntype = \"lambert\"\n" + kSphere + cubeObjects(2));
+    ASSERT_EQ(scene.materials.size(), 2u) << "two instances of one file share its materials";
+    const Material& cube = scene.materials[1];
+    EXPECT_EQ(cube.type, MaterialType::Pbr);
+    EXPECT_EQ(cube.name, "Cube.gltf#Cube");
+    // glTF's factors default to 1: each is the constant its texel multiplies.
+    EXPECT_EQ(cube.diffuse, Color(1.0));
+    EXPECT_EQ(cube.roughness, 1.0);
+    EXPECT_EQ(cube.metallic, 1.0);
+    ASSERT_TRUE(cube.texture(TextureSlot::Color) && cube.texture(TextureSlot::Roughness) &&
+                cube.texture(TextureSlot::Metallic));
+    // glTF's metallicRoughnessTexture: roughness in G, metallic in B, one linear image for both.
+    EXPECT_EQ(cube.texture(TextureSlot::Roughness)->channel, 1u);
+    EXPECT_EQ(cube.texture(TextureSlot::Metallic)->channel, 2u);
+    EXPECT_EQ(cube.texture(TextureSlot::Roughness)->record, cube.texture(TextureSlot::Metallic)->record);
+    EXPECT_FALSE(cube.hasNormalMap());
+    EXPECT_EQ(scene.textures->imageCount(), 2u);
+    ASSERT_EQ(scene.meshes.size(), 2u);
+    EXPECT_EQ(scene.meshes[0].fileMaterials, std::vector<uint32_t>{1});
+    EXPECT_EQ(scene.meshes[1].fileMaterials, std::vector<uint32_t>{1});
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.fileMaterials && features.textures && features.has(MaterialType::Pbr));
+}
+
+TEST_F(SceneParserTextures, UnsupportedGltfFeaturesAreLocatedWarnings)
+{
+    const std::string gltf = triangleGltf(
+        R"("materials": [{"name": "Coat", "alphaMode": "BLEND",
+                          "pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+                              "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}},
+                          "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}}],
+            "textures": [{"source": 0}], "images": [{"uri": "grey.png"}],
+            "extensionsUsed": ["KHR_texture_transform", "KHR_materials_clearcoat"])");
+    std::ofstream(m_dir / "coat.gltf") << gltf;
+    const Scene scene = parse("[[objects]]\nshape = \"mesh\"\nfile = \"coat.gltf\"\nmaterial = \"file\"\n");
+    ASSERT_EQ(scene.materials.size(), 1u);
+    EXPECT_TRUE(scene.materials[0].texture(TextureSlot::Color).has_value());
+    std::string all;
+    for (const std::string& w : scene.warnings) {
+        all += w + "\n";
+        EXPECT_EQ(w.rfind(scenePath() + ":8:12: coat.gltf#Coat: ", 0), 0u) << w;
+    }
+    for (const char* named : {"KHR_texture_transform", "KHR_materials_clearcoat", "BLEND"})
+        EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:\n" << all;
+}
+
+TEST_F(SceneParserTextures, FileMaterialsNeedAFileWithMaterials)
+{
+    std::ofstream(m_dir / "uvs.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+    const std::string error = errorOf("[[objects]]\nshape = \"mesh\"\nfile = \"uvs.obj\"\nmaterial = \"file\"\n");
+    EXPECT_NE(error.find(scenePath() + ":8:12: "), std::string::npos) << error;
+    EXPECT_NE(error.find("has none"), std::string::npos) << error;
+}
+
+TEST_F(SceneParserTextures, MissingGltfTextureIsAnErrorAtTheMaterialKey)
+{
+    std::ofstream(m_dir / "lost.gltf") << triangleGltf(
+        R"("materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0}], "images": [{"uri": "nowhere.png"}])");
+    const std::string error = errorOf("[[objects]]\nshape = \"mesh\"\nfile = \"lost.gltf\"\nmaterial = \"file\"\n");
+    EXPECT_NE(error.find(scenePath() + ":8:12: "), std::string::npos) << error;
+    EXPECT_NE(error.find("nowhere.png"), std::string::npos) << error;
 }
 
 struct BadTexture {

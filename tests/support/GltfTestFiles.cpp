@@ -1,0 +1,53 @@
+#include "support/GltfTestFiles.h"
+
+#include <algorithm>
+
+namespace vkrt::test {
+
+std::string base64(const std::string& bytes)
+{
+    static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        const size_t n = std::min<size_t>(3, bytes.size() - i);
+        uint32_t word = 0;
+        for (size_t k = 0; k < 3; ++k) word = (word << 8) | (k < n ? uint8_t(bytes[i + k]) : 0u);
+        for (size_t k = 0; k < 4; ++k) out.push_back(k <= n ? alphabet[(word >> (18 - 6 * k)) & 63] : '=');
+    }
+    return out;
+}
+
+std::string dataUri(const std::string& type, const std::string& bytes)
+{
+    return "data:" + type + ";base64," + base64(bytes);
+}
+
+std::string triangleBuffer()
+{
+    std::string bytes;
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(bytes, v); // 0: 36 bytes
+    for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) put(bytes, v);                // 36: 24 bytes
+    for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) put(bytes, v);                // 60: 24 bytes
+    for (uint16_t i : {0, 1, 2}) put(bytes, i);                                   // 84: 6 bytes
+    bytes.append(2, '\0');
+    return bytes;
+}
+
+std::string triangleGltf(const std::string& rest, const std::string& material)
+{
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{)" +
+           material + R"("attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}, "indices": 3}]}],
+  "buffers": [{"uri": ")" +
+           dataUri("application/octet-stream", triangleBuffer()) + R"(", "byteLength": 92}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24},
+                  {"buffer": 0, "byteOffset": 60, "byteLength": 24}, {"buffer": 0, "byteOffset": 84, "byteLength": 6}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
+    {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"},
+    {"bufferView": 3, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+  )" + rest + "}";
+}
+
+} // namespace vkrt::test
