@@ -15,6 +15,7 @@ CommandRunner addRenderCommand(CLI::App& app);
 CommandRunner addDevicesCommand(CLI::App& app);
 CommandRunner addInfoCommand(CLI::App& app);
 CommandRunner addCompareCommand(CLI::App& app);
+CommandRunner addMergeCommand(CLI::App& app);
 CommandRunner addViewCommand(CLI::App& app);
 CommandRunner addRegressCommand(CLI::App& app);
 

@@ -44,6 +44,7 @@ struct RenderCommandOptions {
     std::string reference;
     bool sppGiven = false;
     std::string sampler = "auto";
+    std::string shard; ///< "i/n" (docs/farm.md)
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
@@ -61,15 +62,51 @@ std::string defaultOutputFor(const std::string& scenePath)
     return std::filesystem::path(scenePath).stem().string() + ".exr";
 }
 
-SessionConfig sessionConfig(const RenderCommandOptions& options)
+/// Shard i of n: the contiguous sample range [i S / n, (i + 1) S / n) of a render of S spp.
+struct ShardRange {
+    uint32_t index = 0, count = 1;
+    uint32_t begin = 0, end = 0;
+};
+
+std::optional<ShardRange> shardRange(const RenderCommandOptions& options)
+{
+    if (options.shard.empty()) return std::nullopt;
+    auto fail = [&](const std::string& why) -> ShardRange {
+        throw InputError("--shard " + options.shard + ": " + why);
+    };
+    const size_t slash = options.shard.find('/');
+    auto number = [&](const std::string& text) -> uint64_t {
+        if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos)
+            fail("expected i/n, two whole numbers with 0 <= i < n (shard i of n)");
+        return std::stoull(text);
+    };
+    if (slash == std::string::npos) fail("expected i/n, two whole numbers with 0 <= i < n (shard i of n)");
+    const uint64_t index = number(options.shard.substr(0, slash)), count = number(options.shard.substr(slash + 1));
+    if (count == 0) fail("n must be at least 1");
+    if (index >= count) fail("i must be below n (shards are numbered 0 ... n - 1)");
+    if (count > options.spp)
+        fail(std::to_string(count) + " shards of " + std::to_string(options.spp) +
+             " spp would leave some without samples; use at most --spp shards");
+    if (options.timeBudget || options.targetError || !options.report.empty())
+        fail("a shard renders a fixed range of the samples; --time-budget, --target-error and --report apply to "
+             "whole renders");
+    ShardRange range{uint32_t(index), uint32_t(count)};
+    range.begin = uint32_t(index * options.spp / count);
+    range.end = uint32_t((index + 1) * options.spp / count);
+    return range;
+}
+
+SessionConfig sessionConfig(const RenderCommandOptions& options, const std::optional<ShardRange>& shard)
 {
     SessionConfig config;
     config.seed = options.seed;
+    if (shard) config.firstFrame = shard->begin;
     config.jitter = !options.pixelCenters;
     config.uber = options.uber;
     config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
     config.variance = options.varianceNeeds();
-    config.stop = {options.maxSpp(), options.timeBudget, options.targetError, &interruptFlag()};
+    config.stop = {shard ? shard->end - shard->begin : options.maxSpp(), options.timeBudget, options.targetError,
+                   &interruptFlag()};
     return config;
 }
 
@@ -119,6 +156,18 @@ void warnIfTooFewForAnEstimate(const Renderer& renderer)
                  renderer.completedFrames(), gpu::VARIANCE_BATCHES);
 }
 
+/// A shard's EXR carries its range and its tally, which `vkrt merge` adds up.
+void addShard(const ShardRange& shard, uint32_t totalSpp, const Renderer& renderer, Metadata& metadata,
+              std::map<std::string, Image>& layers)
+{
+    metadata["shard"] = std::to_string(shard.index) + "/" + std::to_string(shard.count);
+    metadata["sampleBegin"] = int64_t(shard.begin);
+    // Interrupted: the samples actually rendered (stoppedBy says so).
+    metadata["sampleEnd"] = int64_t(shard.begin + renderer.completedFrames());
+    metadata["totalSpp"] = int64_t(totalSpp);
+    addTallyLayers(renderer.tally(), layers);
+}
+
 /// Runs the session's stop rules with Ctrl-C caught, feeding --report at every checkpoint.
 LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceReport>& report,
                               uint32_t& lastCheckpoint)
@@ -141,12 +190,13 @@ LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceR
 Outcome runRender(const RenderCommandOptions& options)
 {
     auto start = std::chrono::steady_clock::now();
+    const std::optional<ShardRange> shard = shardRange(options);
     Scene scene = loadScene(options.scenePath, {options.width, options.height});
     std::string output = options.output.empty() ? defaultOutputFor(options.scenePath) : options.output;
 
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
     std::optional<Image> reference = loadReference(options, scene);
-    RenderSession session(context, std::move(scene), sessionConfig(options));
+    RenderSession session(context, std::move(scene), sessionConfig(options, shard));
     double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     std::optional<ConvergenceReport> report;
@@ -168,6 +218,7 @@ Outcome runRender(const RenderCommandOptions& options)
             report->add(renderer.completedFrames(), loop.renderSeconds, film.mean, *film.variance); // the last row
         if (options.variance) layers["variance"] = std::move(*film.variance);
     }
+    if (shard) addShard(*shard, options.spp, renderer, metadata, layers);
     RenderCounters counters = renderer.counters();
     writeExr(output, film.mean, metadata, layers);
     if (!options.png.empty()) writePng(options.png, film.mean, options.exposure);
@@ -225,6 +276,9 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "(Owen-scrambled Sobol' points: lower error; any variance estimate comes from " +
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
+    cmd->add_option("--shard", options->shard,
+                    "Render only shard i of n (0 <= i < n): samples [i S/n, (i+1) S/n) of --spp S, seeded as in one "
+                    "run; `vkrt merge` adds the shards (docs/farm.md)");
     return [options] { return exitCodeFor(runRender(*options)); };
 }
 

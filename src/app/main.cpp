@@ -20,6 +20,7 @@ int main(int argc, char** argv)
     add(vkrt::addViewCommand(app));
     add(vkrt::addInfoCommand(app));
     add(vkrt::addCompareCommand(app));
+    add(vkrt::addMergeCommand(app));
     add(vkrt::addRegressCommand(app));
     add(vkrt::addDevicesCommand(app));
 

@@ -51,6 +51,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
 {
     RenderOptions options;
     options.seed = config.seed;
+    options.firstFrame = config.firstFrame;
     options.jitter = config.jitter;
     options.uber = config.uber;
     options.variance = config.variance.any();

@@ -326,7 +326,7 @@ void Renderer::renderFrames(uint32_t frames)
     constexpr uint32_t maxRun = 4096;
     m_context.submitAndWait([&](vk::CommandBuffer cmd) {
         for (uint32_t done = 0; done < frames; done += maxRun)
-            recordFrames(cmd, m_frames + done, std::min(maxRun, frames - done));
+            recordFrames(cmd, m_options.firstFrame + m_frames + done, std::min(maxRun, frames - done));
     });
     m_frames += frames;
     if (m_variant.groupLoopCount && counters().budgetExceeded)
@@ -468,6 +468,45 @@ RenderCounters Renderer::counters() const
     counters.maxLoopIterations = stats->maxLoopIterations;
     counters.budgetExceeded = stats->budgetExceeded;
     return counters;
+}
+
+Tally Renderer::tally() const
+{
+    auto accumBytes = m_accumulation.download(m_context);
+    const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(accumBytes.data());
+    Tally tally;
+    tally.count = Image(width(), height());
+    tally.mean = Image(width(), height());
+    const size_t pixelCount = tally.count.pixelCount();
+    for (size_t i = 0; i < pixelCount; ++i)
+        for (int c = 0; c < 3; ++c) {
+            tally.count.rgb[i * 3 + c] = float(pixels[i].count);
+            if (pixels[i].count > 0) tally.mean.rgb[i * 3 + c] = float(compensatedMean(pixels[i], c));
+        }
+    if (!m_moments) return tally;
+    auto bytes = m_moments->download(m_context);
+    if (batchedVariance()) {
+        const auto* batches = reinterpret_cast<const gpu::AccumPixel*>(bytes.data());
+        for (uint32_t b = 0; b < gpu::VARIANCE_BATCHES; ++b) {
+            Image count(width(), height()), mean(width(), height());
+            for (size_t i = 0; i < pixelCount; ++i) {
+                const gpu::AccumPixel& p = batches[i * gpu::VARIANCE_BATCHES + b];
+                for (int c = 0; c < 3; ++c) {
+                    count.rgb[i * 3 + c] = float(p.count);
+                    if (p.count > 0) mean.rgb[i * 3 + c] = float(compensatedMean(p, c));
+                }
+            }
+            tally.batchCount.push_back(std::move(count));
+            tally.batchMean.push_back(std::move(mean));
+        }
+        return tally;
+    }
+    const auto* moments = reinterpret_cast<const gpu::MomentPixel*>(bytes.data());
+    tally.m2 = Image(width(), height());
+    for (size_t i = 0; i < pixelCount; ++i)
+        for (int c = 0; c < 3; ++c)
+            tally.m2->rgb[i * 3 + c] = float(double(moments[i].m2[c]) - double(moments[i].m2Compensation[c]));
+    return tally;
 }
 
 } // namespace vkrt

@@ -7,6 +7,7 @@
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
 #include "render/GpuScene.h"
+#include "render/Tally.h"
 #include "render/KernelVariant.h"
 #include "shared/Bindings.h"
 
@@ -22,6 +23,7 @@ struct RenderOptions {
     bool variance = false;            ///< also estimate per-pixel variance (a kernel-variant flag)
     bool sobol = false;               ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
     bool storageScene = false;        ///< scene arrays in storage buffers even when they fit uniform ones
+    uint32_t firstFrame = 0;          ///< index of the first frame (sample) rendered: a shard's start
     std::vector<Define> extraDefines; ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
@@ -67,6 +69,8 @@ public:
     /// Degrees of freedom of each pixel's variance estimate (0: none made yet).
     uint64_t varianceDegreesOfFreedom() const;
     RenderCounters counters() const;
+    /// The per-pixel sums a merge adds up (render/Tally.h).
+    Tally tally() const;
 
     const KernelVariant& variant() const { return m_variant; }
     const CompiledKernel& kernel() const { return m_compiled; }
