@@ -1,155 +1,16 @@
-// The render session: its one sampler policy, its stop rules, the metadata it
-// writes for every command, and the validation of overrides (resolution from
-// options or a suite, viewer camera moves) with the scene parser's rules.
+// The render session on a device: its stop rules and the metadata it writes
+// for every command. Its rules that need no device (sampler policy, pacing,
+// Ctrl-C, overrides) are in session_policy_test.cpp (vkrt_cpu_tests).
 #include "render/RenderSession.h"
-#include "scene/SceneOverrides.h"
 #include "shared/Bindings.h"
 #include "support/TestSupport.h"
 #include "view/CameraControl.h"
 
 #include <atomic>
-#include <csignal>
 #include <set>
 
 namespace vkrt::test {
 namespace {
-
-// ---------------------------------------------------------------- sampler policy
-
-constexpr uint64_t kRange = uint64_t(1) << 27; // lavapipe's maxStorageBufferRange
-
-TEST(SamplerPolicy, VarianceLayerGetsIndependentSamples)
-{
-    EXPECT_EQ(resolveSampler(SamplerChoice::Auto, {true, false}, 64, kRange), Sampler::Independent);
-    EXPECT_EQ(resolveSampler(SamplerChoice::Auto, {true, true}, 64, kRange), Sampler::Independent);
-}
-
-TEST(SamplerPolicy, ErrorEstimateFallsBackToIndependentWhenBatchesPassTheStorageRange)
-{
-    uint64_t fitting = kRange / varianceBytesPerPixel(true);
-    EXPECT_EQ(resolveSampler(SamplerChoice::Auto, {false, true}, fitting, kRange), Sampler::Sobol);
-    EXPECT_EQ(resolveSampler(SamplerChoice::Auto, {false, true}, fitting + 1, kRange), Sampler::Independent);
-}
-
-TEST(SamplerPolicy, OtherwiseSobolAndAnExplicitChoiceIsKept)
-{
-    EXPECT_EQ(resolveSampler(SamplerChoice::Auto, {}, 1u << 26, kRange), Sampler::Sobol) << "no batches, no limit";
-    EXPECT_EQ(resolveSampler(SamplerChoice::Sobol, {true, false}, 64, kRange), Sampler::Sobol);
-    EXPECT_EQ(resolveSampler(SamplerChoice::Independent, {}, 64, kRange), Sampler::Independent);
-    EXPECT_EQ(samplerChoiceNamed("auto"), SamplerChoice::Auto);
-    EXPECT_EQ(samplerChoiceNamed("halton"), std::nullopt);
-}
-
-// ---------------------------------------------------------------- overrides
-
-std::string errorOf(const std::function<void()>& action)
-{
-    try {
-        action();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
-
-TEST(SceneOverrides, ResolutionErrorsNameTheOptionWithTheParsersWording)
-{
-    Camera camera;
-    EXPECT_EQ(errorOf([&] {
-                  applyResolution(camera, {0u, std::nullopt});
-              }),
-              "--width: must be between 1 and 16384, got 0");
-    EXPECT_EQ(errorOf([&] {
-                  applyResolution(camera, {std::nullopt, 16385u});
-              }),
-              "--height: must be between 1 and 16384, got 16385");
-    EXPECT_EQ(errorOf([&] {
-                  applyResolution(camera, {16384u, 16384u});
-              }),
-              "--height: width * height = 268435456 pixels exceeds the limit of 67108864");
-    camera.height = 16384;
-    EXPECT_EQ(errorOf([&] {
-                  applyResolution(camera, {8192u, std::nullopt});
-              }),
-              "--width: width * height = 134217728 pixels exceeds the limit of 67108864")
-        << "only the width was given: it is to blame";
-    EXPECT_EQ(camera.width, 640u) << "a refused override changes nothing";
-}
-
-TEST(SceneOverrides, SuiteCaseErrorsNameTheSuiteAndCase)
-{
-    Camera camera;
-    ResolutionOverride fromSuite{99999u, std::nullopt, "suite.toml: case a/b: width", "suite.toml: case a/b: height"};
-    EXPECT_EQ(errorOf([&] { applyResolution(camera, fromSuite); }),
-              "suite.toml: case a/b: width: must be between 1 and 16384, got 99999");
-    applyResolution(camera, {320u, 200u});
-    EXPECT_EQ(camera.width, 320u);
-    EXPECT_EQ(camera.height, 200u);
-}
-
-Camera lookingDownMinusZ()
-{
-    Camera c;
-    c.eye = {0, 1, 5};
-    c.target = {0, 1, 0};
-    return c;
-}
-
-TEST(SceneOverrides, CameraMovesThatCollapseTheViewAreRefused)
-{
-    Camera c = lookingDownMinusZ();
-    EXPECT_EQ(cameraProblem(c), std::nullopt);
-    EXPECT_EQ(cameraProblem(zoom(c, 0.5)), std::nullopt);
-    EXPECT_EQ(cameraProblem(zoom(c, 0.0)), "fov: must be strictly between 0 and 180 degrees, got 0");
-    EXPECT_NE(cameraProblem(zoom(c, std::nan(""))), std::nullopt);
-    EXPECT_EQ(cameraProblem(fly(c, 0, 0, 1e308)), "eye: must be finite") << "an overflowing fly";
-    Camera atTarget = c;
-    atTarget.eye = c.target;
-    EXPECT_EQ(cameraProblem(atTarget), "target: must differ from camera.eye (the view direction would be undefined)");
-    Camera upAlongView = c;
-    upAlongView.up = {0, 0, -3};
-    EXPECT_EQ(cameraProblem(upAlongView), "up: must not be parallel to the view direction (target - eye)");
-    upAlongView.up = {0, 0, 0};
-    EXPECT_EQ(cameraProblem(upAlongView), "up: must not be zero-length");
-    EXPECT_EQ(errorOf([&] { checkCamera(zoom(c, 0.0), "zoom"); }),
-              "zoom: fov: must be strictly between 0 and 180 degrees, got 0");
-}
-
-// ---------------------------------------------------------------- frames
-
-TEST(BatchPacer, GrowsAtMostTwofoldTowardsTheTargetAndShrinksAtOnce)
-{
-    BatchPacer pacer(0.25);
-    EXPECT_EQ(pacer.nextFrames(), 1u);
-    pacer.record(1, 0.001); // far below the target: double, no more
-    EXPECT_EQ(pacer.nextFrames(), 2u);
-    pacer.record(40, 0.0); // unmeasurably fast: double up to the cap
-    EXPECT_EQ(pacer.nextFrames(), 64u);
-    pacer.record(64, 1.0); // four times too long: a quarter
-    EXPECT_EQ(pacer.nextFrames(), 16u);
-    pacer.record(1, 10.0); // one slow frame: still at least one
-    EXPECT_EQ(pacer.nextFrames(), 1u);
-}
-
-// ---------------------------------------------------------------- Ctrl-C
-
-std::atomic<int> g_previousHandlerCalls{0};
-extern "C" void countingHandler(int) { ++g_previousHandlerCalls; }
-
-TEST(InterruptGuard, CatchesSigintAndRestoresThePreviousHandler)
-{
-    auto before = std::signal(SIGINT, countingHandler);
-    {
-        InterruptGuard guard;
-        EXPECT_FALSE(interruptFlag().load()) << "a new guard starts clear";
-        std::raise(SIGINT);
-        EXPECT_TRUE(interruptFlag().load());
-        EXPECT_EQ(g_previousHandlerCalls.load(), 0);
-    }
-    std::raise(SIGINT);
-    EXPECT_EQ(g_previousHandlerCalls.load(), 1) << "the handler from before the guard is back";
-    std::signal(SIGINT, before);
-}
 
 // ---------------------------------------------------------------- session (GPU)
 
