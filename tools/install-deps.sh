@@ -30,6 +30,8 @@ packages=(
   clang-14 libclang-rt-14-dev
   # a real X display for the viewer's tests
   xvfb xauth
+  # the render farm's test runs a real single-node Slurm cluster (tools/slurm/local-cluster.sh)
+  slurm-wlm munge
 )
 backports_source=/etc/apt/sources.list.d/vkrt-bookworm-backports.sources
 

@@ -6,6 +6,7 @@
 #include "regress/Suite.h"
 #include "render/ErrorMetrics.h"
 #include "render/RenderSession.h"
+#include "render/Tally.h"
 #include "util/Error.h"
 
 #include <algorithm>
@@ -111,23 +112,55 @@ struct Rendered {
     Metadata metadata; ///< the session's, for the images written from it
 };
 
-/// Renders `spp` frames after a warm-up frame, with a per-pixel variance (the
-/// per-value test needs it); nullopt when Ctrl-C stopped it.
-std::optional<Rendered> renderCase(const VulkanContext& context, const Scene& scene, uint32_t spp, uint32_t seed,
-                                   const std::vector<Define>& defines)
+SessionConfig caseConfig(uint32_t seed, const std::vector<Define>& defines, uint32_t firstFrame, uint32_t frames)
 {
     SessionConfig config;
     config.seed = seed;
     config.variance.layer = true;
     config.extraDefines = defines;
-    config.stop = {spp, std::nullopt, std::nullopt, &interruptFlag()};
-    RenderSession session(context, scene, config);
+    config.firstFrame = firstFrame;
+    config.stop = {frames, std::nullopt, std::nullopt, &interruptFlag()};
+    return config;
+}
+
+/// Renders `spp` frames after a warm-up frame, with a per-pixel variance (the
+/// per-value test needs it); nullopt when Ctrl-C stopped it.
+std::optional<Rendered> renderCase(const VulkanContext& context, const Scene& scene, uint32_t spp, uint32_t seed,
+                                   const std::vector<Define>& defines)
+{
+    RenderSession session(context, scene, caseConfig(seed, defines, 0, spp));
     LoopResult loop = session.run();
     if (loop.reason == StopReason::Interrupted) return std::nullopt;
     Film film = session.film();
     Metadata metadata = session.metadata(film);
     return Rendered{std::move(film.mean), std::move(*film.variance), loop.renderSeconds,
                     session.renderer().counters().rejectedSamples, std::move(metadata)};
+}
+
+/// As renderCase, but as `shards` sessions over the contiguous sample ranges
+/// `vkrt render --shard i/n` renders, their tallies added as `vkrt merge`
+/// adds them (render/Tally.h): the farm's path through the same test.
+std::optional<Rendered> renderCaseInShards(const VulkanContext& context, const Scene& scene, uint32_t spp,
+                                           uint32_t shards, uint32_t seed, const std::vector<Define>& defines)
+{
+    std::vector<Tally> tallies;
+    Rendered merged;
+    for (uint32_t i = 0; i < shards; ++i) {
+        const auto begin = uint32_t(uint64_t(i) * spp / shards), end = uint32_t(uint64_t(i + 1) * spp / shards);
+        RenderSession session(context, scene, caseConfig(seed, defines, begin, end - begin));
+        LoopResult loop = session.run();
+        if (loop.reason == StopReason::Interrupted) return std::nullopt;
+        tallies.push_back(session.renderer().tally());
+        merged.seconds += loop.renderSeconds;
+        merged.rejectedSamples += session.renderer().counters().rejectedSamples;
+        if (i == 0) merged.metadata = session.metadata(session.film());
+    }
+    const Tally tally = mergeTallies(tallies);
+    merged.mean = tallyMean(tally);
+    merged.variance = *tallyVarianceOfMean(tally);
+    merged.metadata["spp"] = int64_t(spp);
+    merged.metadata["shard"] = "merged from " + std::to_string(shards);
+    return merged;
 }
 
 /// The pooled test per channel: z_c = sum (x - r) / sqrt(sum sigma^2) over the
@@ -244,8 +277,10 @@ std::optional<CaseResult> runCase(const VulkanContext& context, const Regression
     result.baseline = c.baselineSeconds;
     result.reference = referenceLabel(c);
     try {
+        const uint32_t seed = suite.seed + options.seedOffset;
         std::optional<Rendered> r =
-            renderCase(context, pc.scene, c.spp, suite.seed + options.seedOffset, options.kernelDefines);
+            c.shards > 1 ? renderCaseInShards(context, pc.scene, c.spp, c.shards, seed, options.kernelDefines)
+                         : renderCase(context, pc.scene, c.spp, seed, options.kernelDefines);
         if (!r) return std::nullopt;
         result.test = testRender(*r, c.spp, pc.reference, c.referenceSpp, suite);
         result.measured = measureError(r->mean, pc.reference.mean);

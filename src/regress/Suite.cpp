@@ -20,8 +20,9 @@ namespace {
 
 constexpr std::array<std::string_view, 2> topLevelKeys{"suite", "case"};
 constexpr std::array<std::string_view, 5> suiteKeys{"alpha", "pooled_alpha", "min_pass", "max_slowdown", "seed"};
-constexpr std::array<std::string_view, 10> caseKeys{"name", "scene", "reference", "reference_source", "reference_spp",
-                                                    "spp",  "width", "height",    "baseline_seconds", "max_rejected"};
+constexpr std::array<std::string_view, 11> caseKeys{"name",  "scene",  "reference",        "reference_source",
+                                                    "reference_spp", "spp", "width", "height", "baseline_seconds",
+                                                    "max_rejected",  "shards"};
 
 constexpr std::array<EnumName<ReferenceSource>, 2> referenceSources{
     {{"mitsuba", ReferenceSource::Mitsuba}, {"vkrt", ReferenceSource::Vkrt}}};
@@ -73,6 +74,10 @@ RegressionCase readCase(const TableField& table)
     c.height = readOr(table, "height", c.height, readSide);
     c.baselineSeconds = readOr(table, "baseline_seconds", c.baselineSeconds, readPositive);
     c.maxRejected = readOr(table, "max_rejected", c.maxRejected, readTolerance);
+    c.shards = readOr(table, "shards", c.shards, readCount);
+    if (c.shards > c.spp)
+        table.require("shards").fail(std::to_string(c.shards) + " shards of " + std::to_string(c.spp) +
+                                     " spp would leave some without samples; use at most spp shards");
     return c;
 }
 

@@ -21,6 +21,7 @@ struct RegressionCase {
     std::optional<uint32_t> width, height;
     double baselineSeconds = 0.0; ///< 0: no timing check
     uint64_t maxRejected = 0;     ///< non-finite samples tolerated (known bugs only)
+    uint32_t shards = 1;          ///< >1: rendered as that many shards, merged (docs/farm.md)
 };
 
 struct RegressionSuite {

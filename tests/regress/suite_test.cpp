@@ -79,7 +79,7 @@ TEST_F(SuiteFile, ValidManifestWithDefaultsAndResolvedPaths)
     const RegressionSuite suite =
         readRegressionSuite(write("[suite]\nalpha = 0.05\nmin_pass = 1\nseed = 0\n" +
                                   caseText("a", "width = 32\nheight = 24\nmax_rejected = 3\n") +
-                                  caseText("b", "baseline_seconds = 2\n", "mitsuba")));
+                                  caseText("b", "baseline_seconds = 2\nshards = 4\n", "mitsuba")));
     EXPECT_DOUBLE_EQ(suite.alpha, 0.05);
     EXPECT_DOUBLE_EQ(suite.pooledAlpha, 0.001);
     EXPECT_DOUBLE_EQ(suite.minPass, 1.0);
@@ -95,6 +95,8 @@ TEST_F(SuiteFile, ValidManifestWithDefaultsAndResolvedPaths)
     EXPECT_EQ(a.width, 32u);
     EXPECT_EQ(a.height, 24u);
     EXPECT_EQ(a.maxRejected, 3u);
+    EXPECT_EQ(a.shards, 1u);
+    EXPECT_EQ(suite.cases[1].shards, 4u);
     EXPECT_EQ(suite.cases[1].source, ReferenceSource::Mitsuba);
     EXPECT_DOUBLE_EQ(suite.cases[1].baselineSeconds, 2.0);
     EXPECT_FALSE(suite.cases[1].width.has_value());
@@ -135,6 +137,9 @@ TEST_F(SuiteFile, OutOfRangeValuesNameTheRange)
     expectError("[suite]\nseed = -1\n" + caseText(), 2, 8, "suite.seed: must be between 0 and 4294967295, got -1");
     expectError(caseText("a", "width = 0\n"), 8, 9, "case[0].width: must be between 1 and 4294967295, got 0");
     expectError(caseText("a", "baseline_seconds = -2\n"), 8, 20, "case[0].baseline_seconds: must be > 0, got -2");
+    expectError(caseText("a", "shards = 0\n"), 8, 10, "case[0].shards: must be between 1 and 4294967295, got 0");
+    expectError(caseText("a", "shards = 33\n"), 8, 10,
+                "case[0].shards: 33 shards of 32 spp would leave some without samples; use at most spp shards");
 }
 
 TEST_F(SuiteFile, ReferenceSourceIsAChoice)
