@@ -34,7 +34,7 @@ elapsed() { awk "BEGIN { printf \"%.3f\", $(now) - $1 }"; }
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 startup_of() { sed -n 's/.*(start-up \([0-9.]*\) s.*/\1/p' "$1"; }
 
-echo "# vkrt farm figures, $(date -u +%Y-%m-%d), $(nproc) cores, $("$VKRT" devices 2>/dev/null | sed -n 's/^ *0: *//p' | head -n 1)"
+echo "# vkrt farm figures, $(date -u +%Y-%m-%d), $(nproc) cores, $("$VKRT" devices 2>/dev/null | sed -n 's/^[* ]*0: *//p' | head -n 1)"
 echo
 echo "scene $(realpath --relative-to="$root" "$scene"), ${size[1]}x${size[3]}, medians of $repeats"
 echo

@@ -159,17 +159,20 @@ int runMerge(const MergeOptions& options)
     if (!missing.empty() && !options.allowMissing)
         throw InputError("vkrt merge: samples " + joined(missing, ", ") + " of " + std::to_string(total) +
                          " are in no shard given (merge them too, or pass --allow-missing)");
+    const bool shardsHaveVariance = shards.front().exr.layers.count("variance") != 0;
     std::vector<Tally> tallies;
     int64_t spp = 0;
-    for (const Shard& s : shards) {
+    for (Shard& s : shards) {
         tallies.push_back(readTally(s.exr, s.file));
         spp += s.end - s.begin;
+        s.exr.layers.clear(); // only the tally is needed from here on: a 4K shard's layers are ~0.5 GB
+        s.exr.image = Image();
     }
     const Tally merged = mergeTallies(tallies);
     std::map<std::string, Image> layers;
     addTallyLayers(merged, layers);
     const std::optional<Image> variance = tallyVarianceOfMean(merged);
-    if (variance && (options.variance || shards.front().exr.layers.count("variance"))) layers["variance"] = *variance;
+    if (variance && (options.variance || shardsHaveVariance)) layers["variance"] = *variance;
     Metadata metadata = mergedMetadata(shards, spp, missing);
     writeExr(options.output, tallyMean(merged), metadata, layers);
     std::fprintf(stderr, "merged %zu shards, %lld of %lld spp%s -> %s\n", shards.size(),

@@ -11,8 +11,11 @@
 #include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 
+#include <algorithm>
 #include <climits>
+#include <thread>
 
 namespace vkrt {
 
@@ -60,22 +63,31 @@ Metadata readAttributes(const Imf::Header& header)
     return metadata;
 }
 
-Image readLayer(Imf::InputFile& file, const std::string& layer, const std::filesystem::path& path)
+/// Points `frame` at `image` (already sized to the data window) for layer `layer`.
+void addReadSlices(Imf::FrameBuffer& frame, const Imf::Header& header, const std::string& layer, Image& image,
+                   const std::filesystem::path& path)
 {
-    const Imath::Box2i window = file.header().dataWindow();
-    Image image(uint32_t(window.max.x - window.min.x + 1), uint32_t(window.max.y - window.min.y + 1));
-    Imf::FrameBuffer frame;
+    const Imath::Box2i window = header.dataWindow();
     for (int c = 0; c < 3; ++c) {
-        if (!file.header().channels().findChannel(channelName(layer, c)))
+        if (!header.channels().findChannel(channelName(layer, c)))
             throw InputError(path.string() + ": no channel '" + channelName(layer, c) + "'");
         char* base = reinterpret_cast<char*>(image.rgb.data() + c) -
                      (size_t(window.min.x) + size_t(window.min.y) * image.width) * sizeof(float) * 3;
         frame.insert(channelName(layer, c),
                      Imf::Slice(Imf::FLOAT, base, sizeof(float) * 3, sizeof(float) * 3 * image.width));
     }
-    file.setFrameBuffer(frame);
-    file.readPixels(window.min.y, window.max.y);
-    return image;
+}
+
+/// OpenEXR (de)compresses blocks of lines on its own thread pool, which is
+/// empty unless set: with it, a 4K shard with five layers reads and writes
+/// several times faster on a many-core node.
+void useEveryCoreForExr()
+{
+    static const bool done = [] {
+        Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+        return true;
+    }();
+    (void)done;
 }
 
 } // namespace
@@ -83,6 +95,7 @@ Image readLayer(Imf::InputFile& file, const std::string& layer, const std::files
 void writeExr(const std::filesystem::path& path, const Image& image, const Metadata& metadata,
               const std::map<std::string, Image>& layers)
 {
+    useEveryCoreForExr();
     writeFileAtomically(path, [&](const std::filesystem::path& temporary) {
         Imf::Header header(int(image.width), int(image.height));
         header.compression() = Imf::ZIP_COMPRESSION;
@@ -104,12 +117,23 @@ ExrContents readExr(const std::filesystem::path& path)
 {
     if (!std::filesystem::exists(path)) throw InputError(path.string() + ": no such file");
     try {
+        useEveryCoreForExr();
         Imf::InputFile file(path.c_str());
+        const Imath::Box2i window = file.header().dataWindow();
+        const auto width = uint32_t(window.max.x - window.min.x + 1), height = uint32_t(window.max.y - window.min.y + 1);
+        // Every layer in one pass: each compressed block holds all channels of its lines.
         ExrContents contents;
-        contents.image = readLayer(file, "", path);
+        Imf::FrameBuffer frame;
+        contents.image = Image(width, height);
+        addReadSlices(frame, file.header(), "", contents.image, path);
         std::set<std::string> layerNames;
         file.header().channels().layers(layerNames);
-        for (const auto& name : layerNames) contents.layers[name] = readLayer(file, name, path);
+        for (const auto& name : layerNames) {
+            Image& layer = contents.layers[name] = Image(width, height);
+            addReadSlices(frame, file.header(), name, layer, path);
+        }
+        file.setFrameBuffer(frame);
+        file.readPixels(window.min.y, window.max.y);
         contents.metadata = readAttributes(file.header());
         return contents;
     } catch (const InputError&) {
