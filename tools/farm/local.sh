@@ -21,13 +21,9 @@ usage() {
   echo "usage: tools/farm/local.sh SCENE --spp S --out DIR [--devices LIST] [--shards N] [--jobs J] [--seed K] [-- vkrt render options]" >&2
   exit 2
 }
-fail() {
-  echo "local.sh: error: $*" >&2
-  exit 2
-}
-whole_number() { [[ $1 =~ ^[0-9]+$ ]]; }
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$here/common.sh"
 scene="" spp="" out="" devices="" shards="" jobs="" seed=1
 extra=()
 while (($#)); do
@@ -55,10 +51,9 @@ if [[ -n $devices ]]; then
 fi
 shards=${shards:-${#device_list[@]}}
 jobs=${jobs:-${#device_list[@]}}
-whole_number "$spp" && ((10#$spp >= 1)) || fail "--spp $spp: expected a whole number of at least 1"
-whole_number "$shards" && ((10#$shards >= 1)) || fail "--shards $shards: expected a whole number of at least 1"
-whole_number "$jobs" && ((10#$jobs >= 1)) || fail "--jobs $jobs: expected a whole number of at least 1"
-spp=$((10#$spp)) shards=$((10#$shards)) jobs=$((10#$jobs))
+spp=$(count --spp "$spp")
+shards=$(count --shards "$shards")
+jobs=$(count --jobs "$jobs")
 ((shards <= spp)) || fail "--shards $shards of --spp $spp would leave some shards without samples"
 ((jobs <= shards)) || jobs=$shards
 

@@ -16,12 +16,9 @@ usage() {
   echo "usage: tools/farm/merge.sh --shards N --out DIR [-o FRAME.exr] [--allow-missing]" >&2
   exit 2
 }
-fail() {
-  echo "merge.sh: error: $*" >&2
-  exit 2
-}
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$here/common.sh"
 shards="" out="" frame="" allow_missing=false
 while (($#)); do
   case $1 in
@@ -35,8 +32,7 @@ while (($#)); do
   esac
 done
 [[ -n $shards && -n $out ]] || usage
-[[ $shards =~ ^[0-9]+$ ]] && ((10#$shards > 0)) || fail "--shards $shards: expected a whole number of at least 1"
-shards=$((10#$shards))
+shards=$(count --shards "$shards")
 frame=${frame:-$out/frame.exr}
 
 vkrt=${VKRT:-$here/../../build/vkrt}

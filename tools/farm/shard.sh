@@ -20,13 +20,9 @@ usage() {
   echo "usage: tools/farm/shard.sh SCENE --shards N --spp S --out DIR [--index I] [--seed K] [--device D] [-- vkrt render options]" >&2
   exit 2
 }
-fail() {
-  echo "shard.sh: error: $*" >&2
-  exit 2
-}
-whole_number() { [[ $1 =~ ^[0-9]+$ ]]; }
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$here/common.sh"
 scene="" shards="" spp="" out="" index="" seed=1 device=""
 extra=()
 while (($#)); do
@@ -54,7 +50,7 @@ if [[ -z $index ]]; then
 else
   index_from="--index"
 fi
-whole_number "$shards" && ((shards > 0)) || fail "--shards $shards: expected a whole number of at least 1"
+shards=$(count --shards "$shards")
 whole_number "$index" && ((10#$index < shards)) ||
   fail "$index_from = '$index': expected a shard index 0 ... $((shards - 1)) for --shards $shards"
 index=$((10#$index))

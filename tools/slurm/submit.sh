@@ -31,14 +31,10 @@ usage() {
     "[--sbatch-arg ARG]... [--no-check] [--wait] [-- vkrt render options]  (options: the comment at its top)" >&2
   exit 2
 }
-fail() {
-  echo "submit.sh: error: $*" >&2
-  exit 2
-}
-whole_number() { [[ $1 =~ ^[0-9]+$ ]]; }
 
 slurm_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 farm_dir=$(cd "$slurm_dir/../farm" && pwd)
+source "$farm_dir/common.sh"
 scene="" shards="" spp="" out="" seed=1 tasks="" check=true wait=false
 sbatch_args=() extra=()
 while (($#)); do
@@ -62,9 +58,8 @@ done
 
 # ---- checks before anything is submitted
 [[ -f $scene ]] || fail "scene $scene: no such file"
-whole_number "$shards" && ((10#$shards >= 1)) || fail "--shards $shards: expected a whole number of at least 1"
-whole_number "$spp" && ((10#$spp >= 1)) || fail "--spp $spp: expected a whole number of at least 1"
-shards=$((10#$shards)) spp=$((10#$spp))
+shards=$(count --shards "$shards")
+spp=$(count --spp "$spp")
 ((shards <= spp)) || fail "--shards $shards of --spp $spp would leave some shards without samples; use at most --spp shards"
 whole_number "$seed" || fail "--seed $seed: expected a whole number"
 array=0-$((shards - 1))
