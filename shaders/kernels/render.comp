@@ -1,4 +1,4 @@
-// One dispatch adds one sample per pixel to the accumulation buffer.
+// One dispatch adds one or more samples per pixel to the accumulation buffer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
@@ -47,31 +47,35 @@ uvec2 scatteredPixel()
 
 // A capping driver counts the loop passes of a whole subgroup, and a pass
 // runs while any lane needs it: the lanes' sum bounds the group's count.
-void reportLoopIterations()
+// maxLoopIterations reports the longest single sample.
+void reportLoopIterations(uint longestSample)
 {
 #ifdef VKRT_GROUP_LOOP_COUNT
     uint count = subgroupAdd(g_loopIterations);
 #else
     uint count = g_loopIterations;
 #endif
-    atomicMax(stats.maxLoopIterations, count);
+    atomicMax(stats.maxLoopIterations, longestSample);
     if (count >= LOOP_BUDGET)
         atomicAdd(stats.budgetExceeded, 1u);
 }
 
-void main()
+Ray cameraSample(uvec2 pixel, inout Sampler rng)
 {
-    uvec2 pixel = scatteredPixel();
-    if (pixel.x >= u.width || pixel.y >= u.height)
-        return;
-    uint pixelIndex = pixel.y * u.width + pixel.x;
-    uint frameIndex = frame.firstFrame + gl_WorkGroupID.z; // shared/SceneTypes.h: FrameConstants
-    Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? sampleNext2D(rng) : vec2(0.5);
-#ifdef VKRT_INTEGRATOR_PATH
-    vec3 radiance = tracePath(cameraRay(pixel, subpixel), rng);
-#else
-    vec3 radiance = traceWhitted(cameraRay(pixel, subpixel), rng);
+    return cameraRay(pixel, subpixel);
+}
+
+// Measurement hook (path integrator): a sample's radiance becomes the number
+// of path segments it traced, for tools/lane_occupancy.py.
+uint g_segmentsOfSample = 0u;
+
+// The test and measurement hooks replace a finished sample's radiance.
+vec3 testedSample(vec3 radiance, uint pixelIndex, uint frameIndex)
+{
+#ifdef VKRT_MEASURE_SEGMENTS
+    radiance = vec3(float(g_segmentsOfSample));
+    g_segmentsOfSample = 0u;
 #endif
 #ifdef VKRT_TEST_ALTERNATING_SAMPLES
     // Test hook: samples alternate between OFFSET and OFFSET + 1 frame by frame.
@@ -89,6 +93,54 @@ void main()
     if (pixelIndex % 7u == 0u)
         radiance = vec3(uintBitsToFloat(0x7fc00000u));
 #endif
-    accumulateSample(pixelIndex, frameIndex, radiance);
-    reportLoopIterations();
+    return radiance;
+}
+
+// One invocation adds frames [frameIndex, frameEnd) of its pixel (FrameRun),
+// in order, so the sums are the same as one frame per dispatch would give.
+void main()
+{
+    uvec2 pixel = scatteredPixel();
+    if (pixel.x >= u.width || pixel.y >= u.height)
+        return;
+    uint pixelIndex = pixel.y * u.width + pixel.x;
+    uint frameIndex = frame.firstFrame + gl_WorkGroupID.z * run.framesPerInvocation; // shared/SceneTypes.h
+    uint frameEnd = min(frameIndex + run.framesPerInvocation, run.frameEnd);
+    if (frameIndex >= frameEnd)
+        return;
+    AccumPixel sum = accum[pixelIndex];
+    uint sampleStart = 0u, longestSample = 0u;
+    Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
+#ifdef VKRT_INTEGRATOR_PATH
+    // Path regeneration (Novak et al. 2010): 8 lanes run in lockstep, so a
+    // lane whose path has ended starts its next sample at once instead of
+    // idling until the group's longest path ends.
+    PathTracer path = startPath(cameraSample(pixel, rng));
+    for (;;) {
+#ifdef VKRT_MEASURE_SEGMENTS
+        ++g_segmentsOfSample;
+#endif
+        if (advancePath(path, rng))
+            continue;
+        accumulateSample(sum, pixelIndex, frameIndex, testedSample(path.path.radiance, pixelIndex, frameIndex));
+        longestSample = max(longestSample, g_loopIterations - sampleStart);
+        sampleStart = g_loopIterations;
+        if (++frameIndex == frameEnd)
+            break;
+        rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
+        path = startPath(cameraSample(pixel, rng));
+    }
+#else
+    for (;;) {
+        vec3 radiance = traceWhitted(cameraSample(pixel, rng), rng);
+        accumulateSample(sum, pixelIndex, frameIndex, testedSample(radiance, pixelIndex, frameIndex));
+        longestSample = max(longestSample, g_loopIterations - sampleStart);
+        sampleStart = g_loopIterations;
+        if (++frameIndex == frameEnd)
+            break;
+        rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
+    }
+#endif
+    accum[pixelIndex] = sum;
+    reportLoopIterations(longestSample);
 }

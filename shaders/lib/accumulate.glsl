@@ -47,15 +47,14 @@ void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
 }
 #endif
 
-// Adds one sample to the pixel's running sum (and its variance estimate).
-// Non-finite samples are dropped; the host counts them as frames - count.
-void accumulateSample(uint pixelIndex, uint frameIndex, vec3 value)
+// Adds one sample to the pixel's running sum `p` (which the caller stores)
+// and to its variance estimate. Non-finite samples are dropped; the host
+// counts them as frames - count.
+void accumulateSample(inout AccumPixel p, uint pixelIndex, uint frameIndex, vec3 value)
 {
     if (any(isnan(value)) || any(isinf(value)))
         return;
-    AccumPixel p = accum[pixelIndex];
     addCompensated(p, value);
-    accum[pixelIndex] = p;
 #ifdef VKRT_VARIANCE
     accumulateMoments(pixelIndex, frameIndex, value, p.count);
 #endif

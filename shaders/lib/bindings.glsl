@@ -11,6 +11,7 @@ layout(scalar, binding = BINDING_UNIFORMS) uniform UniformBlock { SceneUniforms 
 layout(scalar, binding = BINDING_ACCUMULATION) buffer AccumBlock { AccumPixel accum[]; };
 layout(scalar, binding = BINDING_STATS) buffer StatsBlock { RenderStats stats; };
 layout(push_constant, scalar) uniform PushBlock { FrameConstants frame; };
+layout(scalar, binding = BINDING_FRAME_RUN) readonly buffer FrameRunBlock { FrameRun run; };
 #if defined(VKRT_VARIANCE) && defined(VKRT_SAMPLER_SOBOL)
 // One compensated sum per pixel and batch (pixel-major), lib/accumulate.glsl.
 layout(scalar, binding = BINDING_MOMENTS) buffer BatchBlock { AccumPixel batchSums[]; };

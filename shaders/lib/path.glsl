@@ -104,63 +104,87 @@ bool survivesRoulette(inout PathVertexState path, uint depth, float u)
     return true;
 }
 
-vec3 tracePath(Ray ray, inout Sampler rng)
+// A path under way: its state between two segments, so that a kernel can
+// advance one segment at a time and start a lane's next sample as soon as its
+// path ends (render.comp: path regeneration).
+struct PathTracer {
+    PathVertexState path;
+    Ray ray;     // the next segment to trace
+    uint depth;  // surface interactions so far + 1
+#ifdef VKRT_HAS_TEXTURES
+    float pathLength; // from the camera, for the textures' ray cones
+#endif
+};
+
+PathTracer startPath(Ray cameraRay)
 {
-    PathVertexState path = PathVertexState(vec3(0.0), vec3(1.0), cameraMedia(), true, 0.0);
+    PathTracer p;
+    p.path = PathVertexState(vec3(0.0), vec3(1.0), cameraMedia(), true, 0.0);
+    p.ray = cameraRay;
+    p.depth = 1u;
 #ifdef VKRT_HAS_TEXTURES
-    float pathLength = 0.0; // from the camera, for the textures' ray cones
+    p.pathLength = 0.0;
 #endif
-    for (uint depth = 1u; depth <= u.maxDepth + 1u; ++depth) {
-        ++g_loopIterations;
-        SurfaceHit hit;
-        bool missed = !traceClosest(ray, FLT_MAX, hit);
-        path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
-        if (missed) {
-            path.radiance += path.throughput * environmentOnEscape(path, ray.dir);
-            break;
-        }
-        if (hitsLight(hit)) {
-            path.radiance += path.throughput * emissionOnHit(path, ray, hit);
-            break;
-        }
-#ifdef VKRT_HAS_EMITTERS
-        if (hit.emitter != NO_EMITTER)
-            path.radiance += path.throughput * emitterOnHit(path, ray, hit);
-#endif
-        if (depth == u.maxDepth + 1u)
-            break; // a light or the sky could still end this path, a surface cannot
-#ifdef VKRT_HAS_MATERIALS
-        Material m = materials[hit.material];
-#ifdef VKRT_HAS_TEXTURES
-        pathLength += hit.t;
-        m = texturedMaterial(m, hit, ray.dir, pathLength);
-#endif
-        vec3 n = hit.front ? hit.normal : -hit.normal;
-        vec3 ns = shadingSide(hit, n);
-        vec3 wo = -ray.dir;
-#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
-        m = withInterfaceEta(m, surfaceEta(path.media, hit)); // its eval and pdf need the crossing's eta
-#endif
-        if (!scattersIntoDeltasOnly(m)) {
-            path.radiance += path.throughput * (directFromLightsOneShadowRay(m, hit, n, ns, wo, path.media, rng) +
-                                                directFromEnvironment(m, hit, n, ns, wo, path.media, rng));
-        }
-        vec4 u4 = sampleNext4D(rng);
-        float eta = surfaceEta(path.media, hit);
-        BsdfSample s = sampleBsdf(m, ns, wo, eta, u4.xyz);
-        if (s.weight == vec3(0.0))
-            break;
-        path.throughput *= s.weight;
-        path.specular = s.specular;
-        path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
-        if (s.transmitted)
-            path.media = crossInterface(path.media, hit.material, hit.front);
-        if (!survivesRoulette(path, depth, u4.w))
-            break;
-        ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);
-#endif
+    return p;
+}
+
+// Traces the path's next segment, adds what it finds and scatters; false
+// once the path has ended (p.path.radiance is then its sample).
+bool advancePath(inout PathTracer p, inout Sampler rng)
+{
+    ++g_loopIterations;
+    SurfaceHit hit;
+    bool missed = !traceClosest(p.ray, FLT_MAX, hit);
+    p.path.throughput *= beerLambert(mediumAbsorption(p.path.media), missed ? FLT_MAX : hit.t);
+    if (missed) {
+        p.path.radiance += p.path.throughput * environmentOnEscape(p.path, p.ray.dir);
+        return false;
     }
-    return path.radiance;
+    if (hitsLight(hit)) {
+        p.path.radiance += p.path.throughput * emissionOnHit(p.path, p.ray, hit);
+        return false;
+    }
+#ifdef VKRT_HAS_EMITTERS
+    if (hit.emitter != NO_EMITTER)
+        p.path.radiance += p.path.throughput * emitterOnHit(p.path, p.ray, hit);
+#endif
+    if (p.depth == u.maxDepth + 1u)
+        return false; // a light or the sky could still end this path, a surface cannot
+#ifdef VKRT_HAS_MATERIALS
+    Material m = materials[hit.material];
+#ifdef VKRT_HAS_TEXTURES
+    p.pathLength += hit.t;
+    m = texturedMaterial(m, hit, p.ray.dir, p.pathLength);
+#endif
+    vec3 n = hit.front ? hit.normal : -hit.normal;
+    vec3 ns = shadingSide(hit, n);
+    vec3 wo = -p.ray.dir;
+#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
+    m = withInterfaceEta(m, surfaceEta(p.path.media, hit)); // its eval and pdf need the crossing's eta
+#endif
+    if (!scattersIntoDeltasOnly(m)) {
+        p.path.radiance += p.path.throughput * (directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng) +
+                                                directFromEnvironment(m, hit, n, ns, wo, p.path.media, rng));
+    }
+    vec4 u4 = sampleNext4D(rng);
+    float eta = surfaceEta(p.path.media, hit);
+    BsdfSample s = sampleBsdf(m, ns, wo, eta, u4.xyz);
+    if (s.weight == vec3(0.0))
+        return false;
+    p.path.throughput *= s.weight;
+    p.path.specular = s.specular;
+    p.path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
+    if (s.transmitted)
+        p.path.media = crossInterface(p.path.media, hit.material, hit.front);
+    if (!survivesRoulette(p.path, p.depth, u4.w))
+        return false;
+    p.ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);
+    ++p.depth;
+    return true;
+#else
+    ++p.depth;
+    return p.depth <= u.maxDepth + 1u;
+#endif
 }
 
 #endif

@@ -49,7 +49,9 @@ VKRT_CONSTANT(uint, BINDING_MATERIAL_TEXTURES, BINDING_ENVIRONMENT + 12)
 VKRT_CONSTANT(uint, BINDING_MESH_UVS, BINDING_ENVIRONMENT + 13)
 VKRT_CONSTANT(uint, BINDING_MESH_TANGENTS, BINDING_ENVIRONMENT + 14)
 VKRT_CONSTANT(uint, BINDING_MESH_MATERIALS, BINDING_ENVIRONMENT + 15)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 16)
+// FrameRun: which frames the dispatches of the current run add.
+VKRT_CONSTANT(uint, BINDING_FRAME_RUN, BINDING_ENVIRONMENT + 16)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 17)
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);
 // the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).

@@ -237,6 +237,18 @@ struct FrameConstants {
     uint seed;
 };
 
+/// The frames a run of dispatches adds (a storage buffer written before each
+/// run): dispatch z adds, to every pixel, frames firstFrame + z * S up to
+/// min(firstFrame + (z + 1) * S, frameEnd), S = framesPerInvocation, one
+/// invocation per pixel running them back to back (render.comp: a lane whose
+/// path ends starts its next sample at once). A storage buffer and not push
+/// constants or uniforms, because lavapipe inlines those where they steer
+/// control flow and compiles the kernel again for every new value.
+struct FrameRun {
+    uint framesPerInvocation;
+    uint frameEnd;
+};
+
 /// One pixel's running sum: Kahan-compensated, over `count` accepted samples.
 struct AccumPixel {
     vec3 sum;

@@ -1,7 +1,11 @@
 #pragma once
 // Subcommands of the vkrt executable. Each registers its options on the CLI11
 // app and returns the function that runs it (returning the exit code).
+#include "gpu/ShaderCompiler.h"
+
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -18,6 +22,10 @@ CommandRunner addCompareCommand(CLI::App& app);
 CommandRunner addMergeCommand(CLI::App& app);
 CommandRunner addViewCommand(CLI::App& app);
 CommandRunner addRegressCommand(CLI::App& app);
+
+/// NAME=VALUE texts of --kernel-define (the kernels' test and measurement
+/// hooks) as defines; InputError names a malformed one.
+std::vector<Define> parseKernelDefines(const std::vector<std::string>& texts);
 
 /// Process exit codes.
 enum ExitCode : int {

@@ -27,11 +27,7 @@ CommandRunner addRegressCommand(CLI::App& app)
     cmd->add_flag("--fail-on-slowdown", o->failOnSlowdown, "Fail cases slower than baseline x max_slowdown");
     cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");
     return [o, defines] {
-        for (const std::string& d : *defines) {
-            auto eq = d.find('=');
-            if (eq == std::string::npos || eq == 0) throw InputError("--kernel-define " + d + ": expected NAME=VALUE");
-            o->kernelDefines.emplace_back(d.substr(0, eq), d.substr(eq + 1));
-        }
+        o->kernelDefines = parseKernelDefines(*defines);
         return exitCodeFor(runRegression(*o));
     };
 }

@@ -45,6 +45,8 @@ struct RenderCommandOptions {
     bool sppGiven = false;
     std::string sampler = "auto";
     std::string shard; ///< "i/n" (docs/farm.md)
+    uint32_t samplesPerInvocation = 0; ///< 0: the device's default
+    std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
@@ -100,6 +102,8 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
 {
     SessionConfig config;
     config.seed = options.seed;
+    config.samplesPerInvocation = options.samplesPerInvocation;
+    config.extraDefines = parseKernelDefines(options.kernelDefines);
     if (shard) config.firstFrame = shard->begin;
     config.jitter = !options.pixelCenters;
     config.uber = options.uber;
@@ -279,6 +283,13 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--shard", options->shard,
                     "Render only shard i of n (0 <= i < n): samples [i S/n, (i+1) S/n) of --spp S, seeded as in one "
                     "run; `vkrt merge` adds the shards (docs/farm.md)");
+    cmd->add_option("--samples-per-invocation", options->samplesPerInvocation,
+                    "Samples one shader invocation renders back to back per dispatch (default 8, 1 on Mesa 22's "
+                    "lavapipe); a tuning knob, the image does not depend on it")
+        ->check(CLI::Range(1u, 64u));
+    cmd->add_option("--kernel-define", options->kernelDefines,
+                    "NAME=VALUE define for the kernel (test and measurement hooks, e.g. tools/lane_occupancy.py)")
+        ->group("");
     return [options] { return exitCodeFor(runRender(*options)); };
 }
 

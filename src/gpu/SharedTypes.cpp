@@ -39,7 +39,7 @@ constexpr bool bindingsDistinct()
                               BINDING_MESH_NORMALS, BINDING_TOP_NODES,     BINDING_TOP_REFS,      BINDING_EMITTERS,
                               BINDING_MATERIAL_TABLES, BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
                               BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS, BINDING_MESH_TANGENTS,
-                              BINDING_MESH_MATERIALS};
+                              BINDING_MESH_MATERIALS, BINDING_FRAME_RUN};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -55,6 +55,7 @@ static_assert(sizeof(SceneUniforms) == 104 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_
               "SceneUniforms holds one count per shape and light kind");
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
+static_assert(sizeof(FrameRun) == 8);
 static_assert(sizeof(BvhNode) == 32);
 static_assert(sizeof(MeshTriangle) == 36);
 static_assert(sizeof(MeshNormals) == 36);

@@ -122,7 +122,8 @@ std::vector<std::pair<std::string, std::string>> KernelVariant::defines() const
 
 std::vector<uint32_t> KernelVariant::bindings() const
 {
-    std::vector<uint32_t> result = {gpu::BINDING_UNIFORMS, gpu::BINDING_ACCUMULATION, gpu::BINDING_STATS};
+    std::vector<uint32_t> result = {gpu::BINDING_UNIFORMS, gpu::BINDING_ACCUMULATION, gpu::BINDING_STATS,
+                                   gpu::BINDING_FRAME_RUN};
     if (features.anyPrimitive()) result.push_back(gpu::BINDING_MATERIALS);
     for (const auto& feature : optionalFeatures(*this))
         if (feature.on && feature.binding >= 0) result.push_back(uint32_t(feature.binding));

@@ -52,6 +52,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     RenderOptions options;
     options.seed = config.seed;
     options.firstFrame = config.firstFrame;
+    options.samplesPerInvocation = config.samplesPerInvocation;
     options.jitter = config.jitter;
     options.uber = config.uber;
     options.variance = config.variance.any();

@@ -56,6 +56,7 @@ Scene loadScene(const std::string& path, const ResolutionOverride& resolution = 
 struct SessionConfig {
     uint32_t seed = 0;
     uint32_t firstFrame = 0; ///< the first sample index rendered (a shard's start; docs/farm.md)
+    uint32_t samplesPerInvocation = 0; ///< RenderOptions::samplesPerInvocation
     bool jitter = true;
     bool uber = false;
     bool warmUp = true; ///< render and discard a frame first, so timing excludes the driver's shader compile

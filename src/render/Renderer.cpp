@@ -195,6 +195,8 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
+      m_frameRun(context, sizeof(gpu::FrameRun), kStorage | vk::BufferUsageFlagBits::eTransferDst,
+                 MemoryUse::Device),
       m_kernel(context, m_compiled.spirv, checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants)),
       m_cubemap(scene.background.cubemap)
 {
@@ -211,6 +213,8 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     }
     m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
+    m_kernel.bind(gpu::BINDING_FRAME_RUN, m_frameRun);
+    if (m_options.samplesPerInvocation == 0) m_options.samplesPerInvocation = samplesPerInvocationFor(context.loopCap());
     if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
     bindEnvironment();
     uploadMeshBuffers();
@@ -300,17 +304,41 @@ void Renderer::moveCamera(const Camera& camera)
     reset();
 }
 
-// One bind and push per run of frames; frame i of the run is the dispatch
-// with base workgroup z = i (shared/SceneTypes.h: FrameConstants).
+uint32_t samplesPerInvocationFor(const LoopCap& cap)
+{
+    // 8 measured best of 1, 2, 4, 8 and 16 on the validation scenes
+    // (docs/performance.md, path regeneration).
+    return cap.capped() ? 1 : 8;
+}
+
+// Makes the next dispatches add `run`'s frames (shared/SceneTypes.h: FrameRun).
+void Renderer::recordFrameRun(vk::CommandBuffer cmd, const gpu::FrameRun& run) const
+{
+    // The previous run's dispatches read what this update overwrites.
+    vk::MemoryBarrier before(vk::AccessFlagBits::eShaderRead, vk::AccessFlagBits::eTransferWrite);
+    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer, {}, before,
+                        nullptr, nullptr);
+    cmd.updateBuffer(m_frameRun.handle(), 0, sizeof run, &run);
+    vk::MemoryBarrier after(vk::AccessFlagBits::eTransferWrite, vk::AccessFlagBits::eShaderRead);
+    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, after,
+                        nullptr, nullptr);
+}
+
+// One bind and push per run of frames; dispatch i of the run (base workgroup
+// z = i) adds frames firstFrame + i * S onwards, S per invocation
+// (shared/SceneTypes.h: FrameConstants, FrameRun).
 void Renderer::recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const
 {
+    uint32_t perInvocation = m_options.samplesPerInvocation;
+    recordFrameRun(cmd, gpu::FrameRun{perInvocation, firstFrame + count});
     gpu::FrameConstants constants{firstFrame, m_options.seed};
     uint32_t tilesX = (width() + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
     uint32_t tilesY = (height() + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
     m_kernel.recordBind(cmd, bytesOf(constants));
-    for (uint32_t i = 0; i < count; ++i) {
+    uint32_t dispatches = (count + perInvocation - 1) / perInvocation;
+    for (uint32_t i = 0; i < dispatches; ++i) {
         m_kernel.recordDispatchAt(cmd, i, vk::Extent2D(tilesX, tilesY));
-        // The next frame reads and writes the same accumulation pixels.
+        // The next dispatch reads and writes the same accumulation pixels.
         vk::MemoryBarrier barrier(vk::AccessFlagBits::eShaderWrite,
                                   vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
         cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
@@ -343,6 +371,7 @@ void Renderer::warmUp()
     VKRT_CHECK(m_frames == 0);
     // One workgroup is enough to make lavapipe compile the kernel.
     m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+        recordFrameRun(cmd, gpu::FrameRun{1, 1});
         m_kernel.recordBind(cmd, bytesOf(gpu::FrameConstants{0, m_options.seed}));
         m_kernel.recordDispatchAt(cmd, 0, vk::Extent2D(1, 1));
     });

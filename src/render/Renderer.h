@@ -1,6 +1,7 @@
 #pragma once
 // Progressive renderer: owns the kernel variant for a scene, its GPU buffers
 // and the accumulation buffer; each frame adds one sample per pixel.
+// A dispatch runs several frames per invocation (RenderOptions::samplesPerInvocation).
 #include "gpu/Buffer.h"
 #include "gpu/ComputeKernel.h"
 #include "gpu/CubeTexture.h"
@@ -24,6 +25,10 @@ struct RenderOptions {
     bool sobol = false;               ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
     bool storageScene = false;        ///< scene arrays in storage buffers even when they fit uniform ones
     uint32_t firstFrame = 0;          ///< index of the first frame (sample) rendered: a shard's start
+    /// Frames one invocation runs back to back per dispatch (path
+    /// regeneration); 0: the device's default (samplesPerInvocationFor).
+    /// The image does not depend on it.
+    uint32_t samplesPerInvocation = 0;
     std::vector<Define> extraDefines; ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
@@ -39,7 +44,7 @@ class Renderer {
 public:
     Renderer(const VulkanContext& context, const Scene& scene, RenderOptions options);
 
-    /// Adds `frames` samples per pixel (one dispatch each, one submission) and waits.
+    /// Adds `frames` samples per pixel (in one submission) and waits.
     void renderFrames(uint32_t frames);
     /// Renders and discards one frame, so that the driver's own shader
     /// compilation (lavapipe compiles at the first dispatch) happens now and
@@ -91,6 +96,7 @@ private:
     std::vector<Buffer> m_sceneBuffers;
     Buffer m_accumulation;
     Buffer m_stats;
+    Buffer m_frameRun; ///< gpu::FrameRun of the run being dispatched
     std::optional<Buffer> m_moments;
     ComputeKernel m_kernel;
     std::optional<Cubemap> m_cubemap;
@@ -106,11 +112,19 @@ private:
     void uploadSceneBuffers();
     void uploadMeshBuffers();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
+    void recordFrameRun(vk::CommandBuffer cmd, const gpu::FrameRun& run) const;
 };
 
 /// Bytes per pixel of the variance estimate's buffer: Welford moments, or
 /// under the Sobol' sampler one compensated sum per batch.
 size_t varianceBytesPerPixel(bool sobol);
+
+/// Samples per invocation and dispatch when RenderOptions leaves it at 0:
+/// several, so that lanes whose paths end early start their next sample
+/// (docs/performance.md), but one on a device that caps an invocation's loop
+/// passes in total (Mesa 22 lavapipe), where several samples would share one
+/// budget.
+uint32_t samplesPerInvocationFor(const LoopCap& cap);
 
 /// Worst-case loop iterations one invocation of the scene's kernel can run.
 uint64_t worstCaseLoopIterations(const Scene& scene);
