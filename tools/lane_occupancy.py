@@ -28,6 +28,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import tomllib
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
@@ -93,6 +94,10 @@ def main():
         for scene in scenes:
             if not scene.is_file():
                 sys.exit(f"lane_occupancy: error: {scene}: no such scene file")
+            integrator = tomllib.loads(scene.read_text()).get("render", {}).get("integrator", "whitted")
+            if integrator != "path":
+                sys.exit(f"lane_occupancy: error: {scene}: integrator {integrator}; only the path integrator "
+                         "regenerates paths (and has the segment hook)")
             for count in counts:
                 occupancy, per_sample = measure(args.vkrt, scene, count, args.seeds, (args.width, args.height),
                                                 workdir)
