@@ -284,7 +284,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "Render only shard i of n (0 <= i < n): samples [i S/n, (i+1) S/n) of --spp S, seeded as in one "
                     "run; `vkrt merge` adds the shards (docs/farm.md)");
     cmd->add_option("--samples-per-invocation", options->samplesPerInvocation,
-                    "Samples one shader invocation renders back to back per dispatch (default 8, 1 on Mesa 22's "
+                    "Samples one shader invocation renders back to back per dispatch (default 16, 1 on Mesa 22's "
                     "lavapipe); a tuning knob, the image does not depend on it")
         ->check(CLI::Range(1u, 64u));
     cmd->add_option("--kernel-define", options->kernelDefines,

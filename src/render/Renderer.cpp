@@ -306,9 +306,9 @@ void Renderer::moveCamera(const Camera& camera)
 
 uint32_t samplesPerInvocationFor(const LoopCap& cap)
 {
-    // 8 measured best of 1, 2, 4, 8 and 16 on the validation scenes
-    // (docs/performance.md, path regeneration).
-    return cap.capped() ? 1 : 8;
+    // Of 1, 4, 8, 16 and 32, 16 measured best on the validation scenes
+    // (docs/performance.md, "Path regeneration").
+    return cap.capped() ? 1 : 16;
 }
 
 // Makes the next dispatches add `run`'s frames (shared/SceneTypes.h: FrameRun).
