@@ -12,6 +12,11 @@ What a path tracer's sample costs is mostly its rays. This isolates them:
   description, and no shadow ray. Mrays/s = width x height x --spp / vkrt's
   own rendering time, median of --runs.
 
+* the device's own traversal (VK_KHR_ray_query, acceleration structures
+  built by the driver) on the same meshes, camera and ray count, through
+  vkrt-rayquery-bench (`cmake --build build --target vkrt-rayquery-bench`;
+  the column is left empty without it). It traces only the meshes.
+
 The ratio bounds what any change to the rest of the integrator can gain: a
 sample costs at least its rays.
 
@@ -76,6 +81,17 @@ def vkrt_mrays(vkrt, scene, args, work):
         copy.unlink(missing_ok=True)
 
 
+def rayquery_mrays(binary, scene, args):
+    if not binary or not os.access(binary, os.X_OK):
+        return None
+    result = subprocess.run([binary, str(scene), str(args.spp), str(args.runs), str(args.width), str(args.height)],
+                            capture_output=True, text=True)
+    match = re.search(r"([\d.]+) Mrays/s", result.stdout)
+    if result.returncode != 0 or not match:
+        sys.exit(f"bench_rays: error: {binary} on {scene}:\n{result.stdout}{result.stderr}")
+    return float(match.group(1))
+
+
 def mitsuba_mrays(scene, args, work):
     import drjit as dr
     import mitsuba as mi
@@ -113,6 +129,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenes", nargs="*", type=Path)
     parser.add_argument("--vkrt", default=os.environ.get("VKRT", str(REPO / "build" / "vkrt")))
+    parser.add_argument("--rayquery", default=str(REPO / "build" / "vkrt-rayquery-bench"),
+                        help="vkrt-rayquery-bench binary (default build/vkrt-rayquery-bench; skipped if absent)")
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--spp", type=int, default=16)
     parser.add_argument("--width", type=int, default=320)
@@ -130,15 +148,19 @@ def main():
     print(f"{args.width}x{args.height}, {args.spp} rays per pixel, medians of {args.runs}; Mitsuba {mi.__version__} "
           f"llvm_ad_rgb")
     print()
-    print("| scene | vkrt Mrays/s | Mitsuba Mrays/s | vkrt / Mitsuba |")
-    print("| --- | --- | --- | --- |")
+    print("| scene | vkrt Mrays/s | ray query Mrays/s | Mitsuba Mrays/s | vkrt / Mitsuba | ray query / vkrt |")
+    print("| --- | --- | --- | --- | --- | --- |")
     with tempfile.TemporaryDirectory() as work:
         for scene in scenes:
             if not scene.is_file():
                 sys.exit(f"bench_rays: error: {scene}: no such scene file")
             ours = vkrt_mrays(args.vkrt, scene.resolve(), args, work)
+            query = rayquery_mrays(args.rayquery, scene.resolve(), args)
             theirs = mitsuba_mrays(scene.resolve(), args, work)
-            print(f"| {scene.stem} | {ours:.2f} | {theirs:.2f} | {ours / theirs:.3f} |", flush=True)
+            query_text = f"{query:.2f} | " if query else "— | "
+            query_ratio = f"{query / ours:.3f}" if query else "—"
+            print(f"| {scene.stem} | {ours:.2f} | {query_text}{theirs:.2f} | {ours / theirs:.3f} | {query_ratio} |",
+                  flush=True)
 
 
 if __name__ == "__main__":
