@@ -11,6 +11,8 @@
 #include "texture/TextureImage.h"
 #include "util/Error.h"
 
+#include "texture/TextureTestFiles.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -25,13 +27,9 @@ using vkrt::test::put;
 using vkrt::test::triangleBuffer;
 using vkrt::test::triangleGltf;
 
-namespace {
+using vkrt::test::assetsDir;
 
-fs::path assetsDir()
-{
-    const char* override = std::getenv("VKRT_ASSETS_DIR");
-    return override && *override ? fs::path(override) : fs::path(VKRT_TEST_SOURCE_DIR) / ".." / "shared" / "assets";
-}
+namespace {
 
 fs::path cubeDir() { return assetsDir() / "gltf" / "Cube"; }
 

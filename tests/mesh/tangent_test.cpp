@@ -5,6 +5,8 @@
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 
+#include "texture/TextureTestFiles.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,13 +19,9 @@
 namespace fs = std::filesystem;
 using namespace vkrt;
 
-namespace {
+using vkrt::test::assetsDir;
 
-fs::path assetsDir()
-{
-    const char* override = std::getenv("VKRT_ASSETS_DIR");
-    return override && *override ? fs::path(override) : fs::path(VKRT_TEST_SOURCE_DIR) / ".." / "shared" / "assets";
-}
+namespace {
 
 /// An n x n grid of unit quads on z = 0 over [0, n]^2 with normals +z and uv = uvOf(x, y).
 template <typename UvOf>
