@@ -1,7 +1,8 @@
 // vkrt-rayquery-bench: closest-hit throughput of the device's own ray
-// traversal (VK_KHR_ray_query, acceleration structures built by the driver)
-// on a scene's meshes, to weigh against vkrt's own BVH traversal
-// (tools/bench_rays.py measures that on the same scenes and rays). An
+// traversal (VK_KHR_ray_query, acceleration structures built by the driver;
+// kernel tools/rayquery/closest_hits.comp) on a scene's meshes, to weigh
+// against vkrt's own BVH traversal (tools/bench_rays.py measures both on the
+// same scenes and rays). An
 // optional target: `cmake --build build --target vkrt-rayquery-bench`.
 //   vkrt-rayquery-bench SCENE.toml [SPP [RUNS [WIDTH HEIGHT]]]
 // Only the scene's meshes are built (one bottom-level structure per mesh,
