@@ -17,9 +17,21 @@ namespace {
 
 constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffer;
 
+/// Several samples per invocation would share one loop budget on a device
+/// that caps an invocation's loop passes in total: refused there.
+void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation)
+{
+    if (samplesPerInvocation > 1 && cap.capped())
+        throw InputError("--samples-per-invocation " + std::to_string(samplesPerInvocation) +
+                         ": this device ends every invocation's loops after " + std::to_string(*cap.budget) +
+                         " passes in total (" + cap.evidence +
+                         "), which several samples would share; use 1 (its default) or Mesa 25's lavapipe");
+}
+
 KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
-    checkLoopBudget(scene, context.loopCap()); // before any compilation or allocation
+    checkSamplesPerInvocation(context.loopCap(), options.samplesPerInvocation); // before any compilation
+    checkLoopBudget(scene, context.loopCap());                                   // or allocation
     KernelVariant variant;
     variant.features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     variant.variance = options.variance;

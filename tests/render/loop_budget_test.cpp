@@ -43,6 +43,26 @@ TEST_F(LoopBudget, DriverRuleAgreesWithTheProbe)
     }
 }
 
+// A capped device counts an invocation's loop passes in total, so several
+// samples per invocation would share one budget: refused there, by name.
+TEST_F(LoopBudget, SeveralSamplesPerInvocationAreRefusedWhereLoopsAreCapped)
+{
+    if (!gpu().loopCap().capped()) GTEST_SKIP() << "this device runs every loop to completion";
+    Scene scene = sceneFromText(manyLightsScene(8, 1, 1.0), "few-lights.toml");
+    RenderOptions options = pixelCentreOptions();
+    options.samplesPerInvocation = 4;
+    try {
+        Renderer renderer(gpu(), scene, options);
+        FAIL() << "4 samples per invocation were accepted on a capped device";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--samples-per-invocation 4"), std::string::npos) << e.what();
+    }
+    options.samplesPerInvocation = 1;
+    Renderer renderer(gpu(), scene, options);
+    renderer.renderFrames(2);
+    EXPECT_EQ(renderer.counters().budgetExceeded, 0u);
+}
+
 // 250 lights of intensity 1 at one point must light the plane exactly as one
 // light of intensity 250 does: a driver that cut the light loop short would
 // give a darker image, and a capped one must refuse the scene instead.
