@@ -67,6 +67,9 @@ struct HostBuffer {
     vk::DeviceAddress address = 0;
 };
 
+// Its own instance and device rather than gpu/VulkanContext: ray queries
+// need extensions and features (acceleration structures, buffer device
+// addresses) that the renderer never enables, and this probe alone uses.
 class Gpu {
 public:
     Gpu()

@@ -96,6 +96,24 @@ vec3 testedSample(vec3 radiance, uint pixelIndex, uint frameIndex)
     return radiance;
 }
 
+// The loop passes of the longest sample so far, and where the current one began.
+uint g_longestSample = 0u;
+uint g_sampleStart = 0u;
+
+// Adds frame frameIndex's finished sample to `sum` and moves to the next
+// frame, with its sampler; false after the invocation's last frame.
+bool finishSample(inout AccumPixel sum, uint pixelIndex, inout uint frameIndex, uint frameEnd, vec3 radiance,
+                  inout Sampler rng)
+{
+    accumulateSample(sum, pixelIndex, frameIndex, testedSample(radiance, pixelIndex, frameIndex));
+    g_longestSample = max(g_longestSample, g_loopIterations - g_sampleStart);
+    g_sampleStart = g_loopIterations;
+    if (++frameIndex == frameEnd)
+        return false;
+    rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
+    return true;
+}
+
 // One invocation adds frames [frameIndex, frameEnd) of its pixel (FrameRun),
 // in order, so the sums are the same as one frame per dispatch would give.
 void main()
@@ -109,7 +127,6 @@ void main()
     if (frameIndex >= frameEnd)
         return;
     AccumPixel sum = accum[pixelIndex];
-    uint sampleStart = 0u, longestSample = 0u;
     Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
 #ifdef VKRT_INTEGRATOR_PATH
     // Path regeneration (Novak et al. 2010): 8 lanes run in lockstep, so a
@@ -122,25 +139,17 @@ void main()
 #endif
         if (advancePath(path, rng))
             continue;
-        accumulateSample(sum, pixelIndex, frameIndex, testedSample(path.path.radiance, pixelIndex, frameIndex));
-        longestSample = max(longestSample, g_loopIterations - sampleStart);
-        sampleStart = g_loopIterations;
-        if (++frameIndex == frameEnd)
+        if (!finishSample(sum, pixelIndex, frameIndex, frameEnd, path.path.radiance, rng))
             break;
-        rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
         path = startPath(cameraSample(pixel, rng));
     }
 #else
     for (;;) {
         vec3 radiance = traceWhitted(cameraSample(pixel, rng), rng);
-        accumulateSample(sum, pixelIndex, frameIndex, testedSample(radiance, pixelIndex, frameIndex));
-        longestSample = max(longestSample, g_loopIterations - sampleStart);
-        sampleStart = g_loopIterations;
-        if (++frameIndex == frameEnd)
+        if (!finishSample(sum, pixelIndex, frameIndex, frameEnd, radiance, rng))
             break;
-        rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     }
 #endif
     accum[pixelIndex] = sum;
-    reportLoopIterations(longestSample);
+    reportLoopIterations(g_longestSample);
 }

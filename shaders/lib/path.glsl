@@ -182,8 +182,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     ++p.depth;
     return true;
 #else
-    ++p.depth;
-    return p.depth <= u.maxDepth + 1u;
+    return false; // no surfaces: every ray escapes or finds a light above
 #endif
 }
 

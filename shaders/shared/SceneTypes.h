@@ -267,7 +267,7 @@ struct MomentPixel {
 
 /// Counters written by kernels with atomics.
 struct RenderStats {
-    uint maxLoopIterations; // largest per-invocation loop count seen
+    uint maxLoopIterations; // largest loop count of one sample seen
     uint budgetExceeded;    // invocations that would have crossed LOOP_BUDGET
 };
 

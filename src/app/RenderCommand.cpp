@@ -285,7 +285,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "run; `vkrt merge` adds the shards (docs/farm.md)");
     cmd->add_option("--samples-per-invocation", options->samplesPerInvocation,
                     "Samples one shader invocation renders back to back per dispatch (default 16, 1 on Mesa 22's "
-                    "lavapipe); a tuning knob, the image does not depend on it")
+                    "lavapipe); a tuning knob: the image does not depend on it, up to float rounding in cubemap lookups")
         ->check(CLI::Range(1u, 64u));
     cmd->add_option("--kernel-define", options->kernelDefines,
                     "NAME=VALUE define for the kernel (test and measurement hooks, e.g. tools/lane_occupancy.py)")

@@ -27,7 +27,8 @@ struct RenderOptions {
     uint32_t firstFrame = 0;          ///< index of the first frame (sample) rendered: a shard's start
     /// Frames one invocation runs back to back per dispatch (path
     /// regeneration); 0: the device's default (samplesPerInvocationFor).
-    /// The image does not depend on it.
+    /// The image does not depend on it (up to float rounding where a cubemap
+    /// is sampled: lavapipe's lookup depends on which lanes share a vector).
     uint32_t samplesPerInvocation = 0;
     std::vector<Define> extraDefines; ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
     std::filesystem::path shaderRoot = defaultShaderRoot();
@@ -36,7 +37,7 @@ struct RenderOptions {
 
 struct RenderCounters {
     uint64_t rejectedSamples = 0;   ///< non-finite samples dropped (all pixels)
-    uint32_t maxLoopIterations = 0; ///< largest per-invocation loop count seen
+    uint32_t maxLoopIterations = 0; ///< largest loop count of one sample seen
     uint32_t budgetExceeded = 0;    ///< invocations that reached lavapipe's loop budget
 };
 
