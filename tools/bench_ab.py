@@ -12,7 +12,7 @@ A build is NAME=BINARY, or NAME=BINARY@SHADER_DIR to run a binary on another
 shader tree (VKRT_SHADER_DIR), which is how timing-only shader edits are
 compared without rebuilding:
 
-    tools/bench_ab.py before=/tmp/old/build/vkrt after=build/vkrt \\
+    tools/bench_ab.py before=old/build/vkrt after=build/vkrt \\
         --scenes glass,mirror,lights --rounds 3 --spp 256
 
 Extra arguments for every render go after `--`, e.g. `-- --sampler independent`.

@@ -3,7 +3,7 @@
 # Mrays/s against triangle count, on the default driver.
 #   tools/bench_meshes.sh [COUNTS...]     (default: 100 1000 10000 100000 1000000)
 # env: RUNS (renders per size, default 3: the median is printed), SPP (default 16),
-#      VKRT, MAKE_MESH (paths of the binaries), ASSETS (default ../shared/assets).
+#      VKRT, MAKE_MESH (paths of the binaries), ASSETS (default assets/).
 # For each size: a UV sphere of that many triangles (binary PLY) on a box
 # floor, lit by a point light, seen at 320x240. "primary" renders use
 # max_depth = 1 (one camera ray and at most one shadow ray per sample: Mrays/s
@@ -13,7 +13,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 vkrt=${VKRT:-$root/build/vkrt}
 make_mesh=${MAKE_MESH:-$root/build/vkrt-make-mesh}
-assets=${ASSETS:-$root/../shared/assets}
+assets=${ASSETS:-$root/assets}
 runs=${RUNS:-3}
 spp=${SPP:-16}
 counts=("$@")

@@ -1,19 +1,20 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (tests/fuzz) with clang-14 in build-fuzz/ and
+# Builds the libFuzzer targets (tests/fuzz) with the release's clang (clang-14 on
+# Debian 12, clang-19 on Debian 13; VKRT_FUZZ_CXX for another) in build-fuzz/ and
 # runs each for SECONDS (default 60) from a seed corpus: the small meshes of
-# ../shared/assets and the scenes of scenes/. Exits non-zero if either finds a
+# assets/, a small OBJ written here and the scenes of scenes/. Exits non-zero if either finds a
 # crash, a sanitizer report, a leak, a hang or an exception other than
 # InputError; the input that did it is kept in build-fuzz/artifacts/.
 # The mutation seed is fixed (VKRT_FUZZ_SEED, default 1) so that a CI run
 # explores the same inputs each time; set another to search further.
-#   tools/fuzz.sh [SECONDS]   environment: JOBS (build jobs, default 2), VKRT_ASSETS_DIR, VKRT_FUZZ_SEED
+#   tools/fuzz.sh [SECONDS]   environment: JOBS (build jobs, default 2), VKRT_FUZZ_SEED
 set -euo pipefail
 
 seconds=${1:-60}
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build-fuzz
-assets=${VKRT_ASSETS_DIR:-$root/../shared/assets}
-compiler=${VKRT_FUZZ_CXX:-clang++-14}
+assets=$root/assets
+compiler=${VKRT_FUZZ_CXX:-clang++}
 
 started=$(date +%s)
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$compiler" \
@@ -35,6 +36,29 @@ for file in "$assets"/*.obj "$assets"/*.ply; do
   [[ -f $file && $(stat -c %s "$file") -le 65536 ]] || continue
   case $file in *.obj) seed 0 "$file" ;; *.ply) seed 1 "$file" ;; esac
 done
+# The OBJ assets are all over 64 KiB: an OBJ with every statement kind the
+# loader reads (positions, uvs, normals, a quad and a pentagon, groups).
+cat >"$work/polygons.obj" <<'OBJ'
+o polygons
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0.5 1.5 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vt 0.5 1
+vn 0 0 1
+g quad
+f 1/1/1 2/2/1 3/3/1 4/4/1
+g pentagon
+s 1
+f 1//1 2//1 3//1 5//1 4//1
+f -5/-5 -4/-4 -3/-3
+OBJ
+seed 0 "$work/polygons.obj"
 seed 3 "$assets/gltf/box01.glb"
 # The Cube's .bin as a data: URI, since the fuzzer's file has no neighbours.
 sed "s|\"uri\" *: *\"Cube.bin\"|\"uri\": \"data:application/octet-stream;base64,$(base64 -w0 "$assets/gltf/Cube/Cube.bin")\"|" \

@@ -18,12 +18,14 @@ tools/install-deps.sh
 build_dir=${VKRT_BUILD_DIR:-build}
 jobs=$(nproc)
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVKRT_WERROR=ON
-cmake --build "$build_dir" --parallel "$jobs"
 
 if [[ $mode == render ]]; then
+  # Rendering needs the vkrt executable alone, not the test executables and tools.
+  cmake --build "$build_dir" --parallel "$jobs" --target vkrt
   "$build_dir/vkrt" render scenes/default.toml -o default.exr --png default.png
   echo "wrote $root/default.exr and $root/default.png"
 else
+  cmake --build "$build_dir" --parallel "$jobs"
   # Tests use lavapipe even where a GPU exists, so results match the references.
   export VKRT_TEST_DEVICE=${VKRT_TEST_DEVICE:-llvmpipe}
   ctest --test-dir "$build_dir" --output-on-failure --parallel "$jobs" --timeout 600

@@ -4,6 +4,7 @@
 #include "mesh/MeshData.h"
 #include "mesh/MeshLoader.h"
 #include "support/TestSupport.h"
+#include "texture/TextureTestFiles.h"
 #include "util/Error.h"
 
 #include <gtest/gtest.h>
@@ -22,12 +23,7 @@ using namespace vkrt;
 
 namespace {
 
-/// The shared third-party meshes: ../shared/assets beside the checkout, or $VKRT_ASSETS_DIR (a worktree elsewhere).
-fs::path assetsDir()
-{
-    const char* override = std::getenv("VKRT_ASSETS_DIR");
-    return override && *override ? fs::path(override) : fs::path(VKRT_TEST_SOURCE_DIR) / ".." / "shared" / "assets";
-}
+using test::assetsDir;
 
 /// A fresh directory named after the running test.
 fs::path testDir()

@@ -120,8 +120,7 @@ fs::path writePng(const fs::path& path, uint32_t width, uint32_t height, int bit
 
 fs::path assetsDir()
 {
-    const char* override = std::getenv("VKRT_ASSETS_DIR");
-    return override && *override ? fs::path(override) : fs::path(VKRT_TEST_SOURCE_DIR) / ".." / "shared" / "assets";
+    return fs::path(VKRT_TEST_SOURCE_DIR) / "assets";
 }
 
 } // namespace vkrt::test

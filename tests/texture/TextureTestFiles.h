@@ -26,7 +26,7 @@ std::filesystem::path write8BitPng(const std::filesystem::path& path, uint32_t w
 std::filesystem::path writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, int bitDepth,
                                int colourType, const std::vector<uint16_t>& samples);
 
-/// The shared third-party assets: ../shared/assets beside the checkout, or $VKRT_ASSETS_DIR.
+/// The repository's third-party assets: assets/ (sources and terms in assets/README.md).
 std::filesystem::path assetsDir();
 
 } // namespace vkrt::test
