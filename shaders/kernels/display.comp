@@ -27,7 +27,10 @@ void main()
     uvec2 pixel = gl_GlobalInvocationID.xy;
     if (pixel.x >= display.width || pixel.y >= display.height)
         return;
-    AccumPixel p = accum[pixel.y * display.width + pixel.x];
+    // Band b of the image (render/ImageBands.h) is dispatched at base
+    // workgroup y = b * gl_NumWorkGroups.y and has a buffer of its own rows.
+    uint bandFirstRow = (gl_WorkGroupID.y - gl_WorkGroupID.y % gl_NumWorkGroups.y) * WORKGROUP_SIZE_Y;
+    AccumPixel p = accum[(pixel.y - bandFirstRow) * display.width + pixel.x];
     vec3 mean = p.count > 0u ? (p.sum - p.compensation) / float(p.count) : vec3(0.0);
     vec3 exposed = max(mean * display.exposureScale, vec3(0.0)); // also maps NaN to 0
     vec3 mapped = display.toneMapper == TONE_MAP_FILMIC ? acesFilmic(exposed) : min(exposed, vec3(1.0));

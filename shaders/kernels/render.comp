@@ -33,16 +33,26 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/whitted.glsl"
 #endif
 
+// An image whose per-pixel buffers would exceed one storage buffer's range
+// is rendered in bands of whole workgroup rows (render/ImageBands.h), each
+// with its own buffers: band b's dispatch has base workgroup y = b *
+// gl_NumWorkGroups.y. The first workgroup row of the invocation's band:
+uint bandFirstTileRow()
+{
+    return gl_WorkGroupID.y - gl_WorkGroupID.y % gl_NumWorkGroups.y;
+}
+
 // lavapipe hands each worker thread one contiguous run of workgroups; walking
-// the tiles with a stride coprime to their count gives every thread a share of
-// every part of the image, so no core idles on the cheap sky.
+// the band's tiles (u.tileCount of them) with a stride coprime to their count
+// gives every thread a share of every part of it, so no core idles on the
+// cheap sky.
 uvec2 scatteredPixel()
 {
     uint tilesX = (u.width + WORKGROUP_SIZE_X - 1u) / WORKGROUP_SIZE_X;
-    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    uint group = (gl_WorkGroupID.y % gl_NumWorkGroups.y) * gl_NumWorkGroups.x + gl_WorkGroupID.x;
     uint tile = (group * u.tileStride) % u.tileCount;
-    uvec2 tileOrigin = uvec2(tile % tilesX, tile / tilesX) * uvec2(WORKGROUP_SIZE_X, WORKGROUP_SIZE_Y);
-    return tileOrigin + gl_LocalInvocationID.xy;
+    uvec2 tileInImage = uvec2(tile % tilesX, tile / tilesX + bandFirstTileRow());
+    return tileInImage * uvec2(WORKGROUP_SIZE_X, WORKGROUP_SIZE_Y) + gl_LocalInvocationID.xy;
 }
 
 // A capping driver counts the loop passes of a whole subgroup, and a pass
@@ -100,12 +110,13 @@ vec3 testedSample(vec3 radiance, uint pixelIndex, uint frameIndex)
 uint g_longestSample = 0u;
 uint g_sampleStart = 0u;
 
-// Adds frame frameIndex's finished sample to `sum` and moves to the next
-// frame, with its sampler; false after the invocation's last frame.
-bool finishSample(inout AccumPixel sum, uint pixelIndex, inout uint frameIndex, uint frameEnd, vec3 radiance,
-                  inout Sampler rng)
+// Adds frame frameIndex's finished sample to `sum` (the pixel's record
+// `slot` of its band) and moves to the next frame, with its sampler; false
+// after the invocation's last frame.
+bool finishSample(inout AccumPixel sum, uint pixelIndex, uint slot, inout uint frameIndex, uint frameEnd,
+                  vec3 radiance, inout Sampler rng)
 {
-    accumulateSample(sum, pixelIndex, frameIndex, testedSample(radiance, pixelIndex, frameIndex));
+    accumulateSample(sum, slot, frameIndex, testedSample(radiance, pixelIndex, frameIndex));
     g_longestSample = max(g_longestSample, g_loopIterations - g_sampleStart);
     g_sampleStart = g_loopIterations;
     if (++frameIndex == frameEnd)
@@ -121,12 +132,13 @@ void main()
     uvec2 pixel = scatteredPixel();
     if (pixel.x >= u.width || pixel.y >= u.height)
         return;
-    uint pixelIndex = pixel.y * u.width + pixel.x;
+    uint pixelIndex = pixel.y * u.width + pixel.x; // the image's: seeds the sampler
+    uint slot = pixelIndex - bandFirstTileRow() * WORKGROUP_SIZE_Y * u.width; // its band's buffers'
     uint frameIndex = frame.firstFrame + gl_WorkGroupID.z * run.framesPerInvocation; // shared/SceneTypes.h
     uint frameEnd = min(frameIndex + run.framesPerInvocation, run.frameEnd);
     if (frameIndex >= frameEnd)
         return;
-    AccumPixel sum = accum[pixelIndex];
+    AccumPixel sum = accum[slot];
     Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
 #ifdef VKRT_INTEGRATOR_PATH
     // Path regeneration (Novak et al. 2010): 8 lanes run in lockstep, so a
@@ -139,17 +151,17 @@ void main()
 #endif
         if (advancePath(path, rng))
             continue;
-        if (!finishSample(sum, pixelIndex, frameIndex, frameEnd, path.path.radiance, rng))
+        if (!finishSample(sum, pixelIndex, slot, frameIndex, frameEnd, path.path.radiance, rng))
             break;
         path = startPath(cameraSample(pixel, rng));
     }
 #else
     for (;;) {
         vec3 radiance = traceWhitted(cameraSample(pixel, rng), rng);
-        if (!finishSample(sum, pixelIndex, frameIndex, frameEnd, radiance, rng))
+        if (!finishSample(sum, pixelIndex, slot, frameIndex, frameEnd, radiance, rng))
             break;
     }
 #endif
-    accum[pixelIndex] = sum;
+    accum[slot] = sum;
     reportLoopIterations(g_longestSample);
 }

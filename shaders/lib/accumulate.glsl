@@ -20,22 +20,22 @@ void addCompensated(inout AccumPixel p, vec3 value)
 // batches is an independently scrambled sequence, so the batch means are
 // independent unbiased estimates; the host estimates the variance of the
 // pixel mean from their spread (Renderer::varianceOfMean).
-void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
+void accumulateMoments(uint slot, uint frameIndex, vec3 value, uint count)
 {
     // The host sets the sampler's batch count VKRT_SOBOL_BATCHES to
     // VARIANCE_BATCHES (and refuses to let a test define override it); the
     // buffer is laid out for VARIANCE_BATCHES either way.
-    uint slot = pixelIndex * VARIANCE_BATCHES + frameIndex % VARIANCE_BATCHES;
-    AccumPixel b = batchSums[slot];
+    uint batch = slot * VARIANCE_BATCHES + frameIndex % VARIANCE_BATCHES;
+    AccumPixel b = batchSums[batch];
     addCompensated(b, value);
-    batchSums[slot] = b;
+    batchSums[batch] = b;
 }
 #elif defined(VKRT_VARIANCE)
 // Welford's update (Knuth, TAOCP vol. 2, 4.2.2): numerically stable where the
 // textbook sum-of-squares formula cancels catastrophically.
-void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
+void accumulateMoments(uint slot, uint frameIndex, vec3 value, uint count)
 {
-    MomentPixel m = moments[pixelIndex];
+    MomentPixel m = moments[slot];
     vec3 delta = value - m.mean;
     m.mean += delta / float(count);
     precise vec3 term = delta * (value - m.mean) - m.m2Compensation;
@@ -43,20 +43,21 @@ void accumulateMoments(uint pixelIndex, uint frameIndex, vec3 value, uint count)
     precise vec3 lost = (sum - m.m2) - term;
     m.m2Compensation = lost;
     m.m2 = sum;
-    moments[pixelIndex] = m;
+    moments[slot] = m;
 }
 #endif
 
 // Adds one sample to the pixel's running sum `p` (which the caller stores)
-// and to its variance estimate. Non-finite samples are dropped; the host
-// counts them as frames - count.
-void accumulateSample(inout AccumPixel p, uint pixelIndex, uint frameIndex, vec3 value)
+// and to its variance estimate, the pixel's record `slot` of its band's
+// buffers (render.comp). Non-finite samples are dropped; the host counts
+// them as frames - count.
+void accumulateSample(inout AccumPixel p, uint slot, uint frameIndex, vec3 value)
 {
     if (any(isnan(value)) || any(isinf(value)))
         return;
     addCompensated(p, value);
 #ifdef VKRT_VARIANCE
-    accumulateMoments(pixelIndex, frameIndex, value, p.count);
+    accumulateMoments(slot, frameIndex, value, p.count);
 #endif
 }
 

@@ -44,9 +44,10 @@ struct RenderCommandOptions {
     std::string reference;
     bool sppGiven = false;
     std::string sampler = "auto";
-    std::string shard; ///< "i/n" (docs/farm.md)
-    uint32_t samplesPerInvocation = 0; ///< 0: the device's default
+    std::string shard;                      ///< "i/n" (docs/farm.md)
+    uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
+    uint64_t maxBandBytes = 0;              ///< test hook: bands of at most this many bytes per buffer
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
@@ -104,6 +105,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
     config.seed = options.seed;
     config.samplesPerInvocation = options.samplesPerInvocation;
     config.extraDefines = parseKernelDefines(options.kernelDefines);
+    config.maxBandBytes = options.maxBandBytes;
     if (shard) config.firstFrame = shard->begin;
     config.jitter = !options.pixelCenters;
     config.uber = options.uber;
@@ -283,12 +285,18 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--shard", options->shard,
                     "Render only shard i of n (0 <= i < n): samples [i S/n, (i+1) S/n) of --spp S, seeded as in one "
                     "run; `vkrt merge` adds the shards (docs/farm.md)");
-    cmd->add_option("--samples-per-invocation", options->samplesPerInvocation,
-                    "Samples one shader invocation renders back to back per dispatch (default 16, 1 on Mesa 22's "
-                    "lavapipe); a tuning knob: the image does not depend on it, up to float rounding in cubemap lookups")
+    cmd->add_option(
+           "--samples-per-invocation", options->samplesPerInvocation,
+           "Samples one shader invocation renders back to back per dispatch (default 16, 1 on Mesa 22's "
+           "lavapipe); a tuning knob: the image does not depend on it, up to float rounding in cubemap lookups")
         ->check(CLI::Range(1u, 64u));
     cmd->add_option("--kernel-define", options->kernelDefines,
                     "NAME=VALUE define for the kernel (test and measurement hooks, e.g. tools/lane_occupancy.py)")
+        ->group("");
+    cmd->add_option("--max-band-bytes", options->maxBandBytes,
+                    "Render in bands whose per-pixel buffers hold at most this many bytes (test hook; default: the "
+                    "device's maxStorageBufferRange)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40))
         ->group("");
     return [options] { return exitCodeFor(runRender(*options)); };
 }

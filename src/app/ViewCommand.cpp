@@ -30,6 +30,10 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_flag("--filmic", o->filmic, "Filmic tone curve instead of clamping");
     cmd->add_flag("--variance", o->variance, "Estimate variance (shows the estimated error in the title)");
     cmd->add_flag("--validation", o->validation, "Enable Vulkan validation; any message makes the exit status 3");
+    cmd->add_option("--max-band-bytes", o->maxBandBytes,
+                    "Render and display in bands whose per-pixel buffers hold at most this many bytes (test hook)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40))
+        ->group("");
     return [o] {
         if (!std::isfinite(o->exposure)) throw InputError("--exposure: must be a finite number");
         return exitCodeFor(runViewer(*o));

@@ -23,7 +23,7 @@ std::vector<KernelBinding> renderKernelBindings(const std::vector<uint32_t>& ind
 }
 
 ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv,
-                             std::vector<KernelBinding> bindings, uint32_t pushConstantSize)
+                             std::vector<KernelBinding> bindings, uint32_t pushConstantSize, uint32_t setCount)
     : m_context(context),
       m_bindings(std::move(bindings)),
       m_pushConstantSize(pushConstantSize)
@@ -35,7 +35,7 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
     std::vector<vk::DescriptorPoolSize> poolSizes;
     for (const KernelBinding& binding : m_bindings) {
         layoutBindings.emplace_back(binding.index, binding.type, 1, vk::ShaderStageFlagBits::eCompute);
-        poolSizes.emplace_back(binding.type, 1);
+        poolSizes.emplace_back(binding.type, setCount);
     }
     m_setLayout = vk::raii::DescriptorSetLayout(device, vk::DescriptorSetLayoutCreateInfo({}, layoutBindings));
 
@@ -50,11 +50,13 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
                                     vk::ComputePipelineCreateInfo(vk::PipelineCreateFlagBits::eDispatchBase, stage,
                                                                   *m_pipelineLayout));
 
+    VKRT_CHECK(setCount > 0);
     m_pool = vk::raii::DescriptorPool(device,
                                       vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
-                                                                   1, poolSizes));
-    vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*m_pool, setLayout));
-    m_set = std::move(sets[0]);
+                                                                   setCount, poolSizes));
+    std::vector<vk::DescriptorSetLayout> layouts(setCount, setLayout);
+    vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*m_pool, layouts));
+    for (auto& set : sets) m_sets.push_back(std::move(set));
 }
 
 bool ComputeKernel::uses(uint32_t binding) const
@@ -72,30 +74,39 @@ vk::DescriptorType ComputeKernel::typeOf(uint32_t binding) const
 
 void ComputeKernel::bind(uint32_t binding, const Buffer& buffer)
 {
+    for (uint32_t set = 0; set < m_sets.size(); ++set) bindInSet(set, binding, buffer);
+}
+
+void ComputeKernel::bindInSet(uint32_t set, uint32_t binding, const Buffer& buffer)
+{
     vk::DescriptorBufferInfo info(buffer.handle(), 0, VK_WHOLE_SIZE);
-    vk::WriteDescriptorSet write(*m_set, binding, 0, typeOf(binding), nullptr, info);
+    vk::WriteDescriptorSet write(*m_sets.at(set), binding, 0, typeOf(binding), nullptr, info);
     m_context.device().updateDescriptorSets(write, nullptr);
 }
 
 void ComputeKernel::bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler)
 {
     vk::DescriptorImageInfo info(sampler, view, vk::ImageLayout::eShaderReadOnlyOptimal);
-    vk::WriteDescriptorSet write(*m_set, binding, 0, typeOf(binding), info);
-    m_context.device().updateDescriptorSets(write, nullptr);
+    for (const auto& set : m_sets) {
+        vk::WriteDescriptorSet write(*set, binding, 0, typeOf(binding), info);
+        m_context.device().updateDescriptorSets(write, nullptr);
+    }
 }
 
 void ComputeKernel::bindStorageImage(uint32_t binding, vk::ImageView view)
 {
     vk::DescriptorImageInfo info(nullptr, view, vk::ImageLayout::eGeneral);
-    vk::WriteDescriptorSet write(*m_set, binding, 0, typeOf(binding), info);
-    m_context.device().updateDescriptorSets(write, nullptr);
+    for (const auto& set : m_sets) {
+        vk::WriteDescriptorSet write(*set, binding, 0, typeOf(binding), info);
+        m_context.device().updateDescriptorSets(write, nullptr);
+    }
 }
 
-void ComputeKernel::recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants) const
+void ComputeKernel::recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, uint32_t set) const
 {
     VKRT_CHECK(pushConstants.size() == m_pushConstantSize);
     cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *m_pipeline);
-    cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *m_pipelineLayout, 0, *m_set, nullptr);
+    cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *m_pipelineLayout, 0, *m_sets.at(set), nullptr);
     if (!pushConstants.empty())
         cmd.pushConstants(*m_pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, uint32_t(pushConstants.size()),
                           pushConstants.data());
@@ -108,9 +119,10 @@ void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::b
     cmd.dispatch(groups.width, groups.height, 1);
 }
 
-void ComputeKernel::recordDispatchAt(vk::CommandBuffer cmd, uint32_t baseZ, vk::Extent2D groups) const
+void ComputeKernel::recordDispatchAt(vk::CommandBuffer cmd, vk::Offset2D base, uint32_t baseZ,
+                                     vk::Extent2D groups) const
 {
-    cmd.dispatchBase(0, 0, baseZ, groups.width, groups.height, 1);
+    cmd.dispatchBase(uint32_t(base.x), uint32_t(base.y), baseZ, groups.width, groups.height, 1);
 }
 
 } // namespace vkrt

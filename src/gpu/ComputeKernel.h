@@ -1,7 +1,9 @@
 #pragma once
-// A compute pipeline with its descriptor set. The layout is derived from the
+// A compute pipeline with its descriptor sets. The layout is derived from the
 // list of binding indices the kernel variant uses (shaders/shared/Bindings.h),
-// so no pipeline set-up is ever written twice.
+// so no pipeline set-up is ever written twice. There are several sets of that
+// one layout when an image is rendered in bands (render/ImageBands.h): they
+// differ only in the per-pixel buffers, bound with bindInSet.
 #include "gpu/Buffer.h"
 
 #include <cstdint>
@@ -21,12 +23,14 @@ std::vector<KernelBinding> renderKernelBindings(const std::vector<uint32_t>& ind
 
 class ComputeKernel {
 public:
-    /// `pushConstantSize` in bytes (0: no push constants).
+    /// `pushConstantSize` in bytes (0: no push constants); `setCount` descriptor sets.
     ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv, std::vector<KernelBinding> bindings,
-                  uint32_t pushConstantSize);
+                  uint32_t pushConstantSize, uint32_t setCount = 1);
 
-    /// Points `binding` at `buffer` (the whole buffer).
+    /// Points `binding` at `buffer` (the whole buffer) in every set.
     void bind(uint32_t binding, const Buffer& buffer);
+    /// Points `binding` of set `set` alone at `buffer`.
+    void bindInSet(uint32_t set, uint32_t binding, const Buffer& buffer);
     /// Points a combined image-sampler `binding` at an image view.
     void bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler);
     /// Points a storage-image `binding` at an image view in GENERAL layout.
@@ -36,9 +40,9 @@ public:
     /// Binds the pipeline, descriptor set and push constants once, for a run
     /// of recordDispatchAt calls (lavapipe re-specializes the kernel each time
     /// push constants or bindings change).
-    void recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants) const;
-    /// A dispatch whose workgroups see gl_WorkGroupID.z = baseZ.
-    void recordDispatchAt(vk::CommandBuffer cmd, uint32_t baseZ, vk::Extent2D groups) const;
+    void recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, uint32_t set = 0) const;
+    /// A dispatch of `groups` workgroups whose ids start at (base.x, base.y, baseZ).
+    void recordDispatchAt(vk::CommandBuffer cmd, vk::Offset2D base, uint32_t baseZ, vk::Extent2D groups) const;
     bool uses(uint32_t binding) const;
     vk::DescriptorType typeOf(uint32_t binding) const;
 
@@ -51,7 +55,7 @@ private:
     vk::raii::PipelineLayout m_pipelineLayout = nullptr;
     vk::raii::Pipeline m_pipeline = nullptr;
     vk::raii::DescriptorPool m_pool = nullptr;
-    vk::raii::DescriptorSet m_set = nullptr;
+    std::vector<vk::raii::DescriptorSet> m_sets;
 };
 
 /// The descriptor type each binding index has in the render kernels.

@@ -81,8 +81,8 @@ TextureBuffers packTextures(const Scene& scene, uint64_t maxBytes)
     return buffers;
 }
 
-gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t tableStart,
-                              float internalReflectance, const TextureAtlas* textures)
+gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t tableStart, float internalReflectance,
+                              const TextureAtlas* textures)
 {
     gpu::Material g{};
     g.diffuse = toFloat(m.diffuse);
@@ -525,8 +525,7 @@ uint64_t emissiveTriangleCount(const Scene& scene)
 
 /// One geometry's per-triangle texture coordinates, tangents and materials
 /// (in leaf order, beside its MeshTriangles), for the features that need them.
-void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features,
-                              GpuSceneStatic& fixed)
+void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features, GpuSceneStatic& fixed)
 {
     const MeshData& d = mesh.geometry->data;
     if (features.textures) {
@@ -621,7 +620,9 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
     VKRT_SHAPE_KINDS(VKRT_COUNT_RECORDS)
     VKRT_LIGHT_KINDS(VKRT_COUNT_RECORDS)
 #undef VKRT_COUNT_RECORDS
-    u.tileCount = tileCountFor(u.width, u.height);
+    // Each band's dispatch walks its own tiles (kernels/render.comp); every
+    // band is as tall as the first, the last one's extra rows outside the image.
+    u.tileCount = tileCountFor(u.width, settings.bandRows > 0 ? std::min(settings.bandRows, u.height) : u.height);
     u.tileStride = tileStrideFor(u.tileCount);
     std::vector<uint32_t> media = mediaAroundCamera(scene);
     u.cameraMediumCount = uint32_t(media.size());

@@ -28,13 +28,13 @@ struct GeometryOffsets {
 /// depend on the camera (refitted, never rebuilt, when the camera moves).
 struct TopLevel {
     Bvh bvh;
-    std::vector<uint32_t> refs;      ///< leaf slot -> gpu::TOP_REF
-    std::vector<Aabb> boxes;         ///< leaf slot -> world box (double)
+    std::vector<uint32_t> refs; ///< leaf slot -> gpu::TOP_REF
+    std::vector<Aabb> boxes;    ///< leaf slot -> world box (double)
 };
 
 /// Emissive mesh triangles chosen in proportion to power (Walker's alias method).
 struct EmitterTable {
-    std::vector<double> pdf;         ///< per emitter, in instance-then-leaf order
+    std::vector<double> pdf; ///< per emitter, in instance-then-leaf order
     std::vector<float> threshold;
     std::vector<uint32_t> alias;
     double totalPower = 0.0;
@@ -88,7 +88,8 @@ struct GpuSceneData {
 };
 
 struct FrameSettings {
-    bool jitter = true; ///< random point in each pixel; off = pixel centres
+    bool jitter = true;    ///< random point in each pixel; off = pixel centres
+    uint32_t bandRows = 0; ///< rows of one band of the image (render/ImageBands.h); 0: the whole image
 };
 
 GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, const GpuSceneStatic& fixed);
@@ -107,7 +108,7 @@ std::vector<TriangleLight> emittingTriangleLights(const Scene& scene);
 /// Area of a triangle, computed in double.
 double triangleArea(const std::array<glm::dvec3, 3>& v);
 
-/// Workgroup tiles covering a width x height image.
+/// Workgroup tiles covering a width x height image (or one band of it).
 uint32_t tileCountFor(uint32_t width, uint32_t height);
 /// A stride coprime to tileCount that spreads consecutive workgroups over the image.
 uint32_t tileStrideFor(uint32_t tileCount);

@@ -4,8 +4,8 @@
 #include "util/Hash.h"
 
 #include <chrono>
-#include <cstdio>
 #include <csignal>
+#include <cstdio>
 
 namespace vkrt {
 
@@ -57,6 +57,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     options.uber = config.uber;
     options.variance = config.variance.any();
     options.extraDefines = config.extraDefines;
+    options.maxBandBytes = config.maxBandBytes;
     options.cacheDirectory = config.cacheDirectory;
     uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
     uint64_t range = context.physicalDevice().getProperties().limits.maxStorageBufferRange;

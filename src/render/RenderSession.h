@@ -55,7 +55,7 @@ Scene loadScene(const std::string& path, const ResolutionOverride& resolution = 
 /// Everything a command chooses about a session.
 struct SessionConfig {
     uint32_t seed = 0;
-    uint32_t firstFrame = 0; ///< the first sample index rendered (a shard's start; docs/farm.md)
+    uint32_t firstFrame = 0;           ///< the first sample index rendered (a shard's start; docs/farm.md)
     uint32_t samplesPerInvocation = 0; ///< RenderOptions::samplesPerInvocation
     bool jitter = true;
     bool uber = false;
@@ -63,6 +63,7 @@ struct SessionConfig {
     SamplerChoice sampler = SamplerChoice::Auto;
     VarianceNeeds variance;
     std::vector<Define> extraDefines; ///< test hooks
+    uint64_t maxBandBytes = 0;        ///< RenderOptions::maxBandBytes (a test hook; 0: the device's limit)
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
     StopRules stop; ///< of run(); its interrupt is usually &interruptFlag() (InterruptGuard)
 };

@@ -31,7 +31,7 @@ void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation
 KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
     checkSamplesPerInvocation(context.loopCap(), options.samplesPerInvocation); // before any compilation
-    checkLoopBudget(scene, context.loopCap());                                   // or allocation
+    checkLoopBudget(scene, context.loopCap());                                  // or allocation
     KernelVariant variant;
     variant.features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     variant.variance = options.variance;
@@ -71,8 +71,8 @@ std::vector<KernelBinding> checkedKernelBindings(const VulkanContext& context, c
     auto check = [&](vk::DescriptorType type, uint32_t limit, const char* what) {
         if (count(type) > limit)
             throw InputError(scene.path + ": the scene's kernel needs " + std::to_string(count(type)) + " " + what +
-                             ", more than the device's limit of " + std::to_string(limit) +
-                             " per shader stage (" + variant.describe() + ")");
+                             ", more than the device's limit of " + std::to_string(limit) + " per shader stage (" +
+                             variant.describe() + ")");
     };
     check(vk::DescriptorType::eStorageBuffer, limits.maxPerStageDescriptorStorageBuffers, "storage buffers");
     check(vk::DescriptorType::eUniformBuffer, limits.maxPerStageDescriptorUniformBuffers, "uniform buffers");
@@ -116,42 +116,12 @@ double compensatedMean(const gpu::AccumPixel& p, int channel)
     return (double(p.sum[channel]) - double(p.compensation[channel])) / double(p.count);
 }
 
-std::string gibibytes(double bytes)
+/// Bytes per pixel of the largest per-pixel buffer the options ask for.
+uint64_t largestBytesPerPixel(const RenderOptions& options)
 {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.2f GiB", bytes / (1024.0 * 1024.0 * 1024.0));
-    return text;
-}
-
-/// A device-local storage buffer of `bytesPerPixel` per pixel of the scene's
-/// image. Memory the device cannot allocate is the user's image size, so say
-/// so rather than fail inside Vulkan. A buffer past the device's
-/// maxStorageBufferRange (128 MiB on lavapipe: 4.8 M pixels of accumulation)
-/// is outside what Vulkan guarantees; lavapipe does not bound storage
-/// accesses and renders it correctly (checked at 3840x2160), so it gets a
-/// warning, not a refusal (docs/robustness.md, L8).
-Buffer perPixelBuffer(const VulkanContext& context, const Scene& scene, size_t bytesPerPixel, const std::string& what,
-                      const std::string& hint = "")
-{
-    uint64_t bytes = uint64_t(bytesPerPixel) * scene.camera.width * scene.camera.height;
-    uint64_t range = context.physicalDevice().getProperties().limits.maxStorageBufferRange;
-    std::string size = std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height);
-    std::string advice = "render a smaller image (--width/--height)" + hint;
-    if (bytes > range)
-        std::fprintf(stderr,
-                     "vkrt: warning: a %s image needs %s for %s, more than the %s a storage buffer is guaranteed "
-                     "on %s (maxStorageBufferRange); it works on lavapipe, but Vulkan validation reports it\n",
-                     size.c_str(), gibibytes(double(bytes)).c_str(), what.c_str(), gibibytes(double(range)).c_str(),
-                     context.deviceInfo().name.c_str());
-    try {
-        return Buffer(context, bytes,
-                      kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
-                      MemoryUse::Device);
-    } catch (const vk::SystemError& error) {
-        throw InputError(scene.path + ": a " + size + " image needs " + gibibytes(double(bytes)) + " for " + what +
-                         ", which " + context.deviceInfo().name + " could not allocate (" + error.what() + "); " +
-                         advice);
-    }
+    uint64_t bytes = sizeof(gpu::AccumPixel);
+    if (options.variance) bytes = std::max<uint64_t>(bytes, varianceBytesPerPixel(options.sobol));
+    return bytes;
 }
 
 } // namespace
@@ -159,6 +129,12 @@ Buffer perPixelBuffer(const VulkanContext& context, const Scene& scene, size_t b
 size_t varianceBytesPerPixel(bool sobol)
 {
     return sobol ? sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES : sizeof(gpu::MomentPixel);
+}
+
+ImageBands imageBandsOf(const Scene& scene, const RenderOptions& options, uint64_t maxBytes)
+{
+    if (options.maxBandBytes > 0) maxBytes = std::min(maxBytes, options.maxBandBytes);
+    return imageBandsFor(scene.camera.width, scene.camera.height, largestBytesPerPixel(options), maxBytes, scene.path);
 }
 
 uint64_t worstCaseLoopIterations(const Scene& scene)
@@ -200,37 +176,48 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_scene(scene),
       m_options(std::move(options)),
       m_variant(chooseVariant(context, scene, m_options)),
+      m_bands(imageBandsOf(scene, m_options, context.physicalDevice().getProperties().limits.maxStorageBufferRange)),
       m_static(prepareStaticScene(scene, context.physicalDevice().getProperties().limits.maxStorageBufferRange)),
-      m_data(convertScene(scene, FrameSettings{m_options.jitter}, m_static)),
+      m_data(convertScene(scene, frameSettings(), m_static)),
       m_compiled(compileVariant(m_variant, m_options)),
-      m_accumulation(perPixelBuffer(context, scene, sizeof(gpu::AccumPixel), "the accumulation buffer")),
+      m_accumulation(context, m_bands, sizeof(gpu::AccumPixel), scene.path, "the accumulation buffer"),
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
-      m_frameRun(context, sizeof(gpu::FrameRun), kStorage | vk::BufferUsageFlagBits::eTransferDst,
-                 MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants)),
+      m_frameRun(context, sizeof(gpu::FrameRun), kStorage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Device),
+      m_kernel(context, m_compiled.spirv, checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants),
+               m_bands.count),
       m_cubemap(scene.background.cubemap)
 {
     m_accumulation.clear(context);
     m_stats.clear(context);
     if (m_variant.variance) {
         if (batchedVariance())
-            m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(true),
-                                             "the error estimate's " + std::to_string(gpu::VARIANCE_BATCHES) +
-                                                 " batch sums (Sobol' sampler)",
-                                             ", or estimate the error with --sampler independent (one sum per pixel)"));
-        else m_moments.emplace(perPixelBuffer(context, scene, varianceBytesPerPixel(false), "the variance estimate"));
+            m_moments.emplace(context, m_bands, varianceBytesPerPixel(true), scene.path,
+                              "the error estimate's " + std::to_string(gpu::VARIANCE_BATCHES) +
+                                  " batch sums (Sobol' sampler)",
+                              ", or estimate the error with --sampler independent (one sum per pixel)");
+        else m_moments.emplace(context, m_bands, varianceBytesPerPixel(false), scene.path, "the variance estimate");
         m_moments->clear(context);
     }
-    m_kernel.bind(gpu::BINDING_ACCUMULATION, m_accumulation);
+    bindPerPixelBuffers();
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
     m_kernel.bind(gpu::BINDING_FRAME_RUN, m_frameRun);
-    if (m_options.samplesPerInvocation == 0) m_options.samplesPerInvocation = samplesPerInvocationFor(context.loopCap());
-    if (m_moments) m_kernel.bind(gpu::BINDING_MOMENTS, *m_moments);
+    if (m_options.samplesPerInvocation == 0)
+        m_options.samplesPerInvocation = samplesPerInvocationFor(context.loopCap());
     bindEnvironment();
     uploadMeshBuffers();
     uploadSceneBuffers();
+}
+
+// Descriptor set b of the kernel holds band b's per-pixel buffers; every
+// other binding is the same in all of them.
+void Renderer::bindPerPixelBuffers()
+{
+    for (uint32_t b = 0; b < m_bands.count; ++b) {
+        m_kernel.bindInSet(b, gpu::BINDING_ACCUMULATION, m_accumulation.band(b));
+        if (m_moments) m_kernel.bindInSet(b, gpu::BINDING_MOMENTS, m_moments->band(b));
+    }
 }
 
 void Renderer::uploadMeshBuffers()
@@ -311,7 +298,7 @@ void Renderer::moveCamera(const Camera& camera)
 {
     VKRT_CHECK(camera.width == width() && camera.height == height());
     m_scene.camera = camera;
-    m_data = convertScene(m_scene, FrameSettings{m_options.jitter}, m_static);
+    m_data = convertScene(m_scene, frameSettings(), m_static);
     uploadSceneBuffers();
     reset();
 }
@@ -336,25 +323,29 @@ void Renderer::recordFrameRun(vk::CommandBuffer cmd, const gpu::FrameRun& run) c
                         nullptr, nullptr);
 }
 
-// One bind and push per run of frames; dispatch i of the run (base workgroup
-// z = i) adds frames firstFrame + i * S onwards, S per invocation
-// (shared/SceneTypes.h: FrameConstants, FrameRun).
+// One bind and push per run of frames and band; dispatch i of the run (base
+// workgroup z = i) adds frames firstFrame + i * S onwards, S per invocation
+// (shared/SceneTypes.h: FrameConstants, FrameRun), to band b's rows (base
+// workgroup y = b * the band's workgroup rows; render.comp).
 void Renderer::recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const
 {
     uint32_t perInvocation = m_options.samplesPerInvocation;
     recordFrameRun(cmd, gpu::FrameRun{perInvocation, firstFrame + count});
     gpu::FrameConstants constants{firstFrame, m_options.seed};
     uint32_t tilesX = (width() + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
-    uint32_t tilesY = (height() + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y;
-    m_kernel.recordBind(cmd, bytesOf(constants));
+    uint32_t bandTileRows = m_bands.tileRowsPerBand();
     uint32_t dispatches = (count + perInvocation - 1) / perInvocation;
-    for (uint32_t i = 0; i < dispatches; ++i) {
-        m_kernel.recordDispatchAt(cmd, i, vk::Extent2D(tilesX, tilesY));
-        // The next dispatch reads and writes the same accumulation pixels.
-        vk::MemoryBarrier barrier(vk::AccessFlagBits::eShaderWrite,
-                                  vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
-        cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
-                            barrier, nullptr, nullptr);
+    for (uint32_t band = 0; band < m_bands.count; ++band) {
+        m_kernel.recordBind(cmd, bytesOf(constants), band);
+        for (uint32_t i = 0; i < dispatches; ++i) {
+            m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, int32_t(band * bandTileRows)), i,
+                                      vk::Extent2D(tilesX, bandTileRows));
+            // The next dispatch reads and writes the same accumulation pixels.
+            vk::MemoryBarrier barrier(vk::AccessFlagBits::eShaderWrite,
+                                      vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+            cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader,
+                                {}, barrier, nullptr, nullptr);
+        }
     }
 }
 
@@ -385,7 +376,7 @@ void Renderer::warmUp()
     m_context.submitAndWait([&](vk::CommandBuffer cmd) {
         recordFrameRun(cmd, gpu::FrameRun{1, 1});
         m_kernel.recordBind(cmd, bytesOf(gpu::FrameConstants{0, m_options.seed}));
-        m_kernel.recordDispatchAt(cmd, 0, vk::Extent2D(1, 1));
+        m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, 0), 0, vk::Extent2D(1, 1));
     });
     reset();
 }

@@ -8,8 +8,9 @@
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
 #include "render/GpuScene.h"
-#include "render/Tally.h"
+#include "render/ImageBands.h"
 #include "render/KernelVariant.h"
+#include "render/Tally.h"
 #include "shared/Bindings.h"
 
 #include <filesystem>
@@ -20,17 +21,21 @@ namespace vkrt {
 struct RenderOptions {
     uint32_t seed = 0;
     bool jitter = true;
-    bool uber = false;                ///< all-features kernel instead of the scene's variant
-    bool variance = false;            ///< also estimate per-pixel variance (a kernel-variant flag)
-    bool sobol = false;               ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
-    bool storageScene = false;        ///< scene arrays in storage buffers even when they fit uniform ones
-    uint32_t firstFrame = 0;          ///< index of the first frame (sample) rendered: a shard's start
+    bool uber = false;         ///< all-features kernel instead of the scene's variant
+    bool variance = false;     ///< also estimate per-pixel variance (a kernel-variant flag)
+    bool sobol = false;        ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
+    bool storageScene = false; ///< scene arrays in storage buffers even when they fit uniform ones
+    uint32_t firstFrame = 0;   ///< index of the first frame (sample) rendered: a shard's start
     /// Frames one invocation runs back to back per dispatch (path
     /// regeneration); 0: the device's default (samplesPerInvocationFor).
     /// The image does not depend on it (up to float rounding where a cubemap
     /// is sampled: lavapipe's lookup depends on which lanes share a vector).
     uint32_t samplesPerInvocation = 0;
     std::vector<Define> extraDefines; ///< test hooks (e.g. VKRT_TEST_INJECT_NONFINITE)
+    /// Largest per-pixel buffer of one band of the image (ImageBands.h); 0:
+    /// the device's maxStorageBufferRange. Tests set it to render small
+    /// images in several bands.
+    uint64_t maxBandBytes = 0;
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
 };
@@ -60,8 +65,11 @@ public:
     void moveCamera(const Camera& camera);
     const Scene& scene() const { return m_scene; }
     const VulkanContext& context() const { return m_context; }
-    /// The accumulation buffer (AccumPixel per pixel), for display kernels.
-    const Buffer& accumulation() const { return m_accumulation; }
+    /// The accumulation buffer (AccumPixel per pixel, in bands), for display kernels.
+    const BandedBuffer& accumulation() const { return m_accumulation; }
+    /// How the image's per-pixel buffers are split (one band unless they
+    /// would exceed maxStorageBufferRange).
+    const ImageBands& bands() const { return m_bands; }
 
     /// Per-pixel mean of the accepted samples, resolved in double precision
     /// (with batched variance: the mean of the batch means, see Renderer.cpp).
@@ -90,15 +98,16 @@ private:
     Scene m_scene;
     RenderOptions m_options;
     KernelVariant m_variant;
+    ImageBands m_bands;      ///< before m_data, whose tile count is per band
     GpuSceneStatic m_static; ///< mesh geometry and the top-level topology: uploaded once
     GpuSceneData m_data;
     CompiledKernel m_compiled;
     std::vector<Buffer> m_meshBuffers;
     std::vector<Buffer> m_sceneBuffers;
-    Buffer m_accumulation;
+    BandedBuffer m_accumulation;
     Buffer m_stats;
     Buffer m_frameRun; ///< gpu::FrameRun of the run being dispatched
-    std::optional<Buffer> m_moments;
+    std::optional<BandedBuffer> m_moments;
     ComputeKernel m_kernel;
     std::optional<Cubemap> m_cubemap;
     std::optional<CubeTexture> m_environment;
@@ -106,6 +115,7 @@ private:
     uint32_t m_environmentSize = 0;
     uint32_t m_frames = 0;
 
+    FrameSettings frameSettings() const { return FrameSettings{m_options.jitter, m_bands.rowsPerBand}; }
     bool batchedVariance() const { return m_variant.variance && m_variant.sobolSampler; }
     Image varianceOfMeanFromBatches() const;
     Image meanOfBatchMeans() const;
@@ -113,12 +123,18 @@ private:
     void uploadSceneBuffers();
     void uploadMeshBuffers();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
+    void bindPerPixelBuffers();
     void recordFrameRun(vk::CommandBuffer cmd, const gpu::FrameRun& run) const;
 };
 
 /// Bytes per pixel of the variance estimate's buffer: Welford moments, or
 /// under the Sobol' sampler one compensated sum per batch.
 size_t varianceBytesPerPixel(bool sobol);
+
+/// The bands in which a scene's image is rendered with these options: its
+/// largest per-pixel buffer (accumulation, variance moments or batch sums)
+/// fits `maxBytes` per band.
+ImageBands imageBandsOf(const Scene& scene, const RenderOptions& options, uint64_t maxBytes);
 
 /// Samples per invocation and dispatch when RenderOptions leaves it at 0:
 /// several, so that lanes whose paths end early start their next sample

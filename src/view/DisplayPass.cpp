@@ -39,15 +39,17 @@ std::array<vk::Offset3D, 2> letterbox(uint32_t width, uint32_t height, vk::Exten
 
 } // namespace
 
-DisplayPass::DisplayPass(const VulkanContext& context, const Buffer& accumulation, uint32_t width, uint32_t height)
+DisplayPass::DisplayPass(const VulkanContext& context, const BandedBuffer& accumulation, const ImageBands& bands)
     : m_context(context),
-      m_width(width),
-      m_height(height),
+      m_bands(bands),
+      m_width(bands.width),
+      m_height(bands.height),
       m_kernel(context, displayKernelSpirv(),
                {{gpu::DISPLAY_BINDING_ACCUMULATION, vk::DescriptorType::eStorageBuffer},
                 {gpu::DISPLAY_BINDING_OUTPUT, vk::DescriptorType::eStorageImage}},
-               sizeof(gpu::DisplayConstants))
+               sizeof(gpu::DisplayConstants), bands.count)
 {
+    const uint32_t width = m_width, height = m_height;
     const auto& device = context.device();
     vk::ImageCreateInfo info({}, vk::ImageType::e2D, kDisplayFormat, vk::Extent3D(width, height, 1), 1, 1,
                              vk::SampleCountFlagBits::e1, vk::ImageTiling::eOptimal,
@@ -69,7 +71,8 @@ DisplayPass::DisplayPass(const VulkanContext& context, const Buffer& accumulatio
                      vk::AccessFlagBits::eTransferRead, vk::PipelineStageFlagBits::eTopOfPipe,
                      vk::PipelineStageFlagBits::eTransfer);
     });
-    m_kernel.bind(gpu::DISPLAY_BINDING_ACCUMULATION, accumulation);
+    for (uint32_t b = 0; b < bands.count; ++b)
+        m_kernel.bindInSet(b, gpu::DISPLAY_BINDING_ACCUMULATION, accumulation.band(b));
     m_kernel.bindStorageImage(gpu::DISPLAY_BINDING_OUTPUT, *m_view);
 }
 
@@ -83,9 +86,13 @@ void DisplayPass::recordToneMap(vk::CommandBuffer cmd, const gpu::DisplayConstan
     imageBarrier(cmd, *m_image, vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral,
                  vk::AccessFlagBits::eTransferRead, vk::AccessFlagBits::eShaderWrite,
                  vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader);
-    vk::Extent2D groups((m_width + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X,
-                        (m_height + gpu::WORKGROUP_SIZE_Y - 1) / gpu::WORKGROUP_SIZE_Y);
-    m_kernel.recordDispatch(cmd, std::as_bytes(std::span(&constants, 1)), groups);
+    // One dispatch per band, at base workgroup y = band * its workgroup rows
+    // (display.comp reads the band's own buffer).
+    vk::Extent2D groups((m_width + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X, m_bands.tileRowsPerBand());
+    for (uint32_t b = 0; b < m_bands.count; ++b) {
+        m_kernel.recordBind(cmd, std::as_bytes(std::span(&constants, 1)), b);
+        m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, int32_t(b * groups.height)), 0, groups);
+    }
     imageBarrier(cmd, *m_image, vk::ImageLayout::eGeneral, vk::ImageLayout::eTransferSrcOptimal,
                  vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eTransferRead,
                  vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer);

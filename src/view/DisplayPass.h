@@ -3,6 +3,7 @@
 // and blits it, aspect preserved, into a swapchain image.
 #include "gpu/Buffer.h"
 #include "gpu/ComputeKernel.h"
+#include "render/ImageBands.h"
 #include "shared/Display.h"
 
 #include <vector>
@@ -11,7 +12,8 @@ namespace vkrt {
 
 class DisplayPass {
 public:
-    DisplayPass(const VulkanContext& context, const Buffer& accumulation, uint32_t width, uint32_t height);
+    /// `accumulation` in the renderer's `bands`, whose size is the image's.
+    DisplayPass(const VulkanContext& context, const BandedBuffer& accumulation, const ImageBands& bands);
 
     /// Tone-maps the current accumulation into the display image.
     void recordToneMap(vk::CommandBuffer cmd, const gpu::DisplayConstants& constants) const;
@@ -23,6 +25,7 @@ public:
 
 private:
     const VulkanContext& m_context;
+    ImageBands m_bands;
     uint32_t m_width, m_height;
     vk::raii::DeviceMemory m_memory = nullptr;
     vk::raii::Image m_image = nullptr;

@@ -156,6 +156,7 @@ SessionConfig sessionConfig(const ViewOptions& options)
     SessionConfig config;
     config.seed = options.seed;
     config.variance.layer = options.variance;
+    config.maxBandBytes = options.maxBandBytes;
     config.warmUp = false; // the first frames show at once
     return config;
 }
@@ -179,8 +180,7 @@ Viewer::Viewer(const ViewOptions& options)
 
 void Viewer::createDisplay()
 {
-    m_display =
-        std::make_unique<DisplayPass>(m_context, renderer().accumulation(), renderer().width(), renderer().height());
+    m_display = std::make_unique<DisplayPass>(m_context, renderer().accumulation(), renderer().bands());
 }
 
 void Viewer::recreateSwapchain()

@@ -22,6 +22,7 @@ struct ViewOptions {
     bool filmic = false;
     bool variance = false;
     bool validation = false;
+    uint64_t maxBandBytes = 0; ///< test hook: SessionConfig::maxBandBytes
 };
 
 /// Runs the viewer; Passed, or ValidationMessages with them. Bad input (scene,

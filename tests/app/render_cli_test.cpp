@@ -265,6 +265,39 @@ TEST_F(RenderCli, FailedRunLeavesExistingOutputUntouched)
     EXPECT_EQ(filesInDir(), (std::vector<std::string>{"bad.toml", "keep.exr"}));
 }
 
+// 3840 x 2160 needs 0.22 GiB of accumulation, more than the 128 MiB that
+// lavapipe guarantees one storage buffer: it is rendered in two bands
+// (render/ImageBands.h), which is valid Vulkan (--validation exits 3 on any
+// message), and no pixel is left out.
+TEST_F(RenderCli, UltraHdRendersInBandsWithoutValidationMessages)
+{
+    fs::path out = m_dir / "uhd.exr";
+    std::vector<std::string> args = {"render",   kDefaultScene, "-o",    out.string(), "--width",     "3840",
+                                     "--height", "2160",        "--spp", "1",          "--validation"};
+    if (const char* device = std::getenv("VKRT_TEST_DEVICE")) args.insert(args.end(), {"--device", device});
+    ProcessResult r = runVkrt(args);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+    ExrContents image = readExr(out);
+    ASSERT_EQ(image.image.width, 3840u);
+    ASSERT_EQ(image.image.height, 2160u);
+    EXPECT_EQ(intAttribute(image.metadata, "spp"), 1);
+    // Every row of both bands was rendered: the default scene has no black
+    // pixel (sky above, lit ground below), so a row left at zero would show.
+    const uint32_t width = image.image.width;
+    const std::vector<float>& rgb = image.image.rgb;
+    for (uint32_t y = 0; y < image.image.height; ++y) {
+        double row = 0.0;
+        for (uint32_t x = 0; x < width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                float v = rgb[(size_t(y) * width + x) * 3 + c];
+                ASSERT_TRUE(std::isfinite(v)) << "row " << y;
+                row += v;
+            }
+        ASSERT_GT(row, 0.0) << "row " << y << " is black";
+    }
+}
+
 TEST(DevicesCli, ListsLavapipeAsUsable)
 {
     ProcessResult r = runVkrt({"devices"});

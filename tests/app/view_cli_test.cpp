@@ -74,6 +74,30 @@ TEST_F(ViewCli, ScreenshotMatchesRenderAfterToneMapping)
     EXPECT_LT(differing, a.size() / 100);
 }
 
+// An image in bands (render/ImageBands.h; forced here with the hidden
+// --max-band-bytes: 160 x 16 rows of 28 bytes a band, so 8 bands) is
+// tone-mapped band by band into the same picture as one band, pixel for pixel.
+TEST_F(ViewCli, BandedImageDisplaysExactlyAsOneBand)
+{
+    auto screenshot = [&](const std::string& name, std::vector<std::string> extra) {
+        std::vector<std::string> args = {kScene,    "--frames",    "4",        "--screenshot", (m_dir / name).string(),
+                                         "--width", "160",         "--height", "120",          "--seed",
+                                         "4",       "--validation"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        ProcessResult view = runViewer(args);
+        EXPECT_EQ(view.exitCode, 0) << view.output;
+        int width = 0, height = 0;
+        std::vector<uint8_t> pixels = readPngPixels(m_dir / name, width, height);
+        EXPECT_EQ(width, 160);
+        EXPECT_EQ(height, 120);
+        return pixels;
+    };
+    std::vector<uint8_t> whole = screenshot("whole.png", {});
+    std::vector<uint8_t> banded = screenshot("banded.png", {"--max-band-bytes", std::to_string(160 * 16 * 28)});
+    ASSERT_FALSE(whole.empty());
+    EXPECT_TRUE(whole == banded) << "the banded screenshot differs from the one-band screenshot";
+}
+
 TEST_F(ViewCli, CameraMoveResetsAccumulationAndSaveRecordsTrueSpp)
 {
     fs::path script = m_dir / "session.txt";
