@@ -1,17 +1,20 @@
 #!/usr/bin/env bash
 # Checks that the README's two set-up commands work on a fresh Debian 13
-# (trixie) system, as a new user would run them. Run it before landing a
-# change to the build or to the dependencies.
+# (trixie) system, as a new user would run them; with --release bookworm the
+# same on a fresh Debian 12. Run it before landing a change to the build or
+# to the dependencies (.ci/run runs it for Debian 13).
 #
 # Usage (as root, on a Debian or Debian-derived host):
 #   sudo tools/check-debian13.sh           reuse the chroot if it exists, else make it
 #   sudo tools/check-debian13.sh --fresh   delete the chroot and make a new one
+#   sudo tools/check-debian13.sh --release bookworm   check Debian 12 instead
+#                                               (chroot /var/tmp/vkrt-debian12)
 #   sudo tools/check-debian13.sh --chroot DIR   use DIR instead of the default
 #                                               (default: $VKRT_DEBIAN13_CHROOT or
 #                                               /var/tmp/vkrt-debian13)
 #
 # What it does:
-#   1. makes a minimal trixie chroot with `debootstrap --variant=minbase`
+#   1. makes a minimal chroot of the release with `debootstrap --variant=minbase`
 #      (debootstrap is installed with apt if missing); the Debian archive is
 #      the one the host's own apt sources use, so no mirror is written here;
 #   2. clones this repository's committed HEAD (not the working tree: commit
@@ -29,7 +32,7 @@
 set -euo pipefail
 
 suite=trixie
-chroot_dir=${VKRT_DEBIAN13_CHROOT:-/var/tmp/vkrt-debian13}
+chroot_dir=
 fresh=0
 
 usage() { sed -n '2,/^set -euo/{/^set -euo/d;s/^# \{0,1\}//;p}' "$0"; }
@@ -37,6 +40,10 @@ usage() { sed -n '2,/^set -euo/{/^set -euo/d;s/^# \{0,1\}//;p}' "$0"; }
 while (($# > 0)); do
   case $1 in
     --fresh) fresh=1 ;;
+    --release)
+      [[ $# -ge 2 && ($2 == trixie || $2 == bookworm) ]] \
+        || { echo "check-debian13: --release takes trixie (Debian 13) or bookworm (Debian 12)" >&2; exit 2; }
+      suite=$2; shift ;;
     --chroot)
       [[ $# -ge 2 ]] || { echo "check-debian13: --chroot needs a directory" >&2; exit 2; }
       chroot_dir=$2; shift ;;
@@ -45,6 +52,11 @@ while (($# > 0)); do
   esac
   shift
 done
+
+case $suite in
+  trixie) debian="Debian 13"; chroot_dir=${chroot_dir:-${VKRT_DEBIAN13_CHROOT:-/var/tmp/vkrt-debian13}} ;;
+  bookworm) debian="Debian 12"; chroot_dir=${chroot_dir:-/var/tmp/vkrt-debian12} ;;
+esac
 
 log() { printf 'check-debian13: %s\n' "$*"; }
 die() { printf 'check-debian13: error: %s\n' "$*" >&2; exit 1; }
@@ -120,7 +132,7 @@ mount_in_chroot() { # mount ARGS... TARGET (TARGET relative to the chroot)
 unmount_all() {
   local i
   for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do
-    umount "${mounted[i]}" 2>/dev/null || umount -l "${mounted[i]}" 2>/dev/null \
+    umount -R "${mounted[i]}" 2>/dev/null || umount -R -l "${mounted[i]}" 2>/dev/null \
       || echo "check-debian13: warning: could not unmount ${mounted[i]}" >&2
   done
   mounted=()
@@ -170,7 +182,7 @@ if [[ ! -e $ready_marker ]]; then
     >"$chroot_dir.debootstrap.log" 2>&1 \
     || die "debootstrap failed; see $chroot_dir.debootstrap.log (and $chroot_dir/debootstrap/debootstrap.log)"
   rm -f "$chroot_dir.debootstrap.log"
-  # The sources a Debian 13 installation has: the release, its updates and
+  # The sources a fresh installation of the release has: the release, its updates and
   # its security archive.
   {
     printf 'Types: deb\nURIs: %s\nSuites: %s %s-updates\nComponents: main\n' "$mirror" "$suite" "$suite"
@@ -193,6 +205,12 @@ cp -L /etc/resolv.conf "$chroot_dir/etc/resolv.conf" 2>/dev/null || true
 
 mount_in_chroot -t proc proc /proc
 mount_in_chroot -t sysfs sysfs /sys
+# The host's cgroup hierarchy, whatever its version: slurmd (the render farm's
+# test) refuses to start without one ("No filesystem mounted on /sys/fs/cgroup").
+if mountpoint -q /sys/fs/cgroup; then
+  mount_in_chroot --rbind /sys/fs/cgroup /sys/fs/cgroup
+  mount --make-rslave "$chroot_dir/sys/fs/cgroup"
+fi
 mount_in_chroot --bind /dev /dev
 mount_in_chroot --bind /dev/pts /dev/pts
 mount_in_chroot -t tmpfs -o mode=1777 shm /dev/shm
@@ -244,7 +262,7 @@ run_step setup-test tools/setup.sh test || true
 
 version_of() { in_chroot dpkg-query -W -f='${Version}' "$1" 2>/dev/null || echo "not installed"; }
 echo
-echo "== Debian 13 check of $(git -C "$repo" rev-parse --short "$head") in $chroot_dir =="
+echo "== $debian check of $(git -C "$repo" rev-parse --short "$head") in $chroot_dir =="
 echo "Debian:         $(cat "$chroot_dir/etc/debian_version")"
 echo "g++:            $(in_chroot g++ -dumpfullversion 2>/dev/null || echo 'not installed')"
 echo "cmake:          $(version_of cmake)"
@@ -257,7 +275,7 @@ for t in "${timings[@]}"; do echo "$t"; done
 for r in "${results[@]}"; do echo "$r"; done
 total=$(($(date +%s) - started))
 if ((failed)); then
-  echo "FAIL: Debian 13 check failed (total $total s)"
+  echo "FAIL: $debian check failed (total $total s)"
   exit 1
 fi
-echo "PASS: both README commands work on Debian 13 (total $total s)"
+echo "PASS: both README commands work on $debian (total $total s)"

@@ -17,8 +17,8 @@
 set -euo pipefail
 
 packages=(
-  # build
-  cmake ninja-build g++ pkg-config
+  # build; git, because the repository checks (tools/check-repository-paths.sh) read the tracked files
+  cmake ninja-build g++ pkg-config git
   # Vulkan: loader and headers, validation layers for tests (lavapipe below)
   libvulkan-dev vulkan-validationlayers
   # run-time GLSL compiler, maths, window, images, scene files, options, tests;

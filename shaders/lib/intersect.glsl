@@ -1,6 +1,14 @@
-// Robust ray-primitive tests in float32 (see shared/NUMERICS.md of the team
-// notes and docs/robustness.md). Each returns the hit distance in (0, tMax) or
-// false. Directions are unit length.
+// Robust ray-primitive tests in float32 (docs/robustness.md). Each returns
+// the hit distance in (0, tMax) or false. Directions are unit length.
+//
+// Every value that decides a hit is `precise`: SPIR-V lets a driver contract
+// a * b + c into a fused multiply-add unless told not to, and Mesa 26's
+// lavapipe does (Mesa 22 and 25 never fused). Fusing some products and not
+// others breaks the consistency these tests rely on (the sphere's
+// discriminant at grazing incidence, the watertight edge functions):
+// measured on Mesa 26.1, grazing rays missed spheres they hit on Mesa 25 and
+// rays inside a diffuse sphere lost energy. `precise` gives every driver the
+// arithmetic the tests were validated with.
 #ifndef VKRT_INTERSECT_GLSL
 #define VKRT_INTERSECT_GLSL
 
@@ -15,18 +23,18 @@
 // rounding flips at grazing angles.
 bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit, out vec3 local, out bool front)
 {
-    vec3 f = r.origin - s.center;
-    float b = -dot(f, r.dir);
-    vec3 l = f + b * r.dir;
-    float r2 = s.radius * s.radius;
-    float disc = r2 - dot(l, l);
+    precise vec3 f = r.origin - s.center;
+    precise float b = -dot(f, r.dir);
+    precise vec3 l = f + b * r.dir;
+    precise float r2 = s.radius * s.radius;
+    precise float disc = r2 - dot(l, l);
     if (disc < 0.0)
         return false;
-    float c = dot(f, f) - r2;
-    float rootDisc = sqrt(disc);
-    float q = b + (b >= 0.0 ? rootDisc : -rootDisc);
-    float tNear = c / q;
-    float tFar = q;
+    precise float c = dot(f, f) - r2;
+    precise float rootDisc = sqrt(disc);
+    precise float q = b + (b >= 0.0 ? rootDisc : -rootDisc);
+    precise float tNear = c / q;
+    precise float tFar = q;
     if (tNear > tFar) {
         float tmp = tNear;
         tNear = tFar;
@@ -34,7 +42,8 @@ bool intersectSphere(Sphere s, Ray r, float tMax, out float tHit, out vec3 local
     }
     front = tNear > 0.0;
     tHit = front ? tNear : tFar;
-    local = l + (front ? -rootDisc : rootDisc) * r.dir;
+    precise vec3 hitLocal = l + (front ? -rootDisc : rootDisc) * r.dir;
+    local = hitLocal;
     return tHit > 0.0 && tHit < tMax;
 }
 
@@ -103,30 +112,32 @@ TriangleRay triangleRaySetup(Ray r)
 // vertices round to a tiny nonzero area). `bary` weighs v0, v1, v2.
 bool intersectTriangle(vec3 v0, vec3 v1, vec3 v2, Ray r, TriangleRay tr, float tMax, out float tHit, out vec3 bary)
 {
-    vec3 A = v0 - r.origin;
-    vec3 B = v1 - r.origin;
-    vec3 C = v2 - r.origin;
-    float Ax = A[tr.kx] - tr.shear.x * A[tr.kz];
-    float Ay = A[tr.ky] - tr.shear.y * A[tr.kz];
-    float Bx = B[tr.kx] - tr.shear.x * B[tr.kz];
-    float By = B[tr.ky] - tr.shear.y * B[tr.kz];
-    float Cx = C[tr.kx] - tr.shear.x * C[tr.kz];
-    float Cy = C[tr.ky] - tr.shear.y * C[tr.kz];
-    float U = Cx * By - Cy * Bx;
-    float V = Ax * Cy - Ay * Cx;
-    float W = Bx * Ay - By * Ax;
+    precise vec3 A = v0 - r.origin;
+    precise vec3 B = v1 - r.origin;
+    precise vec3 C = v2 - r.origin;
+    precise float Ax = A[tr.kx] - tr.shear.x * A[tr.kz];
+    precise float Ay = A[tr.ky] - tr.shear.y * A[tr.kz];
+    precise float Bx = B[tr.kx] - tr.shear.x * B[tr.kz];
+    precise float By = B[tr.ky] - tr.shear.y * B[tr.kz];
+    precise float Cx = C[tr.kx] - tr.shear.x * C[tr.kz];
+    precise float Cy = C[tr.ky] - tr.shear.y * C[tr.kz];
+    precise float U = Cx * By - Cy * Bx;
+    precise float V = Ax * Cy - Ay * Cx;
+    precise float W = Bx * Ay - By * Ax;
     if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0))
         return false;
-    float det = U + V + W;
+    precise float det = U + V + W;
     if (det == 0.0)
         return false;
-    float T = U * (tr.shear.z * A[tr.kz]) + V * (tr.shear.z * B[tr.kz]) + W * (tr.shear.z * C[tr.kz]);
+    precise float T = U * (tr.shear.z * A[tr.kz]) + V * (tr.shear.z * B[tr.kz]) + W * (tr.shear.z * C[tr.kz]);
     // t = T / det must lie in (0, tMax); compare before dividing to keep signs exact.
-    float signedT = det < 0.0 ? -T : T;
-    float absDet = abs(det);
-    if (signedT <= 0.0 || signedT >= tMax * absDet)
+    precise float signedT = det < 0.0 ? -T : T;
+    precise float absDet = abs(det);
+    precise float tLimit = tMax * absDet;
+    if (signedT <= 0.0 || signedT >= tLimit)
         return false;
-    if (all(equal(cross(v1 - v0, v2 - v0), vec3(0.0))))
+    precise vec3 area = cross(v1 - v0, v2 - v0);
+    if (all(equal(area, vec3(0.0))))
         return false;
     tHit = T / det;
     bary = vec3(U, V, W) / det;
@@ -135,10 +146,11 @@ bool intersectTriangle(vec3 v0, vec3 v1, vec3 v2, Ray r, TriangleRay tr, float t
 
 bool intersectPlane(Plane p, Ray r, float tMax, out float tHit)
 {
-    float denom = dot(r.dir, p.normal);
+    precise float denom = dot(r.dir, p.normal);
     if (denom == 0.0)
         return false;
-    tHit = dot(p.point - r.origin, p.normal) / denom;
+    precise float along = dot(p.point - r.origin, p.normal);
+    tHit = along / denom;
     return tHit > 0.0 && tHit < tMax;
 }
 

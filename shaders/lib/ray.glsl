@@ -48,8 +48,9 @@ float stepAlongNormal(float x, float nComponent)
 // the scene by construction: no fixed epsilon, no scene-size constant.
 vec3 offsetRayOrigin(vec3 p, vec3 pError, vec3 n)
 {
-    float d = dot(abs(n), pError);
-    vec3 po = p + d * n;
+    // precise: computed as written on every driver (lib/intersect.glsl says why).
+    precise float d = dot(abs(n), pError);
+    precise vec3 po = p + d * n;
     // Written out per coordinate: a loop would count against lavapipe's
     // per-invocation loop budget if the compiler kept it.
     return vec3(stepAlongNormal(po.x, n.x), stepAlongNormal(po.y, n.y), stepAlongNormal(po.z, n.z));

@@ -317,15 +317,31 @@ bool anyHitTriangle(Ray r, float tMax)
     return false;
 }
 
+// How far off a triangle's plane a point must be for the watertight test
+// (lib/intersect.glsl) to tell its side: the test subtracts the ray origin
+// from each vertex and shears the result, rounding at the scale of the
+// vertices, not of the hit point (gamma(5) of the largest vertex coordinate,
+// after pbrt-v4's deltaX/deltaY, section 6.8.4). A ray spawned closer than
+// that, leaving at a grazing angle, was measured hitting its own triangle
+// (Mesa 26.1, tests/gpu/intersection_probe_test.cpp).
+vec3 triangleTestError(vec3 v0, vec3 v1, vec3 v2)
+{
+    vec3 largest = max(max(abs(v0), abs(v1)), abs(v2));
+    return vec3(gammaBound(5) * max(largest.x, max(largest.y, largest.z)));
+}
+
 void describeTriangle(Ray r, HitId id, inout SurfaceHit hit)
 {
 #ifdef VKRT_HAS_TRIANGLES
     // Barycentric interpolation: error gamma(7) sum |b_i v_i| (pbrt-v4 6.8.5).
+    // precise: no fused multiply-adds (lib/intersect.glsl says why).
     Triangle tri = triangles[id.index];
-    hit.normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
-    vec3 b0 = id.detail.x * tri.v0, b1 = id.detail.y * tri.v1, b2 = id.detail.z * tri.v2;
-    hit.position = b0 + b1 + b2;
-    hit.error = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2));
+    precise vec3 area = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+    hit.normal = normalize(area);
+    precise vec3 b0 = id.detail.x * tri.v0, b1 = id.detail.y * tri.v1, b2 = id.detail.z * tri.v2;
+    precise vec3 position = b0 + b1 + b2;
+    hit.position = position;
+    hit.error = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2)) + triangleTestError(tri.v0, tri.v1, tri.v2);
     hit.front = dot(hit.normal, r.dir) < 0.0;
     hit.material = tri.material;
 #ifdef VKRT_HAS_TEXTURES
@@ -551,9 +567,9 @@ void describeMesh(Ray r, HitId id, inout SurfaceHit hit)
     // by |M| (pbrt-v4 section 6.8.5).
     Mesh mesh = meshes[id.index];
     MeshTriangle tri = meshTriangles[mesh.firstTriangle + id.primitive];
-    vec3 b0 = id.detail.x * tri.v0, b1 = id.detail.y * tri.v1, b2 = id.detail.z * tri.v2;
-    vec3 p = b0 + b1 + b2;
-    vec3 objectError = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2));
+    precise vec3 b0 = id.detail.x * tri.v0, b1 = id.detail.y * tri.v1, b2 = id.detail.z * tri.v2;
+    precise vec3 p = b0 + b1 + b2;
+    vec3 objectError = gammaBound(7) * (abs(b0) + abs(b1) + abs(b2)) + triangleTestError(tri.v0, tri.v1, tri.v2);
     mat3 absM = mat3(abs(vec3(mesh.toWorld0.x, mesh.toWorld1.x, mesh.toWorld2.x)),
                      abs(vec3(mesh.toWorld0.y, mesh.toWorld1.y, mesh.toWorld2.y)),
                      abs(vec3(mesh.toWorld0.z, mesh.toWorld1.z, mesh.toWorld2.z)));

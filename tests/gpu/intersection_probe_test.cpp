@@ -369,6 +369,15 @@ bool frontFaceReference(const SpawnCase& c)
     return true;
 }
 
+/// |cos| of the angle between a sphere's normal at the aim point and the
+/// primary ray, exactly (1 for anything but a sphere: never grazing).
+double silhouetteCosine(const SpawnCase& c)
+{
+    if (c.shape.kind != Kind::Sphere) return 1.0;
+    glm::dvec3 centre(c.shape.p[0]), aim(c.aim), origin(c.primaryOrigin);
+    return std::abs(glm::dot(glm::normalize(aim - centre), glm::normalize(aim - origin)));
+}
+
 class IntersectionProbeSelfIntersection : public GpuTest {};
 
 // For each shape, object offset (0, 1e3, 1e4 from the camera at the origin, half of
@@ -575,12 +584,22 @@ TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
     std::vector<SpawnCase> spawns;
     for (const Reproducer& r : cases) spawns.push_back(r.c);
     std::vector<SpawnResult> results = spawnOnGpu(spawns);
+    size_t tested = 0;
     for (size_t i = 0; i < cases.size(); ++i) {
         const SpawnCase& c = cases[i].c;
         const SpawnResult& r = results[i];
         std::string what = std::string(cases[i].cause) + ": " + describe(c, r) + " front face " +
                            std::to_string(r.frontFace) + ", exact " + std::to_string(frontFaceReference(c));
-        ASSERT_TRUE(r.primaryHit) << what;
+        if (!r.primaryHit) {
+            // A primary ray aimed at a sphere's silhouette may round to a miss
+            // on a driver that rounds normalize() or multiply-adds otherwise
+            // (Mesa 26 fuses them, Mesa 25 did not): then the case tests
+            // nothing here. Allowed only where the aim really grazes.
+            EXPECT_LT(silhouetteCosine(c), 1e-2) << "primary ray missed: " << what;
+            std::printf("[ measured ] primary ray missed at the silhouette on this driver: %s\n", cases[i].cause);
+            continue;
+        }
+        ++tested;
         EXPECT_TRUE(finite(r.position) && finite(r.origin) && finite(r.dir)) << what;
         EXPECT_EQ(r.frontFace, frontFaceReference(c)) << what;
         if (c.mode == kTransmit && c.shape.kind == Kind::Sphere) {
@@ -592,6 +611,7 @@ TEST_F(IntersectionProbeSelfIntersection, ReproducersOfFoundFailures)
             EXPECT_FALSE(r.secondHit) << what;
         }
     }
+    EXPECT_GE(tested, cases.size() - 2) << "too few reproducers had a primary hit";
 }
 
 // ---------------------------------------------------------------------------

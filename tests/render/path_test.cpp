@@ -54,7 +54,13 @@ double fractionPassingZTest(const Estimate& e, const std::vector<double>& expect
     for (size_t i = 0; i < n; ++i) {
         double sigma = std::sqrt(e.varianceOfMean[i]);
         double diff = std::abs(e.mean.rgb[i] - expected[i]);
-        if (sigma == 0.0 ? diff <= 1e-5 * std::abs(expected[i]) + 1e-7 : diff / sigma < threshold) ++pass;
+        // Where every sample has the same value (e.g. a diffuse sphere lit
+        // from its centre, k <= 2 bounces), the spread left is float rounding:
+        // then sigma says nothing about the mean's error, and a difference
+        // within float32 rounding passes. (Mesa 26 rounds such samples a few
+        // ulps apart where Mesa 25 gave them bit for bit equal: sigma 1e-9.)
+        bool withinRounding = diff <= 1e-5 * std::abs(expected[i]) + 1e-7;
+        if (withinRounding || (sigma > 0.0 && diff / sigma < threshold)) ++pass;
     }
     return double(pass) / double(n);
 }
