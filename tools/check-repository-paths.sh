@@ -30,6 +30,7 @@ top=$(git -C "$repo" rev-parse --show-toplevel 2>/dev/null) || {
 top=$(cd "$top" && pwd -P)
 allowed_file=$top/tools/repository-paths-allowed.txt
 parent=$(dirname "$top")
+parent_pattern=$(printf '%s' "$parent" | sed 's/[][\.*^$+?(){}|/]/\\&/g')
 
 declare -A allowed=()
 if [[ -f $allowed_file ]]; then
@@ -67,9 +68,10 @@ for file in "${files[@]}"; do
     report "$file" "$line" "${hit#*:}" "absolute path of a machine"
   done < <(grep -nE "$machine" "$file" || true)
   if [[ $parent != / ]]; then
+    # As an absolute path only: "$dir/root/usr" is no mention of a /root parent.
     while IFS= read -r hit; do
       report "$file" "${hit%%:*}" "${hit#*:}" "the folder that holds this checkout"
-    done < <(grep -nF "$parent/" "$file" || true)
+    done < <(grep -nE "(^|[^A-Za-z0-9_.~\$\"/-])$parent_pattern/" "$file" || true)
   fi
   while IFS= read -r hit; do
     line=${hit%%:*}

@@ -42,6 +42,13 @@ git -C "$repo" add -A
 status=0
 output=$("$repo/tools/check-repository-paths.sh" "$repo" 2>&1) || status=$?
 grep -q '^notes.md:1: ' <<<"$output" || fail "the folder holding the checkout ($work) was not reported"
+# ... but only as an absolute path: inside a longer path it names nothing of this machine
+# (a clone in /root, and a script's "$dir/root/usr").
+printf 'library=$dir%s/usr\n' "$work" >"$repo/unpack.sh"
+git -C "$repo" add -A
+output=$("$repo/tools/check-repository-paths.sh" "$repo" 2>&1) || true
+! grep -q '^unpack.sh' <<<"$output" || fail "a path that only contains the checkout's folder was reported: $output"
+rm "$repo/unpack.sh"
 
 printf 'no paths here\n' >"$repo/notes.md"
 printf 'assets=$root/assets\n' >"$repo/tools/bench.sh"
