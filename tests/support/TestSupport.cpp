@@ -11,6 +11,10 @@
 #include <memory>
 #include <sstream>
 
+#include <cerrno>
+
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -78,11 +82,39 @@ RenderOptions pixelCentreOptions()
 
 Scene sceneFromText(const std::string& text, const std::string& path) { return parseSceneString(text, path); }
 
-ProcessResult runVkrt(const std::vector<std::string>& args)
+ProcessResult runVkrt(const std::vector<std::string>& args, const std::string& stdinFile)
 {
-    std::string command = shellQuote(VKRT_BINARY);
-    for (const auto& arg : args) command += " " + shellQuote(arg);
-    return runShell(command);
+    int output[2];
+    if (pipe(output) != 0) return {};
+    const pid_t child = fork();
+    if (child < 0) return {};
+    if (child == 0) {
+        // The vkrt process itself (no shell between), so wait4 sees its memory.
+        const int input = open(stdinFile.c_str(), O_RDONLY);
+        if (input >= 0) dup2(input, STDIN_FILENO);
+        dup2(output[1], STDOUT_FILENO);
+        dup2(output[1], STDERR_FILENO);
+        close(output[0]);
+        std::vector<char*> argv{const_cast<char*>(VKRT_BINARY)};
+        for (const auto& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+        argv.push_back(nullptr);
+        execv(VKRT_BINARY, argv.data());
+        _exit(127);
+    }
+    close(output[1]);
+    ProcessResult result;
+    char buffer[4096];
+    ssize_t n;
+    while ((n = read(output[0], buffer, sizeof buffer)) > 0 || (n < 0 && errno == EINTR))
+        if (n > 0) result.output.append(buffer, static_cast<size_t>(n));
+    close(output[0]);
+    int status = 0;
+    rusage usage{};
+    while (wait4(child, &status, 0, &usage) < 0 && errno == EINTR) {
+    }
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.peakResidentBytes = static_cast<int64_t>(usage.ru_maxrss) * 1024; // Linux reports KiB
+    return result;
 }
 
 ProcessResult runShell(const std::string& shellCommand)

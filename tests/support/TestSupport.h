@@ -46,12 +46,19 @@ RenderOptions pixelCentreOptions();
 Scene sceneFromText(const std::string& text, const std::string& path = "test.toml");
 
 struct ProcessResult {
-    int exitCode = -1;  ///< exit status, or 128 + signal
-    std::string output; ///< stdout and stderr interleaved
+    int exitCode = -1;              ///< exit status, or 128 + signal
+    std::string output;             ///< stdout and stderr interleaved
+    int64_t peakResidentBytes = -1; ///< the process's largest resident set (runVkrt only; -1: unknown)
 };
 
-/// Runs the vkrt executable with `args` (each passed as one argument).
-ProcessResult runVkrt(const std::vector<std::string>& args);
+/// The most memory a test's vkrt process may use on bad input (issue 26:
+/// no process of the suite needs more than 2 GB for any bad input).
+constexpr int64_t kBadInputMemoryLimit = int64_t(2) << 30;
+
+/// Runs the vkrt executable with `args` (each passed as one argument), with
+/// stdin from /dev/null unless `stdinFile` names another file; measures its
+/// peak resident memory (wait4's ru_maxrss).
+ProcessResult runVkrt(const std::vector<std::string>& args, const std::string& stdinFile = "/dev/null");
 
 /// Runs a shell command line as given (stdout and stderr captured together).
 ProcessResult runShell(const std::string& command);

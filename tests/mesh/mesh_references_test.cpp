@@ -1,0 +1,2 @@
+// Issue 26 tests (being written).
+#include "support/TestSupport.h"
