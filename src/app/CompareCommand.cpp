@@ -56,7 +56,8 @@ std::optional<VarianceImage> varianceFor(const std::string& explicitPath, const 
 {
     std::optional<VarianceImage> variance;
     if (!explicitPath.empty()) {
-        ExrContents file = readExr(explicitPath);
+        ExrContents file =
+            readExr(explicitPath, ExpectedSize{shape.width, shape.height, std::string(option) + "'s image is"});
         variance = VarianceImage{file.image, degreesOfFreedomOf(file, explicitPath)};
     } else if (image.layers.count("variance")) {
         variance = VarianceImage{image.layers.at("variance"), degreesOfFreedomOf(image, imagePath)};
@@ -68,18 +69,20 @@ std::optional<VarianceImage> varianceFor(const std::string& explicitPath, const 
     return variance;
 }
 
-void requireSameSize(const CompareOptions& o, const Image& a, const Image& b)
+/// B (and any variance file) must have A's size. Both headers are read
+/// first: a size that differs, or a header that claims more pixels than its
+/// file holds, is refused before either image is allocated.
+ExpectedSize sizeOfA(const CompareOptions& o)
 {
-    if (a.width != b.width || a.height != b.height)
-        throw InputError("cannot compare " + o.a + " (" + std::to_string(a.width) + "x" + std::to_string(a.height) +
-                         ") with " + o.b + " (" + std::to_string(b.width) + "x" + std::to_string(b.height) +
-                         "): sizes differ");
+    const ExrHeader a = readExrHeader(o.a);
+    readExrHeader(o.b, ExpectedSize{a.width, a.height, o.a + " is"});
+    return {a.width, a.height, o.a + " is"};
 }
 
 int runCompare(const CompareOptions& o)
 {
-    ExrContents a = readExr(o.a), b = readExr(o.b);
-    requireSameSize(o, a.image, b.image);
+    const ExpectedSize size = sizeOfA(o);
+    ExrContents a = readExr(o.a, size), b = readExr(o.b, size);
     std::optional<VarianceImage> va = varianceFor(o.varianceA, a, o.a, a.image, "--variance-a");
     std::optional<VarianceImage> vb = varianceFor(o.varianceB, b, o.b, b.image, "--variance-b");
 

@@ -1,6 +1,7 @@
 #include "io/ExrFile.h"
 
 #include "io/AtomicFile.h"
+#include "io/ImageHeader.h"
 #include "util/Error.h"
 
 #include <ImfChannelList.h>
@@ -10,11 +11,14 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
+#include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 
 #include <algorithm>
 #include <climits>
+#include <memory>
+#include <set>
 #include <thread>
 
 namespace vkrt {
@@ -63,19 +67,94 @@ Metadata readAttributes(const Imf::Header& header)
     return metadata;
 }
 
-/// Points `frame` at `image` (already sized to the data window) for layer `layer`.
+/// Points `frame` at `image` for layer `layer`. The image has its size but no
+/// pixels yet: its storage is reserved, so the slices stay valid as it grows.
 void addReadSlices(Imf::FrameBuffer& frame, const Imf::Header& header, const std::string& layer, Image& image,
                    const std::filesystem::path& path)
 {
     const Imath::Box2i window = header.dataWindow();
+    image.rgb.reserve(image.pixelCount() * 3);
     for (int c = 0; c < 3; ++c) {
         if (!header.channels().findChannel(channelName(layer, c)))
             throw InputError(path.string() + ": no channel '" + channelName(layer, c) + "'");
-        char* base = reinterpret_cast<char*>(image.rgb.data() + c) -
-                     (size_t(window.min.x) + size_t(window.min.y) * image.width) * sizeof(float) * 3;
+        char* base =
+            reinterpret_cast<char*>(image.rgb.data() + c) -
+            (int64_t(window.min.x) + int64_t(window.min.y) * int64_t(image.width)) * int64_t(sizeof(float) * 3);
         frame.insert(channelName(layer, c),
                      Imf::Slice(Imf::FLOAT, base, sizeof(float) * 3, sizeof(float) * 3 * image.width));
     }
+}
+
+/// Rows per readPixels call: a multiple of every compression's block height (1, 16, 32, 256).
+constexpr int kStripRows = 256;
+
+/// Reads the rows strip by strip, each image growing (and its memory being
+/// touched) only by the rows just read: a header that claims more pixels
+/// than the file holds fails at the first missing block, not after
+/// allocating them all.
+void readPixelsInStrips(Imf::InputFile& file, const std::vector<Image*>& images)
+{
+    const Imath::Box2i window = file.header().dataWindow();
+    const int height = window.max.y - window.min.y + 1;
+    for (int row = 0; row < height; row += kStripRows) {
+        const int rows = std::min(kStripRows, height - row);
+        for (Image* image : images) image->rgb.resize(size_t(row + rows) * image->width * 3);
+        file.readPixels(window.min.y + row, window.min.y + row + rows - 1);
+    }
+}
+
+/// An image of the data window's size whose pixels are still to be read.
+Image unreadImage(ImageExtent extent)
+{
+    Image image;
+    image.width = extent.width;
+    image.height = extent.height;
+    return image;
+}
+
+void checkExpectedSize(const std::filesystem::path& path, ImageExtent found,
+                       const std::optional<ExpectedSize>& expected)
+{
+    if (expected && (found.width != expected->width || found.height != expected->height))
+        throw InputError(path.string() + ": " + found.str() + " pixels, but " + expected->source + " " +
+                         ImageExtent{expected->width, expected->height}.str());
+}
+
+/// The file opened and its header checked (ImageHeader.h) before OpenEXR allocates anything from it.
+class CheckedExrInput {
+public:
+    CheckedExrInput(const std::filesystem::path& path, const std::optional<ExpectedSize>& expected)
+        : m_stream(openStream(path)),
+          m_header(readCheckedExrHeader(*m_stream, std::filesystem::file_size(path), path.string()))
+    {
+        checkExpectedSize(path, extentOf(m_header), expected);
+    }
+
+    const Imf::Header& header() const { return m_header; }
+    /// OpenEXR's reader on the same stream, from its start.
+    Imf::InputFile open()
+    {
+        m_stream->seekg(0);
+        return Imf::InputFile(*m_stream, Imf::globalThreadCount());
+    }
+
+private:
+    static std::unique_ptr<Imf::StdIFStream> openStream(const std::filesystem::path& path)
+    {
+        if (!std::filesystem::exists(path)) throw InputError(path.string() + ": no such file");
+        if (!std::filesystem::is_regular_file(path)) throw InputError(path.string() + ": is not a regular file");
+        return std::make_unique<Imf::StdIFStream>(path.c_str());
+    }
+
+    std::unique_ptr<Imf::StdIFStream> m_stream;
+    Imf::Header m_header;
+};
+
+std::vector<std::string> layerNamesOf(const Imf::Header& header)
+{
+    std::set<std::string> names;
+    header.channels().layers(names);
+    return {names.begin(), names.end()};
 }
 
 /// OpenEXR (de)compresses blocks of lines on its own thread pool, which is
@@ -113,27 +192,39 @@ void writeExr(const std::filesystem::path& path, const Image& image, const Metad
     });
 }
 
-ExrContents readExr(const std::filesystem::path& path)
+ExrHeader readExrHeader(const std::filesystem::path& path, const std::optional<ExpectedSize>& expected)
 {
-    if (!std::filesystem::exists(path)) throw InputError(path.string() + ": no such file");
+    try {
+        CheckedExrInput input(path, expected);
+        const ImageExtent extent = extentOf(input.header());
+        return {extent.width, extent.height, layerNamesOf(input.header()), readAttributes(input.header())};
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw InputError(path.string() + ": not a readable EXR file: " + e.what());
+    }
+}
+
+ExrContents readExr(const std::filesystem::path& path, const std::optional<ExpectedSize>& expected)
+{
     try {
         useEveryCoreForExr();
-        Imf::InputFile file(path.c_str());
-        const Imath::Box2i window = file.header().dataWindow();
-        const auto width = uint32_t(window.max.x - window.min.x + 1), height = uint32_t(window.max.y - window.min.y + 1);
+        CheckedExrInput input(path, expected);
+        Imf::InputFile file = input.open();
+        const ImageExtent extent = extentOf(file.header());
         // Every layer in one pass: each compressed block holds all channels of its lines.
         ExrContents contents;
         Imf::FrameBuffer frame;
-        contents.image = Image(width, height);
+        contents.image = unreadImage(extent);
         addReadSlices(frame, file.header(), "", contents.image, path);
-        std::set<std::string> layerNames;
-        file.header().channels().layers(layerNames);
-        for (const auto& name : layerNames) {
-            Image& layer = contents.layers[name] = Image(width, height);
+        std::vector<Image*> images{&contents.image};
+        for (const auto& name : layerNamesOf(file.header())) {
+            Image& layer = contents.layers[name] = unreadImage(extent);
             addReadSlices(frame, file.header(), name, layer, path);
+            images.push_back(&layer);
         }
         file.setFrameBuffer(frame);
-        file.readPixels(window.min.y, window.max.y);
+        readPixelsInStrips(file, images);
         contents.metadata = readAttributes(file.header());
         return contents;
     } catch (const InputError&) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -26,8 +27,32 @@ struct ExrContents {
 void writeExr(const std::filesystem::path& path, const Image& image, const Metadata& metadata,
               const std::map<std::string, Image>& layers = {});
 
+/// A size a caller knows the file must have, and why: `source` ends in a
+/// verb, as in "a.exr is" or "the case renders".
+struct ExpectedSize {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::string source;
+};
+
+/// What an EXR's header says, checked (io/ImageHeader.h) without reading pixels.
+struct ExrHeader {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<std::string> layers; ///< extra layers by name
+    Metadata metadata;
+};
+
+/// Reads and checks the header alone: every check of readExr that needs no
+/// pixels, so callers can check all their files before reading any.
+ExrHeader readExrHeader(const std::filesystem::path& path, const std::optional<ExpectedSize>& expected = {});
+
 /// Reads an EXR written by vkrt or any tool with R, G, B channels; throws
-/// InputError naming the path when it is missing, damaged or lacks channels.
-ExrContents readExr(const std::filesystem::path& path);
+/// InputError naming the path when it is missing, damaged, lacks channels,
+/// or its header is refused before any pixel is allocated: larger than
+/// SceneLimits allows, longer than the file could hold, or not `expected`.
+/// Pixels are read in strips, so a file whose header lies costs memory only
+/// for the pixels it really holds.
+ExrContents readExr(const std::filesystem::path& path, const std::optional<ExpectedSize>& expected = {});
 
 } // namespace vkrt

@@ -44,22 +44,33 @@ std::string makeHint(const RegressionCase& c)
     return "make it with tools/make_reference.py (scenes/validation/README.md)";
 }
 
+/// `read()`, its InputError prefixed with the case.
+template <typename Read>
+auto forCase(const RegressionCase& c, Read read)
+{
+    try {
+        return read();
+    } catch (const InputError& e) {
+        throw InputError("case " + c.name + ": " + e.what());
+    }
+}
+
 /// One reference image, checked for size and for values a reference cannot have.
 Image readReferenceImage(const RegressionCase& c, const fs::path& path, uint32_t width, uint32_t height,
                          bool isVariance)
 {
     if (!fs::exists(path))
         throw InputError("case " + c.name + ": missing reference " + path.string() + "; " + makeHint(c));
-    Image image;
-    try {
-        image = readExr(path).image;
-    } catch (const InputError& e) {
-        throw InputError("case " + c.name + ": " + e.what());
-    }
-    if (image.width != width || image.height != height)
-        throw InputError("case " + c.name + ": reference " + path.string() + " is " + std::to_string(image.width) +
-                         "x" + std::to_string(image.height) + " but the case renders " + std::to_string(width) + "x" +
+    // The header must say the case's size before any pixel is read: a
+    // reference that claims gigabytes costs only its header.
+    const ExrHeader header = forCase(c, [&] { return readExrHeader(path); });
+    if (header.width != width || header.height != height)
+        throw InputError("case " + c.name + ": reference " + path.string() + " is " + std::to_string(header.width) +
+                         "x" + std::to_string(header.height) + " but the case renders " + std::to_string(width) + "x" +
                          std::to_string(height) + " (match width/height in the manifest, or regenerate it)");
+    const Image image = forCase(c, [&] {
+        return readExr(path, ExpectedSize{width, height, "the case renders"}).image;
+    });
     size_t invalid = std::count_if(image.rgb.begin(), image.rgb.end(),
                                    [&](float v) { return !std::isfinite(v) || (isVariance && v < 0.0f); });
     if (invalid)

@@ -1,27 +1,68 @@
 #include "render/Environment.h"
 
+#include "io/ImageHeader.h"
 #include "io/PngFile.h"
 #include "util/Error.h"
 
+#include <cmath>
+
 namespace vkrt {
+
+namespace {
+
+const char* const kFaceKeys[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+
+std::string faceLabel(const Cubemap& cubemap, int face)
+{
+    return cubemap.where.str() + ": background.cubemap." + kFaceKeys[face] + ": ";
+}
+
+/// A face's size: square, within kMaxCubeFaceSide, and like the first face's (`first`, 0 for px itself).
+void checkFaceSize(const Cubemap& cubemap, int face, ImageExtent size, uint32_t first)
+{
+    const std::string label = faceLabel(cubemap, face) + cubemap.facePaths[face];
+    if (size.width != size.height || size.width == 0)
+        throw InputError(label + ": a cube face must be square, got " + size.str());
+    if (size.width > kMaxCubeFaceSide)
+        throw InputError(label + ": a cube face may have at most " + std::to_string(kMaxCubeFaceSide) +
+                         " pixels a side, got " + size.str());
+    if (first != 0 && size.width != first)
+        throw InputError(label + ": all faces must have the same size (" + std::to_string(first) + " for px), got " +
+                         std::to_string(size.width));
+}
+
+/// Every face's header, before any face is decoded: six files that claim
+/// more than a cubemap may hold cost nothing but their headers.
+void checkFaceHeaders(const Cubemap& cubemap)
+{
+    uint32_t first = 0;
+    for (int i = 0; i < 6; ++i) {
+        ImageExtent size;
+        try {
+            size = imageFileExtent(cubemap.facePaths[i]);
+        } catch (const InputError& e) {
+            throw InputError(faceLabel(cubemap, i) + e.what());
+        }
+        checkFaceSize(cubemap, i, size, first);
+        first = size.width;
+    }
+}
+
+} // namespace
 
 std::array<Image, 6> loadCubemapFaces(const Cubemap& cubemap)
 {
-    static const char* const kFaceKeys[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+    checkFaceHeaders(cubemap);
     std::array<Image, 6> faces;
     for (int i = 0; i < 6; ++i) {
-        std::string label = cubemap.where.str() + ": background.cubemap." + kFaceKeys[i] + ": ";
+        std::string label = faceLabel(cubemap, i);
         try {
             faces[i] = readRgbImage(cubemap.facePaths[i]);
         } catch (const InputError& e) {
             throw InputError(label + e.what());
         }
-        if (faces[i].width != faces[i].height || faces[i].width == 0)
-            throw InputError(label + cubemap.facePaths[i] + ": a cube face must be square, got " +
-                             std::to_string(faces[i].width) + "x" + std::to_string(faces[i].height));
-        if (faces[i].width != faces[0].width)
-            throw InputError(label + cubemap.facePaths[i] + ": all faces must have the same size (" +
-                             std::to_string(faces[0].width) + " for px), got " + std::to_string(faces[i].width));
+        // The decoder must agree with the header it was checked by.
+        checkFaceSize(cubemap, i, {faces[i].width, faces[i].height}, faces[0].width);
         for (float v : faces[i].rgb)
             if (!std::isfinite(v) || v < 0.0f)
                 throw InputError(label + cubemap.facePaths[i] + ": contains a negative or non-finite value");

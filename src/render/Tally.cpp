@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace vkrt {
 namespace {
@@ -48,6 +49,64 @@ const Image& layer(const ExrContents& contents, const std::string& name, const s
     if (!sameSize(found->second, contents.image))
         throw InputError(file + ": layer '" + name + "' is not the image's size");
     return found->second;
+}
+
+/// sampleEnd - sampleBegin from the shard's metadata: no pixel can have more samples.
+int64_t shardSampleCount(const ExrContents& contents, const std::string& file)
+{
+    auto attribute = [&](const char* key) {
+        const auto found = contents.metadata.find(key);
+        const auto* value = found == contents.metadata.end() ? nullptr : std::get_if<int64_t>(&found->second);
+        if (!value)
+            throw InputError(file + ": no integer '" + key +
+                             "' attribute: not a shard written by `vkrt render --shard`");
+        return *value;
+    };
+    const int64_t begin = attribute("sampleBegin"), end = attribute("sampleEnd");
+    if (begin < 0 || end <= begin)
+        throw InputError(file + ": sample range [" + std::to_string(begin) + ", " + std::to_string(end) +
+                         ") is empty or negative");
+    return end - begin;
+}
+
+std::string formatValue(float value)
+{
+    std::ostringstream text;
+    text << value;
+    return text.str();
+}
+
+/// Names the first value of `image` that `valid` refuses, with its pixel: "FILE: tally.count at pixel (x, y) is V, but
+/// ...".
+template <typename Valid>
+void checkEveryValue(const Image& image, const std::string& name, const std::string& file, const std::string& rule,
+                     Valid valid)
+{
+    for (size_t v = 0; v < image.rgb.size(); ++v) {
+        if (valid(image.rgb[v])) continue;
+        const size_t pixel = v / 3;
+        throw InputError(file + ": " + name + " at pixel (" + std::to_string(pixel % image.width) + ", " +
+                         std::to_string(pixel / image.width) + ") is " + formatValue(image.rgb[v]) + ", but " + rule);
+    }
+}
+
+/// Counts are whole numbers of samples within the shard's range; means and sums are finite.
+void checkTallyValues(const Tally& tally, int64_t samples, const std::string& file)
+{
+    const std::string countRule =
+        "a count is a whole number from 0 to the " + std::to_string(samples) + " samples the shard covers";
+    auto isCount = [&](float n) { return n >= 0.0f && n == std::floor(n) && double(n) <= double(samples); };
+    auto isFinite = [](float x) { return std::isfinite(x); };
+    checkEveryValue(tally.count, "tally.count", file, countRule, isCount);
+    checkEveryValue(tally.mean, "tally.mean", file, "a mean must be finite", isFinite);
+    if (tally.m2)
+        checkEveryValue(*tally.m2, "tally.m2", file, "a sum of squared deviations is finite and >= 0",
+                        [](float x) { return std::isfinite(x) && x >= 0.0f; });
+    for (size_t b = 0; b < tally.batchMean.size(); ++b) {
+        const std::string batch = "tally.batch" + std::to_string(b);
+        checkEveryValue(tally.batchCount[b], batch + ".count", file, countRule, isCount);
+        checkEveryValue(tally.batchMean[b], batch + ".mean", file, "a mean must be finite", isFinite);
+    }
 }
 
 } // namespace
@@ -143,6 +202,7 @@ void addTallyLayers(const Tally& tally, std::map<std::string, Image>& layers)
 
 Tally readTally(const ExrContents& contents, const std::string& file)
 {
+    const int64_t samples = shardSampleCount(contents, file);
     Tally tally;
     tally.count = layer(contents, "tally.count", file);
     tally.mean = layer(contents, "tally.mean", file);
@@ -151,8 +211,7 @@ Tally readTally(const ExrContents& contents, const std::string& file)
         tally.batchCount.push_back(layer(contents, "tally.batch" + std::to_string(b) + ".count", file));
         tally.batchMean.push_back(layer(contents, "tally.batch" + std::to_string(b) + ".mean", file));
     }
-    for (float n : tally.count.rgb)
-        if (!(n >= 0.0f) || n != std::floor(n)) throw InputError(file + ": layer 'tally.count' holds a non-count");
+    checkTallyValues(tally, samples, file);
     return tally;
 }
 

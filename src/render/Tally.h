@@ -19,9 +19,9 @@ namespace vkrt {
 
 /// Per-pixel sums; every image has the same size. Counts are stored in all three channels.
 struct Tally {
-    Image count;              ///< accepted samples
-    Image mean;               ///< of the accepted samples
-    std::optional<Image> m2;  ///< independent samples with variance: sum of squared deviations
+    Image count;                   ///< accepted samples
+    Image mean;                    ///< of the accepted samples
+    std::optional<Image> m2;       ///< independent samples with variance: sum of squared deviations
     std::vector<Image> batchCount; ///< Sobol' batches with variance: per batch, its samples...
     std::vector<Image> batchMean;  ///< ... and their mean
 
@@ -41,7 +41,10 @@ Tally mergeTallies(const std::vector<Tally>& tallies);
 
 /// As EXR layers ("tally.count", "tally.mean", "tally.m2", "tally.batchK.count",
 /// "tally.batchK.mean"), and back; readTally throws InputError naming `file`
-/// when a layer is missing or has the wrong size.
+/// when a layer is missing or has the wrong size, the metadata has no sample
+/// range (sampleBegin, sampleEnd), or a value is one no render writes: a count
+/// that is not a whole number in [0, sampleEnd - sampleBegin], a non-finite
+/// mean, a negative or non-finite m2 (the message names the layer and pixel).
 void addTallyLayers(const Tally& tally, std::map<std::string, Image>& layers);
 Tally readTally(const ExrContents& contents, const std::string& file);
 

@@ -73,7 +73,23 @@ std::string fileKey(const fs::path& file)
 
 } // namespace
 
-uint32_t TextureAtlas::addImage(const TextureImage& image, const std::string& name)
+void TextureAtlas::reserveTexels(const TextureHeader& header, const std::string& name)
+{
+    if (m_texels + header.texels() > kMaxSceneTexels)
+        throw InputError(name + ": a " + std::to_string(header.width) + "x" + std::to_string(header.height) +
+                         " texture brings the scene's textures to " + std::to_string(m_texels + header.texels()) +
+                         " texels, more than the " + std::to_string(kMaxSceneTexels) +
+                         " (one 8192x8192) vkrt loads for one scene; use smaller textures");
+    m_texels += header.texels();
+}
+
+uint32_t TextureAtlas::addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear)
+{
+    reserveTexels(readTextureHeader(bytes, name, linear), name);
+    return addImage(decodeTextureImage(bytes, name, linear), name);
+}
+
+uint32_t TextureAtlas::addImage(TextureImage image, const std::string& name)
 {
     StoredImage stored;
     stored.name = name;
@@ -83,7 +99,8 @@ uint32_t TextureAtlas::addImage(const TextureImage& image, const std::string& na
     for (size_t i = 0; i < image.pixels.texelCount(); ++i)
         for (int c = 0; c < 4; ++c) stored.mean[c] += image.pixels.rgba[i * 4 + c];
     for (double& m : stored.mean) m /= double(image.pixels.texelCount());
-    for (const RgbaImage& level : buildMipPyramid(image.pixels)) {
+    // The pyramid takes level 0 over: no second copy of the largest level.
+    for (const RgbaImage& level : buildMipPyramid(std::move(image.pixels))) {
         stored.levelWords.push_back(stored.words.size());
         appendLevel(level, stored.format, stored.words);
     }
@@ -123,7 +140,7 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
     if (found == m_imageByFile.end()) {
         uint32_t image = 0;
         try {
-            image = addImage(loadTextureImage(request.file, request.linear), request.file.string());
+            image = addDecoded(readTextureFile(request.file), request.file.string(), request.linear);
         } catch (const SceneError&) {
             throw;
         } catch (const InputError& error) {
@@ -135,10 +152,17 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
     return addRecord(found->second, request.wrapU, request.wrapV);
 }
 
+uint32_t TextureAtlas::addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
+                                  TextureWrap wrapU, TextureWrap wrapV)
+{
+    return addRecord(addDecoded(bytes, name, linear), wrapU, wrapV);
+}
+
 uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV)
 {
     VKRT_CHECK(image.pixels.width >= 1 && image.pixels.width <= gpu::TEXTURE_MAX_SIZE);
     VKRT_CHECK(image.pixels.height >= 1 && image.pixels.height <= gpu::TEXTURE_MAX_SIZE);
+    reserveTexels({image.pixels.width, image.pixels.height, image.encoding}, name);
     return addRecord(addImage(image, name), wrapU, wrapV);
 }
 
@@ -160,8 +184,8 @@ TextureBuffers TextureAtlas::pack(uint64_t maxStorageBufferRange) const
         buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
     for (const auto& [imageIndex, wrapU, wrapV] : m_records) {
         const StoredImage& image = m_images[imageIndex];
-        gpu::TextureRecord record{image.width, image.height, image.levels, image.format,
-                                  uint32_t(wrapU), uint32_t(wrapV), {}};
+        gpu::TextureRecord record{
+            image.width, image.height, image.levels, image.format, uint32_t(wrapU), uint32_t(wrapV), {}};
         for (uint32_t level = 0; level < image.levels; ++level)
             record.levelOffset[level] = uint32_t(image.firstWord + image.levelWords[level]);
         buffers.records.push_back(record);

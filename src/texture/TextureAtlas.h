@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <span>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -39,11 +40,23 @@ struct TextureBuffers {
 
 class TextureAtlas {
 public:
+    /// Level-0 texels all of a scene's textures may have together (one
+    /// 8192x8192, or sixteen 2048x2048): checked from each file's header
+    /// before it is decoded, since decoding costs about 32 bytes of CPU memory
+    /// a texel (float RGBA and its mip chain) and the atlas keeps 5.3 (8-bit)
+    /// or 10.7 (half) bytes a texel on the GPU. At most 683 MiB of GPU storage.
+    static constexpr uint64_t kMaxSceneTexels = uint64_t(64) << 20;
+
     /// Loads the file (once per (file, linear) pair) and returns the index of
     /// its record (one per distinct pair and wrap modes). Load errors are
     /// InputErrors naming the file; given a location (the scene's `texture`
     /// key), a SceneError starting "file:line:column: ".
     uint32_t add(const TextureRequest& request, const SourceLocation& where = {});
+
+    /// An image file's bytes already in memory (embedded in a .glb, a data:
+    /// URI): its header checked against the budget before it is decoded.
+    uint32_t addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
+                        TextureWrap wrapU = TextureWrap::Repeat, TextureWrap wrapV = TextureWrap::Repeat);
 
     /// An image made in memory (procedural textures, tests); `name` is used in messages.
     uint32_t add(const TextureImage& image, const std::string& name, TextureWrap wrapU = TextureWrap::Repeat,
@@ -73,13 +86,18 @@ private:
         std::vector<uint32_t> words;      ///< every level, encoded
         std::array<double, 4> mean{};     ///< level 0's mean linear RGBA
     };
-    uint32_t addImage(const TextureImage& image, const std::string& name);
+    uint32_t addImage(TextureImage image, const std::string& name);
+    /// Counts a texture of `header`'s size against kMaxSceneTexels, or refuses it naming `name`.
+    void reserveTexels(const TextureHeader& header, const std::string& name);
+    /// Header check, budget, decoding and storing, for a file's bytes.
+    uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear);
     uint32_t addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV);
 
     std::vector<StoredImage> m_images;
     std::vector<std::tuple<uint32_t, TextureWrap, TextureWrap>> m_records; ///< image, wrap u, wrap v
     std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile;        ///< (canonical path, linear)
     uint64_t m_words = 0;
+    uint64_t m_texels = 0; ///< level 0, of every image added
 };
 
 /// Texel encodings (exposed for tests): RGBA8 words (unpackUnorm4x8 order)

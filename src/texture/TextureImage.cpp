@@ -1,13 +1,13 @@
 #include "texture/TextureImage.h"
 
 #include "io/ExrFile.h"
+#include "io/ImageHeader.h"
 #include "shared/TextureTypes.h"
 #include "util/Error.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
-#include <ImfIO.h>
 #include <ImfInputFile.h>
 
 // stb_image's implementation is compiled once, in the system's libstb (the `stb` target).
@@ -42,7 +42,7 @@ namespace {
 
 [[noreturn]] void fail(const fs::path& file, const std::string& reason) { fail(file.string(), reason); }
 
-std::vector<unsigned char> readBytes(const fs::path& file)
+std::vector<uint8_t> readBytes(const fs::path& file)
 {
     std::error_code error;
     const fs::file_status status = fs::status(file, error);
@@ -52,7 +52,7 @@ std::vector<unsigned char> readBytes(const fs::path& file)
     if (!fs::is_regular_file(status)) fail(file, "is not a regular file");
     std::ifstream in(file, std::ios::binary);
     if (!in) fail(file, "cannot open texture file");
-    std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     if (bytes.empty()) fail(file, "empty file, not an image");
     return bytes;
 }
@@ -104,43 +104,26 @@ TextureImage exrTexture(const Image& rgb, const std::string& file)
     return texture;
 }
 
-/// OpenEXR reading from memory (an image embedded in a mesh file).
-class MemoryStream : public Imf::IStream {
-public:
-    MemoryStream(std::span<const uint8_t> bytes, const std::string& name) : Imf::IStream(name.c_str()), m_bytes(bytes) {}
-
-    bool read(char c[], int n) override
-    {
-        if (n < 0 || m_position + uint64_t(n) > m_bytes.size()) throw std::runtime_error("unexpected end of data");
-        std::memcpy(c, m_bytes.data() + m_position, size_t(n));
-        m_position += uint64_t(n);
-        return m_position < m_bytes.size();
-    }
-    uint64_t tellg() override { return m_position; }
-    void seekg(uint64_t position) override { m_position = position; }
-
-private:
-    std::span<const uint8_t> m_bytes;
-    uint64_t m_position = 0;
-};
-
 /// io/ExrFile's reading of R, G and B (the same messages), from memory, the
-/// size checked before anything is allocated.
+/// header checked (io/ImageHeader.h) before anything is allocated.
 TextureImage decodeExr(std::span<const uint8_t> bytes, const std::string& name)
 {
     try {
-        MemoryStream stream(bytes, name);
+        MemoryExrStream stream(bytes, name);
+        const ImageExtent extent = extentOf(readCheckedExrHeader(stream, bytes.size(), name));
+        checkSize(name, extent.width, extent.height);
+        stream.seekg(0);
         Imf::InputFile file(stream);
         const Imath::Box2i window = file.header().dataWindow();
-        checkSize(name, uint64_t(int64_t(window.max.x) - window.min.x + 1), uint64_t(int64_t(window.max.y) - window.min.y + 1));
-        Image rgb(uint32_t(window.max.x - window.min.x + 1), uint32_t(window.max.y - window.min.y + 1));
+        Image rgb(extent.width, extent.height);
         Imf::FrameBuffer frame;
         const char* const channels[3] = {"R", "G", "B"};
         for (int c = 0; c < 3; ++c) {
             if (!file.header().channels().findChannel(channels[c]))
                 fail(name, "no channel '" + std::string(channels[c]) + "'");
-            char* base = reinterpret_cast<char*>(rgb.rgb.data() + c) -
-                         (int64_t(window.min.x) + int64_t(window.min.y) * int64_t(rgb.width)) * int64_t(sizeof(float) * 3);
+            char* base =
+                reinterpret_cast<char*>(rgb.rgb.data() + c) -
+                (int64_t(window.min.x) + int64_t(window.min.y) * int64_t(rgb.width)) * int64_t(sizeof(float) * 3);
             frame.insert(channels[c], Imf::Slice(Imf::FLOAT, base, sizeof(float) * 3, sizeof(float) * 3 * rgb.width));
         }
         file.setFrameBuffer(frame);
@@ -164,7 +147,8 @@ void decodeChannels(const T* codes, RgbaImage& image, double maxCode, bool linea
     }
 }
 
-TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, bool linear)
+/// stb_image's header: the size, or the reason it cannot be read.
+ImageExtent stbHeader(std::span<const uint8_t> bytes, const std::string& file)
 {
     const auto* data = bytes.data();
     const int length = int(bytes.size());
@@ -174,13 +158,31 @@ TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, 
         // stbi_info tries every format in turn and reports the last one's
         // complaint ("unknown image type"); a decode attempt stops at the
         // format whose signature matches and says what is wrong with it.
+        // (Only a header stb_image cannot parse gets here: no size to believe.)
         StbPixels<stbi_uc> pixels(stbi_load_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
         const std::string reason = pixels ? "its header cannot be read" : stbReason();
         if (reason == "unknown image type") fail(file, "not an image file (stb_image: " + reason + ")");
         fail(file, "unsupported or damaged image (stb_image: " + reason + ")");
     }
     checkSize(file, uint64_t(width), uint64_t(height));
-    TextureImage texture{RgbaImage(uint32_t(width), uint32_t(height)), TexelEncoding::Half};
+    return {uint32_t(width), uint32_t(height)};
+}
+
+TexelEncoding stbEncoding(std::span<const uint8_t> bytes, bool linear)
+{
+    const int length = int(bytes.size());
+    if (stbi_is_hdr_from_memory(bytes.data(), length) || stbi_is_16_bit_from_memory(bytes.data(), length))
+        return TexelEncoding::Half;
+    return linear ? TexelEncoding::Unorm8 : TexelEncoding::Srgb8;
+}
+
+TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, bool linear)
+{
+    const auto* data = bytes.data();
+    const int length = int(bytes.size());
+    const ImageExtent extent = stbHeader(bytes, file);
+    int width = 0, height = 0, channels = 0;
+    TextureImage texture{RgbaImage(extent.width, extent.height), stbEncoding(bytes, linear)};
     // Four channels requested: grey becomes (g, g, g, 1), grey + alpha (g, g, g, a), RGB gets alpha 1.
     if (stbi_is_hdr_from_memory(data, length)) {
         StbPixels<float> pixels(stbi_loadf_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
@@ -195,12 +197,26 @@ TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, 
         StbPixels<stbi_uc> pixels(stbi_load_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
         if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
         decodeChannels(pixels.get(), texture.pixels, 255.0, linear);
-        texture.encoding = linear ? TexelEncoding::Unorm8 : TexelEncoding::Srgb8;
     }
     return texture;
 }
 
 } // namespace
+
+std::vector<uint8_t> readTextureFile(const fs::path& file) { return readBytes(file); }
+
+TextureHeader readTextureHeader(std::span<const uint8_t> bytes, const std::string& name, bool linear)
+{
+    if (bytes.empty()) fail(name, "empty file, not an image");
+    if (isExr(bytes)) {
+        MemoryExrStream stream(bytes, name);
+        const ImageExtent extent = extentOf(readCheckedExrHeader(stream, bytes.size(), name));
+        checkSize(name, extent.width, extent.height);
+        return {extent.width, extent.height, TexelEncoding::Half};
+    }
+    const ImageExtent extent = stbHeader(bytes, name);
+    return {extent.width, extent.height, stbEncoding(bytes, linear)};
+}
 
 TextureImage loadTextureImage(const fs::path& file, bool linear)
 {

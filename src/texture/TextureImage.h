@@ -51,6 +51,21 @@ TextureImage loadTextureImage(const std::filesystem::path& file, bool linear);
 /// `name` where they name the file.
 TextureImage decodeTextureImage(std::span<const uint8_t> bytes, const std::string& name, bool linear);
 
+/// What decoding a file will give, from its header alone: its size (with
+/// the same checks and messages as decoding) and texel encoding.
+struct TextureHeader {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    TexelEncoding encoding = TexelEncoding::Half;
+
+    uint64_t texels() const { return uint64_t(width) * height; }
+};
+TextureHeader readTextureHeader(std::span<const uint8_t> bytes, const std::string& name, bool linear);
+
+/// A texture file's bytes; InputError naming it when it is missing, not a
+/// regular file (a FIFO could block forever) or empty.
+std::vector<uint8_t> readTextureFile(const std::filesystem::path& file);
+
 /// The exact sRGB EOTF (IEC 61966-2-1, piecewise), `encoded` in [0, 1].
 double srgbToLinear(double encoded);
 /// Its inverse.

@@ -113,7 +113,9 @@ TEST_F(StatsCli, CompareRejectsMismatchedSizes)
     writeExr(m_dir / "big.exr", Image(5, 4), {});
     ProcessResult r = runVkrt({"compare", (m_dir / "small.exr").string(), (m_dir / "big.exr").string()});
     EXPECT_EQ(r.exitCode, 2) << r.output;
-    EXPECT_NE(r.output.find("sizes differ"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("big.exr: 5x4 pixels, but " + (m_dir / "small.exr").string() + " is 4x4"),
+              std::string::npos)
+        << r.output;
     ProcessResult missing = runVkrt({"compare", (m_dir / "nope.exr").string(), (m_dir / "big.exr").string()});
     EXPECT_EQ(missing.exitCode, 2) << missing.output;
     EXPECT_NE(missing.output.find("nope.exr"), std::string::npos) << missing.output;

@@ -105,12 +105,21 @@ TEST(TallyMerge, SobolBatchTalliesAddUpToTheWholeSampleSet)
     EXPECT_TRUE(std::isinf(tallyVarianceOfMean(parts[0])->rgb[0]));
 }
 
-TEST(TallyMerge, LayersRoundTripAndMissingOnesAreNamed)
+/// A shard's EXR contents holding tally `t` of samples [begin, end).
+ExrContents shardOf(const Tally& t, int64_t begin, int64_t end)
 {
-    const Tally t = batchedTally(randomSamples(16), 0, 16, 8);
     ExrContents exr;
     exr.image = t.mean;
     addTallyLayers(t, exr.layers);
+    exr.metadata["sampleBegin"] = begin;
+    exr.metadata["sampleEnd"] = end;
+    return exr;
+}
+
+TEST(TallyMerge, LayersRoundTripAndMissingOnesAreNamed)
+{
+    const Tally t = batchedTally(randomSamples(16), 0, 16, 8);
+    ExrContents exr = shardOf(t, 0, 16);
     const Tally back = readTally(exr, "shard.exr");
     ASSERT_EQ(back.batchMean.size(), 8u);
     expectClose(back.batchMean[3], t.batchMean[3], 0.0, "batch mean");
@@ -121,6 +130,66 @@ TEST(TallyMerge, LayersRoundTripAndMissingOnesAreNamed)
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("shard.exr: no layer 'tally.count'"), std::string::npos) << e.what();
     }
+}
+
+/// readTally's message for `exr`, or "" when it accepts it.
+std::string refusal(const ExrContents& exr)
+{
+    try {
+        readTally(exr, "shard.exr");
+        return "";
+    } catch (const InputError& e) {
+        return e.what();
+    }
+}
+
+TEST(TallyRead, PoisonedValuesAreRefusedNamingLayerAndPixel)
+{
+    const Tally t = independentTally({1.0, 2.0}); // 2 x 1 pixels, 2 samples each
+    struct Case {
+        std::string layer;
+        float value;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"tally.mean", NAN, "shard.exr: tally.mean at pixel (1, 0) is nan, but a mean must be finite"},
+        {"tally.mean", INFINITY, "tally.mean at pixel (1, 0) is inf"},
+        {"tally.count", 1e30f,
+         "shard.exr: tally.count at pixel (1, 0) is 1e+30, but a count is a whole number from 0 "
+         "to the 2 samples the shard covers"},
+        {"tally.count", -1.0f, "tally.count at pixel (1, 0) is -1"},
+        {"tally.count", 3.0f, "tally.count at pixel (1, 0) is 3, but"},
+        {"tally.count", 1.5f, "tally.count at pixel (1, 0) is 1.5, but"},
+        {"tally.count", NAN, "tally.count at pixel (1, 0) is nan"},
+        {"tally.m2", -0.5f, "tally.m2 at pixel (1, 0) is -0.5, but a sum of squared deviations is finite and >= 0"},
+        {"tally.m2", INFINITY, "tally.m2 at pixel (1, 0) is inf"},
+    };
+    ASSERT_EQ(refusal(shardOf(t, 0, 2)), "") << "the unpoisoned tally is accepted";
+    for (const Case& c : cases) {
+        ExrContents exr = shardOf(t, 0, 2);
+        exr.layers.at(c.layer).rgb[4] = c.value; // pixel (1, 0), green
+        const std::string message = refusal(exr);
+        EXPECT_NE(message.find(c.message), std::string::npos) << c.layer << " = " << c.value << ": " << message;
+    }
+}
+
+TEST(TallyRead, BatchValuesAndTheSampleRangeAreChecked)
+{
+    const Tally t = batchedTally(randomSamples(16), 0, 16, 8);
+    ExrContents exr = shardOf(t, 0, 16);
+    exr.layers.at("tally.batch3.count").rgb[0] = 17.0f;
+    EXPECT_NE(refusal(exr).find("tally.batch3.count at pixel (0, 0) is 17"), std::string::npos) << refusal(exr);
+    exr = shardOf(t, 0, 16);
+    exr.layers.at("tally.batch5.mean").rgb[2] = NAN;
+    EXPECT_NE(refusal(exr).find("tally.batch5.mean at pixel (0, 0) is nan"), std::string::npos) << refusal(exr);
+    // Counts of 16 in a shard of 8 samples: the range, not the layer, is the limit.
+    exr = shardOf(t, 8, 16);
+    EXPECT_NE(refusal(exr).find("tally.count at pixel (0, 0) is 16, but a count is a whole number from 0 to the 8"),
+              std::string::npos)
+        << refusal(exr);
+    exr = shardOf(t, 0, 16);
+    exr.metadata.erase("sampleEnd");
+    EXPECT_NE(refusal(exr).find("shard.exr: no integer 'sampleEnd' attribute"), std::string::npos) << refusal(exr);
 }
 
 } // namespace
