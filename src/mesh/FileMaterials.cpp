@@ -16,6 +16,7 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 namespace vkrt {
 
@@ -27,6 +28,25 @@ namespace {
 [[noreturn]] void fail(const fs::path& file, const std::string& message)
 {
     throw InputError(file.string() + ": " + message);
+}
+
+/// glTF URIs are RFC 3986: "my%20wood.png" is the file "my wood.png".
+std::string percentDecoded(const std::string& uri)
+{
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        unsigned code = 0;
+        if (uri[i] == '%' && i + 2 < uri.size()) {
+            const auto [end, error] = std::from_chars(uri.data() + i + 1, uri.data() + i + 3, code, 16);
+            if (error == std::errc() && end == uri.data() + i + 3) {
+                out.push_back(char(code));
+                i += 2;
+                continue;
+            }
+        }
+        out.push_back(uri[i]);
+    }
+    return out;
 }
 
 // ---------------------------------------------------------------------------
@@ -90,11 +110,38 @@ std::string masked(std::string text)
     return text;
 }
 
+/// The byte offset of the first '[' or '{' that opens level `limit` + 1, if
+/// any (strings skipped). Assimp's rapidjson parses recursively: about 100,000
+/// nested arrays overflow the stack, so deep nesting is refused before it.
+std::optional<size_t> findExcessiveNesting(std::string_view text, size_t limit)
+{
+    size_t depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\') ++i;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > limit) return i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return std::nullopt;
+}
+
 /// The file's JSON as assimp reads it. Duplicate keys are refused: rapidjson
 /// takes the first, nlohmann the last, and bounds checked on one value
 /// would not protect reads of the other.
 json parseJson(const fs::path& file)
 {
+    const std::string text = masked(readGltfJson(file));
+    if (const auto offset = findExcessiveNesting(text, kMaxGltfJsonNesting))
+        fail(file, "the glTF JSON nests arrays and objects more than " + std::to_string(kMaxGltfJsonNesting) +
+                       " levels deep (at byte " + std::to_string(*offset) + " of the JSON)");
     std::vector<std::set<std::string>> keys;
     std::string duplicate;
     const json::parser_callback_t noteKeys = [&](int, json::parse_event_t event, json& parsed) {
@@ -105,7 +152,7 @@ json parseJson(const fs::path& file)
             duplicate = parsed.get<std::string>();
         return true;
     };
-    json doc = json::parse(masked(readGltfJson(file)), noteKeys, /*allow_exceptions=*/false);
+    json doc = json::parse(text, noteKeys, /*allow_exceptions=*/false);
     if (doc.is_discarded() || !doc.is_object()) fail(file, "the glTF JSON cannot be parsed");
     if (!duplicate.empty()) fail(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
     return doc;
@@ -202,9 +249,9 @@ private:
 // extensions it read, and drops those it does not know).
 
 struct TextureSlot {
-    const char* name;  ///< as glTF names it
-    bool inPbr;        ///< under pbrMetallicRoughness
-    bool honoured;     ///< false: occlusionTexture (FileMaterials.h)
+    const char* name; ///< as glTF names it
+    bool inPbr;       ///< under pbrMetallicRoughness
+    bool honoured;    ///< false: occlusionTexture (FileMaterials.h)
 };
 
 constexpr TextureSlot kTextureSlots[] = {
@@ -286,11 +333,9 @@ struct MaterialReader {
     const aiScene& scene;
     const fs::path& file;
     std::string materialName; ///< for messages
+    const ReferencePolicy& references;
 
-    [[noreturn]] void malformed(const std::string& what) const
-    {
-        fail(file, "material " + materialName + ": " + what);
-    }
+    [[noreturn]] void malformed(const std::string& what) const { fail(file, "material " + materialName + ": " + what); }
 
     float factor(const aiMaterial& m, const char* key, unsigned type, unsigned index, float fallback,
                  const char* gltfName) const
@@ -326,6 +371,7 @@ struct MaterialReader {
         } else {
             if (uri.empty()) malformed("an image has neither a file nor base64 data");
             texture.file = file.parent_path() / percentDecoded(uri);
+            references.check(texture.file, uri, "material " + materialName + "'s image");
             texture.name = texture.file.string();
         }
         texture.wrapU = wrap(m, AI_MATKEY_MAPPINGMODE_U(type, 0));
@@ -358,25 +404,6 @@ struct MaterialReader {
         return TextureWrap::Repeat; // glTF's default sampler
     }
 
-    /// glTF URIs are RFC 3986: "my%20wood.png" is the file "my wood.png".
-    static std::string percentDecoded(const std::string& uri)
-    {
-        std::string out;
-        for (size_t i = 0; i < uri.size(); ++i) {
-            unsigned code = 0;
-            if (uri[i] == '%' && i + 2 < uri.size()) {
-                const auto [end, error] = std::from_chars(uri.data() + i + 1, uri.data() + i + 3, code, 16);
-                if (error == std::errc() && end == uri.data() + i + 3) {
-                    out.push_back(char(code));
-                    i += 2;
-                    continue;
-                }
-            }
-            out.push_back(uri[i]);
-        }
-        return out;
-    }
-
     AlphaMode alphaMode(const aiMaterial& m) const
     {
         aiString mode;
@@ -392,7 +419,8 @@ struct MaterialReader {
     {
         float value = fallback;
         if (m.Get(key, type, index, value) != AI_SUCCESS) return fallback;
-        if (!std::isfinite(value) || value < 0.0f) malformed(std::string(gltfName) + " " + std::to_string(value) + " is negative or not finite");
+        if (!std::isfinite(value) || value < 0.0f)
+            malformed(std::string(gltfName) + " " + std::to_string(value) + " is negative or not finite");
         return value;
     }
 
@@ -432,7 +460,6 @@ std::string describeMaterial(bool isDefault, int fileIndex, const std::string& n
     if (fileIndex < 0) return quoted.empty() ? "(unnamed)" : quoted;
     return std::to_string(fileIndex) + (quoted.empty() ? "" : " " + quoted);
 }
-
 
 bool isGltf2(const json& doc)
 {
@@ -498,9 +525,12 @@ uint64_t elementBytes(const json& accessor)
 {
     const uint64_t component = [&]() -> uint64_t {
         switch (sizeField(accessor, "componentType", 0)) {
-        case 5120: case 5121: return 1;
-        case 5122: case 5123: return 2;
-        case 5125: case 5126: return 4;
+        case 5120:
+        case 5121: return 1;
+        case 5122:
+        case 5123: return 2;
+        case 5125:
+        case 5126: return 4;
         default: return 0;
         }
     }();
@@ -515,18 +545,21 @@ uint64_t elementBytes(const json& accessor)
 
 } // namespace
 
-void checkGltfBufferBounds(const fs::path& file)
+namespace {
+
+void checkBufferBounds(const fs::path& file, const json& doc)
 {
-    const json doc = parseJson(file);
     const json* buffers = arrayMember(doc, "buffers");
     const json* views = arrayMember(doc, "bufferViews");
     constexpr uint64_t kHuge = uint64_t(1) << 40; // no sum or product below overflows
     if (views) {
         for (uint32_t v = 0; v < views->size(); ++v) {
             const json& view = (*views)[v];
-            const json* buffer = element(buffers, uint32_t(std::min<uint64_t>(sizeField(view, "buffer", 0), UINT32_MAX)));
+            const json* buffer =
+                element(buffers, uint32_t(std::min<uint64_t>(sizeField(view, "buffer", 0), UINT32_MAX)));
             if (!buffer) continue;
-            const uint64_t end = std::min(sizeField(view, "byteOffset", 0), kHuge) + std::min(sizeField(view, "byteLength", 0), kHuge);
+            const uint64_t end =
+                std::min(sizeField(view, "byteOffset", 0), kHuge) + std::min(sizeField(view, "byteLength", 0), kHuge);
             const uint64_t length = sizeField(*buffer, "byteLength", 0);
             if (end > length)
                 fail(file, "bufferView " + std::to_string(v) + " ends at byte " + std::to_string(end) +
@@ -551,7 +584,100 @@ void checkGltfBufferBounds(const fs::path& file)
     }
 }
 
-std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path& file)
+/// A child index as assimp reads it, or nullopt (assimp reports those itself).
+std::optional<uint32_t> nodeIndex(const json& value, size_t nodeCount)
+{
+    if (!value.is_number_unsigned() || value.get<uint64_t>() >= nodeCount) return std::nullopt;
+    return uint32_t(value.get<uint64_t>());
+}
+
+constexpr uint32_t kNoParent = UINT32_MAX;
+
+/// Each node's parent (glTF: at most one), from the children lists.
+std::vector<uint32_t> nodeParents(const fs::path& file, const json& nodes)
+{
+    std::vector<uint32_t> parent(nodes.size(), kNoParent);
+    for (uint32_t node = 0; node < nodes.size(); ++node) {
+        const json* children = arrayMember(nodes[node], "children");
+        if (!children) continue;
+        for (const json& each : *children) {
+            const auto child = nodeIndex(each, nodes.size());
+            if (!child) continue;
+            if (*child == node) fail(file, "node " + std::to_string(node) + " lists itself among its children");
+            if (parent[*child] == node)
+                fail(file, "node " + std::to_string(node) + " lists node " + std::to_string(*child) +
+                               " twice among its children");
+            if (parent[*child] != kNoParent)
+                fail(file, "node " + std::to_string(*child) + " is a child of both node " +
+                               std::to_string(parent[*child]) + " and node " + std::to_string(node) +
+                               " (glTF nodes form trees: each has at most one parent)");
+            parent[*child] = node;
+        }
+    }
+    return parent;
+}
+
+/// Refuses cycles and hierarchies deeper than kMaxGltfNodeDepth, walking up
+/// the parent links without recursion: assimp 5.2.5 recurses once per level
+/// (reading, importing, pre-transforming and freeing nodes) and overflows its
+/// stack on a chain of 30,000 nodes. Each node's depth is computed once.
+void checkNodeHierarchy(const fs::path& file, const json& doc)
+{
+    const json* nodes = arrayMember(doc, "nodes");
+    if (!nodes) return;
+    const std::vector<uint32_t> parent = nodeParents(file, *nodes);
+    std::vector<uint32_t> depth(nodes->size(), 0);  // 0: not known yet; a root is 1
+    std::vector<bool> onPath(nodes->size(), false); // on the current walk up
+    std::vector<uint32_t> path;
+    for (uint32_t start = 0; start < nodes->size(); ++start) {
+        uint32_t node = start;
+        for (path.clear(); node != kNoParent && depth[node] == 0 && !onPath[node]; node = parent[node]) {
+            onPath[node] = true;
+            path.push_back(node);
+        }
+        if (node != kNoParent && onPath[node])
+            fail(file, "node " + std::to_string(node) + " is its own ancestor (its children lists form a cycle)");
+        uint32_t level = node == kNoParent ? 0 : depth[node];
+        for (auto it = path.rbegin(); it != path.rend(); ++it) {
+            depth[*it] = ++level;
+            onPath[*it] = false;
+            if (level > kMaxGltfNodeDepth)
+                fail(file, "node " + std::to_string(*it) + " is nested " + std::to_string(level) +
+                               " levels deep in the node hierarchy; vkrt reads at most " +
+                               std::to_string(kMaxGltfNodeDepth) + " levels");
+        }
+    }
+}
+
+/// Every buffer and image the JSON names by a file URI (data: URIs need no file) must be one the policy allows.
+void checkFileReferences(const fs::path& file, const json& doc, const ReferencePolicy& references)
+{
+    for (const char* kind : {"buffers", "images"}) {
+        const json* list = arrayMember(doc, kind);
+        if (!list) continue;
+        for (size_t i = 0; i < list->size(); ++i) {
+            const json* uri = member((*list)[i], "uri");
+            if (!uri || !uri->is_string()) continue;
+            const std::string text = uri->get<std::string>();
+            if (text.rfind("data:", 0) == 0) continue;
+            const std::string what = std::string(kind) == "buffers" ? "buffer " : "image ";
+            references.check(file.parent_path() / percentDecoded(text), text, what + std::to_string(i));
+        }
+    }
+}
+
+} // namespace
+
+void checkGltfBeforeImport(const fs::path& file, const ReferencePolicy& references)
+{
+    const json doc = parseJson(file);
+    checkBufferBounds(file, doc);
+    checkNodeHierarchy(file, doc);
+    checkFileReferences(file, doc, references);
+}
+
+std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path& file,
+                                            const ReferencePolicy& references)
 {
     const json doc = parseJson(file);
     if (!isGltf2(doc) || scene.mNumMaterials == 0) return {};
@@ -575,7 +701,7 @@ std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path
             scene.mMaterials[i]->Get(AI_MATKEY_NAME, aiName);
             name = aiName.C_Str();
         }
-        const MaterialReader reader{scene, file, describeMaterial(isDefault, fileIndex, name)};
+        const MaterialReader reader{scene, file, describeMaterial(isDefault, fileIndex, name), references};
         FileMaterial material = scene.mMaterials[i] ? reader.convert(*scene.mMaterials[i]) : FileMaterial{};
         material.fileIndex = fileIndex;
         if (fileIndex >= 0) material.unsupported = materialProblems(*element(fileMaterials, uint32_t(fileIndex)));

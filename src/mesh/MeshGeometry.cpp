@@ -70,10 +70,11 @@ std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode n
     return geometry;
 }
 
-std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path& file, NormalMode normals)
+std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path& file, NormalMode normals,
+                                                     const MeshLoadOptions& options)
 {
     const auto start = std::chrono::steady_clock::now();
-    MeshData data = loadMeshFile(file);
+    MeshData data = loadMeshFile(file, options);
     const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     auto geometry = makeMeshGeometry(std::move(data), normals, file);
     auto editable = std::const_pointer_cast<MeshGeometry>(geometry);
@@ -81,13 +82,14 @@ std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path
     return geometry;
 }
 
-std::shared_ptr<const MeshGeometry> MeshGeometryCache::get(const std::filesystem::path& file, NormalMode normals)
+std::shared_ptr<const MeshGeometry> MeshGeometryCache::get(const std::filesystem::path& file, NormalMode normals,
+                                                           const MeshLoadOptions& options)
 {
     std::error_code error;
     std::filesystem::path key = std::filesystem::weakly_canonical(file, error);
     if (error) key = file;
-    auto& slot = m_loaded[{key, normals}];
-    if (!slot) slot = makeMeshGeometry(file, normals);
+    auto& slot = m_loaded[{key, normals, options}];
+    if (!slot) slot = makeMeshGeometry(file, normals, options);
     return slot;
 }
 

@@ -4,10 +4,12 @@
 // `[[objects]] shape = "mesh"`) share one MeshGeometry per (file, normals).
 #include "accel/Bvh.h"
 #include "mesh/MeshData.h"
+#include "mesh/ReferencePolicy.h"
 
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <tuple>
 #include <utility>
 
 namespace vkrt {
@@ -25,17 +27,22 @@ struct MeshGeometry {
 
 /// Loads, applies the normal mode, computes tangents where there are uvs and
 /// the file gave none, builds the BVH and reorders the triangles.
-std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path& file, NormalMode normals);
+std::shared_ptr<const MeshGeometry> makeMeshGeometry(const std::filesystem::path& file, NormalMode normals,
+                                                     const MeshLoadOptions& options = {});
 /// The same from data already in memory (procedural meshes, tests).
 std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode normals, std::filesystem::path name);
 
 /// One scene's geometries, so that instances of the same file share one.
+/// The load options are part of the key: a file refused under the default
+/// reference rule may load for an instance that allows outside references.
 class MeshGeometryCache {
 public:
-    std::shared_ptr<const MeshGeometry> get(const std::filesystem::path& file, NormalMode normals);
+    std::shared_ptr<const MeshGeometry> get(const std::filesystem::path& file, NormalMode normals,
+                                            const MeshLoadOptions& options = {});
 
 private:
-    std::map<std::pair<std::filesystem::path, NormalMode>, std::shared_ptr<const MeshGeometry>> m_loaded;
+    using Key = std::tuple<std::filesystem::path, NormalMode, MeshLoadOptions>;
+    std::map<Key, std::shared_ptr<const MeshGeometry>> m_loaded;
 };
 
 } // namespace vkrt

@@ -2,10 +2,12 @@
 
 #include "mesh/FileMaterials.h"
 #include "mesh/PlyReader.h"
+#include "mesh/ReferencePolicy.h"
 
 #include "util/Error.h"
 #include "util/Hash.h"
 
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -201,17 +203,51 @@ constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure   // first: ou
     fail(file, "cannot read the " + formatName(extension) + " file: " + reason, line.value_or(0));
 }
 
-const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, const std::string& extension)
+/// The OBJ line `mtllib` line naming `library`, or 0.
+int mtllibLine(const fs::path& file, const std::string& library)
+{
+    const std::optional<int> line =
+        findObjLine(readText(file), [&](int, std::string_view keyword, std::string_view rest) {
+            return keyword == "mtllib" && rest.find(library) != std::string_view::npos;
+        });
+    return line.value_or(0);
+}
+
+/// A file the mesh references that the policy refused, or that could not be
+/// opened, is the error, whether or not assimp went on without it: assimp
+/// skips a missing .mtl silently, or fails with a bare "File read error".
+void checkReferences(const fs::path& file, const std::string& extension, const ReferencePolicy& policy,
+                     const ReferenceLog& log)
+{
+    const bool obj = extension == ".obj";
+    const char* what = obj ? "the material library" : "the referenced file";
+    if (log.refused) {
+        const std::string uri = policy.uriOf(*log.refused);
+        policy.check(*log.refused, uri, obj ? "its mtllib line" : "", obj ? mtllibLine(file, uri) : 0);
+    }
+    if (log.missing) {
+        const std::string uri = policy.uriOf(*log.missing);
+        fail(file, std::string(what) + " '" + uri + "' cannot be read: " + *log.missing + ": " + log.missingReason,
+             obj ? mtllibLine(file, uri) : 0);
+    }
+}
+
+const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, const std::string& extension,
+                           const ReferencePolicy& policy)
 {
     // Points and lines are dropped by SortByPType; an all-lines file then has no meshes, reported below.
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    ReferenceLog log;
+    importer.SetIOHandler(newConfinedIoSystem(policy, log)); // the importer owns it
     const aiScene* scene = nullptr;
     try {
         // No logger is ever created, so assimp writes nothing to stdout/stderr (its default is a null logger).
         scene = importer.ReadFile(file.string(), kImportSteps);
     } catch (const std::exception& error) {
+        checkReferences(file, extension, policy, log);
         failImport(file, extension, error.what());
     }
+    checkReferences(file, extension, policy, log);
     if (scene) return scene;
     const std::string reason = importer.GetErrorString();
     if (reason.find("No meshes remaining") != std::string::npos ||
@@ -231,6 +267,7 @@ const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, con
 struct MeshCheck {
     const fs::path& file;
     std::string extension;
+    const ReferencePolicy& references;
     size_t meshCount = 0;
 
     bool isGltf() const { return extension == ".gltf" || extension == ".glb"; }
@@ -309,8 +346,8 @@ void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const M
         out.positions.push_back(position);
         if (normals) out.normals.push_back(unitNormal(check, meshIndex, v, mesh.mNormals[v]));
         if (tangents) {
-            out.tangents.push_back(fileTangent(check, meshIndex, v, out.normals.back(), mesh.mTangents[v],
-                                               mesh.mBitangents[v]));
+            out.tangents.push_back(
+                fileTangent(check, meshIndex, v, out.normals.back(), mesh.mTangents[v], mesh.mBitangents[v]));
         }
         if (uvs) {
             const glm::vec2 uv(mesh.mTextureCoords[0][v].x, mesh.mTextureCoords[0][v].y);
@@ -345,7 +382,7 @@ void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const Mes
 std::vector<FileMaterial> sceneMaterials(const aiScene& scene, const MeshCheck& check)
 {
     if (!check.isGltf()) return {};
-    std::vector<FileMaterial> materials = readGltfMaterials(scene, check.file);
+    std::vector<FileMaterial> materials = readGltfMaterials(scene, check.file, check.references);
     if (materials.size() != scene.mNumMaterials) return {};
     return materials;
 }
@@ -356,8 +393,9 @@ void keepUsedMaterials(MeshData& out, std::vector<FileMaterial> all, const MeshC
 {
     std::vector<uint32_t> renumbered(all.size(), UINT32_MAX);
     for (uint32_t& material : out.triangleMaterials) {
-        if (material >= all.size()) fail(check.file, "a mesh uses material " + std::to_string(material) +
-                                                          " of only " + std::to_string(all.size()));
+        if (material >= all.size())
+            fail(check.file,
+                 "a mesh uses material " + std::to_string(material) + " of only " + std::to_string(all.size()));
         renumbered[material] = 0;
     }
     for (size_t i = 0; i < all.size(); ++i) {
@@ -379,8 +417,8 @@ MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
     attributes.normals = every([](const aiMesh* m) { return m->HasNormals(); });
     attributes.uvs = every([](const aiMesh* m) { return m->HasTextureCoords(0); });
     // Tangents belong to uvs and are oriented by normals (glTF has them only with both).
-    attributes.tangents = attributes.normals && attributes.uvs &&
-                          every([](const aiMesh* m) { return m->HasTangentsAndBitangents(); });
+    attributes.tangents =
+        attributes.normals && attributes.uvs && every([](const aiMesh* m) { return m->HasTangentsAndBitangents(); });
     std::vector<FileMaterial> materials = sceneMaterials(scene, check);
     MeshData out;
     for (size_t i = 0; i < meshes.size(); ++i) {
@@ -453,15 +491,16 @@ const std::vector<std::string>& supportedMeshExtensions()
     return extensions;
 }
 
-MeshData loadMeshFile(const fs::path& file)
+MeshData loadMeshFile(const fs::path& file, const MeshLoadOptions& options)
 {
     checkIsMeshFile(file);
     const std::string extension = lowerExtension(file);
     if (extension == ".ply") return readPlyFile(file); // not assimp: see PlyReader.h
-    if (extension == ".gltf" || extension == ".glb") checkGltfBufferBounds(file); // before assimp trusts them
+    const ReferencePolicy policy(file, options);
+    if (extension == ".gltf" || extension == ".glb") checkGltfBeforeImport(file, policy); // before assimp trusts it
     Assimp::Importer importer;
-    const aiScene* scene = importScene(importer, file, extension);
-    MeshData mesh = convertScene(*scene, MeshCheck{file, extension});
+    const aiScene* scene = importScene(importer, file, extension, policy);
+    MeshData mesh = convertScene(*scene, MeshCheck{file, extension, policy});
     if (extension == ".obj") joinIdenticalCorners(mesh);
     return mesh;
 }

@@ -6,6 +6,7 @@
 // or unsupported files, syntax errors, indices out of range, NaN or infinite
 // coordinates, files without triangles. Never a crash, whatever the bytes.
 #include "mesh/MeshData.h"
+#include "mesh/ReferencePolicy.h"
 
 #include <filesystem>
 
@@ -15,8 +16,11 @@ namespace vkrt {
 /// node transforms applied) as one MeshData; polygons are triangulated,
 /// points and lines are ignored. PLY triangle strips are refused with an
 /// error: Debian 12's assimp (5.2.5) keeps one triangle per strip (its bug
-/// #2337), and a silently wrong mesh is worse than none.
-MeshData loadMeshFile(const std::filesystem::path& file);
+/// #2337), and a silently wrong mesh is worse than none. The files the mesh
+/// file references (glTF buffers and images, OBJ material libraries) must lie
+/// in its folder unless `options` allow more (ReferencePolicy.h); one that is
+/// refused or cannot be read is an error naming it. PLY references nothing.
+MeshData loadMeshFile(const std::filesystem::path& file, const MeshLoadOptions& options = {});
 
 /// The extensions loadMeshFile accepts (lower case, with the dot).
 const std::vector<std::string>& supportedMeshExtensions();

@@ -473,8 +473,17 @@ void readPlane(const TableField& table, uint32_t material, Scene& scene)
     scene.planes.push_back({point, *normal, material});
 }
 
-constexpr std::array<std::string_view, 10> meshKeys{"shape",  "material", "file",     "scale",    "rotate",
-                                                    "translate", "matrix", "normals", "emission", "two_sided"};
+constexpr std::array<std::string_view, 11> meshKeys{"shape",
+                                                    "material",
+                                                    "file",
+                                                    "scale",
+                                                    "rotate",
+                                                    "translate",
+                                                    "matrix",
+                                                    "normals",
+                                                    "emission",
+                                                    "two_sided",
+                                                    "allow_outside_references"};
 
 void checkRegularFile(const Field& field, const fs::path& path);
 constexpr std::array<std::string_view, 2> rotateKeys{"axis", "angle"};
@@ -615,6 +624,9 @@ void readMesh(const TableField& table, uint32_t material, Scene& scene)
     const NormalMode normals = readOr(table, "normals", NormalMode::File, [](const Field& field) {
         return readChoice(field, "normals mode", normalModes).value;
     });
+    // The scene is the user's own, so it may trust a mesh file's references outside its folder.
+    MeshLoadOptions loadOptions;
+    loadOptions.allowOutsideReferences = readOr(table, "allow_outside_references", false, readBool);
     mesh.objectToWorld = readObjectToWorld(table);
     mesh.emission = readOr(table, "emission", Color(0.0), readRadiance);
     if (const auto twoSided = table.find("two_sided")) {
@@ -623,7 +635,7 @@ void readMesh(const TableField& table, uint32_t material, Scene& scene)
     }
     try {
         VKRT_CHECK(t_meshCache != nullptr);
-        mesh.geometry = t_meshCache->get(file, normals);
+        mesh.geometry = t_meshCache->get(file, normals, loadOptions);
     } catch (const SceneError&) {
         throw;
     } catch (const InputError& error) {

@@ -3,6 +3,7 @@
 #include "mesh/MeshGeometry.h"
 #include "mesh/Procedural.h"
 #include "scene/SceneParser.h"
+#include "support/GltfTestFiles.h"
 #include "support/TestSupport.h"
 
 #include <gtest/gtest.h>
@@ -76,19 +77,21 @@ TEST_F(SceneParserMesh, ScaleThenRotateThenTranslate)
 
 TEST_F(SceneParserMesh, MatrixRowsAreRows)
 {
-    const Scene scene = parse("file = \"tri.obj\"\nmatrix = [[0, -1, 0, 5], [1, 0, 0, 6], [0, 0, 2, 7], [0, 0, 0, 1]]\n");
+    const Scene scene =
+        parse("file = \"tri.obj\"\nmatrix = [[0, -1, 0, 5], [1, 0, 0, 6], [0, 0, 2, 7], [0, 0, 0, 1]]\n");
     const glm::dvec3 p = apply(scene.meshes[0].objectToWorld, {1, 2, 3});
     EXPECT_EQ(p, glm::dvec3(-2 + 5, 1 + 6, 6 + 7));
 }
 
 TEST_F(SceneParserMesh, InstancesOfOneFileShareGeometryPerNormalMode)
 {
-    const Scene scene = parseSceneString(std::string(kHeader) +
-                                             "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"tri.obj\"\n"
-                                             "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"./tri.obj\"\n"
-                                             "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"tri.obj\"\n"
-                                             "normals = \"smooth\"\n",
-                                         (m_dir / "scene.toml").string());
+    const Scene scene =
+        parseSceneString(std::string(kHeader) +
+                             "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"tri.obj\"\n"
+                             "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"./tri.obj\"\n"
+                             "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"tri.obj\"\n"
+                             "normals = \"smooth\"\n",
+                         (m_dir / "scene.toml").string());
     ASSERT_EQ(scene.meshes.size(), 3u);
     EXPECT_EQ(scene.meshes[0].geometry, scene.meshes[1].geometry);
     EXPECT_NE(scene.meshes[0].geometry, scene.meshes[2].geometry);
@@ -123,7 +126,8 @@ TEST_F(SceneParserMesh, ErrorsNameFileLineAndColumn)
         {"file = \"tri.obj\"\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]\n", "4 rows"},
         {"file = \"tri.obj\"\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]]\n", "singular"},
         {"file = \"tri.obj\"\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]\n", "affine"},
-        {"file = \"tri.obj\"\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\ntranslate = [1, 1, 1]\n",
+        {"file = \"tri.obj\"\nmatrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\ntranslate = [1, 1, "
+         "1]\n",
          "cannot be combined with matrix"},
         {"file = \"tri.obj\"\ntwo_sided = true\n", "only applies to an emissive mesh"},
         {"file = \"tri.obj\"\nemission = [-1, 0, 0]\n", "emission"},
@@ -142,6 +146,50 @@ TEST_F(SceneParserMesh, BrokenMeshFileIsASceneErrorNamingBoth)
     const std::string message = errorOf("file = \"broken.obj\"\n");
     EXPECT_NE(message.find("scene.toml:11:"), std::string::npos) << message;
     EXPECT_NE(message.find("broken.obj"), std::string::npos) << message;
+}
+
+/// A one-triangle glTF in m_dir/model whose buffer is m_dir/tri.bin, outside its folder.
+void writeGltfReadingAboveItsFolder(const std::filesystem::path& dir)
+{
+    std::string bytes;
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(bytes, v);
+    for (uint16_t i : {0, 1, 2}) put(bytes, i);
+    bytes.append(2, '\0');
+    writeText(dir / "tri.bin", bytes);
+    writeText(dir / "model" / "up.gltf",
+              R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "buffers": [{"uri": "../tri.bin", "byteLength": 44}],
+  "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]})");
+}
+
+TEST_F(SceneParserMesh, ReferencesOutsideTheMeshFolderNeedTheScenesPermission)
+{
+    writeGltfReadingAboveItsFolder(m_dir);
+    const std::string message = errorOf("file = \"model/up.gltf\"\n");
+    EXPECT_NE(message.find("scene.toml:11:"), std::string::npos) << message;
+    EXPECT_NE(message.find("cannot load the mesh: " + (m_dir / "model" / "up.gltf").string() +
+                           ": buffer 0 references '../tri.bin' outside its folder"),
+              std::string::npos)
+        << message;
+    const Scene scene = parse("file = \"model/up.gltf\"\nallow_outside_references = true\n");
+    ASSERT_EQ(scene.meshes.size(), 1u);
+    EXPECT_EQ(scene.meshes[0].geometry->data.triangles.size(), 1u);
+    EXPECT_NE(errorOf("file = \"tri.obj\"\nallow_outside_references = \"yes\"\n").find("allow_outside_references"),
+              std::string::npos);
+}
+
+TEST_F(SceneParserMesh, PermissionIsPartOfTheSharedGeometrysKey)
+{
+    // The first instance may read outside; the second, of the same file, may not, and must not reuse the first's.
+    writeGltfReadingAboveItsFolder(m_dir);
+    const std::string message =
+        errorOf("file = \"model/up.gltf\"\nallow_outside_references = true\n"
+                "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"model/up.gltf\"\n");
+    EXPECT_NE(message.find("scene.toml:16:"), std::string::npos) << message;
+    EXPECT_NE(message.find("outside its folder"), std::string::npos) << message;
 }
 
 } // namespace
