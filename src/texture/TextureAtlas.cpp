@@ -75,11 +75,12 @@ std::string fileKey(const fs::path& file)
 
 void TextureAtlas::reserveTexels(const TextureHeader& header, const std::string& name)
 {
-    if (m_texels + header.texels() > kMaxSceneTexels)
+    if (m_texels + header.texels() > m_maxTexels)
         throw InputError(name + ": a " + std::to_string(header.width) + "x" + std::to_string(header.height) +
                          " texture brings the scene's textures to " + std::to_string(m_texels + header.texels()) +
-                         " texels, more than the " + std::to_string(kMaxSceneTexels) +
-                         " (one 8192x8192) vkrt loads for one scene; use smaller textures");
+                         " texels, more than the " + std::to_string(m_maxTexels) +
+                         (m_maxTexels == kMaxSceneTexels ? " (one 8192x8192)" : "") +
+                         " vkrt loads for one scene; use smaller textures");
     m_texels += header.texels();
 }
 

@@ -47,6 +47,9 @@ public:
     /// or 10.7 (half) bytes a texel on the GPU. At most 683 MiB of GPU storage.
     static constexpr uint64_t kMaxSceneTexels = uint64_t(64) << 20;
 
+    /// `maxTexels`: the budget (tests use a small one).
+    explicit TextureAtlas(uint64_t maxTexels = kMaxSceneTexels) : m_maxTexels(maxTexels) {}
+
     /// Loads the file (once per (file, linear) pair) and returns the index of
     /// its record (one per distinct pair and wrap modes). Load errors are
     /// InputErrors naming the file; given a location (the scene's `texture`
@@ -87,7 +90,7 @@ private:
         std::array<double, 4> mean{};     ///< level 0's mean linear RGBA
     };
     uint32_t addImage(TextureImage image, const std::string& name);
-    /// Counts a texture of `header`'s size against kMaxSceneTexels, or refuses it naming `name`.
+    /// Counts a texture of `header`'s size against the budget, or refuses it naming `name`.
     void reserveTexels(const TextureHeader& header, const std::string& name);
     /// Header check, budget, decoding and storing, for a file's bytes.
     uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear);
@@ -97,6 +100,7 @@ private:
     std::vector<std::tuple<uint32_t, TextureWrap, TextureWrap>> m_records; ///< image, wrap u, wrap v
     std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile;        ///< (canonical path, linear)
     uint64_t m_words = 0;
+    uint64_t m_maxTexels = kMaxSceneTexels;
     uint64_t m_texels = 0; ///< level 0, of every image added
 };
 

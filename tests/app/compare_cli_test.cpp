@@ -1,6 +1,7 @@
 // `vkrt compare` and the render stopping rules, as scripts use them.
 #include "io/ExrFile.h"
 #include "support/TestSupport.h"
+#include "texture/TextureTestFiles.h"
 
 #include <fstream>
 #include <sstream>
@@ -119,6 +120,25 @@ TEST_F(StatsCli, CompareRejectsMismatchedSizes)
     ProcessResult missing = runVkrt({"compare", (m_dir / "nope.exr").string(), (m_dir / "big.exr").string()});
     EXPECT_EQ(missing.exitCode, 2) << missing.output;
     EXPECT_NE(missing.output.find("nope.exr"), std::string::npos) << missing.output;
+}
+
+TEST_F(StatsCli, CompareRefusesLyingHeadersQuicklyAndInLittleMemory)
+{
+    writeExr(m_dir / "small.exr", Image(8, 8), {});
+    const fs::path big = writeExrDeclaring(m_dir / "big.exr", 8192, 8192);
+    const fs::path huge = writeExrDeclaring(m_dir / "huge.exr", 16384, 16384);
+    // DWAB's bound is loose (2^18): this one passes the length check and fails reading its first strip.
+    const fs::path dwab = writeExrDeclaring(m_dir / "dwab.exr", 8192, 8192, 9);
+    fs::resize_file(dwab, 6000);
+    for (const fs::path& bad : {big, huge, dwab}) {
+        for (const auto& [a, b] : {std::pair{m_dir / "small.exr", bad}, std::pair{bad, m_dir / "small.exr"}}) {
+            ProcessResult r = runVkrt({"compare", a.string(), b.string()});
+            EXPECT_EQ(r.exitCode, 2) << r.output;
+            EXPECT_NE(r.output.find(bad.filename().string()), std::string::npos) << r.output;
+            EXPECT_LT(r.peakResidentBytes, kBadInputMemoryLimit);
+            EXPECT_LT(r.peakResidentBytes, int64_t(256) << 20) << bad << ": refused before its pixels were allocated";
+        }
+    }
 }
 
 TEST_F(StatsCli, TargetErrorStopsAtTheFirstCheckpointBelowIt)

@@ -4,6 +4,7 @@
 // nothing written.
 #include "io/ExrFile.h"
 #include "support/TestSupport.h"
+#include "texture/TextureTestFiles.h"
 
 #include <cmath>
 #include <fstream>
@@ -90,7 +91,9 @@ TEST_F(MergeCli, MixturesOverlapsGapsAndBadFilesAreRefusedWithNothingWritten)
     ASSERT_EQ(render("a1.exr", {"--spp", "8", "--seed", "1", "--shard", "1/2"}).exitCode, 0);
     ASSERT_EQ(render("b1.exr", {"--spp", "8", "--seed", "2", "--shard", "1/2"}).exitCode, 0);
     ASSERT_EQ(render("whole.exr", {"--spp", "8", "--seed", "1"}).exitCode, 0);
-    { std::ofstream(m_dir / "broken.exr") << "v/1\x01 not really an EXR"; }
+    {
+        std::ofstream(m_dir / "broken.exr") << "v/1\x01 not really an EXR";
+    }
     struct Case {
         std::vector<std::string> inputs;
         std::string message;
@@ -119,14 +122,61 @@ TEST_F(MergeCli, MixturesOverlapsGapsAndBadFilesAreRefusedWithNothingWritten)
     EXPECT_EQ(std::get<std::string>(part.metadata.at("missingSamples")), "[0, 4)");
 }
 
+/// Rewrites a shard with one value of one tally layer replaced.
+void poison(const fs::path& shard, const fs::path& out, const std::string& layer, float value)
+{
+    ExrContents exr = readExr(shard);
+    exr.layers.at(layer).rgb[3 * (2 * exr.image.width + 5)] = value; // pixel (5, 2), red
+    writeExr(out, exr.image, exr.metadata, exr.layers);
+}
+
+TEST_F(MergeCli, PoisonedTalliesAreRefusedNamingLayerAndPixel)
+{
+    ASSERT_EQ(render("a0.exr", {"--spp", "4", "--shard", "0/2"}).exitCode, 0);
+    ASSERT_EQ(render("a1.exr", {"--spp", "4", "--shard", "1/2"}).exitCode, 0);
+    struct Case {
+        std::string layer;
+        float value;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"tally.mean", NAN, "tally.mean at pixel (5, 2) is nan, but a mean must be finite"},
+        {"tally.count", 1e30f,
+         "tally.count at pixel (5, 2) is 1e+30, but a count is a whole number from 0 to the 2 "
+         "samples the shard covers"},
+        {"tally.count", -1.0f, "tally.count at pixel (5, 2) is -1, but"},
+        {"tally.count", 3.0f, "tally.count at pixel (5, 2) is 3, but"},
+    };
+    for (const Case& c : cases) {
+        poison(path("a1.exr"), path("bad.exr"), c.layer, c.value);
+        const ProcessResult result = merge({path("a0.exr"), path("bad.exr"), "-o", path("out.exr")});
+        EXPECT_EQ(result.exitCode, 2) << result.output;
+        EXPECT_NE(result.output.find(path("bad.exr") + ": " + c.message), std::string::npos) << result.output;
+        EXPECT_FALSE(fs::exists(m_dir / "out.exr")) << c.message;
+    }
+}
+
+TEST_F(MergeCli, ShardWithALyingHeaderIsRefusedInLittleMemory)
+{
+    ASSERT_EQ(render("a0.exr", {"--spp", "4", "--shard", "0/2"}).exitCode, 0);
+    for (const auto& [side, name] : {std::pair{8192u, "big.exr"}, std::pair{16384u, "huge.exr"}}) {
+        writeExrDeclaring(m_dir / name, side, side);
+        const ProcessResult result = merge({path("a0.exr"), path(name), "-o", path("out.exr")});
+        EXPECT_EQ(result.exitCode, 2) << result.output;
+        EXPECT_NE(result.output.find(path(name) + ": the header declares"), std::string::npos) << result.output;
+        EXPECT_LT(result.peakResidentBytes, kBadInputMemoryLimit);
+        EXPECT_FALSE(fs::exists(m_dir / "out.exr"));
+    }
+}
+
 TEST_F(MergeCli, BadShardOptionsNameTheOption)
 {
-    for (const auto& [shard, message] : std::vector<std::pair<std::string, std::string>>{
-             {"5/4", "--shard 5/4: i must be below n"},
-             {"0/0", "--shard 0/0: n must be at least 1"},
-             {"one/4", "--shard one/4: expected i/n"},
-             {"3", "--shard 3: expected i/n"},
-             {"1/80", "80 shards of 64 spp"}}) {
+    for (const auto& [shard, message] :
+         std::vector<std::pair<std::string, std::string>>{{"5/4", "--shard 5/4: i must be below n"},
+                                                          {"0/0", "--shard 0/0: n must be at least 1"},
+                                                          {"one/4", "--shard one/4: expected i/n"},
+                                                          {"3", "--shard 3: expected i/n"},
+                                                          {"1/80", "80 shards of 64 spp"}}) {
         const ProcessResult result = render("x.exr", {"--spp", "64", "--shard", shard});
         EXPECT_EQ(result.exitCode, 2) << result.output;
         EXPECT_NE(result.output.find(message), std::string::npos) << result.output;

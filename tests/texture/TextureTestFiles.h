@@ -26,6 +26,18 @@ std::filesystem::path write8BitPng(const std::filesystem::path& path, uint32_t w
 std::filesystem::path writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, int bitDepth,
                                int colourType, const std::vector<uint16_t>& samples);
 
+/// A real, small OpenEXR file (8x8 float RGB, `compression` an Imf::Compression
+/// value, 3 = ZIP) whose header then claims `width` x `height` pixels: what a
+/// damaged or hostile header looks like. A few hundred bytes.
+std::filesystem::path writeExrDeclaring(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                                        int compression = 3);
+
+/// A real `side` x `side` 8-bit grey PNG, every pixel black, deflated at
+/// about 160:1 (fixed-Huffman blocks of 258-byte matches), written as it is
+/// encoded: a decompression bomb (16384 a side: 1.7 MB on disk, 268 MB of
+/// samples, 4 GiB as float RGBA) made without holding the image.
+std::filesystem::path writePngBomb(const std::filesystem::path& path, uint32_t side);
+
 /// The repository's third-party assets: assets/ (sources and terms in assets/README.md).
 std::filesystem::path assetsDir();
 

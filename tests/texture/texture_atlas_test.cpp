@@ -6,6 +6,8 @@
 
 #include <Imath/half.h>
 
+#include <chrono>
+
 #include <gtest/gtest.h>
 
 namespace vkrt::test {
@@ -136,6 +138,73 @@ TEST(TextureAtlas, OverTheBufferLimitIsRefusedNamingTheLargest)
         EXPECT_NE(message.find("maxStorageBufferRange"), std::string::npos) << message;
         EXPECT_NE(message.find("the largest is big.exr (64x32, "), std::string::npos) << message;
     }
+}
+
+/// TextureAtlas::add's message for `file`, or "" when it takes it.
+std::string addRefusal(TextureAtlas& atlas, const fs::path& file)
+{
+    try {
+        atlas.add(TextureRequest{file});
+        return "";
+    } catch (const InputError& e) {
+        return e.what();
+    }
+}
+
+TEST(TextureBudget, TexelsBeyondTheSceneBudgetAreRefusedFromTheHeader)
+{
+    const fs::path dir = textureTestDir();
+    TextureAtlas atlas(3 * 64 * 64); // three 64x64 textures
+    for (int i = 0; i < 3; ++i)
+        EXPECT_EQ(addRefusal(atlas, writePngBomb(dir / ("t" + std::to_string(i) + ".png"), 64)), "") << i;
+    const fs::path fourth = writePngBomb(dir / "t3.png", 64);
+    EXPECT_EQ(addRefusal(atlas, fourth), fourth.string() + ": a 64x64 texture brings the scene's textures to 16384 "
+                                                           "texels, more than the 12288 vkrt loads for one scene; "
+                                                           "use smaller textures");
+    EXPECT_EQ(atlas.imageCount(), 3u);
+    // The same file again is the same image: no new texels.
+    EXPECT_EQ(addRefusal(atlas, dir / "t0.png"), "");
+    // Images made in memory count too.
+    EXPECT_THROW(atlas.add(solid(2, 2, TexelEncoding::Half), "made"), InputError);
+}
+
+TEST(TextureBudget, PngBombIsRefusedBeforeDecoding)
+{
+    const fs::path dir = textureTestDir();
+    const fs::path bomb = writePngBomb(dir / "bomb.png", 16384); // 1.7 MB; decoded 4 GiB as float RGBA
+    TextureAtlas atlas;
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_EQ(addRefusal(atlas, bomb), bomb.string() + ": a 16384x16384 texture brings the scene's textures to " +
+                                           "268435456 texels, more than the 67108864 (one 8192x8192) vkrt loads "
+                                           "for one scene; use smaller textures");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+    EXPECT_EQ(atlas.texelBytes(), 0u);
+}
+
+TEST(TextureBudget, ExrTextureClaimingHugeSizeIsRefusedFromTheHeader)
+{
+    const fs::path dir = textureTestDir();
+    const fs::path huge = writeExrDeclaring(dir / "huge.exr", 16384, 16384);
+    const fs::path big = writeExrDeclaring(dir / "big.exr", 8192, 8192);
+    TextureAtlas atlas;
+    EXPECT_NE(addRefusal(atlas, huge).find(huge.string() + ": the header declares 16384x16384 pixels"),
+              std::string::npos)
+        << addRefusal(atlas, huge);
+    EXPECT_NE(addRefusal(atlas, big).find(big.string() + ": the header declares 8192x8192 pixels of 3 channels"),
+              std::string::npos)
+        << addRefusal(atlas, big);
+}
+
+TEST(TextureBudget, LargeButFineTextureStillLoads)
+{
+    const fs::path dir = textureTestDir();
+    TextureAtlas atlas;
+    const uint32_t record = atlas.add(TextureRequest{writePngBomb(dir / "large.png", 4096)});
+    EXPECT_EQ(atlas.imageCount(), 1u);
+    EXPECT_EQ(atlas.meanOf(record)[0], 0.0);
+    EXPECT_EQ(atlas.meanOf(record)[3], 1.0);
+    // 8-bit sRGB: one word a texel, and a third more for the mip levels.
+    EXPECT_EQ(atlas.texelBytes(), 4 * (uint64_t(4096) * 4096 * 4 - 1) / 3);
 }
 
 } // namespace
