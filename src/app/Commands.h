@@ -34,6 +34,7 @@ enum ExitCode : int {
     kExitBadInput = 2,      ///< scene file, option or input image error
     kExitValidation = 3,    ///< Vulkan validation layer reported messages
     kExitCompareFailed = 4, ///< `compare`: a threshold or the pixel test failed
+    kExitDriverCrashed = 5, ///< the Vulkan driver crashed (SIGSEGV, ...) inside vkrt's calls to it (util/Signals.h)
     kExitInterrupted = 130  ///< SIGINT; partial results were written
 };
 

@@ -7,6 +7,7 @@
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
 #include "io/ExrFile.h"
+#include "io/OutputPaths.h"
 #include "render/Tally.h"
 #include "util/Error.h"
 
@@ -85,7 +86,8 @@ void checkTheyBelongTogether(const std::vector<Shard>& shards)
                              std::to_string(s.exr.image.height) + ", but " + first.file + " is " +
                              std::to_string(first.exr.image.width) + "x" + std::to_string(first.exr.image.height));
         for (const char* key : kSharedKeys) {
-            const std::string mine = text(required(s.exr, key, s.file)), theirs = text(required(first.exr, key, first.file));
+            const std::string mine = text(required(s.exr, key, s.file)),
+                              theirs = text(required(first.exr, key, first.file));
             if (mine != theirs)
                 throw InputError(s.file + ": " + key + " is '" + mine + "', but " + first.file + " has '" + theirs +
                                  "': not shards of one render");
@@ -125,8 +127,8 @@ std::string joined(const std::vector<std::string>& items, const std::string& sep
 Metadata mergedMetadata(const std::vector<Shard>& shards, int64_t spp, const std::vector<std::string>& missing)
 {
     Metadata metadata = shards.front().exr.metadata;
-    for (const char* key : {"shard", "stoppedBy", "estimatedRmse", "estimatedRelMse", "renderSeconds", "device",
-                            "driver", "savedBy"})
+    for (const char* key :
+         {"shard", "stoppedBy", "estimatedRmse", "estimatedRelMse", "renderSeconds", "device", "driver", "savedBy"})
         metadata.erase(key);
     double seconds = 0.0, rejected = 0.0;
     std::vector<std::string> files, interrupted;
@@ -149,8 +151,17 @@ Metadata mergedMetadata(const std::vector<Shard>& shards, int64_t spp, const std
     return metadata;
 }
 
+/// Before reading anything: `-o` must not be one of the shards (it would be destroyed) and must be writable.
+void checkMergeFiles(const MergeOptions& options)
+{
+    std::vector<NamedFile> inputs;
+    for (const std::string& file : options.shards) inputs.push_back({"shard", file});
+    checkOutputs(inputs, {{"-o", options.output}});
+}
+
 int runMerge(const MergeOptions& options)
 {
+    checkMergeFiles(options);
     std::vector<Shard> shards;
     for (const std::string& file : options.shards) shards.push_back(readShard(file));
     checkTheyBelongTogether(shards);
@@ -175,8 +186,8 @@ int runMerge(const MergeOptions& options)
     if (variance && (options.variance || shardsHaveVariance)) layers["variance"] = *variance;
     Metadata metadata = mergedMetadata(shards, spp, missing);
     writeExr(options.output, tallyMean(merged), metadata, layers);
-    std::fprintf(stderr, "merged %zu shards, %lld of %lld spp%s -> %s\n", shards.size(),
-                 static_cast<long long>(spp), static_cast<long long>(total),
+    std::fprintf(stderr, "merged %zu shards, %lld of %lld spp%s -> %s\n", shards.size(), static_cast<long long>(spp),
+                 static_cast<long long>(total),
                  missing.empty() ? "" : (" (missing " + joined(missing, ", ") + ")").c_str(), options.output.c_str());
     return kExitOk;
 }

@@ -1,6 +1,7 @@
 // `vkrt regress`: the regression suite (src/regress/RegressionRun.cpp).
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
+#include "io/OutputPaths.h"
 #include "regress/RegressionRun.h"
 #include "util/Error.h"
 
@@ -9,6 +10,21 @@
 #include <memory>
 
 namespace vkrt {
+
+namespace {
+
+/// Before any case runs: the reports must not overwrite the suite manifest or each other. The
+/// report directory may not exist yet (regress creates it), so only its report.md is compared.
+void checkRegressFiles(const RegressOptions& options)
+{
+    const NamedFile suite{"the suite manifest", options.suite};
+    const NamedFile junit{"--junit", options.junit};
+    checkOutputs({suite}, {junit});
+    if (!options.reportDir.empty())
+        refuseOverlappingFiles({suite, junit}, {{"--report-dir's report.md", options.reportDir / "report.md"}});
+}
+
+} // namespace
 
 CommandRunner addRegressCommand(CLI::App& app)
 {
@@ -27,6 +43,7 @@ CommandRunner addRegressCommand(CLI::App& app)
     cmd->add_flag("--fail-on-slowdown", o->failOnSlowdown, "Fail cases slower than baseline x max_slowdown");
     cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");
     return [o, defines] {
+        checkRegressFiles(*o);
         o->kernelDefines = parseKernelDefines(*defines);
         return exitCodeFor(runRegression(*o));
     };

@@ -4,6 +4,7 @@
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
 #include "io/ExrFile.h"
+#include "io/OutputPaths.h"
 #include "io/PngFile.h"
 #include "render/ConvergenceReport.h"
 #include "render/Progress.h"
@@ -156,10 +157,17 @@ void printSummary(const Renderer& renderer, const VulkanContext& context, const 
 void warnIfTooFewForAnEstimate(const Renderer& renderer)
 {
     if (renderer.varianceDegreesOfFreedom() != 0) return;
-    std::fprintf(stderr,
-                 "vkrt: warning: %u spp are too few for an error estimate (it needs 2, or %u with the "
-                 "Sobol' sampler's batches): the estimate and any variance layer are +inf\n",
-                 renderer.completedFrames(), gpu::VARIANCE_BATCHES);
+    const uint32_t spp = renderer.completedFrames();
+    if (renderer.variant().sobolSampler) // its estimate comes from batches
+        std::fprintf(stderr,
+                     "vkrt: warning: %u spp are too few for an error estimate with the Sobol' sampler: it needs %u "
+                     "(one per independently scrambled batch); the estimate and any variance layer are +inf\n",
+                     spp, gpu::VARIANCE_BATCHES);
+    else
+        std::fprintf(stderr,
+                     "vkrt: warning: %u spp %s too few for an error estimate: it needs at least 2; the estimate "
+                     "and any variance layer are +inf\n",
+                     spp, spp == 1 ? "is" : "are");
 }
 
 /// A shard's EXR carries its range and its tally, which `vkrt merge` adds up.
@@ -174,11 +182,10 @@ void addShard(const ShardRange& shard, uint32_t totalSpp, const Renderer& render
     addTallyLayers(renderer.tally(), layers);
 }
 
-/// Runs the session's stop rules with Ctrl-C caught, feeding --report at every checkpoint.
+/// Runs the session's stop rules, feeding --report at every checkpoint.
 LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceReport>& report,
                               uint32_t& lastCheckpoint)
 {
-    InterruptGuard interrupt;
     const Camera& camera = session.scene().camera;
     Progress progress(session.config().stop.maxSpp, uint64_t(camera.width) * camera.height, isatty(STDERR_FILENO));
     RunHooks hooks;
@@ -193,15 +200,32 @@ LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceR
     return loop;
 }
 
+Outcome interruptedBeforeRendering()
+{
+    return Outcome::of(OutcomeKind::Interrupted, {"vkrt: interrupted before rendering started; nothing written"});
+}
+
+/// Before any work: no output may destroy an input or another output, and each must be writable.
+void checkRenderFiles(const RenderCommandOptions& options, const std::string& output)
+{
+    checkOutputs({{"the scene file", options.scenePath}, {"--reference", options.reference}},
+                 {{"-o", output}, {"--png", options.png}, {"--report", options.report}});
+}
+
 Outcome runRender(const RenderCommandOptions& options)
 {
+    // Ctrl-C asks to stop from the very start (even while a driver hangs creating the instance);
+    // a second one ends the process at once.
+    InterruptGuard interrupt;
     auto start = std::chrono::steady_clock::now();
     const std::optional<ShardRange> shard = shardRange(options);
-    Scene scene = loadScene(options.scenePath, {options.width, options.height});
     std::string output = options.output.empty() ? defaultOutputFor(options.scenePath) : options.output;
+    checkRenderFiles(options, output);
+    Scene scene = loadScene(options.scenePath, {options.width, options.height});
 
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
     std::optional<Image> reference = loadReference(options, scene);
+    if (interruptFlag()) return interruptedBeforeRendering();
     RenderSession session(context, std::move(scene), sessionConfig(options, shard));
     double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -230,6 +254,21 @@ Outcome runRender(const RenderCommandOptions& options)
     if (!options.png.empty()) writePng(options.png, film.mean, options.exposure);
     printSummary(renderer, context, loop, counters, startupSeconds, output);
     return withValidation(session.outcome(), context.validationMessages());
+}
+
+/// "must be > 0 seconds, not 0": CLI::PositiveNumber's message printed its
+/// bound, the largest double, in 310 digits. CLI11 prefixes the option's name.
+CLI::Validator positiveFiniteNumber(const std::string& unit)
+{
+    return CLI::Validator(
+        [unit](const std::string& text) -> std::string {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            if (end == text.c_str() || *end != '\0') return "must be a number of " + unit + ", not " + text;
+            if (!std::isfinite(value) || !(value > 0.0)) return "must be > 0 " + unit + " and finite, not " + text;
+            return std::string();
+        },
+        "POSITIVE");
 }
 
 } // namespace
@@ -265,12 +304,10 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");
     cmd->add_flag("--pixel-centers", options->pixelCenters, "Sample pixel centres only (no anti-aliasing jitter)");
     cmd->add_option("--time-budget", options->timeBudget, "Stop after this many seconds of rendering")
-        ->check(finiteNumber)
-        ->check(CLI::PositiveNumber);
+        ->check(positiveFiniteNumber("seconds"));
     cmd->add_option("--target-error", options->targetError,
                     "Stop once the estimated relMSE falls below this (checked at 1, 2, 4, ... spp)")
-        ->check(finiteNumber)
-        ->check(CLI::PositiveNumber);
+        ->check(positiveFiniteNumber("relMSE"));
     cmd->add_option("--report", options->report, "Write a convergence CSV (error against time, docs/convergence.md)");
     cmd->add_option("--reference", options->reference, "Reference EXR for the report's true error")
         ->needs(cmd->get_option("--report"));

@@ -1,6 +1,7 @@
 // `vkrt view SCENE`: the progressive viewer (src/view/Viewer.cpp).
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
+#include "io/OutputPaths.h"
 #include "util/Error.h"
 #include "view/Viewer.h"
 
@@ -36,6 +37,7 @@ CommandRunner addViewCommand(CLI::App& app)
         ->group("");
     return [o] {
         if (!std::isfinite(o->exposure)) throw InputError("--exposure: must be a finite number");
+        checkOutputs({{"the scene file", o->scenePath}, {"--script", o->script}}, {{"--screenshot", o->screenshot}});
         return exitCodeFor(runViewer(*o));
     };
 }

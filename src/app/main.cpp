@@ -1,6 +1,7 @@
 // vkrt: a Vulkan compute ray tracer. This file only wires subcommands.
 #include "app/Commands.h"
 #include "util/Error.h"
+#include "util/Signals.h"
 
 #include <CLI/CLI.hpp>
 
@@ -8,6 +9,8 @@
 
 int main(int argc, char** argv)
 {
+    // Temporary outputs go with any SIGINT/SIGTERM/SIGHUP; a driver crash is named as such.
+    vkrt::installSignalHandlers({vkrt::kExitInterrupted, vkrt::kExitDriverCrashed});
     CLI::App app("vkrt - Vulkan compute ray tracer", "vkrt");
     app.set_version_flag("--version", VKRT_VERSION);
     app.require_subcommand(1);

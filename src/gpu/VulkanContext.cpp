@@ -1,6 +1,7 @@
 #include "gpu/VulkanContext.h"
 
 #include "util/Error.h"
+#include "util/Signals.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -134,8 +135,16 @@ void tuneSoftwareRasterizerThreads()
 VulkanContext::VulkanContext(const ContextOptions& options) : m_validation(options.validation)
 {
     tuneSoftwareRasterizerThreads();
-    createInstance(options.presentation);
-    chooseDevice(options.deviceSelector);
+    // The loader first calls into drivers here: a broken one crashes or hangs right away.
+    {
+        DriverCrashGuard crash("creating the Vulkan instance");
+        createInstance(options.presentation);
+    }
+    {
+        DriverCrashGuard crash("choosing a Vulkan device");
+        chooseDevice(options.deviceSelector);
+    }
+    DriverCrashGuard crash("creating the Vulkan device");
     createDevice();
 }
 
@@ -232,6 +241,7 @@ vk::raii::CommandBuffer VulkanContext::beginOneShot() const
 void VulkanContext::endSubmitAndWait(const vk::raii::CommandBuffer& cmd) const
 {
     cmd.end();
+    DriverCrashGuard crash("running GPU work (a queue submission and its fence wait)");
     vk::raii::Fence fence(m_device, vk::FenceCreateInfo());
     vk::CommandBuffer handle = *cmd;
     m_queue.submit(vk::SubmitInfo({}, {}, handle), *fence);
@@ -242,6 +252,7 @@ void VulkanContext::endSubmitAndWait(const vk::raii::CommandBuffer& cmd) const
 std::vector<DeviceInfo> listVulkanDevices()
 {
     vk::raii::Context context;
+    DriverCrashGuard crash("listing the Vulkan devices");
     vk::ApplicationInfo app("vkrt", 1, "vkrt", 1, kRequiredApiVersion);
     vk::raii::Instance instance(context, vk::InstanceCreateInfo({}, &app));
     vk::raii::PhysicalDevices physical(instance);

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 
 namespace vkrt {
 
@@ -30,14 +31,27 @@ std::vector<uint8_t> toneMapImage(const Image& image, float exposure)
     return pixels;
 }
 
+namespace {
+
+/// stb's writer appends here instead of writing a file itself: stbi_write_png
+/// ignores fwrite and fclose errors, so a full disk left a short PNG.
+extern "C" void appendToString(void* context, void* data, int size)
+{
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
+}
+
+} // namespace
+
 void writePngPixels(const std::filesystem::path& path, uint32_t width, uint32_t height,
                     const std::vector<uint8_t>& rgba)
 {
     VKRT_CHECK(rgba.size() == size_t(width) * height * 4);
-    writeFileAtomically(path, [&](const std::filesystem::path& temporary) {
-        if (!stbi_write_png(temporary.c_str(), int(width), int(height), 4, rgba.data(), int(width * 4)))
-            throw InputError(path.string() + ": cannot write PNG");
-    });
+    if (resolveOutputTarget(path).kind == OutputTargetKind::Discarded) return; // before the encode's cost
+    std::string encoded;
+    if (!stbi_write_png_to_func(appendToString, &encoded, int(width), int(height), 4, rgba.data(), int(width * 4)))
+        throw InputError(path.string() + ": cannot encode PNG (" + std::to_string(width) + "x" +
+                         std::to_string(height) + ")");
+    writeBytesAtomically(path, encoded);
 }
 
 void writePng(const std::filesystem::path& path, const Image& image, float exposure)

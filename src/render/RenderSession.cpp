@@ -4,7 +4,6 @@
 #include "util/Hash.h"
 
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 
 namespace vkrt {
@@ -199,22 +198,6 @@ Outcome RenderSession::outcome() const
 
 // ---------------------------------------------------------------- Ctrl-C
 
-namespace {
-
-std::atomic<bool> g_interrupted{false};
-
-extern "C" void onInterrupt(int) { g_interrupted.store(true); }
-
-} // namespace
-
-InterruptGuard::InterruptGuard()
-{
-    g_interrupted.store(false);
-    m_previous = std::signal(SIGINT, onInterrupt);
-}
-
-InterruptGuard::~InterruptGuard() { std::signal(SIGINT, m_previous == SIG_ERR ? SIG_DFL : m_previous); }
-
-const std::atomic<bool>& interruptFlag() { return g_interrupted; }
+const std::atomic<bool>& interruptFlag() { return StopOnInterrupt::stopRequested(); }
 
 } // namespace vkrt

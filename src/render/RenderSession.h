@@ -10,6 +10,7 @@
 #include "render/RenderLoop.h"
 #include "render/Renderer.h"
 #include "scene/SceneOverrides.h"
+#include "util/Signals.h"
 
 #include <atomic>
 #include <functional>
@@ -133,18 +134,13 @@ private:
 
 // ---------------------------------------------------------------- Ctrl-C
 
-/// While alive, SIGINT only sets interruptFlag() (cleared on construction), so
-/// that a session stops between submissions and keeps what it has; the
-/// previous handler comes back on destruction.
+/// While alive, the first SIGINT only sets interruptFlag() (cleared on
+/// construction), so that a session stops between submissions and keeps what
+/// it has; a second SIGINT removes any temporary output and exits at once
+/// (util/Signals.h). The previous handler comes back on destruction.
 class InterruptGuard {
-public:
-    InterruptGuard();
-    ~InterruptGuard();
-    InterruptGuard(const InterruptGuard&) = delete;
-    InterruptGuard& operator=(const InterruptGuard&) = delete;
-
 private:
-    void (*m_previous)(int) = nullptr;
+    StopOnInterrupt m_stopOnInterrupt;
 };
 
 /// The flag InterruptGuard's handler sets; pass it as SessionConfig::interrupt.

@@ -193,6 +193,41 @@ TEST_F(RenderCli, InterruptWritesPartialImageWithTrueSpp)
     EXPECT_EQ(filesInDir(), std::vector<std::string>{"partial.exr"});
 }
 
+// Issue 26 item 14: CLI::PositiveNumber printed its bound, the largest double, in 310 digits.
+TEST_F(RenderCli, ZeroTimeBudgetOrTargetErrorGetsAShortMessage)
+{
+    ProcessResult budget = render("x.exr", {"--time-budget", "0"});
+    EXPECT_EQ(budget.exitCode, 2);
+    EXPECT_NE(budget.output.find("--time-budget: must be > 0 seconds and finite, not 0"), std::string::npos)
+        << budget.output;
+    EXPECT_LT(budget.output.size(), 200u) << budget.output;
+    ProcessResult target = render("x.exr", {"--target-error", "-1"});
+    EXPECT_EQ(target.exitCode, 2);
+    EXPECT_NE(target.output.find("--target-error: must be > 0 relMSE and finite, not -1"), std::string::npos)
+        << target.output;
+    ProcessResult word = render("x.exr", {"--time-budget", "soon"});
+    EXPECT_EQ(word.exitCode, 2);
+    EXPECT_NE(word.output.find("--time-budget"), std::string::npos) << word.output;
+    EXPECT_TRUE(filesInDir().empty());
+}
+
+// The warning once said "2 spp are too few ... (it needs 2, ...)": it now names what the sampler needs.
+TEST_F(RenderCli, TooFewSamplesForAnEstimateSaysHowManyItNeeds)
+{
+    ProcessResult sobol = render("s.exr", {"--spp", "2", "--sampler", "sobol", "--variance"});
+    ASSERT_EQ(sobol.exitCode, 0) << sobol.output;
+    EXPECT_NE(sobol.output.find("2 spp are too few for an error estimate with the Sobol' sampler: it needs " +
+                                std::to_string(gpu::VARIANCE_BATCHES)),
+              std::string::npos)
+        << sobol.output;
+    ProcessResult independent = render("i.exr", {"--spp", "1", "--variance"});
+    ASSERT_EQ(independent.exitCode, 0) << independent.output;
+    EXPECT_NE(independent.output.find("1 spp is too few for an error estimate: it needs at least 2"), std::string::npos)
+        << independent.output;
+    ProcessResult enough = render("e.exr", {"--spp", "2", "--variance"});
+    EXPECT_EQ(enough.output.find("too few"), std::string::npos) << enough.output;
+}
+
 TEST_F(RenderCli, BadOptionsNameTheOption)
 {
     struct Case {
