@@ -66,6 +66,19 @@ sed "s|\"uri\" *: *\"Cube.bin\"|\"uri\": \"data:application/octet-stream;base64,
 seed 2 "$work/Cube.gltf"
 for file in "$assets"/gltf/bad/*.gltf; do seed 2 "$file"; done
 find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
+# Nesting at the parser's bound (kMaxTomlNesting, 128 levels) and one past it,
+# as a header, a dotted key and inline tables, so mutations explore both sides.
+nested() { # COUNT SEPARATOR
+  local text=a i
+  for ((i = 1; i < $1; i++)); do text+="$2a"; done
+  printf '%s' "$text"
+}
+for n in 127 129; do
+  printf '[%s]\nx = 1\n' "$(nested $n .)" >"$work/scene/header-$n.toml"
+  printf '%s = 1\n' "$(nested $n .)" >"$work/scene/dotted-$n.toml"
+  { printf 'x = '; for ((i = 1; i < n; i++)); do printf '{a = '; done
+    printf 1; for ((i = 1; i < n; i++)); do printf '}'; done; echo; } >"$work/scene/inline-$n.toml"
+done
 
 status=0
 run() { # TARGET CORPUS

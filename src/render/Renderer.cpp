@@ -1,5 +1,7 @@
 #include "render/Renderer.h"
 
+#include "render/RenderMemory.h"
+
 #include "render/Environment.h"
 #include "render/EnvironmentSampling.h"
 #include "shared/Bindings.h"
@@ -131,6 +133,33 @@ size_t varianceBytesPerPixel(bool sobol)
     return sobol ? sizeof(gpu::AccumPixel) * gpu::VARIANCE_BATCHES : sizeof(gpu::MomentPixel);
 }
 
+namespace {
+
+/// The largest device-local memory heap (where the per-pixel buffers go).
+uint64_t deviceLocalHeapBytes(const VulkanContext& context)
+{
+    const vk::PhysicalDeviceMemoryProperties memory = context.physicalDevice().getMemoryProperties();
+    uint64_t largest = 0;
+    for (uint32_t i = 0; i < memory.memoryHeapCount; ++i)
+        if (memory.memoryHeaps[i].flags & vk::MemoryHeapFlagBits::eDeviceLocal)
+            largest = std::max<uint64_t>(largest, memory.memoryHeaps[i].size);
+    return largest;
+}
+
+/// The image's bands, once it is known that the render's memory is there to have.
+ImageBands checkedImageBands(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
+{
+    const vk::PhysicalDeviceType type = context.physicalDevice().getProperties().deviceType;
+    // lavapipe's and an integrated GPU's buffers are the host's memory.
+    const bool deviceIsHostMemory =
+        type == vk::PhysicalDeviceType::eCpu || type == vk::PhysicalDeviceType::eIntegratedGpu;
+    checkRenderMemory(scene, renderMemoryOf(scene, options), deviceIsHostMemory, deviceLocalHeapBytes(context),
+                      options.availableMemory ? options.availableMemory : availableHostMemory());
+    return imageBandsOf(scene, options, context.physicalDevice().getProperties().limits.maxStorageBufferRange);
+}
+
+} // namespace
+
 ImageBands imageBandsOf(const Scene& scene, const RenderOptions& options, uint64_t maxBytes)
 {
     if (options.maxBandBytes > 0) maxBytes = std::min(maxBytes, options.maxBandBytes);
@@ -176,7 +205,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_scene(scene),
       m_options(std::move(options)),
       m_variant(chooseVariant(context, scene, m_options)),
-      m_bands(imageBandsOf(scene, m_options, context.physicalDevice().getProperties().limits.maxStorageBufferRange)),
+      m_bands(checkedImageBands(context, scene, m_options)),
       m_static(prepareStaticScene(scene, context.physicalDevice().getProperties().limits.maxStorageBufferRange)),
       m_data(convertScene(scene, frameSettings(), m_static)),
       m_compiled(compileVariant(m_variant, m_options)),

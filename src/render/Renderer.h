@@ -36,6 +36,9 @@ struct RenderOptions {
     /// the device's maxStorageBufferRange. Tests set it to render small
     /// images in several bands.
     uint64_t maxBandBytes = 0;
+    /// Host memory the render may use (RenderMemory.h); nullopt: what this
+    /// process can still get. Tests set it to check the refusal.
+    std::optional<uint64_t> availableMemory;
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
 };

@@ -7,7 +7,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace vkrt {
 namespace {
@@ -125,8 +131,168 @@ void checkUtf8(std::string_view text, const TomlSource& source)
     }
 }
 
-struct FileCloser {
-    void operator()(std::FILE* file) const { std::fclose(file); }
+/// How deeply a scene may nest tables and arrays. toml++ bounds bracket
+/// nesting (TOML_MAX_NESTED_VALUES, 256) but not dotted keys and headers, and
+/// it recurses once per level when it builds and when it destroys the tables:
+/// a 50,000-part header (`[a.a.a...]`) overflowed the stack. Scene files need
+/// fewer than 10 levels.
+constexpr int kMaxTomlNesting = 128;
+
+/// Finds the first place where a TOML document nests deeper than
+/// kMaxTomlNesting, before toml++ sees it. It follows only what sets depth
+/// (headers, dotted keys, arrays, inline tables, and the strings and comments
+/// that may hide their characters); for a malformed document it may give up
+/// early, and toml++ then reports the syntax error.
+class TomlNestingScan {
+public:
+    TomlNestingScan(std::string_view text, const TomlSource& source) : m_text(text), m_source(source) {}
+
+    void run()
+    {
+        startKey(0);
+        while (m_at < m_text.size()) m_expectKey ? keyCharacter() : valueCharacter();
+    }
+
+private:
+    struct Container {
+        bool inlineTable;
+        int depth; ///< of the array or table itself
+    };
+
+    char peek(size_t ahead = 0) const { return m_at + ahead < m_text.size() ? m_text[m_at + ahead] : '\0'; }
+
+    void advance()
+    {
+        if (m_text[m_at] == '\n') {
+            ++m_line;
+            m_column = 1;
+        } else if ((static_cast<unsigned char>(m_text[m_at]) & 0xC0) != 0x80) {
+            ++m_column; // columns count code points, as toml++'s do
+        }
+        ++m_at;
+    }
+
+    void check(int depth) const
+    {
+        if (depth <= kMaxTomlNesting) return;
+        throw SceneError({m_source.file, m_line, m_column},
+                         "invalid TOML: tables and arrays nest more than " + std::to_string(kMaxTomlNesting) +
+                             " levels deep here (each part of a dotted key or table header is a level); vkrt "
+                             "accepts at most " +
+                             std::to_string(kMaxTomlNesting));
+    }
+
+    void startKey(int base)
+    {
+        m_expectKey = true;
+        m_keyBase = base;
+        m_keyParts = 1;
+    }
+
+    void skipLine()
+    {
+        while (m_at < m_text.size() && peek() != '\n') advance();
+    }
+
+    /// A string starting here (basic, literal, or either multi-line form).
+    void skipString()
+    {
+        const char quoteChar = peek();
+        const bool multiLine = peek(1) == quoteChar && peek(2) == quoteChar;
+        for (int i = 0; i < (multiLine ? 3 : 1); ++i) advance();
+        while (m_at < m_text.size()) {
+            if (quoteChar == '"' && peek() == '\\' && m_at + 1 < m_text.size()) {
+                advance();
+                advance();
+                continue;
+            }
+            if (!multiLine && peek() == '\n') return; // unterminated: toml++ says so
+            if (peek() == quoteChar && (!multiLine || (peek(1) == quoteChar && peek(2) == quoteChar))) {
+                for (int i = 0; i < (multiLine ? 3 : 1); ++i) advance();
+                // A multi-line string may end in up to two more quotes of its own.
+                for (int i = 0; multiLine && i < 2 && peek() == quoteChar; ++i) advance();
+                return;
+            }
+            advance();
+        }
+    }
+
+    void keyCharacter()
+    {
+        const char c = peek();
+        if (c == '"' || c == '\'') return skipString();
+        if (c == '#') return skipLine();
+        if (c == '[' && m_open.empty() && m_keyParts == 1) return header();
+        if (c == '.') {
+            ++m_keyParts;
+            check(m_keyBase + m_keyParts);
+        } else if (c == '=') {
+            m_valueDepth = m_keyBase + m_keyParts;
+            m_expectKey = false;
+        } else if (c == '}' && !m_open.empty()) { // an empty inline table
+            m_open.pop_back();
+            m_expectKey = false;
+        }
+        advance();
+    }
+
+    /// `[a.b.c]` or `[[a.b.c]]`: later keys are relative to that table.
+    void header()
+    {
+        const bool arrayOfTables = peek(1) == '[';
+        advance();
+        if (arrayOfTables) advance();
+        int parts = 1;
+        while (m_at < m_text.size() && peek() != ']' && peek() != '\n') {
+            if (peek() == '"' || peek() == '\'') {
+                skipString();
+                continue;
+            }
+            if (peek() == '.') check(++parts + (arrayOfTables ? 1 : 0));
+            advance();
+        }
+        m_tableDepth = parts + (arrayOfTables ? 1 : 0);
+        skipLine(); // the closing brackets and any comment
+        startKey(m_tableDepth);
+    }
+
+    void valueCharacter()
+    {
+        const char c = peek();
+        if (c == '"' || c == '\'') return skipString();
+        if (c == '#') return skipLine();
+        if (c == '[' || c == '{') {
+            m_open.push_back({c == '{', m_valueDepth});
+            check(m_valueDepth + 1);
+            advance();
+            if (c == '{') return startKey(m_open.back().depth);
+            m_valueDepth = m_open.back().depth + 1;
+            return;
+        }
+        if ((c == ']' || c == '}') && !m_open.empty()) {
+            m_open.pop_back();
+            if (!m_open.empty() && !m_open.back().inlineTable) m_valueDepth = m_open.back().depth + 1;
+        } else if (c == ',' && !m_open.empty()) {
+            if (m_open.back().inlineTable) {
+                advance();
+                return startKey(m_open.back().depth);
+            }
+            m_valueDepth = m_open.back().depth + 1;
+        } else if (c == '\n' && m_open.empty()) {
+            advance();
+            return startKey(m_tableDepth);
+        }
+        advance();
+    }
+
+    std::string_view m_text;
+    const TomlSource& m_source;
+    size_t m_at = 0;
+    int m_line = 1, m_column = 1;
+    bool m_expectKey = true;
+    int m_keyBase = 0, m_keyParts = 1;
+    int m_tableDepth = 0, m_valueDepth = 0;
+    std::vector<Container> m_open; ///< arrays and inline tables not yet closed
 };
 
 [[noreturn]] void failToRead(std::string_view what, const std::string& path, int error)
@@ -145,7 +311,17 @@ std::string formatNumber(double value)
     return std::string(text, result.ptr);
 }
 
-std::string quote(std::string_view text) { return "'" + std::string(text) + "'"; }
+/// Messages echo at most this many bytes of a value: a 10 MB string in a scene
+/// file must not become a 10 MB error message.
+constexpr size_t kMaxQuotedBytes = 96;
+
+std::string quote(std::string_view text)
+{
+    if (text.size() <= kMaxQuotedBytes) return "'" + std::string(text) + "'";
+    size_t cut = kMaxQuotedBytes - 16;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut; // not inside a UTF-8 sequence
+    return "'" + std::string(text.substr(0, cut)) + "...' (" + std::to_string(text.size()) + " bytes)";
+}
 
 std::string joinList(KeyList words)
 {
@@ -291,6 +467,7 @@ std::string TableField::unknownKeyMessage(const toml::key& key, KeyList allowed)
 toml::table parseToml(std::string_view text, const TomlSource& source)
 {
     checkUtf8(text, source);
+    TomlNestingScan(text, source).run();
     try {
         return toml::parse(text, std::string_view(source.file));
     } catch (const toml::parse_error& error) {
@@ -298,17 +475,56 @@ toml::table parseToml(std::string_view text, const TomlSource& source)
     }
 }
 
-/// Uses stdio rather than iostreams because only stdio reliably reports why (errno) a read failed.
-std::string readFileBytes(const std::string& path, std::string_view what)
+/// A file descriptor closed when it goes out of scope.
+class FileDescriptor {
+public:
+    explicit FileDescriptor(int fd) : m_fd(fd) {}
+    FileDescriptor(const FileDescriptor&) = delete;
+    FileDescriptor& operator=(const FileDescriptor&) = delete;
+    ~FileDescriptor()
+    {
+        if (m_fd >= 0) close(m_fd);
+    }
+    int get() const { return m_fd; }
+
+private:
+    int m_fd;
+};
+
+std::string mebibytes(size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
+/// Reads with POSIX calls, which say why (errno) a read failed. Opening does
+/// not wait: a FIFO nobody writes to would block open() for ever. Reads stop
+/// one byte past the limit, so /dev/zero or an endless pipe costs at most that.
+std::string readFileBytes(const std::string& path, std::string_view what, size_t maxBytes)
 {
-    errno = 0;
-    const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-    if (!file) failToRead(what, path, errno);
+    const FileDescriptor file(open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
+    if (file.get() < 0) failToRead(what, path, errno);
+    struct stat status {};
+    if (fstat(file.get(), &status) != 0) failToRead(what, path, errno);
+    if (S_ISDIR(status.st_mode)) failToRead(what, path, EISDIR);
+    const auto tooLarge = [&](const std::string& size) {
+        throw InputError("cannot read " + std::string(what) + " '" + path + "': it is " + size + "; vkrt reads " +
+                         std::string(what) + "s of at most " + mebibytes(maxBytes));
+    };
+    if (S_ISREG(status.st_mode) && static_cast<uint64_t>(status.st_size) > maxBytes)
+        tooLarge(std::to_string(status.st_size) + " bytes");
+    // Back to blocking reads: a pipe whose writer is slow is read to its end.
+    const int flags = fcntl(file.get(), F_GETFL);
+    if (flags < 0 || fcntl(file.get(), F_SETFL, flags & ~O_NONBLOCK) != 0) failToRead(what, path, errno);
     std::string bytes;
     char buffer[1 << 16];
-    size_t count = 0;
-    while ((count = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) bytes.append(buffer, count);
-    if (std::ferror(file.get())) failToRead(what, path, errno);
+    while (bytes.size() <= maxBytes) {
+        const ssize_t count = read(file.get(), buffer, sizeof buffer);
+        if (count < 0 && errno == EINTR) continue;
+        if (count < 0) failToRead(what, path, errno);
+        if (count == 0) break;
+        bytes.append(buffer, static_cast<size_t>(count));
+    }
+    if (bytes.size() > maxBytes) tooLarge("longer than that (read stopped there)");
+    if (bytes.empty() && S_ISFIFO(status.st_mode))
+        throw InputError("cannot read " + std::string(what) + " '" + path +
+                         "': it is a pipe, and nothing was writing to it");
     return bytes;
 }
 
@@ -322,6 +538,10 @@ double readNumber(const Field& field)
         node.is_integer() ? static_cast<double>(node.as_integer()->get()) : node.as_floating_point()->get();
     // TOML allows nan and inf literals; nothing vkrt reads can use them.
     if (!std::isfinite(value)) field.fail("must be finite, got " + formatNumber(value));
+    // The GPU computes in 32-bit floats, where this would be infinite.
+    if (std::abs(value) > std::numeric_limits<float>::max())
+        field.fail("must be within +-3.4e38 (the range of the 32-bit floats vkrt renders with), got " +
+                   formatNumber(value));
     return value;
 }
 

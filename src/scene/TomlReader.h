@@ -120,8 +120,15 @@ private:
 /// Parses a whole document; syntax errors become a SceneError at their position.
 toml::table parseToml(std::string_view text, const TomlSource& source);
 
-/// The bytes of a file; InputError "cannot read <what> 'path': <reason>" when it cannot be read.
-std::string readFileBytes(const std::string& path, std::string_view what);
+/// The longest scene or suite file vkrt reads (docs/robustness.md): far above
+/// any hand-written file (meshes and images are separate files), and small
+/// enough that /dev/zero or an endless pipe given as a scene costs little.
+constexpr size_t kMaxTextFileBytes = size_t(64) << 20;
+
+/// The bytes of a file of at most maxBytes, which may be a pipe or a device;
+/// InputError "cannot read <what> 'path': <reason>" when it cannot be read,
+/// is a directory, is longer, or is a pipe nobody writes to.
+std::string readFileBytes(const std::string& path, std::string_view what, size_t maxBytes = kMaxTextFileBytes);
 
 // ------------------------------------------------------------ scalar values
 

@@ -6,9 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <sys/stat.h>
 
 namespace vkrt {
 namespace {
@@ -205,6 +211,124 @@ TEST(TomlReaderTables, ChoicesSuggestAndListTheAlternatives)
     EXPECT_EQ(readError("v = \"noe\"\n", readPick),
               "t.toml:1:5: v: unknown pick 'noe'; did you mean 'one'? (expected one of: one, two)");
     EXPECT_EQ(readError("v = \"two\"\n", readPick), "no error");
+}
+
+// ------------------------------------------------------------------ bounds (issue 26)
+
+std::string repeated(const std::string& part, int count, const std::string& separator)
+{
+    std::string out;
+    for (int i = 0; i < count; ++i) out += (i ? separator : "") + part;
+    return out;
+}
+
+const std::string kTooDeep = "invalid TOML: tables and arrays nest more than 128 levels deep here (each part of a "
+                             "dotted key or table header is a level); vkrt accepts at most 128";
+
+TEST(TomlReaderNesting, DeepHeadersAndDottedKeysAreRefusedBeforeTomlxxRecurses)
+{
+    // 50,000 parts overflowed the stack inside toml++; the error is at the 129th part.
+    EXPECT_EQ(parseOutcome("[" + repeated("a", 50000, ".") + "]\nx = 1\n"), "t.toml:1:257: " + kTooDeep);
+    EXPECT_EQ(parseOutcome("\n" + repeated("a", 50000, ".") + " = 1\n"), "t.toml:2:256: " + kTooDeep);
+    EXPECT_EQ(parseOutcome("[[" + repeated("a", 50000, ".") + "]]\n"), "t.toml:1:256: " + kTooDeep);
+    EXPECT_EQ(parseOutcome("[" + repeated("a", 128, ".") + "]\nx = 1\n"), "parsed");
+    EXPECT_EQ(parseOutcome(repeated("a", 128, ".") + " = 1\n"), "parsed");
+}
+
+TEST(TomlReaderNesting, LevelsAddUpAcrossHeadersKeysArraysAndInlineTables)
+{
+    const std::string header = "[" + repeated("a", 100, ".") + "]\n"; // 100 levels
+    EXPECT_EQ(parseOutcome(header + repeated("b", 28, ".") + " = 1\n"), "parsed");
+    EXPECT_EQ(parseOutcome(header + repeated("b", 29, ".") + " = 1\n").substr(0, 12), "t.toml:2:56:");
+    EXPECT_EQ(parseOutcome(header + "v = " + std::string(27, '[') + "1" + std::string(27, ']') + "\n"), "parsed");
+    EXPECT_EQ(parseOutcome(header + "v = " + std::string(28, '[') + "1" + std::string(28, ']') + "\n"),
+              "t.toml:2:32: " + kTooDeep);
+    // An inline table is its key's value; its dotted keys add their parts: 101 + 9 x 3 = 128 levels.
+    const auto inlineChain = [](int n) { return repeated("{x.y.z = ", n, "") + "1" + std::string(n, '}'); };
+    EXPECT_EQ(parseOutcome(header + "v = " + inlineChain(9) + "\n"), "parsed");
+    EXPECT_NE(parseOutcome(header + "v = " + inlineChain(10) + "\n").find(kTooDeep), std::string::npos);
+    // A later line of the same table starts again from the header's depth.
+    EXPECT_EQ(parseOutcome(header + "v = [[[1]]]\n" + repeated("b", 26, ".") + " = [2, {c = 3}]\n"), "parsed");
+}
+
+TEST(TomlReaderNesting, StringsAndCommentsDoNotCount)
+{
+    const std::string dots(10000, '.'), brackets(10000, '[');
+    EXPECT_EQ(parseOutcome("\"" + dots + "\" = 1\n"), "parsed");
+    EXPECT_EQ(parseOutcome("'" + dots + "' = 1\n"), "parsed");
+    EXPECT_EQ(parseOutcome("v = \"" + brackets + "\"\n"), "parsed");
+    EXPECT_EQ(parseOutcome("v = '''\n" + brackets + "\n" + dots + "'''\n"), "parsed");
+    EXPECT_EQ(parseOutcome("v = \"\"\"\\\"\"\"" + brackets + "\"\"\"\"\"\nw = 1\n"),
+              "parsed"); // escaped and extra quotes
+    EXPECT_EQ(parseOutcome("# " + brackets + dots + "\nv = 1 # " + brackets + "\n"), "parsed");
+    EXPECT_EQ(parseOutcome("v = [\n  1, # " + brackets + "\n  2,\n]\n"), "parsed");
+    EXPECT_EQ(parseOutcome("v = 1.5e3\nw = 1979-05-27T07:32:00.999\n"), "parsed");
+}
+
+TEST(TomlReaderValues, NumbersBeyondFloatRangeAreRefused)
+{
+    EXPECT_EQ(readError("v = 1e308\n", readNumber),
+              "t.toml:1:5: v: must be within +-3.4e38 (the range of the 32-bit floats vkrt renders with), got 1e+308");
+    EXPECT_NE(readError("v = -3.5e38\n", readNumber), "no error");
+    EXPECT_EQ(readError("v = 3.4e38\n", readNumber), "no error");
+}
+
+TEST(TomlReaderWording, LongValuesAreCutInMessages)
+{
+    const std::string huge(10 << 20, 'x');
+    const std::string quoted = quote(huge);
+    EXPECT_EQ(quoted, "'" + std::string(80, 'x') + "...' (10485760 bytes)");
+    EXPECT_EQ(quote(std::string(96, 'y')), "'" + std::string(96, 'y') + "'");
+    // A cut never splits a UTF-8 sequence: 40 two-byte letters then ASCII.
+    std::string accented;
+    for (int i = 0; i < 60; ++i) accented += "\xC3\xA9";
+    EXPECT_EQ(quote(accented), "'" + accented.substr(0, 80) + "...' (120 bytes)");
+}
+
+/// The message of readFileBytes(path), or "read N bytes".
+std::string readOutcome(const std::string& path, size_t limit = kMaxTextFileBytes)
+{
+    try {
+        return "read " + std::to_string(readFileBytes(path, "scene file", limit).size()) + " bytes";
+    } catch (const InputError& error) {
+        return error.what();
+    }
+}
+
+TEST(TomlReaderFiles, EndlessAndOversizedFilesStopAtTheLimit)
+{
+    EXPECT_EQ(readOutcome("/dev/zero"), "cannot read scene file '/dev/zero': it is longer than that (read stopped "
+                                        "there); vkrt reads scene files of at most 64 MiB");
+    EXPECT_EQ(readOutcome("/dev/null"), "read 0 bytes");
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "vkrt-toml-reader-files";
+    std::filesystem::create_directories(dir);
+    const std::string sparse = (dir / "sparse.toml").string();
+    {
+        std::ofstream(sparse) << "v = 1\n";
+    }
+    std::filesystem::resize_file(sparse, (size_t(64) << 20) + 1); // refused by its size, without reading it
+    EXPECT_EQ(readOutcome(sparse), "cannot read scene file '" + sparse +
+                                       "': it is 67108865 bytes; vkrt reads scene files of at most 64 MiB");
+    std::filesystem::resize_file(sparse, 6);
+    EXPECT_EQ(readOutcome(sparse), "read 6 bytes");
+    EXPECT_EQ(readOutcome(dir.string()), "cannot read scene file '" + dir.string() + "': Is a directory");
+}
+
+TEST(TomlReaderFiles, APipeWithoutWriterIsRefusedAtOnce)
+{
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "vkrt-toml-reader-fifo";
+    std::filesystem::create_directories(dir);
+    const std::string fifo = (dir / "scene.toml").string();
+    std::filesystem::remove(fifo);
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+    const auto started = std::chrono::steady_clock::now();
+    EXPECT_EQ(readOutcome(fifo), "cannot read scene file '" + fifo + "': it is a pipe, and nothing was writing to it");
+    EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(5));
+    // With a writer the pipe is read to its end.
+    std::thread writer([&] { std::ofstream(fifo) << "v = 1\n"; });
+    std::this_thread::sleep_for(std::chrono::milliseconds(200)); // the writer opens first
+    EXPECT_EQ(readOutcome(fifo), "read 6 bytes");
+    writer.join();
 }
 
 } // namespace
