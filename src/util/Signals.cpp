@@ -125,12 +125,15 @@ struct sigaction actionFor(void (*handler)(int), int flags = 0)
     return action;
 }
 
-/// Installs `handler` for `signal` unless the signal is ignored (nohup, or a
-/// shell's background job): ignoring it was the parent's wish.
-void installUnlessIgnored(int signal, void (*handler)(int))
+/// Installs `handler` for `signal` only over the default action: an ignored
+/// signal (nohup, a shell's background job) was the parent's wish, and a
+/// handler someone installed before us is theirs.
+void installOverDefault(int signal, void (*handler)(int))
 {
     struct sigaction previous {};
-    if (sigaction(signal, nullptr, &previous) != 0 || previous.sa_handler == SIG_IGN) return;
+    if (sigaction(signal, nullptr, &previous) != 0 || (previous.sa_flags & SA_SIGINFO) ||
+        previous.sa_handler != SIG_DFL)
+        return;
     struct sigaction action = actionFor(handler);
     sigaction(signal, &action, nullptr);
 }
@@ -162,7 +165,7 @@ void installSignalHandlers()
 {
     static std::once_flag once;
     std::call_once(once, [] {
-        for (int signal : {SIGINT, SIGTERM, SIGHUP}) installUnlessIgnored(signal, onTerminatingSignal);
+        for (int signal : {SIGINT, SIGTERM, SIGHUP}) installOverDefault(signal, onTerminatingSignal);
         useAlternateSignalStack();
     });
 }

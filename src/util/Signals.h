@@ -17,9 +17,11 @@ struct SignalExitCodes {
 };
 
 /// Installs the SIGINT/SIGTERM/SIGHUP handlers that remove registered
-/// temporaries and then die of the signal as before. A signal the parent set
-/// to be ignored (nohup, a background job's SIGINT) stays ignored. Idempotent;
-/// the classes below call it themselves, main() calls it to set the codes.
+/// temporaries and then die of the signal as before. Only signals with the
+/// default action get them: one the parent set to be ignored (nohup, a
+/// background job's SIGINT) stays ignored, and a handler installed earlier
+/// stays. Idempotent; the classes below call it themselves, main() calls it
+/// first to set the codes.
 void installSignalHandlers(const SignalExitCodes& codes);
 void installSignalHandlers();
 
