@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <map>
 #include <optional>
 #include <span>
@@ -65,6 +66,12 @@ double checkChannel(const Field& field, double value, ColorRange range)
     if (range == ColorRange::Unit && !(value >= 0 && value <= 1))
         field.fail("must be in [0, 1], got " + formatNumber(value));
     if (value < 0) field.fail("must be >= 0, got " + formatNumber(value));
+    // Colours reach the GPU as they are, in 32-bit floats, where this would be
+    // infinite. (Positions may exceed it: they are made camera-relative in
+    // double precision first.)
+    if (value > std::numeric_limits<float>::max())
+        field.fail("must be at most 3.4e38 (the largest 32-bit float; vkrt renders with those), got " +
+                   formatNumber(value));
     return value;
 }
 

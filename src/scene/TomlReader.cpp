@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <limits>
 #include <memory>
 #include <vector>
 
@@ -538,10 +537,6 @@ double readNumber(const Field& field)
         node.is_integer() ? static_cast<double>(node.as_integer()->get()) : node.as_floating_point()->get();
     // TOML allows nan and inf literals; nothing vkrt reads can use them.
     if (!std::isfinite(value)) field.fail("must be finite, got " + formatNumber(value));
-    // The GPU computes in 32-bit floats, where this would be infinite.
-    if (std::abs(value) > std::numeric_limits<float>::max())
-        field.fail("must be within +-3.4e38 (the range of the 32-bit floats vkrt renders with), got " +
-                   formatNumber(value));
     return value;
 }
 

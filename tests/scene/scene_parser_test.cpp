@@ -486,6 +486,14 @@ TEST_P(SceneParserBad, ReportsMessageAndPosition)
     EXPECT_EQ(message.rfind(error.where().str() + ": ", 0), 0u) << message;
 }
 
+/// "a.a.a...": a dotted key of `parts` parts.
+std::string repeatedParts(int parts)
+{
+    std::string key = "a";
+    for (int i = 1; i < parts; ++i) key += ".a";
+    return key;
+}
+
 // kCamera occupies lines 1-4, so text appended to it starts on line 5.
 const std::vector<BadScene> kBadScenes = {
     {"SyntaxError", kCamera + "width = 640 480\n", 5, 13, "invalid TOML: "},
@@ -633,6 +641,14 @@ const std::vector<BadScene> kBadScenes = {
      5, 16, "invalid TOML: invalid UTF-8 (byte 0xFF)"},
     {"UnknownIntegrator", "[render]\nintegrator = \"pathh\"\n" + kCamera, 2, 14,
      "render.integrator: unknown integrator 'pathh'; did you mean 'path'?"},
+    // Colours go to the GPU as 32-bit floats, where 1e308 was infinite (issue 26).
+    {"IntensityBeyondFloat",
+     kCamera + "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = [1, 1e308, 1]\n", 8, 17,
+     "lights[0].intensity[1]: must be at most 3.4e38 (the largest 32-bit float; vkrt renders with those), got 1e+308"},
+    {"BackgroundBeyondFloat", kCamera + "[background]\ncolor = 3.5e38\n", 6, 9,
+     "background.color: must be at most 3.4e38"},
+    {"DeepTomlNesting", kCamera + "[" + repeatedParts(20000) + "]\n", 5, 257,
+     "invalid TOML: tables and arrays nest more than 128 levels deep here"},
 };
 
 INSTANTIATE_TEST_SUITE_P(AllCases, SceneParserBad, ::testing::ValuesIn(kBadScenes),
@@ -794,7 +810,7 @@ TEST_F(SceneParserCubemap, UnknownFaceKey)
 TEST(SceneParserMaterials, RoughDielectricOfRoughnessZeroIsTheSmoothDielectric)
 {
     const Scene scene = parseSceneString(kCamera + "[materials.a]\ntype = \"rough_dielectric\"\nroughness = 0\n"
-                                                "[materials.b]\ntype = \"rough_dielectric\"\n");
+                                                   "[materials.b]\ntype = \"rough_dielectric\"\n");
     ASSERT_EQ(scene.materials.size(), 2u);
     EXPECT_EQ(scene.materials[0].type, MaterialType::Dielectric); // same kind, kernel and image as `dielectric`
     EXPECT_EQ(scene.materials[1].type, MaterialType::RoughDielectric);
@@ -804,8 +820,8 @@ TEST(SceneParserMaterials, RoughDielectricOfRoughnessZeroIsTheSmoothDielectric)
 TEST(SceneParserMaterials, NamedMetalsAndDefaults)
 {
     const Scene scene = parseSceneString(kCamera + "[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\n"
-                                                "[materials.perfect]\ntype = \"conductor\"\n"
-                                                "[materials.gltf]\ntype = \"pbr\"\n");
+                                                   "[materials.perfect]\ntype = \"conductor\"\n"
+                                                   "[materials.gltf]\ntype = \"pbr\"\n");
     EXPECT_NEAR(scene.materials[0].eta.r, 0.1431, 1e-9);
     EXPECT_NEAR(scene.materials[0].k.b, 1.6032, 1e-9);
     EXPECT_EQ(scene.materials[1].eta, Color(0.0)); // Mitsuba's "none": F = 1 at every angle
