@@ -65,6 +65,23 @@ sed "s|\"uri\" *: *\"Cube.bin\"|\"uri\": \"data:application/octet-stream;base64,
   "$assets/gltf/Cube/Cube.gltf" >"$work/Cube.gltf"
 seed 2 "$work/Cube.gltf"
 for file in "$assets"/gltf/bad/*.gltf; do seed 2 "$file"; done
+# Node hierarchies at the bound (kMaxGltfNodeDepth, 1024 levels) and one past
+# it, a cycle, and JSON nesting at kMaxGltfJsonNesting (1024) and past it
+# (src/mesh/FileMaterials.h): 1024 '[' inside the top-level object are 1025 levels.
+gltf_chain() { # DEPTH
+  local i nodes=""
+  for ((i = 0; i + 1 < $1; i++)); do nodes+="{\"children\": [$((i + 1))]}, "; done
+  printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [%s{}]}' "$nodes"
+}
+for n in 1024 1025; do gltf_chain $n >"$work/chain-$n.gltf"; seed 2 "$work/chain-$n.gltf"; done
+printf '{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{}, {"children": [2]}, {"children": [1]}]}' \
+  >"$work/cycle.gltf"
+seed 2 "$work/cycle.gltf"
+for n in 1023 1024; do
+  { printf '{"asset": {"version": "2.0"}, "extras": '; printf '[%.0s' $(seq $n); printf ']%.0s' $(seq $n); printf '}'; } \
+    >"$work/nested-$n.gltf"
+  seed 2 "$work/nested-$n.gltf"
+done
 find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
 # Nesting at the parser's bound (kMaxTomlNesting, 128 levels) and one past it,
 # as a header, a dotted key and inline tables, so mutations explore both sides.
