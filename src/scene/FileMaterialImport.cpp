@@ -2,7 +2,6 @@
 
 #include "mesh/FileMaterials.h"
 #include "mesh/MeshGeometry.h"
-#include "texture/TextureImage.h"
 
 namespace vkrt {
 namespace {
@@ -13,16 +12,20 @@ uint32_t addFileTexture(const FileTexture& texture, bool linear, const MeshGeome
                         const SourceLocation& where, TextureAtlas& atlas)
 {
     try {
+        // Embedded bytes go through the same header check and budget as a
+        // file, before they are decoded: a small .glb may hold a PNG bomb.
         if (!texture.embedded.empty())
-            return atlas.add(decodeTextureImage(texture.embedded, texture.name, linear), texture.name, texture.wrapU,
-                             texture.wrapV);
+            return atlas.addEncoded(texture.embedded, texture.name, linear, texture.wrapU, texture.wrapV);
         return atlas.add(TextureRequest{texture.file, linear, texture.wrapU, texture.wrapV});
     } catch (const InputError& error) {
         throw SceneError(where, "a texture of the mesh file " + geometry.file.string() + ": " + error.what());
     }
 }
 
-MaterialTexture slot(uint32_t record, uint32_t channel = 0) { return MaterialTexture{record, channel, glm::dvec2(1.0)}; }
+MaterialTexture slot(uint32_t record, uint32_t channel = 0)
+{
+    return MaterialTexture{record, channel, glm::dvec2(1.0)};
+}
 
 std::string displayName(const FileMaterial& f, size_t index)
 {

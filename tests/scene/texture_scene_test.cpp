@@ -5,12 +5,16 @@
 #include "scene/FeatureSet.h"
 #include "scene/SceneParser.h"
 #include "support/GltfTestFiles.h"
+#include "support/TestSupport.h"
 #include "texture/TextureAtlas.h"
+#include "texture/TextureImage.h"
 #include "texture/TextureTestFiles.h"
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 
 namespace vkrt::test {
 namespace {
@@ -72,8 +76,9 @@ TEST_F(SceneParserTextures, ScalarTexturesPickTheirChannelAndKeepRoughKinds)
                               "roughness = { texture = \"grey.png\", channel = \"b\", linear = true }\n"
                               "[materials.n]\ntype = \"pbr\"\nmetallic = { texture = \"grey.png\", channel = \"a\" }\n"
                               "normal_map = { texture = \"grey.png\", strength = 0.5 }\n" +
-                              kSphere + "[[objects]]\nshape = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n"
-                                        "material = \"n\"\n");
+                              kSphere +
+                              "[[objects]]\nshape = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n"
+                              "material = \"n\"\n");
     const Material& glass = scene.materials[0];
     EXPECT_EQ(glass.type, MaterialType::RoughDielectric) << "a textured roughness is never the smooth kind";
     EXPECT_EQ(glass.roughness, 1.0);
@@ -172,6 +177,74 @@ TEST_F(SceneParserTextures, MissingGltfTextureIsAnErrorAtTheMaterialKey)
     EXPECT_NE(error.find("nowhere.png"), std::string::npos) << error;
 }
 
+// ---------------------------------------------------------------------------
+// Images embedded in a glTF (data: URIs, .glb) meet the texture budget from
+// their header, before they are decoded, as image files do (issue 26).
+
+/// The members of triangleGltf for one material whose base colour is the embedded PNG `png`.
+std::string embeddedPngMaterial(const std::string& png)
+{
+    return R"("materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0}], "images": [{"uri": ")" +
+           dataUri("image/png", png) + R"("}])";
+}
+
+std::string fileBytes(const std::filesystem::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+const std::string kFileMaterialMesh = "[[objects]]\nshape = \"mesh\"\nfile = \"embedded.gltf\"\nmaterial = \"file\"\n";
+
+/// The budget's refusal of a 16384x16384 embedded image of `gltf`, at the mesh's `material` key.
+std::string budgetRefusal(const std::string& scenePath, const std::filesystem::path& gltf)
+{
+    return scenePath + ":8:12: a texture of the mesh file " + gltf.string() + ": " + gltf.string() +
+           " (embedded image 0): a 16384x16384 texture brings the scene's textures to 268435456 texels, more than "
+           "the 67108864 (one 8192x8192) vkrt loads for one scene; use smaller textures";
+}
+
+TEST_F(SceneParserTextures, EmbeddedImageOverTheBudgetIsRefusedFromItsHeaderBeforeDecoding)
+{
+    // A PNG bomb's header and the first 4 KiB of its pixel data: decoding it
+    // fails (the data stops short), so only a check of the header before any
+    // decoding gives the budget's message.
+    const std::string bomb = fileBytes(writePngBomb(m_dir / "bomb.png", 16384));
+    const std::filesystem::path gltf = m_dir / "embedded.gltf";
+    std::ofstream(gltf) << triangleGltf(embeddedPngMaterial(bomb.substr(0, 4096)));
+    EXPECT_EQ(errorOf(kFileMaterialMesh), budgetRefusal(scenePath(), gltf));
+}
+
+TEST_F(SceneParserTextures, EmbeddedImageWithinTheBudgetLoads)
+{
+    const std::filesystem::path grey = m_dir / "grey.png";
+    std::ofstream(m_dir / "embedded.gltf") << triangleGltf(embeddedPngMaterial(fileBytes(grey)));
+    const Scene scene = parse(kFileMaterialMesh);
+    ASSERT_EQ(scene.materials.size(), 1u);
+    ASSERT_TRUE(scene.materials[0].texture(TextureSlot::Color).has_value());
+    ASSERT_TRUE(scene.textures);
+    EXPECT_EQ(scene.textures->imageCount(), 1u);
+    EXPECT_NEAR(scene.textures->meanOf(scene.materials[0].texture(TextureSlot::Color)->record)[0],
+                srgbToLinear(128.0 / 255.0), 1e-6);
+}
+
+TEST_F(SceneParserTextures, VkrtRefusesAnEmbeddedPngBombInBoundedMemory)
+{
+    // vkrt_cpu_tests is built alone by the sanitizer preset; vkrt reads the scene before any Vulkan call.
+    if (!std::filesystem::exists(VKRT_BINARY)) GTEST_SKIP() << VKRT_BINARY << " is not built";
+    // The whole bomb (1.7 MB; 4 GiB decoded as float RGBA) in a data: URI.
+    const std::filesystem::path gltf = m_dir / "embedded.gltf";
+    std::ofstream(gltf) << triangleGltf(embeddedPngMaterial(fileBytes(writePngBomb(m_dir / "bomb.png", 16384))));
+    writeText(scenePath(), kCamera + kFileMaterialMesh);
+    const std::filesystem::path output = m_dir / "out.exr";
+    const ProcessResult result = runVkrt({"render", scenePath(), "-o", output.string()});
+    EXPECT_EQ(result.exitCode, 2) << result.output;
+    EXPECT_NE(result.output.find(budgetRefusal(scenePath(), gltf)), std::string::npos) << result.output;
+    EXPECT_LT(result.peakResidentBytes, kBadInputMemoryLimit);
+    EXPECT_FALSE(std::filesystem::exists(output));
+}
+
 struct BadTexture {
     const char* name;
     std::string body;
@@ -202,8 +275,8 @@ const BadTexture kBadTextures[] = {
     {"ChannelOnAColour", kLambert + "albedo = { texture = \"grey.png\", channel = \"r\" }\n" + kSphere, "7:34",
      "unknown key 'channel'"},
     {"UnknownChannel",
-     "[materials.m]\ntype = \"conductor\"\nroughness = { texture = \"grey.png\", channel = \"x\" }\n" + kSphere,
-     "7:47", "unknown channel 'x'"},
+     "[materials.m]\ntype = \"conductor\"\nroughness = { texture = \"grey.png\", channel = \"x\" }\n" + kSphere, "7:47",
+     "unknown channel 'x'"},
     {"UnknownWrapMode", kLambert + "albedo = { texture = \"grey.png\", wrap = \"repet\" }\n" + kSphere, "7:41",
      "unknown wrap mode 'repet'; did you mean 'repeat'?"},
     {"ZeroScale", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 0] }\n" + kSphere, "7:46",
