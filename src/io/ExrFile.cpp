@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <memory>
 #include <set>
 #include <thread>
@@ -169,27 +170,84 @@ void useEveryCoreForExr()
     (void)done;
 }
 
+/// An OpenEXR output stream into memory. OpenEXR writes its line offset
+/// table last, seeking back over the placeholder it wrote after the header,
+/// so writes may overwrite earlier bytes as well as append.
+class MemoryOStream : public Imf::OStream {
+public:
+    explicit MemoryOStream(size_t expectedBytes) : Imf::OStream("memory")
+    {
+        // Reserved, not touched: only the bytes written become resident, and
+        // the buffer is never copied to grow (which would double the peak).
+        m_bytes.reserve(expectedBytes);
+    }
+
+    void write(const char c[], int n) override
+    {
+        const size_t end = m_position + size_t(n);
+        if (end > m_bytes.size()) m_bytes.resize(end);
+        std::memcpy(m_bytes.data() + m_position, c, size_t(n));
+        m_position = end;
+    }
+    uint64_t tellp() override { return m_position; }
+    void seekp(uint64_t position) override { m_position = size_t(position); }
+
+    std::string take() { return std::move(m_bytes); }
+
+private:
+    std::string m_bytes;
+    size_t m_position = 0;
+};
+
+/// An upper bound of the encoded size: ZIP blocks that would not shrink are
+/// stored raw, so the pixels never take more than their own bytes; the rest
+/// (header, offset table, block headers) is small beside them.
+size_t encodedSizeBound(const Image& image, const Metadata& metadata, size_t layerCount)
+{
+    constexpr size_t kZipBlockRows = 16, kHeaderAllowance = 64 * 1024;
+    size_t bound = image.pixelCount() * 3 * sizeof(float) * (1 + layerCount);
+    bound += (image.height / kZipBlockRows + 1) * 16 + kHeaderAllowance;
+    for (const auto& [name, value] : metadata)
+        if (const auto* text = std::get_if<std::string>(&value)) bound += name.size() + text->size() + 32;
+    return bound;
+}
+
+/// The whole EXR file in memory. OpenEXR writes to a std::ofstream without
+/// checking its last buffered flush (a full disk gave an empty file and
+/// success), so vkrt encodes first and writes with writeBytesAtomically,
+/// which checks every write. Costs the encoded file's size in memory once.
+std::string encodeExr(const Image& image, const Metadata& metadata, const std::map<std::string, Image>& layers)
+{
+    Imf::Header header(int(image.width), int(image.height));
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const auto& [name, value] : metadata) addAttribute(header, name, value);
+    Imf::FrameBuffer frame;
+    addChannels(header, frame, "", image);
+    for (const auto& [name, layer] : layers) addChannels(header, frame, name, layer);
+    MemoryOStream stream(encodedSizeBound(image, metadata, layers.size()));
+    {
+        // The offset table is written when the file is destroyed: the bytes are whole only after this block.
+        Imf::OutputFile file(stream, header);
+        file.setFrameBuffer(frame);
+        file.writePixels(int(image.height));
+    }
+    return stream.take();
+}
+
 } // namespace
 
 void writeExr(const std::filesystem::path& path, const Image& image, const Metadata& metadata,
               const std::map<std::string, Image>& layers)
 {
+    if (resolveOutputTarget(path).kind == OutputTargetKind::Discarded) return; // before the encode's cost
     useEveryCoreForExr();
-    writeFileAtomically(path, [&](const std::filesystem::path& temporary) {
-        Imf::Header header(int(image.width), int(image.height));
-        header.compression() = Imf::ZIP_COMPRESSION;
-        for (const auto& [name, value] : metadata) addAttribute(header, name, value);
-        Imf::FrameBuffer frame;
-        addChannels(header, frame, "", image);
-        for (const auto& [name, layer] : layers) addChannels(header, frame, name, layer);
-        try {
-            Imf::OutputFile file(temporary.c_str(), header);
-            file.setFrameBuffer(frame);
-            file.writePixels(int(image.height));
-        } catch (const std::exception& e) {
-            throw InputError(path.string() + ": cannot write EXR: " + e.what());
-        }
-    });
+    std::string encoded;
+    try {
+        encoded = encodeExr(image, metadata, layers);
+    } catch (const std::exception& e) {
+        throw InputError(path.string() + ": cannot write EXR: " + e.what());
+    }
+    writeBytesAtomically(path, encoded);
 }
 
 ExrHeader readExrHeader(const std::filesystem::path& path, const std::optional<ExpectedSize>& expected)

@@ -397,11 +397,11 @@ TEST_F(FullDiskOutputs, CheckedBytesThatDoNotFitFailAndKeepTheOldFile)
     EXPECT_TRUE(temporariesIn(m_full).empty());
 }
 
-// DISABLED until writeExr (src/io/ExrFile.cpp) encodes to memory and writes
-// through writeBytesAtomically: OpenEXR's std::ofstream reports no error for
-// its last buffered bytes (flushed in its destructor), so today a small EXR on
-// a full disk is renamed over the old file empty, with exit 0.
-TEST_F(FullDiskOutputs, DISABLED_AnExrThatDoesNotFitFailsAndKeepsTheOldFile)
+// OpenEXR's own std::ofstream reports no error for its last buffered bytes
+// (flushed in its destructor): before writeExr encoded to memory and wrote
+// through writeBytesAtomically, a small EXR on a full disk was renamed over
+// the old file empty, with exit 0.
+TEST_F(FullDiskOutputs, AnExrThatDoesNotFitFailsAndKeepsTheOldFile)
 {
     ProcessResult exr = render({"-o", (m_full / "old.exr").string()});
     EXPECT_EQ(exr.exitCode, 2) << exr.output;
