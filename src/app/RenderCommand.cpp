@@ -6,9 +6,11 @@
 #include "io/ExrFile.h"
 #include "io/OutputPaths.h"
 #include "io/PngFile.h"
+#include "mesh/MeshGeometry.h"
 #include "render/ConvergenceReport.h"
 #include "render/Progress.h"
 #include "render/RenderSession.h"
+#include "texture/TextureAtlas.h"
 #include "util/Error.h"
 
 #include <CLI/CLI.hpp>
@@ -18,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <vector>
 
 #include <unistd.h>
 
@@ -205,11 +208,31 @@ Outcome interruptedBeforeRendering()
     return Outcome::of(OutcomeKind::Interrupted, {"vkrt: interrupted before rendering started; nothing written"});
 }
 
+std::vector<NamedFile> renderOutputs(const RenderCommandOptions& options, const std::string& output)
+{
+    return {{"-o", output}, {"--png", options.png}, {"--report", options.report}};
+}
+
 /// Before any work: no output may destroy an input or another output, and each must be writable.
 void checkRenderFiles(const RenderCommandOptions& options, const std::string& output)
 {
     checkOutputs({{"the scene file", options.scenePath}, {"--reference", options.reference}},
-                 {{"-o", output}, {"--png", options.png}, {"--report", options.report}});
+                 renderOutputs(options, output));
+}
+
+/// The files a parsed scene read besides itself (meshes, textures, cube
+/// faces): `-o sky/px.exr` must not replace one of its own faces.
+std::vector<NamedFile> filesTheSceneRead(const Scene& scene)
+{
+    std::vector<NamedFile> files;
+    for (const Mesh& mesh : scene.meshes) files.push_back({"a mesh the scene loads", mesh.geometry->file});
+    if (scene.textures)
+        for (uint32_t r = 0; r < scene.textures->recordCount(); ++r)
+            files.push_back({"a texture the scene loads", scene.textures->nameOf(r)});
+    if (scene.background.cubemap)
+        for (const std::string& face : scene.background.cubemap->facePaths)
+            files.push_back({"a cube face the scene loads", face});
+    return files;
 }
 
 Outcome runRender(const RenderCommandOptions& options)
@@ -222,6 +245,7 @@ Outcome runRender(const RenderCommandOptions& options)
     std::string output = options.output.empty() ? defaultOutputFor(options.scenePath) : options.output;
     checkRenderFiles(options, output);
     Scene scene = loadScene(options.scenePath, {options.width, options.height});
+    refuseOverlappingFiles(filesTheSceneRead(scene), renderOutputs(options, output));
 
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
     std::optional<Image> reference = loadReference(options, scene);

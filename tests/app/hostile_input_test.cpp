@@ -4,6 +4,7 @@
 // machine's memory and many triangle lights. Each case is made here, on the
 // fly; each must end in a clear error (exit 2) or a warning, quickly, with
 // the process's memory bounded.
+#include "io/PngFile.h"
 #include "render/RenderMemory.h"
 #include "support/TestSupport.h"
 
@@ -214,6 +215,31 @@ TEST(RenderMemoryRule, BytesAreWrittenWithUnits)
     EXPECT_EQ(formatBytes(999), "999 bytes");
     EXPECT_EQ(formatBytes(4450000000ull), "4.45 GB");
     EXPECT_EQ(formatBytes(25600000), "25.6 MB");
+}
+
+// ------------------------------------------------------------ outputs
+
+TEST_F(HostileInput, AnOutputThatIsOneOfTheScenesOwnFilesIsRefused)
+{
+    // The scene's texture, named as --png (through another spelling of its path): refused after
+    // the scene is read, before rendering, and the texture is left as it was.
+    fs::create_directories(m_dir / "textures");
+    const fs::path texture = m_dir / "textures" / "wood.png";
+    writePngPixels(texture, 1, 1, {200, 100, 50, 255});
+    const auto bytesOf = [](const fs::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string before = bytesOf(texture);
+    std::string text = planeScene();
+    text.replace(text.find("albedo = [0.8, 0.8, 0.8]"), 24, "albedo = { texture = \"textures/wood.png\" }");
+    const fs::path scene = write("scene.toml", text);
+    const ProcessResult r =
+        render(scene.string(), {"--png", (m_dir / "textures" / ".." / "textures" / "wood.png").string()});
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--png is the same file as a texture the scene loads"), std::string::npos) << r.output;
+    EXPECT_EQ(bytesOf(texture), before);
+    EXPECT_FALSE(fs::exists(m_dir / "out.exr"));
 }
 
 // ------------------------------------------------------------ triangle lights
