@@ -438,11 +438,7 @@ std::string junitReport(const std::vector<CaseResult>& results)
 
 void writeText(const fs::path& path, const std::string& text)
 {
-    writeFileAtomically(path, [&](const fs::path& temporary) {
-        std::ofstream out(temporary, std::ios::binary);
-        out << text;
-        if (!out) throw InputError(path.string() + ": cannot write");
-    });
+    writeBytesAtomically(path, text); // every write checked: an unchecked ofstream's last flush can fail silently
 }
 
 /// Rewritten after every case, so an interrupted run keeps what finished.

@@ -1,10 +1,8 @@
 #include "render/ConvergenceReport.h"
 
 #include "io/AtomicFile.h"
-#include "util/Error.h"
 
 #include <cstdio>
-#include <fstream>
 
 namespace vkrt {
 
@@ -20,12 +18,8 @@ void ConvergenceReport::add(uint32_t spp, double renderSeconds, const Image& mea
     ConvergenceRow row{spp, renderSeconds, estimateError(mean, varianceOfMean), std::nullopt};
     if (m_reference) row.measured = measureError(mean, *m_reference);
     m_rows.push_back(row);
-    std::string csv = text();
-    writeFileAtomically(m_path, [&](const std::filesystem::path& temporary) {
-        std::ofstream out(temporary, std::ios::binary);
-        out << csv;
-        if (!out) throw InputError(m_path.string() + ": cannot write report");
-    });
+    // Whole-buffer write: every write, the flush and the close are checked, so a full disk keeps the old report.
+    writeBytesAtomically(m_path, text());
 }
 
 std::string ConvergenceReport::text() const

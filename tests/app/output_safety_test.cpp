@@ -410,6 +410,19 @@ TEST_F(FullDiskOutputs, AnExrThatDoesNotFitFailsAndKeepsTheOldFile)
     EXPECT_TRUE(temporariesIn(m_full).empty());
 }
 
+// The convergence CSV is small enough to sit in a std::ofstream's buffer
+// until close, whose error was not checked: the old report became empty.
+TEST_F(FullDiskOutputs, AConvergenceReportThatDoesNotFitFailsAndKeepsTheOldFile)
+{
+    const fs::path image = m_dir / "a.exr";
+    ProcessResult report = render({"-o", image.string(), "--report", (m_full / "old.csv").string()});
+    EXPECT_EQ(report.exitCode, 2) << report.output;
+    EXPECT_TRUE(contains(report.output, (m_full / "old.csv").string() + ": cannot write: No space left on device"))
+        << report.output;
+    EXPECT_TRUE(kept("old.csv")) << "the old report was damaged";
+    EXPECT_TRUE(temporariesIn(m_full).empty());
+}
+
 // ---------------------------------------------------------------- 4 and 12: signals
 
 /// Runs `body` in a child process and returns its wait status.
