@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,54 +41,74 @@ std::string text(const MetadataValue& value)
     return std::to_string(std::get<double>(value));
 }
 
-const MetadataValue& required(const ExrContents& exr, const std::string& key, const std::string& file)
+const MetadataValue& required(const Metadata& metadata, const std::string& key, const std::string& file)
 {
-    const auto found = exr.metadata.find(key);
-    if (found == exr.metadata.end())
+    const auto found = metadata.find(key);
+    if (found == metadata.end())
         throw InputError(file + ": no '" + key + "' attribute: not a shard written by `vkrt render --shard`");
     return found->second;
 }
 
-int64_t integer(const ExrContents& exr, const std::string& key, const std::string& file)
+int64_t integer(const Metadata& metadata, const std::string& key, const std::string& file)
 {
-    const auto* value = std::get_if<int64_t>(&required(exr, key, file));
+    const auto* value = std::get_if<int64_t>(&required(metadata, key, file));
     if (!value) throw InputError(file + ": attribute '" + key + "' is not an integer");
     return *value;
 }
 
+/// A shard as its header describes it: merge checks every shard's header
+/// before it reads any shard's pixels.
 struct Shard {
     std::string file;
-    ExrContents exr;
+    ExrHeader header;
     int64_t begin = 0, end = 0;
     bool interrupted = false;
 };
 
-Shard readShard(const std::string& file)
+/// Reads and checks `file`'s header alone, of the size `expected` when given.
+Shard readShard(const std::string& file, const std::optional<ExpectedSize>& expected)
 {
-    Shard shard{file, readExr(file)};
-    required(shard.exr, "shard", file);
-    shard.begin = integer(shard.exr, "sampleBegin", file);
-    shard.end = integer(shard.exr, "sampleEnd", file);
+    Shard shard{file, readExrHeader(file, expected)};
+    const Metadata& metadata = shard.header.metadata;
+    required(metadata, "shard", file);
+    shard.begin = integer(metadata, "sampleBegin", file);
+    shard.end = integer(metadata, "sampleEnd", file);
     if (shard.begin < 0 || shard.end <= shard.begin)
         throw InputError(file + ": sample range [" + std::to_string(shard.begin) + ", " + std::to_string(shard.end) +
                          ") is empty or negative");
-    const auto stopped = shard.exr.metadata.find("stoppedBy");
-    shard.interrupted = stopped != shard.exr.metadata.end() && text(stopped->second) == "interrupted";
+    const auto stopped = metadata.find("stoppedBy");
+    shard.interrupted = stopped != metadata.end() && text(stopped->second) == "interrupted";
     return shard;
 }
 
-/// Every shard like the first (naming the odd one), and no two ranges overlapping.
+/// The size every shard must have: the first one's.
+ExpectedSize sizeOfFirst(const std::vector<Shard>& shards)
+{
+    const Shard& first = shards.front();
+    return {first.header.width, first.header.height, first.file + " is"};
+}
+
+/// Every shard's header, each checked against the first's size as it is read.
+std::vector<Shard> readShardHeaders(const std::vector<std::string>& files)
+{
+    std::vector<Shard> shards;
+    for (const std::string& file : files) {
+        std::optional<ExpectedSize> size;
+        if (!shards.empty()) size = sizeOfFirst(shards);
+        shards.push_back(readShard(file, size));
+    }
+    return shards;
+}
+
+/// Every shard like the first (naming the odd one), and no two ranges
+/// overlapping. Sizes were checked as the headers were read.
 void checkTheyBelongTogether(const std::vector<Shard>& shards)
 {
     const Shard& first = shards.front();
     for (const Shard& s : shards) {
-        if (s.exr.image.width != first.exr.image.width || s.exr.image.height != first.exr.image.height)
-            throw InputError(s.file + ": " + std::to_string(s.exr.image.width) + "x" +
-                             std::to_string(s.exr.image.height) + ", but " + first.file + " is " +
-                             std::to_string(first.exr.image.width) + "x" + std::to_string(first.exr.image.height));
         for (const char* key : kSharedKeys) {
-            const std::string mine = text(required(s.exr, key, s.file)),
-                              theirs = text(required(first.exr, key, first.file));
+            const std::string mine = text(required(s.header.metadata, key, s.file)),
+                              theirs = text(required(first.header.metadata, key, first.file));
             if (mine != theirs)
                 throw InputError(s.file + ": " + key + " is '" + mine + "', but " + first.file + " has '" + theirs +
                                  "': not shards of one render");
@@ -126,15 +147,16 @@ std::string joined(const std::vector<std::string>& items, const std::string& sep
 
 Metadata mergedMetadata(const std::vector<Shard>& shards, int64_t spp, const std::vector<std::string>& missing)
 {
-    Metadata metadata = shards.front().exr.metadata;
+    Metadata metadata = shards.front().header.metadata;
     for (const char* key :
          {"shard", "stoppedBy", "estimatedRmse", "estimatedRelMse", "renderSeconds", "device", "driver", "savedBy"})
         metadata.erase(key);
     double seconds = 0.0, rejected = 0.0;
     std::vector<std::string> files, interrupted;
     for (const Shard& s : shards) {
-        if (const auto* t = std::get_if<double>(&s.exr.metadata.at("renderSeconds"))) seconds += *t;
-        if (const auto found = s.exr.metadata.find("rejectedSamples"); found != s.exr.metadata.end())
+        const Metadata& shardMetadata = s.header.metadata;
+        if (const auto* t = std::get_if<double>(&shardMetadata.at("renderSeconds"))) seconds += *t;
+        if (const auto found = shardMetadata.find("rejectedSamples"); found != shardMetadata.end())
             if (const auto* n = std::get_if<int64_t>(&found->second)) rejected += double(*n);
         files.push_back(s.file);
         if (s.interrupted) interrupted.push_back(s.file);
@@ -151,6 +173,16 @@ Metadata mergedMetadata(const std::vector<Shard>& shards, int64_t spp, const std
     return metadata;
 }
 
+/// One shard's pixels at a time, of which only the tally is kept: a 4K
+/// shard's image and layers are ~0.5 GB, its tally part of that.
+std::vector<Tally> readTallies(const std::vector<Shard>& shards)
+{
+    const ExpectedSize size = sizeOfFirst(shards);
+    std::vector<Tally> tallies;
+    for (const Shard& s : shards) tallies.push_back(readTally(readExr(s.file, size), s.file));
+    return tallies;
+}
+
 /// Before reading anything: `-o` must not be one of the shards (it would be destroyed) and must be writable.
 void checkMergeFiles(const MergeOptions& options)
 {
@@ -162,23 +194,19 @@ void checkMergeFiles(const MergeOptions& options)
 int runMerge(const MergeOptions& options)
 {
     checkMergeFiles(options);
-    std::vector<Shard> shards;
-    for (const std::string& file : options.shards) shards.push_back(readShard(file));
+    // Headers first: a bad shard is refused before any good shard's pixels are read.
+    std::vector<Shard> shards = readShardHeaders(options.shards);
     checkTheyBelongTogether(shards);
-    const int64_t total = integer(shards.front().exr, "totalSpp", shards.front().file);
+    const int64_t total = integer(shards.front().header.metadata, "totalSpp", shards.front().file);
     const std::vector<std::string> missing = missingRanges(shards, total);
     if (!missing.empty() && !options.allowMissing)
         throw InputError("vkrt merge: samples " + joined(missing, ", ") + " of " + std::to_string(total) +
                          " are in no shard given (merge them too, or pass --allow-missing)");
-    const bool shardsHaveVariance = shards.front().exr.layers.count("variance") != 0;
-    std::vector<Tally> tallies;
+    const std::vector<std::string>& firstLayers = shards.front().header.layers;
+    const bool shardsHaveVariance = std::count(firstLayers.begin(), firstLayers.end(), "variance") != 0;
+    std::vector<Tally> tallies = readTallies(shards);
     int64_t spp = 0;
-    for (Shard& s : shards) {
-        tallies.push_back(readTally(s.exr, s.file));
-        spp += s.end - s.begin;
-        s.exr.layers.clear(); // only the tally is needed from here on: a 4K shard's layers are ~0.5 GB
-        s.exr.image = Image();
-    }
+    for (const Shard& s : shards) spp += s.end - s.begin;
     const Tally merged = mergeTallies(tallies);
     std::map<std::string, Image> layers;
     addTallyLayers(merged, layers);
