@@ -169,6 +169,45 @@ TEST_F(MergeCli, ShardWithALyingHeaderIsRefusedInLittleMemory)
     }
 }
 
+/// The bytes of pixels reading `file` allocates: its image and every layer, float RGB.
+int64_t pixelBytesOf(const fs::path& file)
+{
+    const ExrHeader header = readExrHeader(file);
+    return int64_t(header.width) * header.height * 3 * int64_t(sizeof(float)) * int64_t(1 + header.layers.size());
+}
+
+// Headers first: a lying shard given last is refused before the good shards'
+// pixels are read, so the refusal costs what reading headers costs, not the
+// pixels of every shard before it (two 1024x1024 shards: ~60 MB each).
+TEST_F(MergeCli, ALyingShardGivenLastIsRefusedBeforeAnyPixelsAreRead)
+{
+    for (const char* shard : {"0/3", "1/3"}) {
+        const std::string name = std::string("good") + shard[0] + ".exr";
+        const ProcessResult good = runVkrt({"render", kScene, "-o", path(name), "--width", "1024", "--height", "1024",
+                                            "--spp", "3", "--shard", shard, "--sampler", "independent", "--variance"});
+        ASSERT_EQ(good.exitCode, 0) << good.output;
+    }
+    writeExrDeclaring(m_dir / "lying.exr", 1024, 1024); // the good shards' size: only its length gives it away
+    const int64_t shardPixelBytes = pixelBytesOf(m_dir / "good0.exr");
+    const ProcessResult alone = merge({path("lying.exr"), "-o", path("out.exr")});
+    ASSERT_EQ(alone.exitCode, 2) << alone.output;
+
+    const ProcessResult last = merge({path("good0.exr"), path("good1.exr"), path("lying.exr"), "-o", path("out.exr")});
+    EXPECT_EQ(last.exitCode, 2) << last.output;
+    EXPECT_NE(last.output.find(path("lying.exr") + ": the header declares"), std::string::npos) << last.output;
+    EXPECT_FALSE(fs::exists(m_dir / "out.exr"));
+    EXPECT_LT(last.peakResidentBytes, kBadInputMemoryLimit);
+    EXPECT_LT(last.peakResidentBytes, alone.peakResidentBytes + shardPixelBytes / 2)
+        << "the good shards' pixels were read before the lying one was refused";
+
+    // The measure can tell: merging the good shards alone reads their pixels.
+    const ProcessResult goodOnly =
+        merge({path("good0.exr"), path("good1.exr"), "--allow-missing", "-o", path("out.exr")});
+    ASSERT_EQ(goodOnly.exitCode, 0) << goodOnly.output;
+    EXPECT_GT(goodOnly.peakResidentBytes, alone.peakResidentBytes + shardPixelBytes / 2);
+    for (const char* name : {"good0.exr", "good1.exr", "out.exr"}) fs::remove(m_dir / name); // ~60 MB
+}
+
 TEST_F(MergeCli, BadShardOptionsNameTheOption)
 {
     for (const auto& [shard, message] :
