@@ -23,7 +23,10 @@ struct ExrContents {
     Metadata metadata;                   ///< vkrt's attributes (standard ones omitted)
 };
 
-/// Writes atomically (temporary file + rename); throws InputError naming the path.
+/// Encodes the whole file in memory (ZIP, one part), then writes it with
+/// writeBytesAtomically, so a full disk is an InputError naming the path and
+/// the old file stays; costs the encoded file's size in memory, once. A path
+/// that is /dev/null is neither encoded nor written.
 void writeExr(const std::filesystem::path& path, const Image& image, const Metadata& metadata,
               const std::map<std::string, Image>& layers = {});
 
