@@ -621,11 +621,11 @@ std::vector<uint32_t> nodeParents(const fs::path& file, const json& nodes)
 /// the parent links without recursion: assimp 5.2.5 recurses once per level
 /// (reading, importing, pre-transforming and freeing nodes) and overflows its
 /// stack on a chain of 30,000 nodes. Each node's depth is computed once.
-void checkNodeHierarchy(const fs::path& file, const json& doc)
+std::vector<uint32_t> checkNodeHierarchy(const fs::path& file, const json& doc)
 {
     const json* nodes = arrayMember(doc, "nodes");
-    if (!nodes) return;
-    const std::vector<uint32_t> parent = nodeParents(file, *nodes);
+    if (!nodes) return {};
+    std::vector<uint32_t> parent = nodeParents(file, *nodes);
     std::vector<uint32_t> depth(nodes->size(), 0);  // 0: not known yet; a root is 1
     std::vector<bool> onPath(nodes->size(), false); // on the current walk up
     std::vector<uint32_t> path;
@@ -647,6 +647,201 @@ void checkNodeHierarchy(const fs::path& file, const json& doc)
                                std::to_string(kMaxGltfNodeDepth) + " levels");
         }
     }
+    return parent;
+}
+
+// ---------------------------------------------------------------------------
+// What the import will cost. Assimp reads a node once per time its scene
+// reaches it, and PreTransformVertices gives every node naming a mesh its
+// own copy of the mesh: a small file naming one large mesh from many nodes
+// asks for memory without bound. Counted here from the JSON alone.
+
+uint64_t saturatingAdd(uint64_t a, uint64_t b)
+{
+    uint64_t sum = 0;
+    return __builtin_add_overflow(a, b, &sum) ? UINT64_MAX : sum;
+}
+
+uint64_t saturatingMultiply(uint64_t a, uint64_t b)
+{
+    uint64_t product = 0;
+    return __builtin_mul_overflow(a, b, &product) ? UINT64_MAX : product;
+}
+
+/// 3456789012 as "3,456,789,012".
+std::string withThousands(uint64_t value)
+{
+    std::string digits = std::to_string(value);
+    for (size_t at = digits.size(); at > 3; at -= 3) digits.insert(at - 3, ",");
+    return digits;
+}
+
+/// An accessor's `count` (clamped far above any bound), or 0 when `index` names none.
+uint64_t accessorCount(const json* accessors, std::optional<uint32_t> index)
+{
+    const json* accessor = index ? element(accessors, *index) : nullptr;
+    return accessor ? std::min(sizeField(*accessor, "count", 0), uint64_t(1) << 40) : 0;
+}
+
+/// The triangles one primitive gives: glTF modes 4 TRIANGLES (the default),
+/// 5 TRIANGLE_STRIP and 6 TRIANGLE_FAN; points and lines (0-3) give none.
+uint64_t primitiveTriangles(const json& primitive, const json* accessors)
+{
+    const json* attributes = member(primitive, "attributes");
+    const uint64_t count =
+        member(primitive, "indices")
+            ? accessorCount(accessors, uintMember(primitive, "indices"))
+            : accessorCount(accessors, attributes ? uintMember(*attributes, "POSITION") : std::nullopt);
+    switch (uintMember(primitive, "mode").value_or(4)) {
+    case 4: return count / 3;
+    case 5:
+    case 6: return count >= 3 ? count - 2 : 0;
+    default: return 0;
+    }
+}
+
+std::vector<uint64_t> meshTriangles(const json& doc)
+{
+    const json* meshes = arrayMember(doc, "meshes");
+    const json* accessors = arrayMember(doc, "accessors");
+    std::vector<uint64_t> triangles(meshes ? meshes->size() : 0, 0);
+    for (size_t m = 0; m < triangles.size(); ++m)
+        if (const json* primitives = arrayMember((*meshes)[m], "primitives"))
+            for (const json& primitive : *primitives)
+                triangles[m] = saturatingAdd(triangles[m], primitiveTriangles(primitive, accessors));
+    return triangles;
+}
+
+/// How many times the import reaches each node: once per listing of it or
+/// of an ancestor among the roots of the scene assimp imports (`scene`, or
+/// 0). Parents come before children in a walk down from the forest's roots.
+std::vector<uint64_t> importsPerNode(const json& doc, const json& nodes, const std::vector<uint32_t>& parent)
+{
+    std::vector<uint64_t> times(nodes.size(), 0);
+    const json* scene = element(arrayMember(doc, "scenes"), uintMember(doc, "scene").value_or(0));
+    if (const json* roots = scene ? arrayMember(*scene, "nodes") : nullptr)
+        for (const json& each : *roots)
+            if (const auto root = nodeIndex(each, nodes.size())) times[*root] = saturatingAdd(times[*root], 1);
+    std::vector<uint32_t> order;
+    for (uint32_t node = 0; node < nodes.size(); ++node)
+        if (parent[node] == kNoParent) order.push_back(node);
+    for (size_t next = 0; next < order.size(); ++next) {
+        const uint32_t node = order[next];
+        if (const json* children = arrayMember(nodes[node], "children"))
+            for (const json& each : *children)
+                if (const auto child = nodeIndex(each, nodes.size())) {
+                    times[*child] = saturatingAdd(times[*child], times[node]);
+                    order.push_back(*child);
+                }
+    }
+    return times;
+}
+
+/// Refuses a file whose import would read more than kMaxGltfNodes nodes or
+/// make more than kMaxGltfTriangles triangles, naming the mesh that gives most.
+void checkInstancing(const fs::path& file, const json& doc, const std::vector<uint32_t>& parent)
+{
+    const json* nodes = arrayMember(doc, "nodes");
+    if (!nodes) return;
+    if (nodes->size() > kMaxGltfNodes)
+        fail(file, "the file has " + withThousands(nodes->size()) + " nodes; vkrt reads at most " +
+                       withThousands(kMaxGltfNodes) + " (the glTF reader slows with the square of their number)");
+    const std::vector<uint64_t> times = importsPerNode(doc, *nodes, parent);
+    const std::vector<uint64_t> triangles = meshTriangles(doc);
+    std::vector<uint64_t> instances(triangles.size(), 0);
+    uint64_t importedNodes = 0, meshInstances = 0;
+    for (uint32_t node = 0; node < nodes->size(); ++node) {
+        importedNodes = saturatingAdd(importedNodes, times[node]);
+        const auto mesh = uintMember((*nodes)[node], "mesh");
+        if (!mesh || *mesh >= instances.size()) continue;
+        instances[*mesh] = saturatingAdd(instances[*mesh], times[node]);
+        meshInstances = saturatingAdd(meshInstances, times[node]);
+    }
+    if (importedNodes > kMaxGltfNodes)
+        fail(file, "the scene imports " + withThousands(importedNodes) +
+                       " nodes (a node listed more than once among its roots is imported each time, with its "
+                       "children); vkrt reads at most " +
+                       withThousands(kMaxGltfNodes));
+    uint64_t total = 0;
+    size_t largest = 0;
+    for (size_t m = 0; m < triangles.size(); ++m) {
+        const uint64_t made = saturatingMultiply(instances[m], triangles[m]);
+        total = saturatingAdd(total, made);
+        if (made > saturatingMultiply(instances[largest], triangles[largest])) largest = m;
+    }
+    if (total > kMaxGltfTriangles)
+        fail(file, "the node hierarchy instances meshes " + withThousands(meshInstances) + " times, " +
+                       withThousands(total) + " triangles in all (mesh " + std::to_string(largest) + ", " +
+                       withThousands(triangles[largest]) + " triangles, " + withThousands(instances[largest]) +
+                       " times); vkrt reads at most " + withThousands(kMaxGltfTriangles) +
+                       " triangles after instancing");
+}
+
+/// The bytes of accessor data one reference asks assimp for: count x
+/// element size, twice without a bufferView (zeros made, then copied).
+uint64_t referencedBytes(const json* accessors, std::optional<uint32_t> index)
+{
+    const json* accessor = index ? element(accessors, *index) : nullptr;
+    if (!accessor) return 0;
+    const uint64_t bytes = saturatingMultiply(accessorCount(accessors, index), elementBytes(*accessor));
+    return member(*accessor, "bufferView") ? bytes : saturatingMultiply(bytes, 2);
+}
+
+/// Every accessor an object's members name (mesh attributes, a morph target).
+uint64_t namedAccessorBytes(const json* accessors, const json* object)
+{
+    uint64_t bytes = 0;
+    if (object && object->is_object())
+        for (const auto& [name, value] : object->items())
+            if (value.is_number_unsigned() && value.get<uint64_t>() <= UINT32_MAX)
+                bytes = saturatingAdd(bytes, referencedBytes(accessors, uint32_t(value.get<uint64_t>())));
+    return bytes;
+}
+
+uint64_t meshAccessorBytes(const json& doc, const json* accessors)
+{
+    uint64_t bytes = 0;
+    if (const json* meshes = arrayMember(doc, "meshes"))
+        for (const json& mesh : *meshes)
+            if (const json* primitives = arrayMember(mesh, "primitives"))
+                for (const json& primitive : *primitives) {
+                    bytes = saturatingAdd(bytes, namedAccessorBytes(accessors, member(primitive, "attributes")));
+                    bytes = saturatingAdd(bytes, referencedBytes(accessors, uintMember(primitive, "indices")));
+                    if (const json* targets = arrayMember(primitive, "targets"))
+                        for (const json& target : *targets)
+                            bytes = saturatingAdd(bytes, namedAccessorBytes(accessors, &target));
+                }
+    return bytes;
+}
+
+uint64_t skinAndAnimationAccessorBytes(const json& doc, const json* accessors)
+{
+    uint64_t bytes = 0;
+    if (const json* skins = arrayMember(doc, "skins"))
+        for (const json& skin : *skins)
+            bytes = saturatingAdd(bytes, referencedBytes(accessors, uintMember(skin, "inverseBindMatrices")));
+    if (const json* animations = arrayMember(doc, "animations"))
+        for (const json& animation : *animations)
+            if (const json* samplers = arrayMember(animation, "samplers"))
+                for (const json& sampler : *samplers)
+                    for (const char* key : {"input", "output"})
+                        bytes = saturatingAdd(bytes, referencedBytes(accessors, uintMember(sampler, key)));
+    return bytes;
+}
+
+/// Refuses accessor data beyond kMaxGltfAccessorBytes: an accessor lies
+/// inside its buffer, but many references to it, or one without a buffer
+/// (zeros with a sparse patch), ask for more than the file holds.
+void checkAccessorUse(const fs::path& file, const json& doc)
+{
+    const json* accessors = arrayMember(doc, "accessors");
+    const uint64_t bytes =
+        saturatingAdd(meshAccessorBytes(doc, accessors), skinAndAnimationAccessorBytes(doc, accessors));
+    if (bytes > kMaxGltfAccessorBytes)
+        fail(file, "the meshes, morph targets, skins and animations use " + withThousands(bytes) +
+                       " bytes of accessor data (each use counted, an accessor without a bufferView twice); vkrt "
+                       "reads at most " +
+                       withThousands(kMaxGltfAccessorBytes));
 }
 
 /// Every buffer and image the JSON names by a file URI (data: URIs need no file) must be one the policy allows.
@@ -672,7 +867,8 @@ void checkGltfBeforeImport(const fs::path& file, const ReferencePolicy& referenc
 {
     const json doc = parseJson(file);
     checkBufferBounds(file, doc);
-    checkNodeHierarchy(file, doc);
+    checkInstancing(file, doc, checkNodeHierarchy(file, doc));
+    checkAccessorUse(file, doc);
     checkFileReferences(file, doc, references);
 }
 

@@ -11,8 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -68,6 +70,12 @@ std::string nodeChain(int depth)
     std::string nodes = "[";
     for (int i = 0; i + 1 < depth; ++i) nodes += R"({"children": [)" + std::to_string(i + 1) + "]}, ";
     return nodes + R"({"mesh": 0}])";
+}
+
+std::string fileText(const fs::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 /// The message of the InputError loading `file` must throw.
@@ -353,6 +361,153 @@ TEST(MeshReferences, GlbJsonChunkIsCheckedToo)
 }
 
 // ---------------------------------------------------------------------------
+// Instancing: every node naming a mesh gets its own copy (PreTransformVertices)
+
+/// Vertices (0,0,0) (1,0,0) (0,1,0), then `indexCount` uint16 indices 0 1 2 0 1 2 ...
+std::string indexedMeshBytes(uint64_t indexCount)
+{
+    std::string bytes = triangleBytes(1.0f).substr(0, 36);
+    for (uint64_t i = 0; i < indexCount; ++i) put(bytes, uint16_t(i % 3));
+    return bytes;
+}
+
+/// A glTF whose mesh 0 is one primitive of `indexCount` indices in glTF
+/// `mode`, read from mesh.bin (indexedMeshBytes) beside it; node 0 is the
+/// scene's root (listed `rootListings` times) with `instances` children
+/// naming the mesh, each moved 2 along x from the one before.
+std::string instancedGltf(uint64_t indexCount, uint32_t instances, int mode = 4, uint32_t rootListings = 1)
+{
+    std::string children, nodes, roots;
+    for (uint32_t i = 1; i <= instances; ++i) {
+        children += (i > 1 ? "," : "") + std::to_string(i);
+        nodes += R"(, {"mesh": 0, "translation": [)" + std::to_string(2 * i) + ", 0, 0]}";
+    }
+    for (uint32_t i = 0; i < rootListings; ++i) roots += i > 0 ? ",0" : "0";
+    const uint64_t indexBytes = 2 * indexCount;
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [)" + roots +
+           R"(]}], "nodes": [{"children": [)" + children + "]}" + nodes + R"(],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": )" +
+           std::to_string(mode) + R"(}]}],
+  "buffers": [{"uri": "mesh.bin", "byteLength": )" +
+           std::to_string(36 + indexBytes) + R"(}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                  {"buffer": 0, "byteOffset": 36, "byteLength": )" +
+           std::to_string(indexBytes) + R"(}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5123, "count": )" +
+           std::to_string(indexCount) + R"(, "type": "SCALAR"}]})";
+}
+
+/// An instanced file written into `dir` (instancedGltf's arguments), its mesh.bin beside it.
+fs::path writeInstanced(const fs::path& dir, uint64_t indexCount, uint32_t instances, int mode = 4,
+                        uint32_t rootListings = 1)
+{
+    writeFile(dir / "mesh.bin", indexedMeshBytes(indexCount));
+    return writeFile(dir / "instanced.gltf", instancedGltf(indexCount, instances, mode, rootListings));
+}
+
+/// The message checkGltfBeforeImport throws for `file`, or "" when it accepts it (nothing is imported).
+std::string preImportError(const fs::path& file)
+{
+    try {
+        checkGltfBeforeImport(file, ReferencePolicy(file, {}));
+    } catch (const InputError& error) {
+        return error.what();
+    }
+    return "";
+}
+
+TEST(MeshInstancing, ManyNodesNamingALargeMeshAreRefusedBeforeImport)
+{
+    // 100,000 triangles (600 KB of indices) named by 5,000 nodes: 500 million triangles after instancing.
+    const fs::path file = writeInstanced(testDir(), 300000, 5000);
+    EXPECT_EQ(loadError(file), file.string() + ": the node hierarchy instances meshes 5,000 times, 500,000,000 "
+                                               "triangles in all (mesh 0, 100,000 triangles, 5,000 times); vkrt "
+                                               "reads at most 8,388,608 triangles after instancing");
+}
+
+TEST(MeshInstancing, TheTriangleBoundIsExactForListsStripsAndFans)
+{
+    const fs::path dir = testDir();
+    // 4,096 triangles a mesh, 2,048 nodes: exactly 8 Mi triangles; one node more is refused.
+    EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 2048)), "");
+    EXPECT_NE(preImportError(writeInstanced(dir, 3 * 4096, 2049)).find(" 8,392,704 triangles in all"),
+              std::string::npos);
+    for (int stripOrFan : {5, 6}) { // n indices make n - 2 triangles: 4,097 x 2,048 = 8,390,656
+        EXPECT_EQ(preImportError(writeInstanced(dir, 4098, 2048, stripOrFan)), "") << stripOrFan;
+        EXPECT_NE(preImportError(writeInstanced(dir, 4099, 2048, stripOrFan)).find(" 8,390,656 triangles in all"),
+                  std::string::npos)
+            << stripOrFan;
+    }
+    // Points and lines make no triangles, however many.
+    for (int pointsOrLines : {0, 1, 2, 3})
+        EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 4096, pointsOrLines)), "") << pointsOrLines;
+}
+
+TEST(MeshInstancing, RepeatedSceneRootsCountOncePerListing)
+{
+    // Assimp imports a root once per listing, with its subtree: 1,024 instances of 4,096 triangles listed
+    // twice are exactly 8 Mi triangles, three times 12 Mi.
+    const fs::path dir = testDir();
+    EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 1024, 4, 2)), "");
+    EXPECT_NE(preImportError(writeInstanced(dir, 3 * 4096, 1024, 4, 3))
+                  .find("instances meshes 3,072 times, 12,582,912 triangles in all"),
+              std::string::npos);
+}
+
+TEST(MeshInstancing, InstancedFileUnderTheBoundLoadsEveryCopy)
+{
+    const MeshData mesh = loadMeshFile(writeInstanced(testDir(), 3, 1000));
+    ASSERT_EQ(mesh.triangles.size(), 1000u);
+    const auto [lowest, highest] = std::minmax_element(mesh.positions.begin(), mesh.positions.end(),
+                                                       [](const auto& a, const auto& b) { return a.x < b.x; });
+    EXPECT_EQ(lowest->x, 2.0f);            // the first node's translation
+    EXPECT_EQ(highest->x, 2000.0f + 1.0f); // the last node's, plus the triangle's width
+}
+
+TEST(MeshInstancing, NodeCountsAreBounded)
+{
+    const fs::path dir = testDir();
+    // The nodes array: assimp's reader slows with the square of its length, reachable nodes or not.
+    const fs::path many = writeInstanced(dir, 3, uint32_t(kMaxGltfNodes));
+    EXPECT_EQ(loadError(many), many.string() + ": the file has 65,537 nodes; vkrt reads at most 65,536 (the glTF "
+                                               "reader slows with the square of their number)");
+    // One node listed as the scene's root 65,536 times loads (a copy each); once more is refused.
+    const fs::path roots = writeFile(dir / "roots.gltf", gltf(kInlineBuffer));
+    std::string text = fileText(roots);
+    const std::string listing = R"("nodes": [0])";
+    std::string repeated = R"("nodes": [0)";
+    for (uint64_t i = 1; i < kMaxGltfNodes; ++i) repeated += ",0";
+    text.replace(text.find(listing), listing.size(), repeated + "]");
+    writeFile(roots, text);
+    EXPECT_EQ(loadMeshFile(roots).triangles.size(), kMaxGltfNodes);
+    text.replace(text.find(repeated), repeated.size(), repeated + ",0");
+    writeFile(roots, text);
+    EXPECT_EQ(loadError(roots), roots.string() + ": the scene imports 65,537 nodes (a node listed more than once "
+                                                 "among its roots is imported each time, with its children); vkrt "
+                                                 "reads at most 65,536");
+}
+
+TEST(MeshInstancing, AccessorDataWithoutABufferIsBounded)
+{
+    // A morph target of 100 million zeros (a sparse accessor with no bufferView): 600 bytes of JSON that
+    // made assimp allocate 2.4 GB.
+    std::string text = gltf(kInlineBuffer);
+    const std::string accessorsEnd = R"("type": "SCALAR"}])";
+    text.replace(text.find(accessorsEnd), accessorsEnd.size(),
+                 R"("type": "SCALAR"}, {"componentType": 5126, "count": 100000000, "type": "VEC3",
+                    "sparse": {"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                               "values": {"bufferView": 0}}}])");
+    const std::string attributes = R"("attributes": {"POSITION": 0})";
+    text.replace(text.find(attributes), attributes.size(), attributes + R"(, "targets": [{"POSITION": 2}])");
+    const fs::path file = writeFile(testDir() / "sparse.gltf", text);
+    EXPECT_EQ(loadError(file), file.string() + ": the meshes, morph targets, skins and animations use "
+                                               "2,400,000,042 bytes of accessor data (each use counted, an "
+                                               "accessor without a bufferView twice); vkrt reads at most "
+                                               "1,073,741,824");
+}
+
+// ---------------------------------------------------------------------------
 // Through the vkrt executable: a bad mesh is exit code 2, located, in bounded memory.
 
 TEST(MeshReferences, VkrtRefusesHostileMeshReferencesWithExitCode2)
@@ -377,6 +532,25 @@ TEST(MeshReferences, VkrtRefusesHostileMeshReferencesWithExitCode2)
         EXPECT_LT(result.peakResidentBytes, kBadInputMemoryLimit);
         EXPECT_FALSE(fs::exists(tree.root / "out.exr"));
     }
+}
+
+TEST(MeshInstancing, VkrtRefusesAMeshInstancedPastTheBoundWithExitCode2InBoundedMemory)
+{
+    if (!fs::exists(VKRT_BINARY)) GTEST_SKIP() << VKRT_BINARY << " is not built";
+    const fs::path dir = testDir();
+    const fs::path mesh = writeInstanced(dir, 300000, 5000); // 500 million triangles after instancing
+    const fs::path scene = dir / "scene.toml";
+    writeText(scene, "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov = 40\n[materials.clay]\ntype = \"lambert\"\n"
+                     "[[objects]]\nshape = \"mesh\"\nmaterial = \"clay\"\nfile = \"instanced.gltf\"\n");
+    const ProcessResult result = runVkrt({"render", scene.string(), "-o", (dir / "out.exr").string()});
+    EXPECT_EQ(result.exitCode, 2) << result.output;
+    EXPECT_NE(result.output.find(scene.string() + ":10:8: objects[0].file: cannot load the mesh: " + mesh.string() +
+                                 ": the node hierarchy instances meshes 5,000 times, 500,000,000 triangles"),
+              std::string::npos)
+        << result.output;
+    EXPECT_LT(result.peakResidentBytes, kBadInputMemoryLimit);
+    EXPECT_LT(result.peakResidentBytes, int64_t(256) << 20) << "refused from the JSON, before any copy is made";
+    EXPECT_FALSE(fs::exists(dir / "out.exr"));
 }
 
 } // namespace
