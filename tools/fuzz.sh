@@ -82,6 +82,21 @@ for n in 1023 1024; do
     >"$work/nested-$n.gltf"
   seed 2 "$work/nested-$n.gltf"
 done
+# Instancing past kMaxGltfTriangles (8 Mi after instancing): 4,096 triangles
+# listed as the scene's root 16 and 2,049 times.
+gltf_instanced() { # ROOT_LISTINGS
+  local bin roots i
+  bin=$( { head -c 36 /dev/zero; for ((i = 0; i < 4096; i++)); do printf '\000\000\001\000\002\000'; done; } | base64 -w0)
+  roots=0
+  for ((i = 1; i < $1; i++)); do roots+=",0"; done
+  printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [%s]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "buffers": [{"uri": "data:application/octet-stream;base64,%s", "byteLength": 24612}],
+  "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24576}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5123, "count": 12288, "type": "SCALAR"}]}' "$roots" "$bin"
+}
+for n in 16 2049; do gltf_instanced $n >"$work/instanced-$n.gltf"; seed 2 "$work/instanced-$n.gltf"; done
 find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
 # Nesting at the parser's bound (kMaxTomlNesting, 128 levels) and one past it,
 # as a header, a dotted key and inline tables, so mutations explore both sides.

@@ -3,8 +3,9 @@
 // a crash, a sanitizer report, a hang) is a bug. tools/fuzz.sh runs it. The
 // default MeshLoadOptions apply: a glTF's buffer or image URI, or an OBJ's
 // mtllib, that leaves the fuzzer's folder is refused (ReferencePolicy.h), so no
-// input makes the target read other files; glTF node depth and JSON nesting
-// are bounded before assimp (FileMaterials.h).
+// input makes the target read other files; glTF node depth, JSON nesting, node
+// counts, triangles after instancing and accessor data are bounded before
+// assimp (FileMaterials.h).
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "util/Error.h"
