@@ -14,9 +14,10 @@ namespace vkrt {
 namespace {
 
 /// Before any case runs: the reports must not overwrite the suite manifest or each other. The
-/// report directory may not exist yet (regress creates it), so only its report.md is compared.
+/// report directory is made first, since --junit is often inside it (DIR/junit.xml).
 void checkRegressFiles(const RegressOptions& options)
 {
+    if (!options.reportDir.empty()) createReportDir(options.reportDir);
     const NamedFile suite{"the suite manifest", options.suite};
     const NamedFile junit{"--junit", options.junit};
     checkOutputs({suite}, {junit});

@@ -635,6 +635,8 @@ std::unique_ptr<VulkanContext> openContext(const RegressOptions& options)
     }
 }
 
+} // namespace
+
 void createReportDir(const fs::path& dir)
 {
     std::error_code error;
@@ -643,8 +645,6 @@ void createReportDir(const fs::path& dir)
         throw InputError("--report-dir " + dir.string() + ": cannot create it (" +
                          (error ? error.message() : "not a directory") + ")");
 }
-
-} // namespace
 
 void selectVulkanDriver(const fs::path& icdManifest)
 {

@@ -32,6 +32,9 @@ Outcome runRegression(const RegressOptions& options);
 /// Points the Vulkan loader at one ICD manifest; throws InputError naming the
 /// path if it is missing, not a JSON ICD manifest, or names a library file
 /// that does not exist. Call before any instance exists.
+/// Creates --report-dir (and its parents); InputError naming the option if it cannot.
+void createReportDir(const std::filesystem::path& dir);
+
 void selectVulkanDriver(const std::filesystem::path& icdManifest);
 
 } // namespace vkrt

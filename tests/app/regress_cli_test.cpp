@@ -152,6 +152,19 @@ void expectInputError(const ProcessResult& r, const std::vector<std::string>& fr
 
 // ------------------------------------------------------------ deliberate bias
 
+// As ctest runs the suite on a clean build: --junit inside a --report-dir that
+// does not exist yet. The output checks run before any case, so the report
+// directory must be made before them (a clean clone failed here).
+TEST_F(RegressCli, JunitInsideAReportDirThatDoesNotExistYet)
+{
+    const fs::path report = m_dir / "not" / "yet" / "there";
+    ProcessResult r = regress(
+        {"--filter", "seed/baseline", "--junit", (report / "junit.xml").string(), "--report-dir", report.string()});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(junitOutcomes(report / "junit.xml")["seed/baseline"], "pass") << r.output;
+    EXPECT_TRUE(fs::exists(report / "report.md"));
+}
+
 // VKRT_TEST_FRESNEL_SCALE=1.02 (shaders/lib/fresnel.glsl) makes every dielectric
 // reflect 2 % more. The cases whose image is dominated by a Fresnel term must
 // fail: kappa-halfspace shows only the Fresnel reflection of an opaque glass
