@@ -14,7 +14,9 @@
 #include <thread>
 #include <vector>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace vkrt {
 namespace {
@@ -316,11 +318,16 @@ TEST(TomlReaderFiles, APipeWithoutWriterIsRefusedAtOnce)
     const auto started = std::chrono::steady_clock::now();
     EXPECT_EQ(readOutcome(fifo), "cannot read scene file '" + fifo + "': it is a pipe, and nothing was writing to it");
     EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(5));
-    // With a writer the pipe is read to its end.
-    std::thread writer([&] { std::ofstream(fifo) << "v = 1\n"; });
-    std::this_thread::sleep_for(std::chrono::milliseconds(200)); // the writer opens first
+    // What was written to the pipe is read to its end. A reader held open keeps
+    // the pipe and its bytes alive after the writer has gone, with no thread timing.
+    const int keeper = open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+    ASSERT_GE(keeper, 0);
+    const int writer = open(fifo.c_str(), O_WRONLY);
+    ASSERT_GE(writer, 0);
+    ASSERT_EQ(write(writer, "v = 1\n", 6), 6);
+    close(writer);
     EXPECT_EQ(readOutcome(fifo), "read 6 bytes");
-    writer.join();
+    close(keeper);
 }
 
 } // namespace
