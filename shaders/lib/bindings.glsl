@@ -20,7 +20,10 @@ layout(scalar, binding = BINDING_MOMENTS) buffer MomentBlock { MomentPixel momen
 #endif
 
 // Scene arrays: fixed-size uniform blocks in the uniform-scene variant,
-// runtime-sized storage buffers otherwise (shared/SceneTypes.h).
+// runtime-sized storage buffers otherwise (shared/SceneTypes.h). Each shape
+// and light kind declares its own array in its file (lib/shapes/*.glsl,
+// lib/lights/*.glsl); the top-level BVH is declared by lib/scene.glsl and the
+// emitters by lib/emitters.glsl.
 #ifdef VKRT_UNIFORM_SCENE
 #define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity) \
     layout(scalar, binding = binding_) uniform Block { Type name[capacity]; };
@@ -32,30 +35,12 @@ layout(scalar, binding = BINDING_MOMENTS) buffer MomentBlock { MomentPixel momen
 #ifdef VKRT_HAS_MATERIALS
 VKRT_SCENE_ARRAY(BINDING_MATERIALS, MaterialBlock, Material, materials, UNIFORM_MATERIALS)
 #endif
-#ifdef VKRT_HAS_SPHERES
-VKRT_SCENE_ARRAY(BINDING_SPHERES, SphereBlock, Sphere, spheres, UNIFORM_SPHERES)
-#endif
-#ifdef VKRT_HAS_BOXES
-VKRT_SCENE_ARRAY(BINDING_BOXES, BoxBlock, Box, boxes, UNIFORM_BOXES)
-#endif
-#ifdef VKRT_HAS_TRIANGLES
-VKRT_SCENE_ARRAY(BINDING_TRIANGLES, TriangleBlock, Triangle, triangles, UNIFORM_TRIANGLES)
-#endif
-#ifdef VKRT_HAS_PLANES
-VKRT_SCENE_ARRAY(BINDING_PLANES, PlaneBlock, Plane, planes, UNIFORM_PLANES)
-#endif
 #ifdef VKRT_HAS_MESHES
-VKRT_SCENE_ARRAY(BINDING_MESHES, MeshBlock, Mesh, meshes, UNIFORM_MESHES)
 layout(scalar, binding = BINDING_MESH_NODES) readonly buffer MeshNodeBlock { BvhNode meshNodes[]; };
 layout(scalar, binding = BINDING_MESH_TRIANGLES) readonly buffer MeshTriangleBlock { MeshTriangle meshTriangles[]; };
-layout(scalar, binding = BINDING_TOP_NODES) readonly buffer TopNodeBlock { BvhNode topNodes[]; };
-layout(scalar, binding = BINDING_TOP_REFS) readonly buffer TopRefBlock { uint topRefs[]; };
 #endif
 #ifdef VKRT_HAS_MESH_NORMALS
 layout(scalar, binding = BINDING_MESH_NORMALS) readonly buffer MeshNormalBlock { MeshNormals meshNormals[]; };
-#endif
-#ifdef VKRT_HAS_EMITTERS
-layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitter emitters[]; };
 #endif
 #ifdef VKRT_HAS_MATERIAL_TABLES
 layout(scalar, binding = BINDING_MATERIAL_TABLES) readonly buffer MaterialTableBlock { float materialTables[]; };
@@ -81,17 +66,11 @@ layout(scalar, binding = BINDING_MESH_MATERIALS) readonly buffer MeshMaterialBlo
 #if defined(VKRT_HAS_MESH_NORMALS) || defined(VKRT_HAS_NORMAL_MAPS)
 #define VKRT_HAS_SHADING_NORMALS
 #endif
-#ifdef VKRT_HAS_POINT_LIGHTS
-VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
-#endif
 #ifdef VKRT_HAS_CUBEMAP
 layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
 #endif
 #ifdef VKRT_ENVIRONMENT_SAMPLING
 layout(scalar, binding = BINDING_ENVIRONMENT_CDF) readonly buffer EnvironmentCdfBlock { float environmentCdf[]; };
-#endif
-#ifdef VKRT_HAS_TRIANGLE_LIGHTS
-VKRT_SCENE_ARRAY(BINDING_TRIANGLE_LIGHTS, TriangleLightBlock, TriangleLight, triangleLights, UNIFORM_TRIANGLE_LIGHTS)
 #endif
 
 #endif

@@ -1,11 +1,12 @@
 // Unbiased path tracing (`integrator = "path"`). At each non-specular vertex:
 // next-event estimation for every point light and one area-sampled point on
-// every triangle light, with one shadow ray for all of them (chosen by
+// one emitter (triangle lights and emissive mesh triangles, chosen in
+// proportion to power), with one shadow ray for all of them (chosen by
 // unshadowed contribution), and for the environment (a second shadow ray),
-// weighted against BSDF
-// sampling with the power heuristic; then one BSDF-sampled continuation. A continuation that hits a
-// light adds its emission with the complementary MIS weight (full weight after
-// a specular bounce or from the camera); one that escapes adds the environment.
+// weighted against BSDF sampling with the power heuristic; then one
+// BSDF-sampled continuation. A continuation that hits an emitter adds its
+// emission with the complementary MIS weight (full weight after a specular
+// bounce or from the camera); one that escapes adds the environment.
 // Russian roulette from the fourth vertex on keeps long paths unbiased.
 // max_depth counts surface interactions with light sampling, so the longest
 // path has max_depth + 1 segments (Mitsuba's max_depth = ours + 1).
@@ -20,25 +21,6 @@ struct PathVertexState {
     float bsdfPdf;         // solid-angle pdf of the last BSDF sample
 };
 
-// Emission of a light hit by a BSDF-sampled ray, MIS-weighted against having
-// sampled that light directly from the previous vertex.
-vec3 emissionOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
-{
-#ifdef VKRT_HAS_TRIANGLE_LIGHTS
-    TriangleLight light = triangleLights[hit.index];
-    vec3 le = emittedRadiance(light, -ray.dir);
-    if (path.specular || le == vec3(0.0))
-        return le;
-    float cosLight = abs(dot(triangleLightNormal(light), ray.dir));
-    float lightPdf = triangleLightPdf(light.area, hit.t * hit.t, cosLight);
-    return le * powerHeuristic(path.bsdfPdf, lightPdf);
-#else
-    return vec3(0.0);
-#endif
-}
-
-// Emission of an emissive mesh triangle hit by a BSDF-sampled ray, weighted
-// like emissionOnHit against having sampled it (lib/lights.glsl: sampleEmitters).
 vec3 emitterOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
 {
 #ifdef VKRT_HAS_EMITTERS
@@ -140,14 +122,12 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
         p.path.radiance += p.path.throughput * environmentOnEscape(p.path, p.ray.dir);
         return false;
     }
-    if (hitsLight(hit)) {
-        p.path.radiance += p.path.throughput * emissionOnHit(p.path, p.ray, hit);
-        return false;
-    }
 #ifdef VKRT_HAS_EMITTERS
     if (hit.emitter != NO_EMITTER)
         p.path.radiance += p.path.throughput * emitterOnHit(p.path, p.ray, hit);
 #endif
+    if (hitsLight(hit))
+        return false; // a light is black: its emission, just added, is all it gives
     if (p.depth == u.maxDepth + 1u)
         return false; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS

@@ -1,6 +1,7 @@
 // Whitted-style integrator, faithful to the seed renderer: at every surface,
-// direct light from point lights (hard shadows) and triangle lights (one
-// sample per light per frame: soft shadows converge over frames), then one
+// direct light from point lights (hard shadows) and emitters (triangle lights
+// and emissive meshes: one sample of one emitter, chosen in proportion to
+// power, per frame: soft shadows converge over frames), then one
 // continuation ray chosen by the material's scattering model (perfect
 // specular, Lambert, glossy, Fresnel-weighted dielectric reflection or
 // refraction), up to max_depth. A light is seen only along purely specular
@@ -17,20 +18,8 @@ struct PathState {
     bool countEmission;
 };
 
-// Radiance a continuation ray picks up when it leaves the scene or hits a light.
-void addEscapedRadiance(inout PathState path, Ray ray, SurfaceHit hit, bool missed)
-{
-    if (missed) {
-        path.radiance += path.throughput * environmentRadiance(ray.dir);
-        return;
-    }
-#ifdef VKRT_HAS_TRIANGLE_LIGHTS
-    if (path.countEmission)
-        path.radiance += path.throughput * emittedRadiance(triangleLights[hit.index], -ray.dir);
-#endif
-}
-
-// An emissive mesh seen along a specular chain from the camera.
+// An emitter (triangle light or emissive mesh) seen along a specular chain
+// from the camera.
 void addEmitterRadiance(inout PathState path, Ray ray, SurfaceHit hit)
 {
 #ifdef VKRT_HAS_EMITTERS
@@ -51,11 +40,13 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         bool missed = !traceClosest(ray, FLT_MAX, hit);
         // Beer-Lambert over the segment just travelled inside a dielectric.
         path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
-        if (missed || hitsLight(hit)) {
-            addEscapedRadiance(path, ray, hit, missed);
+        if (missed) {
+            path.radiance += path.throughput * environmentRadiance(ray.dir);
             break;
         }
         addEmitterRadiance(path, ray, hit);
+        if (hitsLight(hit))
+            break;
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
 #ifdef VKRT_HAS_TEXTURES
@@ -69,11 +60,8 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         m = withInterfaceEta(m, surfaceEta(path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
         if (!scattersIntoDeltasOnly(m)) {
-            path.radiance += path.throughput * (directFromPointLights(m, hit, n, ns, wo, path.media) +
-                                                directFromTriangleLights(m, hit, n, ns, wo, path.media, rng));
-#ifdef VKRT_HAS_EMITTERS
+            path.radiance += path.throughput * directFromLights(m, hit, n, ns, wo, path.media, rng);
             path.radiance += path.throughput * directFromEmitters(m, hit, n, ns, wo, path.media, rng);
-#endif
         }
         if (depth == u.maxDepth)
             break;

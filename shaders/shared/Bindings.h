@@ -14,9 +14,9 @@ VKRT_CONSTANT(uint, BINDING_STATS, 2)        // RenderStats
 VKRT_CONSTANT(uint, BINDING_MATERIALS, 3)    // Material[]
 // Then one array per shape and light kind of the registry (shared/Kinds.h), in
 // its order: BINDING_SPHERES = 4 (Sphere[]), ..., BINDING_TRIANGLE_LIGHTS = 9.
-#define VKRT_SHAPE_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_SHAPE_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     VKRT_CONSTANT(uint, BINDING_##ARRAY, 4 + value)
-#define VKRT_LIGHT_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_LIGHT_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     VKRT_CONSTANT(uint, BINDING_##ARRAY, 4 + SHAPE_KIND_COUNT + value)
 VKRT_SHAPE_KINDS(VKRT_SHAPE_BINDING)
 VKRT_LIGHT_KINDS(VKRT_LIGHT_BINDING)

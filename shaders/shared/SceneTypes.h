@@ -135,10 +135,12 @@ struct MeshTangents {
     vec4 t2;
 };
 
-/// One emissive mesh triangle as a light, camera-relative world space. Lights
-/// are chosen in proportion to power with Walker's alias method: pick slot i
-/// uniformly, keep it if u < aliasThreshold, else take `alias`; `pdf` is the
-/// probability of choosing this triangle.
+/// One emitting triangle, camera-relative world space: the triangle lights
+/// first (TriangleLight::emitter), then every emissive mesh triangle
+/// (Mesh::firstEmitter). Emitters are chosen in proportion to power with
+/// Walker's alias method: pick slot i uniformly, keep it if u <
+/// aliasThreshold, else take `alias`; `pdf` is the probability of choosing
+/// this triangle.
 struct Emitter {
     vec3 v0;
     float area;
@@ -156,13 +158,14 @@ struct PointLight {
     vec3 intensity;
 };
 
+/// A triangle light's geometry, camera-relative world space: what rays are
+/// tested against. What it emits is emitters[emitter] (Emitter), in the one
+/// alias table of every emitting triangle.
 struct TriangleLight {
     vec3 v0;
-    float area;
+    uint emitter;
     vec3 v1;
-    uint twoSided;
     vec3 v2;
-    vec3 radiance;
 };
 
 /// One node of a bounding volume hierarchy (src/accel/Bvh.h). Inner node
@@ -185,8 +188,8 @@ struct MeshTriangle {
 };
 
 // Top-level BVH leaves reference records as TOP_REF(kind, index): the
-// shape kind (SHAPE_*, or SHAPE_KIND_COUNT + a LIGHT_* kind for lights) in
-// the top 8 bits, the record's index in the low 24.
+// kind's HIT_Type code (shared/Kinds.h) in the top 8 bits, the record's
+// index in the low 24.
 VKRT_CONSTANT(uint, TOP_REF_INDEX_BITS, 24)
 VKRT_CONSTANT(uint, TOP_REF_MAX_INDEX, 16777215)
 
@@ -205,7 +208,7 @@ VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 163) // 16384 / 100
 
 // One record count per shape and light array, in registry order:
 // sphereCount, boxCount, triangleCount, planeCount, pointLightCount, ...
-#define VKRT_COUNT_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) uint field##Count;
+#define VKRT_COUNT_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) uint field##Count;
 
 struct SceneUniforms {
     vec3 cameraRight; // scaled by tan(fov/2) * aspect
@@ -223,7 +226,7 @@ struct SceneUniforms {
     uint environmentSize;   // cubemap face width N (0 without a cubemap)
     uint cameraMediumCount; // dielectrics containing the eye (lib/media.glsl)
     uvec4 cameraMedia;      // their materials, innermost last
-    uint emitterCount;      // Emitter records (emissive mesh triangles)
+    uint emitterCount;      // Emitter records (triangle lights, then emissive mesh triangles)
     uint topNodeCount;      // nodes of the top-level BVH (0: none; the kernel loops over the arrays)
 };
 

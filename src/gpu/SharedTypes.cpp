@@ -19,7 +19,7 @@ constexpr uint32_t kUniformArrayBytes = 16384;
 static_assert(UNIFORM_MATERIALS * sizeof(Material) <= kUniformArrayBytes &&
               (UNIFORM_MATERIALS + 1) * sizeof(Material) > kUniformArrayBytes);
 // The registry's capacities (shared/Kinds.h) are exactly what 16 KiB holds.
-#define VKRT_CHECK_CAPACITY(KIND, Type, name, value, field, array, ARRAY, capacity)                      \
+#define VKRT_CHECK_CAPACITY(KIND, Type, name, value, field, array, ARRAY, capacity, bounded)             \
     static_assert(capacity == UNIFORM_##ARRAY && UNIFORM_##ARRAY * sizeof(Type) <= kUniformArrayBytes && \
                       (UNIFORM_##ARRAY + 1) * sizeof(Type) > kUniformArrayBytes,                         \
                   "shared/Kinds.h: the capacity of " #array " must be 16384 / sizeof(" #Type ")");
@@ -28,18 +28,19 @@ VKRT_LIGHT_KINDS(VKRT_CHECK_CAPACITY)
 #undef VKRT_CHECK_CAPACITY
 
 // Every scene array has a binding of its own, distinct from the fixed ones.
-#define VKRT_BINDING_OF(KIND, Type, name, value, field, array, ARRAY, capacity) BINDING_##ARRAY,
+#define VKRT_BINDING_OF(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) BINDING_##ARRAY,
 constexpr uint kSceneArrayBindings[] = {BINDING_MATERIALS,
                                         VKRT_SHAPE_KINDS(VKRT_BINDING_OF) VKRT_LIGHT_KINDS(VKRT_BINDING_OF)};
 #undef VKRT_BINDING_OF
 constexpr bool bindingsDistinct()
 {
-    constexpr uint fixed[] = {BINDING_UNIFORMS,    BINDING_ACCUMULATION,   BINDING_STATS,         BINDING_ENVIRONMENT,
-                              BINDING_MOMENTS,     BINDING_ENVIRONMENT_CDF, BINDING_MESH_NODES,   BINDING_MESH_TRIANGLES,
-                              BINDING_MESH_NORMALS, BINDING_TOP_NODES,     BINDING_TOP_REFS,      BINDING_EMITTERS,
-                              BINDING_MATERIAL_TABLES, BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
-                              BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS, BINDING_MESH_TANGENTS,
-                              BINDING_MESH_MATERIALS, BINDING_FRAME_RUN};
+    constexpr uint fixed[] = {BINDING_UNIFORMS,          BINDING_ACCUMULATION,   BINDING_STATS,
+                              BINDING_ENVIRONMENT,       BINDING_MOMENTS,        BINDING_ENVIRONMENT_CDF,
+                              BINDING_MESH_NODES,        BINDING_MESH_TRIANGLES, BINDING_MESH_NORMALS,
+                              BINDING_TOP_NODES,         BINDING_TOP_REFS,       BINDING_EMITTERS,
+                              BINDING_MATERIAL_TABLES,   BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
+                              BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS,       BINDING_MESH_TANGENTS,
+                              BINDING_MESH_MATERIALS,    BINDING_FRAME_RUN};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -68,6 +69,6 @@ static_assert(sizeof(RenderStats) == 8);
 static_assert(sizeof(MomentPixel) == 36);
 static_assert(offsetof(SceneUniforms, tileStride) == 96);
 static_assert(offsetof(Material, fresnel) == 48 && offsetof(Material, eta) == 64 && offsetof(Material, k) == 80);
-static_assert(offsetof(TriangleLight, radiance) == 44);
+static_assert(sizeof(TriangleLight) == 40 && offsetof(TriangleLight, emitter) == 12);
 
 } // namespace vkrt::gpu

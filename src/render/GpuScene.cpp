@@ -4,6 +4,7 @@
 
 #include "mesh/MeshGeometry.h"
 #include "scene/FeatureSet.h"
+#include "scene/kinds/Kinds.h"
 #include "shared/Bindings.h"
 
 #include <chrono>
@@ -19,12 +20,6 @@ namespace vkrt {
 namespace {
 
 glm::vec3 toFloat(const glm::dvec3& v) { return glm::vec3(v); }
-
-/// World -> camera-relative float32.
-struct Relativizer {
-    glm::dvec3 eye;
-    glm::vec3 operator()(const glm::dvec3& p) const { return glm::vec3(p - eye); }
-};
 
 /// GGX alphas from perceptual roughness (alpha = roughness^2) and anisotropy
 /// (Burley 2012: aspect = sqrt(1 - 0.9 anisotropy), alphaX = alpha / aspect,
@@ -141,22 +136,6 @@ void prepareMaterialTables(const Scene& scene, GpuSceneStatic& fixed)
     }
 }
 
-// One conversion per shape and light kind (shared/Kinds.h), found by overload.
-gpu::Sphere toGpu(const Sphere& s, const Relativizer& rel) { return {rel(s.center), float(s.radius), s.material}; }
-gpu::Box toGpu(const Box& b, const Relativizer& rel) { return {rel(b.min), b.material, rel(b.max)}; }
-gpu::Triangle toGpu(const Triangle& t, const Relativizer& rel)
-{
-    return {rel(t.vertices[0]), t.material, rel(t.vertices[1]), rel(t.vertices[2])};
-}
-gpu::Plane toGpu(const Plane& p, const Relativizer& rel) { return {rel(p.point), p.material, toFloat(p.normal)}; }
-gpu::PointLight toGpu(const PointLight& l, const Relativizer& rel) { return {rel(l.position), toFloat(l.intensity)}; }
-gpu::TriangleLight toGpu(const TriangleLight& l, const Relativizer& rel)
-{
-    double area = triangleArea(l.vertices);
-    return {rel(l.vertices[0]),   float(area),        rel(l.vertices[1]),
-            l.twoSided ? 1u : 0u, rel(l.vertices[2]), toFloat(l.radiance)};
-}
-
 /// The records of a kind that reach the GPU: all of them, except that
 /// triangle lights that cannot emit are dropped.
 template <class Record>
@@ -168,9 +147,6 @@ std::vector<TriangleLight> recordsToUpload(const Scene& scene, const std::vector
 {
     return emittingTriangleLights(scene);
 }
-/// Mesh instances need their geometry's offsets: convertMeshes does them.
-std::vector<Mesh> recordsToUpload(const Scene&, const std::vector<Mesh>&) { return {}; }
-gpu::Mesh toGpu(const Mesh&, const Relativizer&) { return {}; }
 
 // ------------------------------------------------------------------ meshes
 
@@ -245,9 +221,12 @@ EmitterTable aliasTable(const std::vector<double>& power)
     return table;
 }
 
+/// Every emitter's power, in emitter order: the triangle lights, then each
+/// emissive mesh's triangles.
 EmitterTable emitterTableOf(const Scene& scene)
 {
     std::vector<double> power;
+    for (const TriangleLight& light : emittingTriangleLights(scene)) power.push_back(emittedPower(light));
     for (const Mesh& mesh : scene.meshes) {
         if (!meshEmits(scene, mesh)) continue;
         const MeshGeometry& g = *mesh.geometry;
@@ -262,22 +241,6 @@ EmitterTable emitterTableOf(const Scene& scene)
     return aliasTable(power);
 }
 
-Aabb worldBox(const Mesh& mesh)
-{
-    Aabb box;
-    const Aabb& b = mesh.geometry->bounds;
-    for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p((corner & 1) ? b.upper.x : b.lower.x, (corner & 2) ? b.upper.y : b.lower.y,
-                           (corner & 4) ? b.upper.z : b.lower.z);
-        box.extend(glm::dvec3(mesh.objectToWorld * glm::dvec4(p, 1.0)));
-    }
-    // The transform itself rounds: widen by a few ulps of the box's size.
-    const glm::dvec3 margin = (glm::abs(box.lower) + glm::abs(box.upper)) * 1e-12;
-    box.lower -= margin;
-    box.upper += margin;
-    return box;
-}
-
 uint32_t topRef(int kind, size_t index)
 {
     if (index > gpu::TOP_REF_MAX_INDEX)
@@ -286,37 +249,30 @@ uint32_t topRef(int kind, size_t index)
     return (uint32_t(kind) << gpu::TOP_REF_INDEX_BITS) | uint32_t(index);
 }
 
+/// One kind's leaves of the top-level BVH: its bounds and TOP_REF, for a kind
+/// with bounded = 1 in the registry; nothing for the others, which the kernel
+/// tests in a loop.
+template <bool Bounded, class Record>
+void addTopLevelLeaves(const std::vector<Record>& records, int kind, std::vector<Aabb>& boxes,
+                       std::vector<uint32_t>& refs)
+{
+    if constexpr (Bounded) {
+        for (size_t i = 0; i < records.size(); ++i) {
+            boxes.push_back(boundsOf(records[i]));
+            refs.push_back(topRef(kind, i));
+        }
+    }
+}
+
 TopLevel buildTopLevel(const Scene& scene)
 {
     std::vector<Aabb> boxes;
     std::vector<uint32_t> refs;
-    for (size_t i = 0; i < scene.spheres.size(); ++i) {
-        const Sphere& s = scene.spheres[i];
-        boxes.push_back({s.center - glm::dvec3(s.radius), s.center + glm::dvec3(s.radius)});
-        refs.push_back(topRef(gpu::SHAPE_SPHERE, i));
-    }
-    for (size_t i = 0; i < scene.boxes.size(); ++i) {
-        boxes.push_back({scene.boxes[i].min, scene.boxes[i].max});
-        refs.push_back(topRef(gpu::SHAPE_BOX, i));
-    }
-    auto triangleBox = [](const std::array<glm::dvec3, 3>& v) {
-        Aabb box;
-        for (const auto& p : v) box.extend(p);
-        return box;
-    };
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
-        boxes.push_back(triangleBox(scene.triangles[i].vertices));
-        refs.push_back(topRef(gpu::SHAPE_TRIANGLE, i));
-    }
-    const std::vector<TriangleLight> lights = emittingTriangleLights(scene);
-    for (size_t i = 0; i < lights.size(); ++i) {
-        boxes.push_back(triangleBox(lights[i].vertices));
-        refs.push_back(topRef(gpu::SHAPE_KIND_COUNT + gpu::LIGHT_TRIANGLE, i));
-    }
-    for (size_t i = 0; i < scene.meshes.size(); ++i) {
-        boxes.push_back(worldBox(scene.meshes[i]));
-        refs.push_back(topRef(gpu::SHAPE_MESH, i));
-    }
+#define VKRT_ADD_LEAVES(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    addTopLevelLeaves<bounded != 0>(recordsToUpload(scene, scene.array), gpu::HIT_##Type, boxes, refs);
+    VKRT_SHAPE_KINDS(VKRT_ADD_LEAVES)
+    VKRT_LIGHT_KINDS(VKRT_ADD_LEAVES)
+#undef VKRT_ADD_LEAVES
     TopLevel top;
     top.bvh = buildBvh(boxes, BvhOptions{.maxLeafSize = 2});
     for (uint32_t slot : top.bvh.order) {
@@ -369,9 +325,39 @@ void checkBufferSize(uint64_t bytes, uint64_t maxBytes, const std::string& what,
                      "; use fewer or smaller meshes");
 }
 
+/// An emitter with its alias-table entry (choice probability, threshold, alias).
+gpu::Emitter withAliasEntry(gpu::Emitter e, const EmitterTable& table, uint32_t index)
+{
+    e.pdf = float(table.pdf[index]);
+    e.aliasThreshold = table.threshold[index];
+    e.alias = table.alias[index];
+    return e;
+}
+
+/// One kind's GPU records, in upload order (toGpu: scene/kinds/).
+template <class Record, class GpuRecord>
+void appendGpuRecords(const std::vector<Record>& records, const Relativizer& rel, std::vector<GpuRecord>& out)
+{
+    for (size_t i = 0; i < records.size(); ++i) out.push_back(toGpu(records[i], rel, uint32_t(i)));
+}
+
+/// Mesh instances need the geometry pool: convertMeshes makes their records.
+void appendGpuRecords(const std::vector<Mesh>&, const Relativizer&, std::vector<gpu::Mesh>&) {}
+
+/// The triangle lights' emitters, the first of all (toGpu gives each light its index).
+void convertTriangleLightEmitters(const Scene& scene, const GpuSceneStatic& fixed, GpuSceneData& data)
+{
+    const Relativizer rel{scene.camera.eye};
+    for (const TriangleLight& light : emittingTriangleLights(scene)) {
+        const auto index = uint32_t(data.emitters.size());
+        data.emitters.push_back(withAliasEntry(emitterOf(light, rel), fixed.emitters, index));
+    }
+}
+
+/// Mesh instances, with their emitters after those of the triangle lights.
 void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::dvec3& eye, GpuSceneData& data)
 {
-    uint32_t firstEmitter = 0;
+    auto firstEmitter = uint32_t(data.emitters.size());
     for (const Mesh& mesh : scene.meshes) {
         const MeshGeometry& g = *mesh.geometry;
         const GeometryOffsets& at = fixed.offsets.at(&g);
@@ -406,11 +392,8 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
             e.v2 = toFloat(v[2]);
             e.area = float(triangleArea(v));
             e.twoSided = mesh.twoSided ? 1u : 0u;
-            e.pdf = float(fixed.emitters.pdf[firstEmitter]);
             e.radiance = toFloat(triangleEmission(scene, mesh, slot));
-            e.aliasThreshold = fixed.emitters.threshold[firstEmitter];
-            e.alias = fixed.emitters.alias[firstEmitter];
-            data.emitters.push_back(e);
+            data.emitters.push_back(withAliasEntry(e, fixed.emitters, firstEmitter));
         }
     }
 }
@@ -431,19 +414,11 @@ void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
 
 } // namespace
 
-double triangleArea(const std::array<glm::dvec3, 3>& v)
-{
-    return 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
-}
-
 std::vector<TriangleLight> emittingTriangleLights(const Scene& scene)
 {
     std::vector<TriangleLight> lights;
-    for (const auto& l : scene.triangleLights) {
-        double area = triangleArea(l.vertices);
-        // A light whose area is zero (or rounds to zero in float) emits nothing.
-        if (area > 0.0 && float(area) > 0.0 && std::isfinite(area)) lights.push_back(l);
-    }
+    for (const auto& l : scene.triangleLights)
+        if (emits(l)) lights.push_back(l);
     return lights;
 }
 
@@ -553,6 +528,8 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     for (const Material& m : scene.materials) fixed.materialTextures.push_back(convertMaterialTextures(m));
     if (fixed.materialTextures.empty()) fixed.materialTextures.push_back(gpu::MaterialTextures{});
     fixed.textures = packTextures(scene, maxBytes);
+    fixed.emitters = emitterTableOf(scene);
+    checkBufferSize(fixed.emitters.pdf.size() * sizeof(gpu::Emitter), maxBytes, "emitters", scene);
     if (scene.meshes.empty()) return fixed;
     const FeatureSet features = featuresOf(scene);
     // The per-triangle attributes start at index 0 beside meshTriangles: drop the placeholders.
@@ -585,8 +562,6 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     const auto start = std::chrono::steady_clock::now();
     fixed.top = buildTopLevel(scene);
     fixed.topBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fixed.emitters = emitterTableOf(scene);
-    checkBufferSize(fixed.emitters.pdf.size() * sizeof(gpu::Emitter), maxBytes, "emissive triangles", scene);
     return fixed;
 }
 
@@ -599,11 +574,12 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
                                                  fixed.materialTableStart.at(i), fixed.internalReflectance.at(i),
                                                  scene.textures.get()));
     }
-#define VKRT_CONVERT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    for (const auto& record : recordsToUpload(scene, scene.array)) data.array.push_back(toGpu(record, rel));
+#define VKRT_CONVERT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    appendGpuRecords(recordsToUpload(scene, scene.array), rel, data.array);
     VKRT_SHAPE_KINDS(VKRT_CONVERT_RECORDS)
     VKRT_LIGHT_KINDS(VKRT_CONVERT_RECORDS)
 #undef VKRT_CONVERT_RECORDS
+    convertTriangleLightEmitters(scene, fixed, data);
     convertMeshes(scene, fixed, scene.camera.eye, data);
     if (fixed.top) {
         data.topNodes = refitTopLevel(*fixed.top, scene.camera.eye);
@@ -615,7 +591,7 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
     u.flags = settings.jitter ? gpu::RENDER_FLAG_JITTER : 0u;
     u.backgroundColor = toFloat(scene.background.color);
     u.maxDepth = uint32_t(scene.render.maxDepth);
-#define VKRT_COUNT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_COUNT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     u.field##Count = uint32_t(data.array.size());
     VKRT_SHAPE_KINDS(VKRT_COUNT_RECORDS)
     VKRT_LIGHT_KINDS(VKRT_COUNT_RECORDS)

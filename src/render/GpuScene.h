@@ -4,6 +4,7 @@
 // far from the world origin keeps full float precision near the camera.
 #include "accel/Bvh.h"
 #include "scene/Scene.h"
+#include "scene/kinds/Kinds.h"
 #include "shared/SceneTypes.h"
 #include "shared/TextureTypes.h"
 #include "texture/TextureAtlas.h"
@@ -22,9 +23,9 @@ struct GeometryOffsets {
     bool normals = false;
 };
 
-/// The top-level BVH over every bounded record of a scene with meshes
-/// (spheres, boxes, triangles, triangle lights, mesh instances; planes are
-/// unbounded and stay a list). Built once in world space; only its boxes
+/// The top-level BVH over the records of every kind with bounded = 1 in the
+/// registry (shared/Kinds.h), in a scene with meshes (the unbounded kinds,
+/// planes, stay a list). Built once in world space; only its boxes
 /// depend on the camera (refitted, never rebuilt, when the camera moves).
 struct TopLevel {
     Bvh bvh;
@@ -32,9 +33,10 @@ struct TopLevel {
     std::vector<Aabb> boxes;    ///< leaf slot -> world box (double)
 };
 
-/// Emissive mesh triangles chosen in proportion to power (Walker's alias method).
+/// Every emitter (triangle lights, then emissive mesh triangles) chosen in
+/// proportion to power (Walker's alias method).
 struct EmitterTable {
-    std::vector<double> pdf; ///< per emitter, in instance-then-leaf order
+    std::vector<double> pdf; ///< per emitter: triangle lights, then mesh instances' leaves in order
     std::vector<float> threshold;
     std::vector<uint32_t> alias;
     double totalPower = 0.0;
@@ -81,7 +83,8 @@ struct GpuSceneData {
     std::vector<gpu::Emitter> emitters;
     std::vector<gpu::Material> materials;
     // One array per shape and light kind (shared/Kinds.h), named as in Scene.
-#define VKRT_GPU_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) std::vector<gpu::Type> array;
+#define VKRT_GPU_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    std::vector<gpu::Type> array;
     VKRT_SHAPE_KINDS(VKRT_GPU_ARRAY_MEMBER)
     VKRT_LIGHT_KINDS(VKRT_GPU_ARRAY_MEMBER)
 #undef VKRT_GPU_ARRAY_MEMBER
@@ -104,9 +107,6 @@ std::vector<uint32_t> mediaAroundCamera(const Scene& scene);
 
 /// Triangle lights that can emit: zero-area (degenerate) ones are dropped.
 std::vector<TriangleLight> emittingTriangleLights(const Scene& scene);
-
-/// Area of a triangle, computed in double.
-double triangleArea(const std::array<glm::dvec3, 3>& v);
 
 /// Workgroup tiles covering a width x height image (or one band of it).
 uint32_t tileCountFor(uint32_t width, uint32_t height);

@@ -24,11 +24,11 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
 {
     const FeatureSet& f = v.features;
     std::vector<OptionalFeature> list;
-#define VKRT_SHAPE_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    list.push_back(                                                                \
+#define VKRT_SHAPE_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    list.push_back(                                                                         \
         {f.has(ShapeKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(ShapeKind::Type)});
-#define VKRT_LIGHT_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    list.push_back(                                                                \
+#define VKRT_LIGHT_FEATURE(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    list.push_back(                                                                         \
         {f.has(LightKind::Type), "VKRT_HAS_" #ARRAY, int(gpu::BINDING_##ARRAY), featureName(LightKind::Type)});
     VKRT_SHAPE_KINDS(VKRT_SHAPE_FEATURE)
     VKRT_LIGHT_KINDS(VKRT_LIGHT_FEATURE)
@@ -41,7 +41,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({meshes, "VKRT_HAS_TOP_NODES", int(gpu::BINDING_TOP_NODES), ""});
     list.push_back({meshes, "VKRT_HAS_TOP_REFS", int(gpu::BINDING_TOP_REFS), ""});
     list.push_back({meshes && f.meshNormals, "VKRT_HAS_MESH_NORMALS", int(gpu::BINDING_MESH_NORMALS), "mesh-normals"});
-    list.push_back({meshes && f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emissive-meshes"});
+    list.push_back({f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emitters"});
     // Textures: the texel buffer, the texture records and each material's slots;
     // meshes add their triangles' uvs, tangents for normal maps, and each
     // triangle's material when they use their file's materials.
@@ -50,8 +50,8 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({f.textures, "VKRT_HAS_MATERIAL_TEXTURES", int(gpu::BINDING_MATERIAL_TEXTURES), ""});
     list.push_back({f.textures && f.normalMaps, "VKRT_HAS_NORMAL_MAPS", -1, "normal-maps"});
     list.push_back({meshes && f.textures, "VKRT_HAS_MESH_UVS", int(gpu::BINDING_MESH_UVS), ""});
-    list.push_back({meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS),
-                    ""});
+    list.push_back(
+        {meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS), ""});
     list.push_back(
         {meshes && f.fileMaterials, "VKRT_HAS_MESH_MATERIALS", int(gpu::BINDING_MESH_MATERIALS), "file-materials"});
     // The rough plastics' coating tables come with the plastic kind.
@@ -74,7 +74,7 @@ std::string upper(std::string text)
 
 const std::vector<SceneArrayBinding>& sceneArrayBindings()
 {
-#define VKRT_ARRAY_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_ARRAY_BINDING(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     SceneArrayBinding{gpu::BINDING_##ARRAY, gpu::UNIFORM_##ARRAY},
     static const std::vector<SceneArrayBinding> bindings{SceneArrayBinding{gpu::BINDING_MATERIALS,
                                                                            gpu::UNIFORM_MATERIALS},
@@ -88,7 +88,7 @@ bool sceneFitsUniformBuffers(const Scene& scene)
 {
     // Triangle lights count before zero-area ones are dropped: an upper bound.
     bool fits = scene.materials.size() <= gpu::UNIFORM_MATERIALS;
-#define VKRT_ARRAY_FITS(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_ARRAY_FITS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     fits = fits && scene.array.size() <= gpu::UNIFORM_##ARRAY;
     VKRT_SHAPE_KINDS(VKRT_ARRAY_FITS)
     VKRT_LIGHT_KINDS(VKRT_ARRAY_FITS)
@@ -123,7 +123,7 @@ std::vector<std::pair<std::string, std::string>> KernelVariant::defines() const
 std::vector<uint32_t> KernelVariant::bindings() const
 {
     std::vector<uint32_t> result = {gpu::BINDING_UNIFORMS, gpu::BINDING_ACCUMULATION, gpu::BINDING_STATS,
-                                   gpu::BINDING_FRAME_RUN};
+                                    gpu::BINDING_FRAME_RUN};
     if (features.anyPrimitive()) result.push_back(gpu::BINDING_MATERIALS);
     for (const auto& feature : optionalFeatures(*this))
         if (feature.on && feature.binding >= 0) result.push_back(uint32_t(feature.binding));

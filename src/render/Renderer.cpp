@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <type_traits>
 
 namespace vkrt {
 
@@ -166,18 +167,36 @@ ImageBands imageBandsOf(const Scene& scene, const RenderOptions& options, uint64
     return imageBandsFor(scene.camera.width, scene.camera.height, largestBytesPerPixel(options), maxBytes, scene.path);
 }
 
+namespace {
+
+/// The light samples one shading point draws: one per record of every light
+/// kind, except that all emitters (triangle lights, emissive meshes) are one
+/// sample together (lib/lights.glsl).
+uint64_t sampledLightCount(const Scene& scene)
+{
+    uint64_t count = featuresOf(scene).emitters ? 1 : 0;
+#define VKRT_COUNT_SAMPLED(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if constexpr (!std::is_same_v<Type, TriangleLight>) count += scene.array.size();
+    VKRT_LIGHT_KINDS(VKRT_COUNT_SAMPLED)
+#undef VKRT_COUNT_SAMPLED
+    return count;
+}
+
+} // namespace
+
 uint64_t worstCaseLoopIterations(const Scene& scene)
 {
     // Per depth: one depth-loop step, a closest-hit query over every hittable
-    // (primitives and triangle lights), and per light one light-loop step plus
-    // a shadow query. Whitted shadow queries pass through glass, repeating once
+    // (primitives and triangle lights), and per point light one light-loop
+    // step plus a shadow query, and as much for the one sample of all
+    // emitters (triangle lights, emissive meshes). Whitted shadow queries pass through glass, repeating once
     // per interface crossed; the path integrator's stop at glass but its
     // paths take one more closest-hit step after the last vertex.
     uint64_t hittables = scene.primitiveCount() + emittingTriangleLights(scene).size();
     bool whitted = scene.render.integrator == Integrator::Whitted;
     bool glassShadows = whitted && featuresOf(scene).has(MaterialType::Dielectric);
     uint64_t shadowQuery = glassShadows ? gpu::MAX_SHADOW_CROSSINGS * (1 + hittables) : hittables;
-    uint64_t lights = scene.pointLights.size() + emittingTriangleLights(scene).size();
+    uint64_t lights = sampledLightCount(scene);
     uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery);
     uint64_t depth = uint64_t(scene.render.maxDepth);
     if (whitted) return depth * perDepth;
@@ -299,7 +318,7 @@ void Renderer::uploadSceneBuffers()
     m_data.uniforms.environmentSize = m_environmentSize;
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
-#define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     addBuffer(gpu::BINDING_##ARRAY, m_data.array, gpu::UNIFORM_##ARRAY);
     VKRT_SHAPE_KINDS(VKRT_UPLOAD_ARRAY)
     VKRT_LIGHT_KINDS(VKRT_UPLOAD_ARRAY)

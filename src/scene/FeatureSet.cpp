@@ -1,4 +1,5 @@
 #include "scene/FeatureSet.h"
+#include "scene/kinds/Kinds.h"
 
 #include "mesh/MeshGeometry.h"
 
@@ -12,7 +13,7 @@ std::string materialTypeName(MaterialType type) { return std::string(kindName(ty
 
 std::string featureName(ShapeKind kind)
 {
-#define VKRT_ARRAY_NAME(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_ARRAY_NAME(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     case ShapeKind::Type: return #array;
     switch (kind) {
         VKRT_SHAPE_KINDS(VKRT_ARRAY_NAME)
@@ -54,7 +55,7 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
         set.textures = set.textures || material.hasTextures();
         set.normalMaps = set.normalMaps || material.hasNormalMap();
     };
-#define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     for (const auto& shape : scene.array) markUsed(shape.material);
     VKRT_SHAPE_KINDS(VKRT_MARK_SHAPE_MATERIALS)
 #undef VKRT_MARK_SHAPE_MATERIALS
@@ -81,6 +82,7 @@ FeatureSet featuresOf(const Scene& scene)
     set.cubemap = scene.background.cubemap.has_value();
     set.environmentSampling = set.cubemap && scene.render.integrator == Integrator::Path;
     set.integrator = scene.render.integrator;
+    for (const TriangleLight& light : scene.triangleLights) set.emitters = set.emitters || emits(light);
     for (const Mesh& mesh : scene.meshes) {
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();
         set.emitters = set.emitters || meshEmits(scene, mesh);

@@ -17,7 +17,7 @@ struct FeatureSet {
     bool cubemap = false;
     bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
     bool meshNormals = false;         ///< some mesh has per-vertex shading normals
-    bool emitters = false;            ///< some mesh emits (its triangles are lights)
+    bool emitters = false;            ///< some triangle light or mesh emits (the emitters array: shared/SceneTypes.h)
     bool textures = false;            ///< some material in use has a texture
     bool normalMaps = false;          ///< ... a normal map
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)

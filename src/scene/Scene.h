@@ -268,7 +268,7 @@ struct Scene {
     Camera camera;
     std::vector<Material> materials;
     // One array per shape and light kind: spheres, boxes, ..., pointLights, triangleLights.
-#define VKRT_SCENE_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity) std::vector<Type> array;
+#define VKRT_SCENE_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) std::vector<Type> array;
     VKRT_SHAPE_KINDS(VKRT_SCENE_ARRAY_MEMBER)
     VKRT_LIGHT_KINDS(VKRT_SCENE_ARRAY_MEMBER)
 #undef VKRT_SCENE_ARRAY_MEMBER
@@ -285,7 +285,7 @@ struct Scene {
     size_t count(LightKind kind) const;
 };
 
-#define VKRT_SCENE_COUNT_CASE(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_SCENE_COUNT_CASE(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     case decltype(kind)::Type: return array.size();
 inline size_t Scene::count(ShapeKind kind) const
 {

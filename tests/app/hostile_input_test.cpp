@@ -256,17 +256,17 @@ std::string triangleLights(int count)
     return text;
 }
 
-TEST_F(HostileInput, ManyTriangleLightsGetAWarningThatNamesTheFasterWay)
+// Triangle lights are emitters in the one alias table (shared/SceneTypes.h):
+// a shading point samples one of them, whatever their number, so a scene of
+// thousands renders with neither a warning nor a loop budget to exceed.
+TEST_F(HostileInput, ThousandsOfTriangleLightsRenderWithoutAWarning)
 {
-    const std::string warning = "triangle lights: each shading point samples every one, so the Whitted integrator's "
-                                "cost grows with the square of their number";
-    const ProcessResult few = render(write("few.toml", planeScene(triangleLights(64))).string());
-    EXPECT_EQ(few.exitCode, 0) << few.output;
-    EXPECT_EQ(few.output.find("warning"), std::string::npos) << few.output;
-    const ProcessResult many = render(write("many.toml", planeScene(triangleLights(65))).string());
-    EXPECT_EQ(many.exitCode, 0) << many.output;
-    EXPECT_NE(many.output.find(":17:1: 65 " + warning), std::string::npos) << many.output;
-    EXPECT_NE(many.output.find("as a mesh with `emission`"), std::string::npos);
+    for (const char* integrator : {"whitted", "path"}) {
+        const std::string text = planeScene(triangleLights(2000), integrator);
+        const ProcessResult r = render(write(std::string(integrator) + ".toml", text).string());
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+        EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+    }
 }
 
 } // namespace

@@ -25,11 +25,11 @@ std::vector<std::pair<std::string, int64_t>> cppConstants()
     std::vector<std::pair<std::string, int64_t>> constants;
 #define VKRT_CPP_MATERIAL(KIND, Type, name, value, delta) \
     constants.emplace_back("material_" #KIND, gpu::MATERIAL_##KIND);
-#define VKRT_CPP_SHAPE(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    constants.emplace_back("shape_" #KIND, gpu::SHAPE_##KIND);                 \
+#define VKRT_CPP_SHAPE(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    constants.emplace_back("shape_" #KIND, gpu::SHAPE_##KIND);                          \
     constants.emplace_back("capacity_" #ARRAY, gpu::UNIFORM_##ARRAY);
-#define VKRT_CPP_LIGHT(KIND, Type, name, value, field, array, ARRAY, capacity) \
-    constants.emplace_back("light_" #KIND, gpu::LIGHT_##KIND);                 \
+#define VKRT_CPP_LIGHT(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    constants.emplace_back("light_" #KIND, gpu::LIGHT_##KIND);                          \
     constants.emplace_back("capacity_" #ARRAY, gpu::UNIFORM_##ARRAY);
     VKRT_MATERIAL_KINDS(VKRT_CPP_MATERIAL)
     VKRT_SHAPE_KINDS(VKRT_CPP_SHAPE)

@@ -93,11 +93,9 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(pointLights, PointLight, position),
         ARRAY_MEMBER(pointLights, PointLight, intensity),
         ARRAY_MEMBER(triangleLights, TriangleLight, v0),
-        ARRAY_MEMBER(triangleLights, TriangleLight, area),
+        ARRAY_MEMBER(triangleLights, TriangleLight, emitter),
         ARRAY_MEMBER(triangleLights, TriangleLight, v1),
-        ARRAY_MEMBER(triangleLights, TriangleLight, twoSided),
         ARRAY_MEMBER(triangleLights, TriangleLight, v2),
-        ARRAY_MEMBER(triangleLights, TriangleLight, radiance),
         ARRAY_MEMBER(accum, AccumPixel, sum),
         ARRAY_MEMBER(accum, AccumPixel, count),
         ARRAY_MEMBER(accum, AccumPixel, compensation),
@@ -151,7 +149,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     // src/gpu/SharedTypes.cpp pin. Here check the last member ends the struct.
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
     EXPECT_EQ(offsets.at("materials[0].internalReflectance") + 4, int(sizeof(gpu::Material)));
-    EXPECT_EQ(offsets.at("triangleLights[0].radiance") + 12, int(sizeof(gpu::TriangleLight)));
+    EXPECT_EQ(offsets.at("triangleLights[0].v2") + 12, int(sizeof(gpu::TriangleLight)));
     EXPECT_EQ(offsets.at("u.topNodeCount") + 4, int(sizeof(gpu::SceneUniforms)));
     EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));
     EXPECT_EQ(offsets.at("emitters[0].alias") + 4, int(sizeof(gpu::Emitter)));

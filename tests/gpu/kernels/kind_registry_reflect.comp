@@ -9,12 +9,12 @@
 #include "shared/Kinds.h"
 
 #define VKRT_PROBE_MATERIAL(KIND, Type, name, value, delta) uint material_##KIND[MATERIAL_##KIND + 1]; uint end_material_##KIND;
-#define VKRT_PROBE_SHAPE(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_PROBE_SHAPE(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     uint shape_##KIND[SHAPE_##KIND + 1];                                         \
     uint end_shape_##KIND;                                                       \
     uint capacity_##ARRAY[UNIFORM_##ARRAY + 1];                                  \
     uint end_capacity_##ARRAY;
-#define VKRT_PROBE_LIGHT(KIND, Type, name, value, field, array, ARRAY, capacity) \
+#define VKRT_PROBE_LIGHT(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     uint light_##KIND[LIGHT_##KIND + 1];                                         \
     uint end_light_##KIND;                                                       \
     uint capacity_##ARRAY[UNIFORM_##ARRAY + 1];                                  \

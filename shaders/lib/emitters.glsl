@@ -1,0 +1,85 @@
+// Emitters: every emitting triangle, whether a triangle light or a triangle
+// of an emissive mesh, in one array with one alias table (chosen in
+// proportion to power, src/render/GpuScene.cpp), one sampling routine and one
+// MIS weight (lib/path.glsl: emitterOnHit).
+#ifndef VKRT_EMITTERS_GLSL
+#define VKRT_EMITTERS_GLSL
+
+#ifdef VKRT_HAS_EMITTERS
+layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitter emitters[]; };
+
+// Unit normal of an emitter: its counter-clockwise side.
+vec3 emitterNormal(Emitter e) { return normalize(cross(e.v1 - e.v0, e.v2 - e.v0)); }
+
+// Radiance an emitter sends towards direction `towards` (from the emitter).
+vec3 emitterRadiance(Emitter e, vec3 towards)
+{
+    float facing = dot(emitterNormal(e), towards);
+    return (facing > 0.0 || (e.twoSided != 0u && facing < 0.0)) ? e.radiance : vec3(0.0);
+}
+
+// Solid-angle density of choosing emitter e (in proportion to power) and
+// then a uniform point on it, seen at squared distance distSq and |cos| cosLight.
+float emitterPdf(Emitter e, float distSq, float cosLight) { return e.pdf * distSq / (cosLight * e.area); }
+
+// Walker's alias method: slot from uSlot, then the slot or its alias by uAlias.
+uint pickEmitter(float uSlot, float uAlias)
+{
+    uint slot = min(uint(uSlot * float(u.emitterCount)), u.emitterCount - 1u);
+    return uAlias < emitters[slot].aliasThreshold ? slot : emitters[slot].alias;
+}
+
+// One emitter, chosen in proportion to power, through a uniformly sampled
+// point on it: an unbiased estimate of the direct light from every emitter,
+// MIS-weighted against BSDF sampling (path integrator).
+LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin)
+{
+    Emitter e = emitters[pickEmitter(u4.x, u4.y)];
+    vec3 point = sampleTriangle(e.v0, e.v1, e.v2, u4.zw);
+    // Aim just short of the emitter so it does not shadow itself.
+    vec3 target = mix(origin, point, 1.0 - 1.0 / 65536.0);
+    vec3 toLight = point - hit.position;
+    float distSq = dot(toLight, toLight);
+    vec3 wi = toLight * inversesqrt(distSq);
+    float cosSurface = dot(ns, wi);
+    float cosLight = abs(dot(emitterNormal(e), wi));
+    vec3 le = emitterRadiance(e, -wi);
+    if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0) || !(e.pdf > 0.0) || distSq == 0.0)
+        return LightSample(vec3(0.0), target);
+    float lightPdf = emitterPdf(e, distSq, cosLight);
+    vec3 contribution = evalBsdf(m, ns, wo, wi) * le * (cosSurface / lightPdf);
+#ifdef VKRT_INTEGRATOR_PATH
+    contribution *= powerHeuristic(lightPdf, pdfBsdf(m, ns, wo, wi));
+#endif
+    return LightSample(contribution, target);
+}
+#endif
+
+// One sample of all emitters with its shadow ray (the Whitted integrator).
+vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+{
+#ifdef VKRT_HAS_EMITTERS
+    if (u.emitterCount == 0u)
+        return vec3(0.0);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightSample s = sampleEmitters(sampleNext4D(rng), m, hit, ns, wo, origin);
+    if (s.unshadowed != vec3(0.0))
+        return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
+#endif
+    return vec3(0.0);
+}
+
+// All emitters as one more candidate of the path integrator's shadow ray: a
+// power-proportional choice of one of them (unbiased for their sum).
+void offerEmitterSample(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                        inout Sampler rng)
+{
+#ifdef VKRT_HAS_EMITTERS
+    if (u.emitterCount > 0u) {
+        vec4 u4 = sampleNext4D(rng);
+        offerLightSample(r, sampleEmitters(u4, m, hit, ns, wo, origin), sampleNext1D(rng));
+    }
+#endif
+}
+
+#endif

@@ -1,0 +1,60 @@
+// Point lights (`type = "point"`): no area, so never hit (no records to
+// intersect); each is sampled on its own, with its own shadow ray in the
+// Whitted integrator and as one candidate of the path integrator's reservoir.
+#ifndef VKRT_LIGHT_POINT_GLSL
+#define VKRT_LIGHT_POINT_GLSL
+
+#ifdef VKRT_HAS_POINT_LIGHTS
+VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
+#endif
+
+bool hitOnePointLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }
+VKRT_NO_RECORDS(PointLight)
+void describePointLight(Ray r, HitId id, inout SurfaceHit hit) {}
+
+#ifdef VKRT_HAS_POINT_LIGHTS
+// One point light: f * I * cos / d^2. Geometry from the surface point itself;
+// only the shadow ray starts at the offset origin (measuring from it would
+// bias 1/d^2 by the offset).
+LightSample samplePointLight(PointLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo)
+{
+    vec3 toLight = light.position - hit.position;
+    float distSq = dot(toLight, toLight);
+    vec3 wi = toLight * inversesqrt(distSq);
+    float cosTheta = dot(ns, wi);
+    if (cosTheta <= 0.0)
+        return LightSample(vec3(0.0), light.position);
+    vec3 f = evalBsdf(m, ns, wo, wi);
+    return LightSample(f * light.intensity * (cosTheta / distSq), light.position);
+}
+#endif
+
+// Every point light, each with its shadow ray (the Whitted integrator).
+vec3 directFromPointLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+{
+    vec3 radiance = vec3(0.0);
+#ifdef VKRT_HAS_POINT_LIGHTS
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    for (uint i = 0u; i < u.pointLightCount; ++i) {
+        ++g_loopIterations;
+        LightSample s = samplePointLight(pointLights[i], m, hit, ns, wo);
+        if (s.unshadowed != vec3(0.0))
+            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
+    }
+#endif
+    return radiance;
+}
+
+// Every point light as a candidate of the path integrator's one shadow ray.
+void offerPointLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                            inout Sampler rng)
+{
+#ifdef VKRT_HAS_POINT_LIGHTS
+    for (uint i = 0u; i < u.pointLightCount; ++i) {
+        ++g_loopIterations;
+        offerLightSample(r, samplePointLight(pointLights[i], m, hit, ns, wo), sampleNext1D(rng));
+    }
+#endif
+}
+
+#endif

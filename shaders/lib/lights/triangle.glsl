@@ -1,0 +1,55 @@
+// Triangle lights (`type = "triangle"`): black, opaque, emitting triangles.
+// A record holds only the geometry rays are tested against; what it emits is
+// its Emitter (lib/emitters.glsl), in the one alias table with the emissive
+// mesh triangles, so sampling and MIS are those of every emitter.
+#ifndef VKRT_LIGHT_TRIANGLE_GLSL
+#define VKRT_LIGHT_TRIANGLE_GLSL
+
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+VKRT_SCENE_ARRAY(BINDING_TRIANGLE_LIGHTS, TriangleLightBlock, TriangleLight, triangleLights, UNIFORM_TRIANGLE_LIGHTS)
+#endif
+
+bool hitOneTriangleLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)
+{
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    float t;
+    vec3 bary;
+    TriangleLight light = triangleLights[i];
+    if (intersectTriangle(light.v0, light.v1, light.v2, r, tr, tMax, t, bary)) {
+        hit = HitId(HIT_TriangleLight, i, t, bary, true, 0u);
+        return true;
+    }
+#endif
+    return false;
+}
+
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+VKRT_RECORD_LOOPS(TriangleLight, u.triangleLightCount)
+#else
+VKRT_NO_RECORDS(TriangleLight)
+#endif
+
+void describeTriangleLight(Ray r, HitId id, inout SurfaceHit hit)
+{
+#ifdef VKRT_HAS_TRIANGLE_LIGHTS
+    // Its counter-clockwise side, as its Emitter's (emitterNormal).
+    TriangleLight light = triangleLights[id.index];
+    hit.normal = normalize(cross(light.v1 - light.v0, light.v2 - light.v0));
+    hit.front = dot(hit.normal, r.dir) < 0.0;
+    hit.emitter = light.emitter;
+#endif
+}
+
+// Sampled with every emitter (lib/emitters.glsl), not on their own.
+vec3 directFromTriangleLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
+                             inout Sampler rng)
+{
+    return vec3(0.0);
+}
+
+void offerTriangleLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                               inout Sampler rng)
+{
+}
+
+#endif
