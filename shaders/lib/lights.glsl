@@ -132,6 +132,7 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 // leaves from, for offsets) and the shading normal ns on the same side (for
 // the BSDF and its cosine); ns == n except on meshes with vertex normals.
 #include "emitters.glsl"
+#define VKRT_LIGHT_SAMPLING
 #include "lights/point.glsl"
 #include "lights/triangle.glsl"
 

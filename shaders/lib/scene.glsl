@@ -3,9 +3,9 @@
 // rays. Integrators and light sampling call only these two, so an
 // acceleration structure can replace the per-kind loops behind them.
 // Each kind's file supplies the functions lib/surface.glsl lists; everything
-// here is expanded from the registry, so a kind is added there and in its
-// own files (shapes: included below; lights: by lib/lights.glsl, which also
-// holds their sampling, declared here first).
+// here is expanded from the registry, so a kind is added there, in its own
+// files and in the includes below (a light kind's file is included again by
+// lib/lights.glsl for its sampling).
 #ifndef VKRT_SCENE_GLSL
 #define VKRT_SCENE_GLSL
 
@@ -15,13 +15,8 @@
 #include "shapes/triangle.glsl"
 #include "shapes/plane.glsl"
 #include "shapes/mesh.glsl"
-
-#define VKRT_DECLARE_HIT_FUNCTIONS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
-    bool hitOne##Type(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit);   \
-    void closest##Type(Ray r, TriangleRay tr, inout HitId best);                                   \
-    bool anyHit##Type(Ray r, TriangleRay tr, float tMax);                                          \
-    void describe##Type(Ray r, HitId id, inout SurfaceHit hit);
-VKRT_LIGHT_KINDS(VKRT_DECLARE_HIT_FUNCTIONS)
+#include "lights/point.glsl"
+#include "lights/triangle.glsl"
 
 #define VKRT_CLOSEST_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     closest##Type(r, tr, best);

@@ -203,7 +203,7 @@ TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
 TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
 {
     std::vector<ManifestCase> cases = {shipped("seed/baseline", 16, "width = 96\nheight = 72"),
-                                       shipped("extreme/kappa-shadow", 32), shipped("extreme/degenerate-lights", 32),
+                                       shipped("extreme/kappa-shadow", 32), shipped("seed/area-light", 16, "width = 96\nheight = 72"),
                                        shipped("extreme/ior-huge", 32)};
     fs::path suite = writeManifest(cases, "alpha = 0.01");
     constexpr int kRuns = 10;
@@ -339,8 +339,8 @@ TEST_F(RegressCli, UpdateMakesReferencesTheSuiteAccepts)
     ManifestCase made = shipped("extreme/kappa-shadow", 16, "width = 32\nheight = 24");
     made.reference = m_dir / "made";
     made.referenceSpp = 256;
-    ManifestCase mitsuba = shipped("extreme/degenerate-lights", 16);
-    mitsuba.reference = copyReference("extreme/degenerate-lights");
+    ManifestCase mitsuba = shipped("extreme/tir", 16);
+    mitsuba.reference = copyReference("extreme/tir");
     mitsuba.source = "mitsuba";
     std::string before = readFile(mitsuba.reference / "mean.exr");
     fs::path suite = writeManifest({made, mitsuba});

@@ -1119,7 +1119,14 @@ TEST_F(ExtremeLights, ZeroAreaAndEdgeOnLightsChangeNothing)
         EXPECT_EQ(nonFinite(a.mean), 0u) << name;
         EXPECT_EQ(a.mean.rgb, b.mean.rgb) << name << ": the zero-area light must not change a bit";
         reportSameSeed(a.mean, b.mean, std::string(name) + ": with vs without the zero-area light");
-        expectSameImage(a, render(reference, {128, 2}),
+        // The edge-on light (in the floor's plane, radiance 50) holds about 99 %
+        // of the emitters' power, so the one alias table gives the proper light
+        // about 1 % of the light samples: the expectation is unchanged, the
+        // variance far larger. Compared where enough samples reach it: a
+        // quarter of the image in each direction, 64 times the samples.
+        Scene smallFull = full, smallReference = reference;
+        for (Scene* s : {&smallFull, &smallReference}) s->camera.width = 16, s->camera.height = 12;
+        expectSameImage(render(smallFull, {8192, 1}), render(smallReference, {2048, 2}),
                         std::string(name) + ": with the zero-area, edge-on and float-collapsed lights vs without");
     }
 }

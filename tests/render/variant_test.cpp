@@ -186,7 +186,7 @@ radiance = 1
     EXPECT_FALSE(f.has(MaterialType::Dielectric)) << "an unused material must not pull in its code";
     KernelVariant v{f};
     v.uniformScene = sceneFitsUniformBuffers(scene);
-    EXPECT_EQ(v.describe(), "whitted; triangles triangle-lights; glossy; uniform-scene");
+    EXPECT_EQ(v.describe(), "whitted; triangles triangle-lights emitters; glossy; uniform-scene");
     EXPECT_TRUE(v.uniformScene) << "a small scene's arrays fit uniform buffers";
     EXPECT_TRUE(v.isUniformBinding(gpu::BINDING_TRIANGLES));
     EXPECT_TRUE(v.isUniformBinding(gpu::BINDING_MATERIALS));

@@ -1,8 +1,10 @@
 // Point lights (`type = "point"`): no area, so never hit (no records to
 // intersect); each is sampled on its own, with its own shadow ray in the
 // Whitted integrator and as one candidate of the path integrator's reservoir.
-#ifndef VKRT_LIGHT_POINT_GLSL
-#define VKRT_LIGHT_POINT_GLSL
+// Included twice: by lib/scene.glsl for what rays hit, and by lib/lights.glsl
+// (VKRT_LIGHT_SAMPLING) for the sampling, which needs the BSDFs and media.
+#ifndef VKRT_LIGHT_POINT_HITS
+#define VKRT_LIGHT_POINT_HITS
 
 #ifdef VKRT_HAS_POINT_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
@@ -11,6 +13,11 @@ VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights,
 bool hitOnePointLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }
 VKRT_NO_RECORDS(PointLight)
 void describePointLight(Ray r, HitId id, inout SurfaceHit hit) {}
+
+#endif
+
+#if defined(VKRT_LIGHT_SAMPLING) && !defined(VKRT_LIGHT_POINT_SAMPLING)
+#define VKRT_LIGHT_POINT_SAMPLING
 
 #ifdef VKRT_HAS_POINT_LIGHTS
 // One point light: f * I * cos / d^2. Geometry from the surface point itself;

@@ -2,8 +2,10 @@
 // A record holds only the geometry rays are tested against; what it emits is
 // its Emitter (lib/emitters.glsl), in the one alias table with the emissive
 // mesh triangles, so sampling and MIS are those of every emitter.
-#ifndef VKRT_LIGHT_TRIANGLE_GLSL
-#define VKRT_LIGHT_TRIANGLE_GLSL
+// Included twice: by lib/scene.glsl for what rays hit, and by lib/lights.glsl
+// (VKRT_LIGHT_SAMPLING) for the sampling, which needs the BSDFs and media.
+#ifndef VKRT_LIGHT_TRIANGLE_HITS
+#define VKRT_LIGHT_TRIANGLE_HITS
 
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_TRIANGLE_LIGHTS, TriangleLightBlock, TriangleLight, triangleLights, UNIFORM_TRIANGLE_LIGHTS)
@@ -39,6 +41,11 @@ void describeTriangleLight(Ray r, HitId id, inout SurfaceHit hit)
     hit.emitter = light.emitter;
 #endif
 }
+
+#endif
+
+#if defined(VKRT_LIGHT_SAMPLING) && !defined(VKRT_LIGHT_TRIANGLE_SAMPLING)
+#define VKRT_LIGHT_TRIANGLE_SAMPLING
 
 // Sampled with every emitter (lib/emitters.glsl), not on their own.
 vec3 directFromTriangleLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,

@@ -27,6 +27,8 @@ Sphere spheres[1];
 Box boxes[1];
 Triangle triangles[1];
 Plane planes[1];
+// The probe's records are the globals above: the kinds' buffer declarations are left out.
+#define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity)
 #include "lib/scene.glsl"
 
 void main()
