@@ -34,4 +34,49 @@ bool entersBox(vec3 lower, vec3 upper, BvhRay r, float tMax, out float tEntry)
     return tEntry <= tExit;
 }
 
+// The stack walk of both trees, the top level (lib/scene.glsl: traverseTop)
+// and each mesh's (lib/shapes/mesh.glsl: traverseMesh), written once: a
+// walker declares VKRT_BVH_WALK_STATE, and for each node it visits either
+// handles a leaf or calls VKRT_BVH_DESCEND on its two children, then
+// VKRT_BVH_POP_UNLESS(descend, limit) takes the next node from the stack
+// (near child first; nodes entered beyond `limit` are skipped).
+#define VKRT_BVH_WALK_STATE                \
+    uint stackNode[BVH_STACK_SIZE];        \
+    float stackEntry[BVH_STACK_SIZE];      \
+    uint depth = 0u;                       \
+    uint node = 0u;                        \
+    float tEntry;
+
+#define VKRT_BVH_DESCEND(a, b, first, br, limit, descend)           \
+    {                                                              \
+        float ta, tb;                                              \
+        bool ha = entersBox(a.lower, a.upper, br, limit, ta);      \
+        bool hb = entersBox(b.lower, b.upper, br, limit, tb);      \
+        if (ha && hb) {                                            \
+            bool aFirst = ta <= tb;                                \
+            stackNode[depth] = aFirst ? first + 1u : first;        \
+            stackEntry[depth] = aFirst ? tb : ta;                  \
+            ++depth;                                               \
+            node = aFirst ? first : first + 1u;                    \
+            descend = true;                                        \
+        } else if (ha || hb) {                                     \
+            node = ha ? first : first + 1u;                        \
+            descend = true;                                        \
+        }                                                          \
+    }
+
+#define VKRT_BVH_POP_UNLESS(descend, limit)             \
+    if (!descend) {                                     \
+        visiting = false;                               \
+        while (depth > 0u) {                            \
+            ++g_loopIterations;                         \
+            --depth;                                    \
+            if (stackEntry[depth] <= (limit)) {         \
+                node = stackNode[depth];                \
+                visiting = true;                        \
+                break;                                  \
+            }                                           \
+        }                                               \
+    }
+
 #endif

@@ -70,11 +70,7 @@ bool anyHitRecord(Ray r, TriangleRay tr, uint ref, float tMax)
 bool traverseTop(Ray r, TriangleRay tr, bool anyHit, float tMax, inout HitId best)
 {
     BvhRay br = bvhRaySetup(r);
-    uint stackNode[BVH_STACK_SIZE];
-    float stackEntry[BVH_STACK_SIZE];
-    uint depth = 0u;
-    uint node = 0u;
-    float tEntry;
+    VKRT_BVH_WALK_STATE
     BvhNode root = topNodes[0];
     bool visiting = entersBox(root.lower, root.upper, br, anyHit ? tMax : best.t, tEntry);
     while (visiting) {
@@ -96,33 +92,9 @@ bool traverseTop(Ray r, TriangleRay tr, bool anyHit, float tMax, inout HitId bes
             float limit = anyHit ? tMax : best.t;
             BvhNode a = topNodes[n.first];
             BvhNode b = topNodes[n.first + 1u];
-            float ta, tb;
-            bool ha = entersBox(a.lower, a.upper, br, limit, ta);
-            bool hb = entersBox(b.lower, b.upper, br, limit, tb);
-            if (ha && hb) {
-                bool aFirst = ta <= tb;
-                stackNode[depth] = aFirst ? n.first + 1u : n.first;
-                stackEntry[depth] = aFirst ? tb : ta;
-                ++depth;
-                node = aFirst ? n.first : n.first + 1u;
-                descend = true;
-            } else if (ha || hb) {
-                node = ha ? n.first : n.first + 1u;
-                descend = true;
-            }
+            VKRT_BVH_DESCEND(a, b, n.first, br, limit, descend)
         }
-        if (!descend) {
-            visiting = false;
-            while (depth > 0u) {
-                ++g_loopIterations;
-                --depth;
-                if (stackEntry[depth] <= (anyHit ? tMax : best.t)) {
-                    node = stackNode[depth];
-                    visiting = true;
-                    break;
-                }
-            }
-        }
+        VKRT_BVH_POP_UNLESS(descend, anyHit ? tMax : best.t)
     }
     return false;
 }

@@ -44,11 +44,7 @@ bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId
     Ray r = rayToObject(mesh, worldRay);
     TriangleRay tr = triangleRaySetup(r);
     BvhRay br = bvhRaySetup(r);
-    uint stackNode[BVH_STACK_SIZE];
-    float stackEntry[BVH_STACK_SIZE];
-    uint depth = 0u;
-    uint node = 0u; // relative to mesh.root
-    float tEntry;
+    VKRT_BVH_WALK_STATE // node: relative to mesh.root
     BvhNode root = meshNodes[mesh.root];
     bool visiting = entersBox(root.lower, root.upper, br, anyHit ? tMax : best.t, tEntry);
     bool found = false;
@@ -75,33 +71,9 @@ bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId
         } else {
             BvhNode a = meshNodes[mesh.root + n.first];
             BvhNode b = meshNodes[mesh.root + n.first + 1u];
-            float ta, tb;
-            bool ha = entersBox(a.lower, a.upper, br, limit, ta);
-            bool hb = entersBox(b.lower, b.upper, br, limit, tb);
-            if (ha && hb) {
-                bool aFirst = ta <= tb;
-                stackNode[depth] = aFirst ? n.first + 1u : n.first;
-                stackEntry[depth] = aFirst ? tb : ta;
-                ++depth;
-                node = aFirst ? n.first : n.first + 1u;
-                descend = true;
-            } else if (ha || hb) {
-                node = ha ? n.first : n.first + 1u;
-                descend = true;
-            }
+            VKRT_BVH_DESCEND(a, b, n.first, br, limit, descend)
         }
-        if (!descend) {
-            visiting = false;
-            while (depth > 0u) {
-                ++g_loopIterations;
-                --depth;
-                if (stackEntry[depth] <= (anyHit ? tMax : best.t)) {
-                    node = stackNode[depth];
-                    visiting = true;
-                    break;
-                }
-            }
-        }
+        VKRT_BVH_POP_UNLESS(descend, anyHit ? tMax : best.t)
     }
     return found;
 }
