@@ -822,6 +822,12 @@ TEST_F(ExtremeNestedGlass, CoincidentSpheresActAsOne)
 TEST_F(ExtremeNestedGlass, IndexMatchedInnerSphereIsInvisible)
 {
     Scene single = loadExtreme("nested-glass.toml");
+    // The inner sphere's two interfaces are two more path vertices: at the
+    // scene's max_depth of 10 the nested image loses the paths they push past
+    // it (pooled z +3.1 and +4.3 for seed pairs 5/6 and 7/8, before and after
+    // the emitters became one table). At 24 that loss is below the noise
+    // (pooled z -2.96 ... +1.96 over five seed pairs).
+    single.render.maxDepth = 24;
     Scene nested = single;
     nested.spheres.push_back({single.spheres[0].center, 0.4, materialIndex(single, "matched")});
     Render a = render(single, {256, 1}), b = render(nested, {256, 2});
