@@ -1,8 +1,11 @@
 // `vkrt info SCENE`: what the scene needs (its FeatureSet), the kernel
 // variant that was built for it, and how long it took to get a first frame.
+// `--json` writes the same facts as one JSON object (docs/machine-output.md).
 #include "app/Commands.h"
+#include "app/JsonOutput.h"
 #include "mesh/MeshGeometry.h"
 #include "render/RenderSession.h"
+#include "scene/FeatureSet.h"
 #include "texture/TextureAtlas.h"
 
 #include <CLI/CLI.hpp>
@@ -20,6 +23,7 @@ struct InfoOptions {
     std::string scenePath;
     std::string device;
     bool uber = false;
+    std::string json; ///< --json FILE, or "-" for standard output
 };
 
 double secondsSince(std::chrono::steady_clock::time_point start)
@@ -27,48 +31,258 @@ double secondsSince(std::chrono::steady_clock::time_point start)
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// Instances, geometries, triangles, BVH nodes, build times and GPU memory of the meshes.
-void printMeshes(const Scene& scene, const GpuSceneStatic& meshData, double parseSeconds)
+/// How long each step took (seconds).
+struct InfoTimes {
+    double parse = 0.0;
+    double setup = 0.0;      ///< compile or load, pipeline, buffers
+    double firstFrame = 0.0; ///< from set-up's start to the first finished frame
+};
+
+// ---------------------------------------------------------------- counts
+
+/// Records of each shape, light and material kind, by the scene file's names.
+struct KindCounts {
+    std::vector<std::pair<std::string, size_t>> shapes, lights, materials;
+};
+
+KindCounts kindCounts(const Scene& scene)
 {
-    std::set<const MeshGeometry*> geometries;
-    double loadSeconds = 0, buildSeconds = 0;
-    uint64_t uniqueTriangles = 0;
-    uint32_t deepest = 0;
-    for (const Mesh& mesh : scene.meshes) {
-        if (!geometries.insert(mesh.geometry.get()).second) continue;
-        loadSeconds += mesh.geometry->loadSeconds;
-        buildSeconds += mesh.geometry->bvh.buildSeconds;
-        uniqueTriangles += mesh.geometry->data.triangles.size();
-        deepest = std::max(deepest, mesh.geometry->bvh.depth);
+    KindCounts counts;
+    for (ShapeKind kind : kAllShapeKinds) counts.shapes.emplace_back(kindName(kind), scene.count(kind));
+    for (LightKind kind : kAllLightKinds) counts.lights.emplace_back(kindName(kind), scene.count(kind));
+    for (MaterialType type : kAllMaterialTypes) {
+        size_t n = 0;
+        for (const Material& material : scene.materials) n += material.type == type;
+        counts.materials.emplace_back(kindName(type), n);
     }
-    const size_t topNodes = meshData.top ? meshData.top->bvh.nodes.size() : 0;
-    const double bytes = double(meshData.meshNodes.size() * sizeof(gpu::BvhNode) +
-                                meshData.meshTriangles.size() * sizeof(gpu::MeshTriangle) +
-                                meshData.meshNormals.size() * sizeof(gpu::MeshNormals) +
-                                emissiveTriangleCount(scene) * sizeof(gpu::Emitter) + topNodes * sizeof(gpu::BvhNode));
-    std::printf("meshes:         %zu instances of %zu files; %llu triangles (%llu rendered), %llu emissive\n",
-                scene.meshes.size(), geometries.size(), static_cast<unsigned long long>(uniqueTriangles),
-                static_cast<unsigned long long>(meshTriangleCount(scene)),
-                static_cast<unsigned long long>(emissiveTriangleCount(scene)));
-    std::printf("bvh:            %zu mesh nodes (deepest %u levels), %zu top-level nodes over %zu records\n",
-                meshData.meshNodes.size(), deepest, topNodes, meshData.top ? meshData.top->refs.size() : 0);
-    std::printf("mesh times:     load %.3f s, BVH build %.3f s (+ top level %.4f s); whole parse %.3f s\n",
-                loadSeconds, buildSeconds, meshData.topBuildSeconds, parseSeconds);
-    std::printf("mesh memory:    %.1f MiB on the GPU\n", bytes / (1024.0 * 1024.0));
+    return counts;
 }
 
-/// Distinct images, records (image and wrap modes) and texel memory.
-void printTextures(const TextureAtlas& textures)
+/// "sphere 3, plane 1", the kinds present only ("none" without any).
+std::string describeCounts(const std::vector<std::pair<std::string, size_t>>& counts)
 {
-    std::printf("textures:       %zu images, %zu records, %.1f MiB of texels (all mip levels)\n",
-                textures.imageCount(), textures.recordCount(), double(textures.texelBytes()) / (1024.0 * 1024.0));
+    std::string text;
+    for (const auto& [name, n] : counts)
+        if (n) text += (text.empty() ? "" : ", ") + name + " " + std::to_string(n);
+    return text.empty() ? "none" : text;
+}
+
+JsonObject countsJson(const std::vector<std::pair<std::string, size_t>>& counts)
+{
+    JsonObject json = JsonObject::object();
+    for (const auto& [name, n] : counts) json[name] = n;
+    return json;
+}
+
+// ---------------------------------------------------------------- meshes
+
+/// Instances, geometries, triangles, BVH nodes, build times and GPU memory of the meshes.
+struct MeshFacts {
+    size_t instances = 0, geometries = 0;
+    uint64_t triangles = 0; ///< of the distinct geometries
+    uint64_t renderedTriangles = 0, emissiveTriangles = 0;
+    size_t meshNodes = 0;
+    uint32_t deepest = 0;
+    size_t topNodes = 0, topRecords = 0;
+    double loadSeconds = 0.0, buildSeconds = 0.0, topBuildSeconds = 0.0;
+    uint64_t gpuBytes = 0;
+};
+
+MeshFacts meshFacts(const Scene& scene, const GpuSceneStatic& meshData)
+{
+    MeshFacts facts;
+    std::set<const MeshGeometry*> geometries;
+    for (const Mesh& mesh : scene.meshes) {
+        if (!geometries.insert(mesh.geometry.get()).second) continue;
+        facts.loadSeconds += mesh.geometry->loadSeconds;
+        facts.buildSeconds += mesh.geometry->bvh.buildSeconds;
+        facts.triangles += mesh.geometry->data.triangles.size();
+        facts.deepest = std::max(facts.deepest, mesh.geometry->bvh.depth);
+    }
+    facts.instances = scene.meshes.size();
+    facts.geometries = geometries.size();
+    facts.renderedTriangles = meshTriangleCount(scene);
+    facts.emissiveTriangles = emissiveTriangleCount(scene);
+    facts.meshNodes = meshData.meshNodes.size();
+    facts.topNodes = meshData.top ? meshData.top->bvh.nodes.size() : 0;
+    facts.topRecords = meshData.top ? meshData.top->refs.size() : 0;
+    facts.topBuildSeconds = meshData.topBuildSeconds;
+    facts.gpuBytes = meshData.meshNodes.size() * sizeof(gpu::BvhNode) +
+                     meshData.meshTriangles.size() * sizeof(gpu::MeshTriangle) +
+                     meshData.meshNormals.size() * sizeof(gpu::MeshNormals) +
+                     facts.emissiveTriangles * sizeof(gpu::Emitter) + facts.topNodes * sizeof(gpu::BvhNode);
+    return facts;
+}
+
+void printMeshes(std::FILE* out, const MeshFacts& facts, double parseSeconds)
+{
+    std::fprintf(out, "meshes:         %zu instances of %zu files; %llu triangles (%llu rendered), %llu emissive\n",
+                 facts.instances, facts.geometries, static_cast<unsigned long long>(facts.triangles),
+                 static_cast<unsigned long long>(facts.renderedTriangles),
+                 static_cast<unsigned long long>(facts.emissiveTriangles));
+    std::fprintf(out, "bvh:            %zu mesh nodes (deepest %u levels), %zu top-level nodes over %zu records\n",
+                 facts.meshNodes, facts.deepest, facts.topNodes, facts.topRecords);
+    std::fprintf(out, "mesh times:     load %.3f s, BVH build %.3f s (+ top level %.4f s); whole parse %.3f s\n",
+                 facts.loadSeconds, facts.buildSeconds, facts.topBuildSeconds, parseSeconds);
+    std::fprintf(out, "mesh memory:    %.1f MiB on the GPU\n", double(facts.gpuBytes) / (1024.0 * 1024.0));
+}
+
+JsonObject meshJson(const MeshFacts& facts)
+{
+    return {{"instances", facts.instances},
+            {"geometries", facts.geometries},
+            {"triangles", facts.triangles},
+            {"renderedTriangles", facts.renderedTriangles},
+            {"emissiveTriangles", facts.emissiveTriangles},
+            {"bvhNodes", facts.meshNodes},
+            {"bvhDepth", facts.deepest},
+            {"topLevelNodes", facts.topNodes},
+            {"topLevelRecords", facts.topRecords},
+            {"loadSeconds", facts.loadSeconds},
+            {"buildSeconds", facts.buildSeconds},
+            {"topLevelBuildSeconds", facts.topBuildSeconds},
+            {"gpuBytes", facts.gpuBytes}};
+}
+
+// ---------------------------------------------------------------- textures
+
+/// Distinct images, records (image and wrap modes) and texel memory.
+void printTextures(std::FILE* out, const TextureAtlas& textures)
+{
+    std::fprintf(out, "textures:       %zu images, %zu records, %.1f MiB of texels (all mip levels)\n",
+                 textures.imageCount(), textures.recordCount(), double(textures.texelBytes()) / (1024.0 * 1024.0));
+}
+
+JsonObject texturesJson(const TextureAtlas& textures)
+{
+    return {{"images", textures.imageCount()},
+            {"records", textures.recordCount()},
+            {"texelBytes", textures.texelBytes()}};
+}
+
+// ---------------------------------------------------------------- the whole report
+
+/// The worst-case loop passes of one invocation; none for meshes (BVH traversal has no static bound).
+std::optional<uint64_t> staticLoopBound(const Scene& scene)
+{
+    if (!scene.meshes.empty()) return std::nullopt;
+    return worstCaseLoopIterations(scene);
+}
+
+void printLoopPasses(std::FILE* out, const Scene& scene, const LoopCap& cap)
+{
+    if (const std::optional<uint64_t> bound = staticLoopBound(scene))
+        std::fprintf(out, "loop passes:    worst case %llu per invocation%s\n", static_cast<unsigned long long>(*bound),
+                     cap.capped() ? (" of " + std::to_string(*cap.budget)).c_str() : "");
+    else
+        std::fprintf(out, "loop passes:    no static bound (BVH traversal)%s\n",
+                     cap.capped() ? "; each subgroup's count is checked against the cap as it renders" : "");
+}
+
+void printInfo(std::FILE* out, const RenderSession& session, const InfoOptions& options, const InfoTimes& times)
+{
+    const Scene& scene = session.scene();
+    const KernelVariant& features = session.renderer().variant();
+    const CompiledKernel& kernel = session.renderer().kernel();
+    const KindCounts counts = kindCounts(scene);
+    std::fprintf(out, "scene:          %s (%ux%u)\n", scene.path.c_str(), scene.camera.width, scene.camera.height);
+    std::fprintf(out, "features:       %s\n", features.describe().c_str());
+    std::fprintf(out, "objects:        %s; lights: %s; materials: %s\n", describeCounts(counts.shapes).c_str(),
+                 describeCounts(counts.lights).c_str(), describeCounts(counts.materials).c_str());
+    std::fprintf(out, "variant:        %s%s\n", kernel.cacheKey.c_str(), options.uber ? " (uber)" : "");
+    std::fprintf(out, "defines:        %s\n", describeDefines(features.defines()).c_str());
+    std::fprintf(out, "bindings:       %zu\n", features.bindings().size());
+    std::fprintf(out, "spirv bytes:    %zu\n", kernel.spirv.size() * sizeof(uint32_t));
+    std::fprintf(out, "glslang:        %s\n",
+                 kernel.fromCache ? "cache hit (0 s)" : (std::to_string(kernel.compileSeconds) + " s").c_str());
+    std::fprintf(out, "spirv cache:    %s\n", session.renderOptions().cacheDirectory.c_str());
+    std::fprintf(out, "set-up:         %.3f s (parse excluded: compile or load, pipeline, buffers)\n", times.setup);
+    std::fprintf(out, "first frame:    %.3f s after set-up began (includes the driver's shader compile)\n",
+                 times.firstFrame);
+    std::fprintf(out, "loop cap:       %s\n", session.context().loopCap().describe().c_str());
+    printLoopPasses(out, scene, session.context().loopCap());
+    if (!scene.meshes.empty()) printMeshes(out, meshFacts(scene, session.renderer().meshData()), times.parse);
+    if (scene.textures) printTextures(out, *scene.textures);
+    std::fprintf(out, "device:         %s\n", session.context().deviceInfo().name.c_str());
+}
+
+/// What the kernel was built for: the scene's kinds (every kind with --uber) and other features.
+JsonObject featuresJson(const KernelVariant& variant)
+{
+    const FeatureSet& features = variant.features;
+    JsonObject shapes = JsonObject::array(), lights = JsonObject::array(), materials = JsonObject::array();
+    for (ShapeKind kind : kAllShapeKinds)
+        if (features.has(kind)) shapes.push_back(kindName(kind));
+    for (LightKind kind : kAllLightKinds)
+        if (features.has(kind)) lights.push_back(kindName(kind));
+    for (MaterialType type : kAllMaterialTypes)
+        if (features.has(type)) materials.push_back(kindName(type));
+    return {{"description", variant.describe()},
+            {"integrator", integratorName(features.integrator)},
+            {"shapes", shapes},
+            {"lights", lights},
+            {"materials", materials},
+            {"cubemap", features.cubemap},
+            {"environmentSampling", features.environmentSampling},
+            {"meshNormals", features.meshNormals},
+            {"emitters", features.emitters},
+            {"textures", features.textures},
+            {"normalMaps", features.normalMaps},
+            {"fileMaterials", features.fileMaterials}};
+}
+
+JsonObject kernelJson(const RenderSession& session, const InfoOptions& options)
+{
+    const KernelVariant& variant = session.renderer().variant();
+    const CompiledKernel& kernel = session.renderer().kernel();
+    JsonObject defines = JsonObject::object();
+    for (const auto& [name, value] : variant.defines()) defines[name] = value;
+    return {{"cacheKey", kernel.cacheKey},
+            {"uber", options.uber},
+            {"defines", defines},
+            {"bindings", variant.bindings().size()},
+            {"spirvBytes", kernel.spirv.size() * sizeof(uint32_t)},
+            {"fromCache", kernel.fromCache},
+            {"compileSeconds", kernel.compileSeconds},
+            {"cacheDirectory", session.renderOptions().cacheDirectory.string()}};
+}
+
+JsonObject infoJson(const RenderSession& session, const InfoOptions& options, const InfoTimes& times)
+{
+    const Scene& scene = session.scene();
+    const LoopCap& cap = session.context().loopCap();
+    const KindCounts counts = kindCounts(scene);
+    JsonObject json = jsonDocument("info");
+    json["scene"] = scene.path;
+    json["width"] = scene.camera.width;
+    json["height"] = scene.camera.height;
+    json["device"] = {{"name", session.context().deviceInfo().name}, {"driver", session.context().deviceInfo().driver}};
+    json["integrator"] = integratorName(scene.render.integrator);
+    json["features"] = featuresJson(session.renderer().variant());
+    json["counts"] = {{"shapes", countsJson(counts.shapes)},
+                      {"lights", countsJson(counts.lights)},
+                      {"materials", countsJson(counts.materials)}};
+    json["kernel"] = kernelJson(session, options);
+    json["parseSeconds"] = times.parse;
+    json["setupSeconds"] = times.setup;
+    json["firstFrameSeconds"] = times.firstFrame;
+    json["loopCap"] = {{"capped", cap.capped()}, {"budget", valueOrNull(cap.budget)}, {"description", cap.describe()}};
+    json["loopPassesWorstCase"] = valueOrNull(staticLoopBound(scene));
+    json["meshes"] =
+        scene.meshes.empty() ? JsonObject(nullptr) : meshJson(meshFacts(scene, session.renderer().meshData()));
+    json["textures"] = scene.textures ? texturesJson(*scene.textures) : JsonObject(nullptr);
+    return json;
 }
 
 int runInfo(const InfoOptions& options)
 {
+    // --json must not replace the scene, nor fail to be written after the work.
+    checkOutputs({{"the scene file", options.scenePath}}, {jsonOutputFile(options.json)});
+    InfoTimes times;
     const auto parseStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(options.scenePath);
-    const double parseSeconds = secondsSince(parseStart);
+    times.parse = secondsSince(parseStart);
+    refuseOverlappingFiles(filesTheSceneRead(scene), {jsonOutputFile(options.json)});
     VulkanContext context({options.device, false});
     SessionConfig config;
     config.uber = options.uber;
@@ -76,38 +290,14 @@ int runInfo(const InfoOptions& options)
     // The variant info has always described: independent samples, no variance.
     config.sampler = SamplerChoice::Independent;
     auto start = std::chrono::steady_clock::now();
-    RenderSession session(context, scene, config);
-    double setupSeconds = secondsSince(start);
+    RenderSession session(context, std::move(scene), config);
+    times.setup = secondsSince(start);
     session.renderFrames(1);
-    double firstFrameSeconds = secondsSince(start);
+    times.firstFrame = secondsSince(start);
 
-    const KernelVariant& features = session.renderer().variant();
-    const CompiledKernel& kernel = session.renderer().kernel();
-    const RenderOptions& renderOptions = session.renderOptions();
-    std::printf("scene:          %s (%ux%u)\n", scene.path.c_str(), scene.camera.width, scene.camera.height);
-    std::printf("features:       %s\n", features.describe().c_str());
-    std::printf("variant:        %s%s\n", kernel.cacheKey.c_str(), options.uber ? " (uber)" : "");
-    std::printf("defines:        %s\n", describeDefines(features.defines()).c_str());
-    std::printf("bindings:       %zu\n", features.bindings().size());
-    std::printf("spirv bytes:    %zu\n", kernel.spirv.size() * sizeof(uint32_t));
-    std::printf("glslang:        %s\n",
-                kernel.fromCache ? "cache hit (0 s)" : (std::to_string(kernel.compileSeconds) + " s").c_str());
-    std::printf("spirv cache:    %s\n", renderOptions.cacheDirectory.c_str());
-    std::printf("set-up:         %.3f s (parse excluded: compile or load, pipeline, buffers)\n", setupSeconds);
-    std::printf("first frame:    %.3f s after set-up began (includes the driver's shader compile)\n",
-                firstFrameSeconds);
-    std::printf("loop cap:       %s\n", context.loopCap().describe().c_str());
-    if (scene.meshes.empty())
-        std::printf("loop passes:    worst case %llu per invocation%s\n",
-                    static_cast<unsigned long long>(worstCaseLoopIterations(scene)),
-                    context.loopCap().capped() ? (" of " + std::to_string(*context.loopCap().budget)).c_str() : "");
-    else
-        std::printf("loop passes:    no static bound (BVH traversal)%s\n",
-                    context.loopCap().capped() ? "; each subgroup's count is checked against the cap as it renders"
-                                               : "");
-    if (!scene.meshes.empty()) printMeshes(scene, session.renderer().meshData(), parseSeconds);
-    if (scene.textures) printTextures(*scene.textures);
-    std::printf("device:         %s\n", context.deviceInfo().name.c_str());
+    // With the JSON on standard output, the lines for people go to stderr.
+    printInfo(options.json == "-" ? stderr : stdout, session, options, times);
+    if (!options.json.empty()) writeJson(options.json, infoJson(session, options, times));
     return kExitOk;
 }
 
@@ -120,6 +310,9 @@ CommandRunner addInfoCommand(CLI::App& app)
     cmd->add_option("scene", options->scenePath, "Scene file")->required();
     cmd->add_option("--device", options->device, "Vulkan device index or name");
     cmd->add_flag("--uber", options->uber, "Describe the all-features kernel instead");
+    cmd->add_option("--json", options->json,
+                    "Also write these facts as one JSON object to FILE, or to standard output for - (the lines "
+                    "above then go to stderr; docs/machine-output.md)");
     return [options] { return runInfo(*options); };
 }
 

@@ -3,15 +3,16 @@
 // accumulated, with its true spp in the metadata.
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
+#include "app/JsonOutput.h"
 #include "io/ExrFile.h"
 #include "io/OutputPaths.h"
 #include "io/PngFile.h"
-#include "mesh/MeshGeometry.h"
 #include "render/ConvergenceReport.h"
 #include "render/Progress.h"
 #include "render/RenderSession.h"
-#include "texture/TextureAtlas.h"
+#include "scene/FeatureSet.h"
 #include "util/Error.h"
+#include "util/Hash.h"
 
 #include <CLI/CLI.hpp>
 
@@ -46,6 +47,7 @@ struct RenderCommandOptions {
     std::optional<double> targetError;
     std::string report;
     std::string reference;
+    std::string json; ///< --json FILE, or "-" for standard output (docs/machine-output.md)
     bool sppGiven = false;
     std::string sampler = "auto";
     std::string shard;                      ///< "i/n" (docs/farm.md)
@@ -140,21 +142,127 @@ std::string reportHeader(const Scene& scene, const VulkanContext& context, doubl
     return text;
 }
 
-void printSummary(const Renderer& renderer, const VulkanContext& context, const LoopResult& loop,
-                  const RenderCounters& counters, double startupSeconds, const std::string& output)
+/// What a finished render reports. The summary line and --json are both
+/// made from one of these, so the two cannot disagree.
+struct RenderFacts {
+    uint32_t spp = 0;
+    uint32_t width = 0, height = 0;
+    double renderSeconds = 0.0;
+    double startupSeconds = 0.0;
+    double samplesPerSecond = 0.0;
+    std::string device;
+    bool kernelFromCache = false;
+    RenderCounters counters;
+    bool loopCapped = false; ///< only then do loop-cap hits make a wrong image
+    std::string output;
+};
+
+RenderFacts renderFacts(const RenderSession& session, const LoopResult& loop, double startupSeconds,
+                        const std::string& output)
 {
-    double samples = double(renderer.completedFrames()) * renderer.width() * renderer.height();
-    std::fprintf(stderr, "%u spp  %.2f s  %ssamples/s  %s  (start-up %.2f s%s)  -> %s\n", renderer.completedFrames(),
-                 loop.renderSeconds, humanCount(loop.renderSeconds > 0 ? samples / loop.renderSeconds : 0).c_str(),
-                 context.deviceInfo().name.c_str(), startupSeconds,
-                 renderer.kernel().fromCache ? ", kernel cached" : ", kernel compiled", output.c_str());
-    if (counters.rejectedSamples)
+    const Renderer& renderer = session.renderer();
+    RenderFacts facts;
+    facts.spp = renderer.completedFrames();
+    facts.width = renderer.width();
+    facts.height = renderer.height();
+    facts.renderSeconds = loop.renderSeconds;
+    facts.startupSeconds = startupSeconds;
+    const double samples = double(facts.spp) * facts.width * facts.height;
+    facts.samplesPerSecond = loop.renderSeconds > 0 ? samples / loop.renderSeconds : 0.0;
+    facts.device = session.context().deviceInfo().name;
+    facts.kernelFromCache = renderer.kernel().fromCache;
+    facts.counters = renderer.counters();
+    facts.loopCapped = session.context().loopCap().capped();
+    facts.output = output;
+    return facts;
+}
+
+void printSummary(const RenderFacts& facts)
+{
+    std::fprintf(stderr, "%u spp  %.2f s  %ssamples/s  %s  (start-up %.2f s%s)  -> %s\n", facts.spp,
+                 facts.renderSeconds, humanCount(facts.samplesPerSecond).c_str(), facts.device.c_str(),
+                 facts.startupSeconds, facts.kernelFromCache ? ", kernel cached" : ", kernel compiled",
+                 facts.output.c_str());
+    if (facts.counters.rejectedSamples)
         std::fprintf(stderr, "warning: %llu non-finite samples were rejected\n",
-                     static_cast<unsigned long long>(counters.rejectedSamples));
-    // Only a device that cuts loops short makes a long loop a wrong image.
-    if (counters.budgetExceeded && context.loopCap().capped())
+                     static_cast<unsigned long long>(facts.counters.rejectedSamples));
+    if (facts.counters.budgetExceeded && facts.loopCapped)
         std::fprintf(stderr, "warning: %u invocations reached the device's loop cap; the image may be wrong\n",
-                     counters.budgetExceeded);
+                     facts.counters.budgetExceeded);
+}
+
+// ---------------------------------------------------------------- --json (docs/machine-output.md)
+
+JsonObject errorEstimateJson(const RenderSession& session, const Film& film)
+{
+    if (!film.estimated) return nullptr;
+    const Renderer& renderer = session.renderer();
+    return {{"rmse", film.estimated->rmse},
+            {"relMse", film.estimated->relMse},
+            {"degreesOfFreedom", renderer.varianceDegreesOfFreedom()},
+            {"estimator", session.sampler() == Sampler::Sobol ? "batches" : "independent-samples"}};
+}
+
+JsonObject shardJson(const std::optional<ShardRange>& shard, uint32_t totalSpp, uint32_t spp)
+{
+    if (!shard) return nullptr;
+    return {{"index", shard->index},
+            {"count", shard->count},
+            {"sampleBegin", shard->begin},
+            {"sampleEnd", shard->begin + spp},
+            {"totalSpp", totalSpp}};
+}
+
+JsonObject outputsJson(const RenderCommandOptions& options, const RenderFacts& facts,
+                       const std::map<std::string, Image>& layers)
+{
+    auto optionalPath = [](const std::string& path) { return path.empty() ? JsonObject(nullptr) : JsonObject(path); };
+    JsonObject layerNames = JsonObject::array();
+    for (const auto& [name, image] : layers) layerNames.push_back(name);
+    return {{"exr", facts.output},
+            {"exrLayers", layerNames},
+            {"png", optionalPath(options.png)},
+            {"report", optionalPath(options.report)}};
+}
+
+JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& session, const RenderFacts& facts,
+                      const Film& film, const std::map<std::string, Image>& layers,
+                      const std::optional<ShardRange>& shard, size_t validationMessages)
+{
+    const Scene& scene = session.scene();
+    const Renderer& renderer = session.renderer();
+    const DeviceInfo& device = session.context().deviceInfo();
+    JsonObject json = jsonDocument("render");
+    json["scene"] = scene.path;
+    json["sceneHash"] = "fnv1a64:" + toHex(scene.fileHash);
+    json["device"] = {{"name", facts.device}, {"driver", device.driver}};
+    json["integrator"] = integratorName(scene.render.integrator);
+    json["sampler"] = samplerName(session.sampler());
+    json["kernel"] = {{"variant", renderer.variant().describe()},
+                      {"uber", options.uber},
+                      {"cacheKey", renderer.kernel().cacheKey},
+                      {"fromCache", facts.kernelFromCache},
+                      {"compileSeconds", renderer.kernel().compileSeconds}};
+    json["seed"] = options.seed;
+    json["spp"] = facts.spp;
+    json["width"] = facts.width;
+    json["height"] = facts.height;
+    json["renderSeconds"] = facts.renderSeconds;
+    json["startupSeconds"] = facts.startupSeconds;
+    json["firstFrameSeconds"] = nullptr; // render's warm-up frame is inside startupSeconds; `vkrt info` measures it
+    json["samplesPerSecond"] = facts.samplesPerSecond;
+    json["rejectedSamples"] = facts.counters.rejectedSamples;
+    json["loopCap"] = {{"capped", facts.loopCapped},
+                       {"budget", valueOrNull(session.context().loopCap().budget)},
+                       {"invocationsAtCap", facts.counters.budgetExceeded}};
+    json["stoppedBy"] = stopReasonName(session.stoppedBy().value_or(StopReason::SppReached));
+    json["timeBudgetSeconds"] = valueOrNull(options.timeBudget);
+    json["targetRelMse"] = valueOrNull(options.targetError);
+    json["errorEstimate"] = errorEstimateJson(session, film);
+    json["shard"] = shardJson(shard, options.spp, facts.spp);
+    json["outputs"] = outputsJson(options, facts, layers);
+    json["validationMessages"] = validationMessages;
+    return json;
 }
 
 void warnIfTooFewForAnEstimate(const Renderer& renderer)
@@ -210,7 +318,7 @@ Outcome interruptedBeforeRendering()
 
 std::vector<NamedFile> renderOutputs(const RenderCommandOptions& options, const std::string& output)
 {
-    return {{"-o", output}, {"--png", options.png}, {"--report", options.report}};
+    return {{"-o", output}, {"--png", options.png}, {"--report", options.report}, jsonOutputFile(options.json)};
 }
 
 /// Before any work: no output may destroy an input or another output, and each must be writable.
@@ -218,21 +326,6 @@ void checkRenderFiles(const RenderCommandOptions& options, const std::string& ou
 {
     checkOutputs({{"the scene file", options.scenePath}, {"--reference", options.reference}},
                  renderOutputs(options, output));
-}
-
-/// The files a parsed scene read besides itself (meshes, textures, cube
-/// faces): `-o sky/px.exr` must not replace one of its own faces.
-std::vector<NamedFile> filesTheSceneRead(const Scene& scene)
-{
-    std::vector<NamedFile> files;
-    for (const Mesh& mesh : scene.meshes) files.push_back({"a mesh the scene loads", mesh.geometry->file});
-    if (scene.textures)
-        for (uint32_t r = 0; r < scene.textures->recordCount(); ++r)
-            files.push_back({"a texture the scene loads", scene.textures->nameOf(r)});
-    if (scene.background.cubemap)
-        for (const std::string& face : scene.background.cubemap->facePaths)
-            files.push_back({"a cube face the scene loads", face});
-    return files;
 }
 
 Outcome runRender(const RenderCommandOptions& options)
@@ -273,10 +366,13 @@ Outcome runRender(const RenderCommandOptions& options)
         if (options.variance) layers["variance"] = std::move(*film.variance);
     }
     if (shard) addShard(*shard, options.spp, renderer, metadata, layers);
-    RenderCounters counters = renderer.counters();
     writeExr(output, film.mean, metadata, layers);
     if (!options.png.empty()) writePng(options.png, film.mean, options.exposure);
-    printSummary(renderer, context, loop, counters, startupSeconds, output);
+    const RenderFacts facts = renderFacts(session, loop, startupSeconds, output);
+    printSummary(facts);
+    if (!options.json.empty())
+        writeJson(options.json,
+                  renderJson(options, session, facts, film, layers, shard, context.validationMessages().size()));
     return withValidation(session.outcome(), context.validationMessages());
 }
 
@@ -333,6 +429,9 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "Stop once the estimated relMSE falls below this (checked at 1, 2, 4, ... spp)")
         ->check(positiveFiniteNumber("relMSE"));
     cmd->add_option("--report", options->report, "Write a convergence CSV (error against time, docs/convergence.md)");
+    cmd->add_option("--json", options->json,
+                    "Also write the run's facts (spp, times, samples/s, device, outputs, ...) as one JSON object to "
+                    "FILE, or to standard output for - (docs/machine-output.md)");
     cmd->add_option("--reference", options->reference, "Reference EXR for the report's true error")
         ->needs(cmd->get_option("--report"));
     cmd->add_flag("--variance", options->variance,
