@@ -1,9 +1,11 @@
 // `vkrt compare A.exr B.exr`: error measures between two images, and with
-// variances a per-pixel statistical test; exits non-zero when a threshold is
-// exceeded so scripts and CI can rely on it.
+// variances a per-pixel statistical test; a threshold exceeded is a Failed
+// outcome (exit 4) so scripts and CI can rely on it.
 #include "app/Commands.h"
+#include "app/ExitCodes.h"
 #include "io/ExrFile.h"
 #include "render/ErrorMetrics.h"
+#include "render/Outcome.h"
 #include "util/Error.h"
 
 #include <CLI/CLI.hpp>
@@ -79,7 +81,9 @@ ExpectedSize sizeOfA(const CompareOptions& o)
     return {a.width, a.height, o.a + " is"};
 }
 
-int runCompare(const CompareOptions& o)
+/// The FAIL lines go to stdout with the measures above them, so the outcome
+/// carries no messages of its own.
+Outcome runCompare(const CompareOptions& o)
 {
     const ExpectedSize size = sizeOfA(o);
     ExrContents a = readExr(o.a, size), b = readExr(o.b, size);
@@ -114,7 +118,7 @@ int runCompare(const CompareOptions& o)
     }
     for (const auto& f : failures) std::printf("FAIL: %s\n", f.c_str());
     if (failures.empty()) std::printf("OK\n");
-    return failures.empty() ? kExitOk : kExitCompareFailed;
+    return failures.empty() ? Outcome::passed() : Outcome::of(OutcomeKind::Failed);
 }
 
 } // namespace
@@ -133,7 +137,7 @@ CommandRunner addCompareCommand(CLI::App& app)
         ->check(CLI::Range(1e-12, 0.5));
     cmd->add_option("--min-pass", o->minPass, "Fraction of values that must pass the pixel test")
         ->check(CLI::Range(0.0, 1.0));
-    return [o] { return runCompare(*o); };
+    return [o] { return exitCodeFor(runCompare(*o)); };
 }
 
 } // namespace vkrt

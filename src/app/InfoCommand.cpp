@@ -3,9 +3,11 @@
 // `--json` writes the same facts as one JSON object (docs/machine-output.md).
 #include "app/Commands.h"
 #include "app/JsonOutput.h"
+#include "io/AtomicFile.h"
 #include "mesh/MeshGeometry.h"
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
+#include "scene/SceneExport.h"
 #include "texture/TextureAtlas.h"
 
 #include <CLI/CLI.hpp>
@@ -23,8 +25,25 @@ struct InfoOptions {
     std::string scenePath;
     std::string device;
     bool uber = false;
-    std::string json; ///< --json FILE, or "-" for standard output
+    std::string json;      ///< --json FILE, or "-" for standard output
+    std::string sceneJson; ///< --scene-json FILE, or "-" for standard output
 };
+
+/// --scene-json as an output for the checks ("-" is no file).
+NamedFile sceneJsonFile(const std::string& path) { return {"--scene-json", path == "-" ? "" : path}; }
+
+/// `--scene-json`: the parsed scene (docs/scene-json.md); info stops there, before making a device.
+int writeSceneJson(const Scene& scene, const std::string& path)
+{
+    const std::string text = exportSceneText(scene);
+    if (path != "-") {
+        writeBytesAtomically(path, text);
+        return kExitOk;
+    }
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+        throw InputError("--scene-json: cannot write to standard output");
+    return kExitOk;
+}
 
 double secondsSince(std::chrono::steady_clock::time_point start)
 {
@@ -277,12 +296,14 @@ JsonObject infoJson(const RenderSession& session, const InfoOptions& options, co
 int runInfo(const InfoOptions& options)
 {
     // --json must not replace the scene, nor fail to be written after the work.
-    checkOutputs({{"the scene file", options.scenePath}}, {jsonOutputFile(options.json)});
+    checkOutputs({{"the scene file", options.scenePath}},
+                 {jsonOutputFile(options.json), sceneJsonFile(options.sceneJson)});
     InfoTimes times;
     const auto parseStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(options.scenePath);
     times.parse = secondsSince(parseStart);
-    refuseOverlappingFiles(filesTheSceneRead(scene), {jsonOutputFile(options.json)});
+    refuseOverlappingFiles(filesTheSceneRead(scene), {jsonOutputFile(options.json), sceneJsonFile(options.sceneJson)});
+    if (!options.sceneJson.empty()) return writeSceneJson(scene, options.sceneJson);
     VulkanContext context({options.device, false});
     SessionConfig config;
     config.uber = options.uber;
@@ -313,6 +334,9 @@ CommandRunner addInfoCommand(CLI::App& app)
     cmd->add_option("--json", options->json,
                     "Also write these facts as one JSON object to FILE, or to standard output for - (the lines "
                     "above then go to stderr; docs/machine-output.md)");
+    cmd->add_option("--scene-json", options->sceneJson,
+                    "Write the scene as vkrt parsed it, as JSON, to FILE or to standard output for -, and stop "
+                    "there: no device is needed (docs/scene-json.md)");
     return [options] { return runInfo(*options); };
 }
 

@@ -8,6 +8,7 @@
 #include "app/ExitCodes.h"
 #include "io/ExrFile.h"
 #include "io/OutputPaths.h"
+#include "render/Outcome.h"
 #include "render/Tally.h"
 #include "util/Error.h"
 
@@ -191,7 +192,8 @@ void checkMergeFiles(const MergeOptions& options)
     checkOutputs(inputs, {{"-o", options.output}});
 }
 
-int runMerge(const MergeOptions& options)
+/// Bad shards throw InputError (exit 2, from main); a merge written is Passed.
+Outcome runMerge(const MergeOptions& options)
 {
     checkMergeFiles(options);
     // Headers first: a bad shard is refused before any good shard's pixels are read.
@@ -217,7 +219,7 @@ int runMerge(const MergeOptions& options)
     std::fprintf(stderr, "merged %zu shards, %lld of %lld spp%s -> %s\n", shards.size(), static_cast<long long>(spp),
                  static_cast<long long>(total),
                  missing.empty() ? "" : (" (missing " + joined(missing, ", ") + ")").c_str(), options.output.c_str());
-    return kExitOk;
+    return Outcome::passed();
 }
 
 } // namespace
@@ -231,7 +233,7 @@ CommandRunner addMergeCommand(CLI::App& app)
     cmd->add_flag("--allow-missing", o->allowMissing,
                   "Merge although some sample ranges are in no shard (the result says which, and its true spp)");
     cmd->add_flag("--variance", o->variance, "Write the variance layer even when the shards have none of their own");
-    return [o] { return runMerge(*o); };
+    return [o] { return exitCodeFor(runMerge(*o)); };
 }
 
 } // namespace vkrt

@@ -67,7 +67,8 @@ static_assert(offsetof(Mesh, emission) == 96 && offsetof(Mesh, firstEmitter) == 
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);
 static_assert(sizeof(MomentPixel) == 36);
-static_assert(offsetof(SceneUniforms, tileStride) == 96);
+// The per-kind counts sit before tileStride, so a new kind moves it (and needs no edit here).
+static_assert(offsetof(SceneUniforms, tileStride) == 68 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT));
 static_assert(offsetof(Material, fresnel) == 48 && offsetof(Material, eta) == 64 && offsetof(Material, k) == 80);
 static_assert(sizeof(TriangleLight) == 40 && offsetof(TriangleLight, emitter) == 12);
 

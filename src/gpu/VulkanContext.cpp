@@ -132,13 +132,13 @@ void tuneSoftwareRasterizerThreads()
     setenv("LP_NUM_THREADS", std::to_string(4 * cores).c_str(), /*overwrite=*/0);
 }
 
-VulkanContext::VulkanContext(const ContextOptions& options) : m_validation(options.validation)
+VulkanContext::VulkanContext(const ContextOptions& options)
 {
     tuneSoftwareRasterizerThreads();
     // The loader first calls into drivers here: a broken one crashes or hangs right away.
     {
         DriverCrashGuard crash("creating the Vulkan instance");
-        createInstance(options.presentation);
+        createInstance(options.validation, options.presentation);
     }
     {
         DriverCrashGuard crash("choosing a Vulkan device");
@@ -148,14 +148,14 @@ VulkanContext::VulkanContext(const ContextOptions& options) : m_validation(optio
     createDevice();
 }
 
-void VulkanContext::createInstance(const std::optional<PresentationSupport>& presentation)
+void VulkanContext::createInstance(bool validation, const std::optional<PresentationSupport>& presentation)
 {
-    if (m_validation && !hasLayer(m_context, kValidationLayer))
+    if (validation && !hasLayer(m_context, kValidationLayer))
         throw GpuError("validation requested but VK_LAYER_KHRONOS_validation is not installed "
                        "(Debian package vulkan-validationlayers)");
     vk::ApplicationInfo app("vkrt", 1, "vkrt", 1, kRequiredApiVersion);
     std::vector<const char*> layers, extensions;
-    if (m_validation) {
+    if (validation) {
         layers.push_back(kValidationLayer);
         extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
@@ -163,7 +163,7 @@ void VulkanContext::createInstance(const std::optional<PresentationSupport>& pre
         for (const auto& e : presentation->instanceExtensions) extensions.push_back(e.c_str());
     m_instance = vk::raii::Instance(m_context, vk::InstanceCreateInfo({}, &app, layers, extensions));
     if (presentation) m_surface = vk::raii::SurfaceKHR(m_instance, presentation->createSurface(*m_instance));
-    if (!m_validation) return;
+    if (!validation) return;
     using Severity = vk::DebugUtilsMessageSeverityFlagBitsEXT;
     using Type = vk::DebugUtilsMessageTypeFlagBitsEXT;
     // Built as the C struct and converted: Vulkan-Hpp 1.4 deprecates the

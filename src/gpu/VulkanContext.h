@@ -71,7 +71,6 @@ public:
     const vk::raii::Device& device() const { return m_device; }
     const vk::raii::Queue& queue() const { return m_queue; }
     uint32_t queueFamily() const { return *deviceInfo().computeQueueFamily; }
-    const vk::raii::CommandPool& commandPool() const { return m_commandPool; }
     /// The window surface (viewer only; null otherwise).
     const vk::raii::SurfaceKHR& surface() const { return m_surface; }
 
@@ -79,7 +78,6 @@ public:
     /// lavapipe); decided once, on first use, by detectLoopCap.
     const LoopCap& loopCap() const;
 
-    bool validationEnabled() const { return m_validation; }
     /// Messages the validation layer has emitted so far (empty when disabled).
     std::vector<std::string> validationMessages() const { return m_validationLog->messages(); }
 
@@ -100,7 +98,6 @@ public:
     void endSubmitAndWait(const vk::raii::CommandBuffer& cmd) const;
 
 private:
-    bool m_validation = false;
     std::unique_ptr<ValidationLog> m_validationLog = std::make_unique<ValidationLog>();
     vk::raii::Context m_context;
     vk::raii::Instance m_instance = nullptr;
@@ -114,7 +111,7 @@ private:
     vk::raii::CommandPool m_commandPool = nullptr;
     mutable std::optional<LoopCap> m_loopCap;
 
-    void createInstance(const std::optional<PresentationSupport>& presentation);
+    void createInstance(bool validation, const std::optional<PresentationSupport>& presentation);
     void chooseDevice(const std::string& selector);
     void createDevice();
 };

@@ -5,6 +5,14 @@
 
 namespace vkrt {
 
+/// The largest image vkrt renders or reads (docs/scene-format.md): the scene
+/// format's image limits (SceneLimits) are these, and image files whose
+/// header declares more are refused before their pixels are allocated.
+struct ImageLimits {
+    static constexpr uint32_t maxSide = 16384;
+    static constexpr uint64_t maxPixels = 64ull * 1024 * 1024;
+};
+
 struct Image {
     uint32_t width = 0;
     uint32_t height = 0;

@@ -1,6 +1,6 @@
 #include "io/ImageHeader.h"
 
-#include "scene/Scene.h"
+#include "io/Image.h"
 #include "util/Error.h"
 
 #include <ImfChannelList.h>
@@ -102,12 +102,12 @@ void checkExrExtent(const Imf::Header& header, const std::string& name)
     const int64_t width = int64_t(window.max.x) - window.min.x + 1, height = int64_t(window.max.y) - window.min.y + 1;
     const std::string size = std::to_string(width) + "x" + std::to_string(height);
     if (width < 1 || height < 1) fail(name, "the header declares an empty data window (" + size + ")");
-    if (width > SceneLimits::maxImageSide || height > SceneLimits::maxImageSide)
+    if (width > ImageLimits::maxSide || height > ImageLimits::maxSide)
         fail(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
-                       std::to_string(SceneLimits::maxImageSide) + " pixels a side");
-    if (uint64_t(width * height) > SceneLimits::maxImagePixels)
+                       std::to_string(ImageLimits::maxSide) + " pixels a side");
+    if (uint64_t(width * height) > ImageLimits::maxPixels)
         fail(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
-                       std::to_string(SceneLimits::maxImagePixels) + " pixels");
+                       std::to_string(ImageLimits::maxPixels) + " pixels");
 }
 
 size_t channelCount(const Imf::Header& header)

@@ -34,8 +34,8 @@ uint64_t exrMaxCompressionRatio(Imf::Compression compression);
 /// Reads the (first part's) header of the OpenEXR file in `stream`, which
 /// holds `streamBytes` bytes and is read from its start, and checks before
 /// anything is allocated from it: every attribute fits in the file, the file
-/// is not deep, the data window is within SceneLimits::maxImageSide a side
-/// and SceneLimits::maxImagePixels, tiles are no larger than the image (or
+/// is not deep, the data window is within ImageLimits::maxSide a side
+/// and ImageLimits::maxPixels, tiles are no larger than the image (or
 /// 256 a side), and the file is long enough for the chunks and pixels the
 /// header declares. Throws InputError starting with `name`.
 Imf::Header readCheckedExrHeader(Imf::IStream& stream, uint64_t streamBytes, const std::string& name);

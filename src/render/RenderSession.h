@@ -143,7 +143,9 @@ private:
     StopOnInterrupt m_stopOnInterrupt;
 };
 
-/// The flag InterruptGuard's handler sets; pass it as SessionConfig::interrupt.
+/// The flag InterruptGuard's handler sets; pass its address as
+/// SessionConfig::stop.interrupt (StopRules::interrupt), which run() polls
+/// between submissions.
 const std::atomic<bool>& interruptFlag();
 
 } // namespace vkrt

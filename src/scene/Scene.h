@@ -3,6 +3,7 @@
 // world space; conversion to the GPU's float32, camera-relative form happens in
 // render/GpuScene. A Scene is only ever produced by parseScene*, which has
 // already checked every value, so consumers need not re-validate.
+#include "io/Image.h"
 #include "shared/Kinds.h"
 #include "shared/TextureTypes.h"
 #include "util/Error.h"
@@ -26,8 +27,8 @@ using Color = glm::dvec3; ///< linear RGB
 
 /// Documented hard limits of the scene format (docs/scene-format.md).
 struct SceneLimits {
-    static constexpr uint32_t maxImageSide = 16384;
-    static constexpr uint64_t maxImagePixels = 64ull * 1024 * 1024;
+    static constexpr uint32_t maxImageSide = ImageLimits::maxSide;
+    static constexpr uint64_t maxImagePixels = ImageLimits::maxPixels;
     static constexpr int maxDepth = 64;
     static constexpr double maxIor = 1e30;
 };
@@ -268,7 +269,8 @@ struct Scene {
     Camera camera;
     std::vector<Material> materials;
     // One array per shape and light kind: spheres, boxes, ..., pointLights, triangleLights.
-#define VKRT_SCENE_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) std::vector<Type> array;
+#define VKRT_SCENE_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    std::vector<Type> array;
     VKRT_SHAPE_KINDS(VKRT_SCENE_ARRAY_MEMBER)
     VKRT_LIGHT_KINDS(VKRT_SCENE_ARRAY_MEMBER)
 #undef VKRT_SCENE_ARRAY_MEMBER

@@ -8,8 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
 #include <string>
 
 namespace vkrt {
@@ -194,6 +198,76 @@ TEST_P(SuiteFileTomlTrap, IsALocatedSyntaxError)
 
 INSTANTIATE_TEST_SUITE_P(TomlTraps, SuiteFileTomlTrap, ::testing::ValuesIn(kTomlTraps),
                          [](const ::testing::TestParamInfo<TomlTrap>& info) { return info.param.name; });
+
+/// The case counts docs/regress.md gives for the default suite: the total, and
+/// per row of its table each `pattern` (n), where "prefix/*" counts the cases
+/// whose name starts with "prefix/" and a plain name counts that case.
+struct DocumentedCounts {
+    size_t total = 0;
+    std::map<std::string, size_t> perPattern;
+};
+
+DocumentedCounts documentedCounts(const fs::path& doc)
+{
+    std::ifstream file(doc);
+    std::stringstream text;
+    text << file.rdbuf();
+    const std::string all = text.str();
+    DocumentedCounts counts;
+    std::smatch match;
+    if (!std::regex_search(all, match, std::regex("`tests/regress/suite\\.toml`, ([0-9]+) cases"))) return counts;
+    counts.total = std::stoul(match[1]);
+    // The table follows the sentence; its first column names the cases.
+    std::istringstream rest(match.suffix().str());
+    std::string line;
+    bool inTable = false;
+    const std::regex pattern("`([^`]+)` \\(([0-9]+)\\)");
+    while (std::getline(rest, line)) {
+        if (line.rfind("|", 0) != 0) {
+            if (inTable) break;
+            continue;
+        }
+        inTable = true;
+        const std::string firstCell = line.substr(1, line.find('|', 1) - 1);
+        for (auto it = std::sregex_iterator(firstCell.begin(), firstCell.end(), pattern); it != std::sregex_iterator();
+             ++it)
+            counts.perPattern[(*it)[1]] = std::stoul((*it)[2]);
+    }
+    return counts;
+}
+
+bool caseMatches(const std::string& name, const std::string& pattern)
+{
+    if (pattern.size() >= 2 && pattern.ends_with("/*"))
+        return name.rfind(pattern.substr(0, pattern.size() - 1), 0) == 0;
+    return name == pattern;
+}
+
+/// docs/regress.md says how many cases the default suite has and which rows
+/// hold them: a case added to the manifest without the doc fails here.
+TEST(DefaultSuiteDoc, CountsMatchTheManifest)
+{
+    const fs::path root = VKRT_TEST_SOURCE_DIR;
+    const RegressionSuite suite = readRegressionSuite(root / "tests/regress/suite.toml");
+    const DocumentedCounts doc = documentedCounts(root / "docs/regress.md");
+    ASSERT_GT(doc.total, 0u) << "docs/regress.md no longer says \"`tests/regress/suite.toml`, N cases\"";
+    ASSERT_FALSE(doc.perPattern.empty()) << "docs/regress.md: no `pattern` (n) in the table after the count";
+    EXPECT_EQ(doc.total, suite.cases.size()) << "docs/regress.md gives the default suite's case count";
+    size_t rowTotal = 0;
+    for (const auto& [pattern, count] : doc.perPattern) {
+        const size_t actual =
+            size_t(std::count_if(suite.cases.begin(), suite.cases.end(),
+                                 [&](const RegressionCase& c) { return caseMatches(c.name, pattern); }));
+        EXPECT_EQ(count, actual) << "docs/regress.md: `" << pattern << "`";
+        rowTotal += count;
+    }
+    EXPECT_EQ(rowTotal, doc.total) << "docs/regress.md: the table's rows do not add up to the count";
+    for (const RegressionCase& c : suite.cases) {
+        const bool covered = std::any_of(doc.perPattern.begin(), doc.perPattern.end(),
+                                         [&](const auto& entry) { return caseMatches(c.name, entry.first); });
+        EXPECT_TRUE(covered) << c.name << " is in no row of docs/regress.md's table";
+    }
+}
 
 } // namespace
 } // namespace vkrt
