@@ -1,5 +1,6 @@
 #pragma once
 // A linear float32 RGB image, rows top to bottom.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -19,11 +20,11 @@ struct Image {
     std::vector<float> rgb; ///< width * height * 3 floats
 
     Image() = default;
-    Image(uint32_t w, uint32_t h) : width(w), height(h), rgb(size_t(w) * h * 3, 0.0f) {}
+    Image(uint32_t w, uint32_t h) : width(w), height(h), rgb(std::size_t(w) * h * 3, 0.0f) {}
 
-    size_t pixelCount() const { return size_t(width) * height; }
-    float* at(uint32_t x, uint32_t y) { return &rgb[(size_t(y) * width + x) * 3]; }
-    const float* at(uint32_t x, uint32_t y) const { return &rgb[(size_t(y) * width + x) * 3]; }
+    std::size_t pixelCount() const { return std::size_t(width) * height; }
+    float* at(uint32_t x, uint32_t y) { return &rgb[(std::size_t(y) * width + x) * 3]; }
+    const float* at(uint32_t x, uint32_t y) const { return &rgb[(std::size_t(y) * width + x) * 3]; }
 };
 
 } // namespace vkrt
