@@ -72,8 +72,15 @@ void reportLoopIterations(uint longestSample)
 
 Ray cameraSample(uvec2 pixel, inout Sampler rng)
 {
+#ifdef VKRT_THIN_LENS
+    // One 4-D sample: the point in the pixel and the point on the lens.
+    vec4 s = sampleNext4D(rng);
+    vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? s.xy : vec2(0.5);
+    return thinLensRay(pixel, subpixel, s.zw);
+#else
     vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? sampleNext2D(rng) : vec2(0.5);
     return cameraRay(pixel, subpixel);
+#endif
 }
 
 // Measurement hook (path integrator): a sample's radiance becomes the number

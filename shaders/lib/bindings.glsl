@@ -66,7 +66,9 @@ layout(scalar, binding = BINDING_MESH_MATERIALS) readonly buffer MeshMaterialBlo
 #if defined(VKRT_HAS_MESH_NORMALS) || defined(VKRT_HAS_NORMAL_MAPS)
 #define VKRT_HAS_SHADING_NORMALS
 #endif
-#ifdef VKRT_HAS_CUBEMAP
+#if defined(VKRT_HAS_LATLONG)
+layout(binding = BINDING_ENVIRONMENT) uniform sampler2D environmentLatLong;
+#elif defined(VKRT_HAS_CUBEMAP)
 layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
 #endif
 #ifdef VKRT_ENVIRONMENT_SAMPLING

@@ -135,11 +135,52 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 #define VKRT_LIGHT_SAMPLING
 #include "lights/point.glsl"
 #include "lights/triangle.glsl"
+#include "lights/directional.glsl"
+#include "lights/spot.glsl"
 
 #define VKRT_DIRECT_FROM_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     +directFrom##Type(m, hit, n, ns, wo, media, rng)
 #define VKRT_OFFER_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     offer##Type##Samples(r, m, hit, ns, wo, origin, rng);
+
+// Next-event estimation of the environment map, MIS-weighted against BSDF
+// sampling (which finds the same light when a ray escapes: environmentOnEscape).
+vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+{
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    float pdf;
+    vec3 wi = sampleEnvironment(sampleNext4D(rng).xyz, pdf);
+    float cosI = dot(ns, wi);
+    if (pdf <= 0.0 || cosI <= 0.0)
+        return vec3(0.0);
+    vec3 f = evalBsdf(m, ns, wo, wi);
+    if (f == vec3(0.0))
+        return vec3(0.0);
+    float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
+#ifdef VKRT_HAS_SHADING_NORMALS
+    // Behind the geometric surface (shading normals): blocked by it (lib/lights.glsl).
+    if (ns != n && dot(wi, n) <= 0.0)
+        return vec3(0.0);
+#endif
+    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
+    return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
+#else
+    return vec3(0.0);
+#endif
+}
+
+// Environment radiance found by a ray that escaped after a scattering of
+// solid-angle density bsdfPdf (`specular`: a delta event, or the camera),
+// MIS-weighted when the environment is also sampled directly.
+vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf)
+{
+    vec3 le = environmentRadiance(dir);
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    if (!specular)
+        le *= powerHeuristic(bsdfPdf, environmentPdf(dir));
+#endif
+    return le;
+}
 
 // Direct light from every light kind, each light with its own shadow ray
 // (the Whitted integrator, which adds one sample of the emitters to it).

@@ -35,44 +35,6 @@ vec3 emitterOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
 #endif
 }
 
-// Next-event estimation of the cubemap environment, MIS-weighted against
-// BSDF sampling (which finds the same light when a ray escapes).
-vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
-{
-#ifdef VKRT_ENVIRONMENT_SAMPLING
-    float pdf;
-    vec3 wi = sampleEnvironment(sampleNext4D(rng).xyz, pdf);
-    float cosI = dot(ns, wi);
-    if (pdf <= 0.0 || cosI <= 0.0)
-        return vec3(0.0);
-    vec3 f = evalBsdf(m, ns, wo, wi);
-    if (f == vec3(0.0))
-        return vec3(0.0);
-    float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
-#ifdef VKRT_HAS_SHADING_NORMALS
-    // Behind the geometric surface (shading normals): blocked by it (lib/lights.glsl).
-    if (ns != n && dot(wi, n) <= 0.0)
-        return vec3(0.0);
-#endif
-    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
-    return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
-#else
-    return vec3(0.0);
-#endif
-}
-
-// Environment radiance found by an escaping ray, MIS-weighted when the
-// environment is also sampled directly.
-vec3 environmentOnEscape(PathVertexState path, vec3 dir)
-{
-    vec3 le = environmentRadiance(dir);
-#ifdef VKRT_ENVIRONMENT_SAMPLING
-    if (!path.specular)
-        le *= powerHeuristic(path.bsdfPdf, environmentPdf(dir));
-#endif
-    return le;
-}
-
 // Russian roulette: continue with probability q = min(1, max throughput
 // component) and divide by q, so the estimate stays unbiased.
 bool survivesRoulette(inout PathVertexState path, uint depth, float u)
@@ -119,7 +81,8 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     bool missed = !traceClosest(p.ray, FLT_MAX, hit);
     p.path.throughput *= beerLambert(mediumAbsorption(p.path.media), missed ? FLT_MAX : hit.t);
     if (missed) {
-        p.path.radiance += p.path.throughput * environmentOnEscape(p.path, p.ray.dir);
+        p.path.radiance += p.path.throughput * (environmentOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf) +
+                                                directionalOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf));
         return false;
     }
 #ifdef VKRT_HAS_EMITTERS

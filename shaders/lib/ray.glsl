@@ -3,6 +3,9 @@
 
 const float FLT_MAX = 3.402823466e38;
 const float PI = 3.14159265358979323846;
+// How far a shadow ray towards a light at infinity (a sun) looks: as far as
+// a float vector's length can be taken without overflow (its square < FLT_MAX).
+const float FAR_LIGHT_DISTANCE = 1e18;
 const float INV_PI = 0.31830988618379067154;
 
 // x^e with 0^0 = 1 (GLSL leaves pow(0, 0) undefined).

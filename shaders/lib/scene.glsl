@@ -17,6 +17,8 @@
 #include "shapes/mesh.glsl"
 #include "lights/point.glsl"
 #include "lights/triangle.glsl"
+#include "lights/directional.glsl"
+#include "lights/spot.glsl"
 
 #define VKRT_CLOSEST_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     closest##Type(r, tr, best);

@@ -16,6 +16,10 @@ struct PathState {
     vec3 throughput;
     MediumStack media; // the dielectrics the ray travels in
     bool countEmission;
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    bool specular;     // the last scattering was a delta event (or the camera)
+    float bsdfPdf;     // solid-angle pdf of the last BSDF sample
+#endif
 };
 
 // An emitter (triangle light or emissive mesh) seen along a specular chain
@@ -30,7 +34,11 @@ void addEmitterRadiance(inout PathState path, Ray ray, SurfaceHit hit)
 
 vec3 traceWhitted(Ray ray, inout Sampler rng)
 {
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true, true, 0.0);
+#else
     PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true);
+#endif
 #ifdef VKRT_HAS_TEXTURES
     float pathLength = 0.0; // from the camera, for the textures' ray cones
 #endif
@@ -41,7 +49,15 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         // Beer-Lambert over the segment just travelled inside a dielectric.
         path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
         if (missed) {
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+            // The map is also sampled at every vertex: MIS as in the path integrator.
+            path.radiance += path.throughput * environmentOnEscape(ray.dir, path.specular, path.bsdfPdf);
+#else
             path.radiance += path.throughput * environmentRadiance(ray.dir);
+#endif
+            // A soft sun is seen only along specular chains, as emitters are.
+            if (path.countEmission)
+                path.radiance += path.throughput * directionalOnEscape(ray.dir, true, 0.0);
             break;
         }
         addEmitterRadiance(path, ray, hit);
@@ -62,6 +78,9 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         if (!scattersIntoDeltasOnly(m)) {
             path.radiance += path.throughput * directFromLights(m, hit, n, ns, wo, path.media, rng);
             path.radiance += path.throughput * directFromEmitters(m, hit, n, ns, wo, path.media, rng);
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+            path.radiance += path.throughput * directFromEnvironment(m, hit, n, ns, wo, path.media, rng);
+#endif
         }
         if (depth == u.maxDepth)
             break;
@@ -71,6 +90,10 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
             break;
         path.throughput *= s.weight;
         path.countEmission = path.countEmission && s.specular;
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+        path.specular = s.specular;
+        path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
+#endif
         if (s.transmitted)
             path.media = crossInterface(path.media, hit.material, hit.front);
         ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);

@@ -50,7 +50,9 @@
 
 #define VKRT_LIGHT_KINDS(X)                                                       \
     X(POINT, PointLight, point, 0, pointLight, pointLights, POINT_LIGHTS, 682, 0) \
-    X(TRIANGLE, TriangleLight, triangle, 1, triangleLight, triangleLights, TRIANGLE_LIGHTS, 409, 1)
+    X(TRIANGLE, TriangleLight, triangle, 1, triangleLight, triangleLights, TRIANGLE_LIGHTS, 409, 1) \
+    X(DIRECTIONAL, DirectionalLight, directional, 2, directionalLight, directionalLights, DIRECTIONAL_LIGHTS, 512, 0) \
+    X(SPOT, SpotLight, spot, 3, spotLight, spotLights, SPOT_LIGHTS, 372, 0)
 
 // ------------------------------------------------------ derived constants
 

@@ -158,6 +158,32 @@ struct PointLight {
     vec3 intensity;
 };
 
+/// A directional light (a sun): from every point the same direction,
+/// `toLight`, or (oneMinusCos > 0) a cone of directions around it of half
+/// angle alpha, oneMinusCos = 1 - cos(alpha) and sin2Alpha = sin^2(alpha),
+/// both from double on the host (float loses a small cone's 1 - cos). A
+/// delta light's `radiance` is its irradiance (W/m^2 facing it); a cone's is
+/// the uniform radiance that gives that irradiance, E / (pi sin^2 alpha).
+struct DirectionalLight {
+    vec3 toLight;
+    float oneMinusCos;
+    vec3 radiance;
+    float sin2Alpha;
+};
+
+/// A spot light: a point light whose intensity (W/sr on the axis) falls off
+/// as glTF's KHR_lights_punctual says: t = clamp((cos a - cosOuter) *
+/// falloffScale, 0, 1) squared, a the angle from `axis`, falloffScale =
+/// 1 / (cos inner - cos outer); falloffScale = 0 for inner == outer (a hard
+/// edge: 1 inside the cone, 0 outside).
+struct SpotLight {
+    vec3 position;
+    float cosOuter;
+    vec3 intensity;
+    float falloffScale;
+    vec3 axis;
+};
+
 /// A triangle light's geometry, camera-relative world space: what rays are
 /// tested against. What it emits is emitters[emitter] (Emitter), in the one
 /// alias table of every emitting triangle.
@@ -228,6 +254,15 @@ struct SceneUniforms {
     uvec4 cameraMedia;      // their materials, innermost last
     uint emitterCount;      // Emitter records (triangle lights, then emissive mesh triangles)
     uint topNodeCount;      // nodes of the top-level BVH (0: none; the kernel loops over the arrays)
+    float apertureRadius;   // thin lens (VKRT_THIN_LENS): the lens's radius, scene units
+    float focusDistance;    // ... and the plane in focus's distance along cameraForward
+    uvec2 environmentExtent; // lat-long map (VKRT_HAS_LATLONG): width W, height H in texels
+    uvec2 environmentGrid;   // its sampling grid: columns, rows (render/EnvironmentSampling.h)
+    uint environmentBlock;   // bilinear cells a side per grid cell
+    // The map -> world rotation's columns: world = x * axisX + y * axisY + z * axisZ.
+    vec3 environmentAxisX;
+    vec3 environmentAxisY;
+    vec3 environmentAxisZ;
 };
 
 /// Per-batch values (push constants), pushed once per submission: lavapipe

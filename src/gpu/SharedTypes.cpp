@@ -52,7 +52,7 @@ constexpr bool bindingsDistinct()
     return true;
 }
 static_assert(bindingsDistinct(), "shared/Bindings.h: every scene array needs its own binding below BINDING_COUNT");
-static_assert(sizeof(SceneUniforms) == 104 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
+static_assert(sizeof(SceneUniforms) == 168 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
               "SceneUniforms holds one count per shape and light kind");
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
@@ -71,5 +71,7 @@ static_assert(sizeof(MomentPixel) == 36);
 static_assert(offsetof(SceneUniforms, tileStride) == 68 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT));
 static_assert(offsetof(Material, fresnel) == 48 && offsetof(Material, eta) == 64 && offsetof(Material, k) == 80);
 static_assert(sizeof(TriangleLight) == 40 && offsetof(TriangleLight, emitter) == 12);
+static_assert(sizeof(DirectionalLight) == 32 && offsetof(DirectionalLight, sin2Alpha) == 28);
+static_assert(sizeof(SpotLight) == 44 && offsetof(SpotLight, axis) == 32);
 
 } // namespace vkrt::gpu

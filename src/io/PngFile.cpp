@@ -81,13 +81,27 @@ Image readPng(const std::filesystem::path& path)
     return image;
 }
 
+Image readRadianceHdr(const std::filesystem::path& path)
+{
+    int width = 0, height = 0, channels = 0;
+    std::unique_ptr<float, void (*)(void*)> pixels(stbi_loadf(path.c_str(), &width, &height, &channels, 3),
+                                                   stbi_image_free);
+    if (!pixels || !stbi_is_hdr(path.c_str()))
+        throw InputError(path.string() + ": cannot read Radiance HDR: " +
+                         (pixels ? "not an HDR file" : stbi_failure_reason() ? stbi_failure_reason() : "?"));
+    Image image{uint32_t(width), uint32_t(height)};
+    std::copy_n(pixels.get(), image.rgb.size(), image.rgb.begin());
+    return image;
+}
+
 Image readRgbImage(const std::filesystem::path& path)
 {
     std::string extension = path.extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (extension == ".exr") return readExr(path).image;
     if (extension == ".png") return readPng(path);
-    throw InputError(path.string() + ": unsupported image type (expected .exr or .png)");
+    if (extension == ".hdr") return readRadianceHdr(path);
+    throw InputError(path.string() + ": unsupported image type (expected .exr, .hdr or .png)");
 }
 
 } // namespace vkrt

@@ -27,7 +27,10 @@ float srgb8ToLinear(uint8_t value);
 /// Reads an 8-bit sRGB PNG as linear RGB; throws InputError naming the path.
 Image readPng(const std::filesystem::path& path);
 
-/// Reads .exr (linear) or .png (sRGB) by extension; throws InputError naming the path.
+/// Reads a Radiance RGBE (.hdr) file as linear RGB; throws InputError naming the path.
+Image readRadianceHdr(const std::filesystem::path& path);
+
+/// Reads .exr or .hdr (linear) or .png (sRGB) by extension; throws InputError naming the path.
 Image readRgbImage(const std::filesystem::path& path);
 
 } // namespace vkrt

@@ -71,3 +71,43 @@ std::array<Image, 6> loadCubemapFaces(const Cubemap& cubemap)
 }
 
 } // namespace vkrt
+
+namespace vkrt {
+
+namespace {
+
+void checkLatLongSize(const std::string& label, ImageExtent size)
+{
+    if (size.width < 2 || size.height < 2)
+        throw InputError(label + ": a lat-long map needs at least 2x2 texels, got " + size.str());
+    if (size.width > kMaxLatLongSide || size.height > kMaxLatLongSide || size.pixels() > ImageLimits::maxPixels)
+        throw InputError(label + ": a lat-long map may have at most " + std::to_string(kMaxLatLongSide) +
+                         " texels a side and " + std::to_string(ImageLimits::maxPixels) + " in all, got " +
+                         size.str());
+}
+
+} // namespace
+
+Image loadEnvironmentMap(const EnvironmentMap& map)
+{
+    const std::string label = map.where.str() + ": background.environment.file: " + map.path;
+    Image image;
+    try {
+        checkLatLongSize(label, imageFileExtent(map.path));
+        image = readRgbImage(map.path);
+    } catch (const InputError& e) {
+        if (std::string(e.what()).starts_with(label)) throw;
+        throw InputError(map.where.str() + ": background.environment.file: " + e.what());
+    }
+    checkLatLongSize(label, {image.width, image.height}); // the decoder must agree with the header
+    for (size_t i = 0; i < image.rgb.size(); ++i) {
+        const float value = float(double(image.rgb[i]) * map.scale[int(i % 3)]);
+        if (!std::isfinite(image.rgb[i]) || image.rgb[i] < 0.0f || !std::isfinite(value))
+            throw InputError(label + ": contains a negative or non-finite value" +
+                             (std::isfinite(image.rgb[i]) ? " once scaled" : ""));
+        image.rgb[i] = value;
+    }
+    return image;
+}
+
+} // namespace vkrt

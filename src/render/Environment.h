@@ -19,3 +19,18 @@ constexpr uint32_t kMaxCubeFaceSide = 4096;
 std::array<Image, 6> loadCubemapFaces(const Cubemap& cubemap);
 
 } // namespace vkrt
+
+namespace vkrt {
+
+/// A lat-long map's sides: at least 2 x 2 texels (its bilinear cells need
+/// two rows), at most 16384 wide (Vulkan's guaranteed 2D image side is
+/// smaller; lavapipe's and desktop GPUs' are 16384) and ImageLimits' pixels.
+constexpr uint32_t kMaxLatLongSide = 16384;
+
+/// Reads the scene's lat-long map (.exr or .hdr) times its scale; throws
+/// InputError naming the scene location and the file when it cannot be
+/// read, is too small or too large (from its header, before decoding), or
+/// holds (or scales to) a negative or non-finite value.
+Image loadEnvironmentMap(const EnvironmentMap& map);
+
+} // namespace vkrt

@@ -410,6 +410,8 @@ void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
     u.cameraForward = toFloat(forward);
     u.width = camera.width;
     u.height = camera.height;
+    u.apertureRadius = float(camera.apertureRadius);
+    u.focusDistance = float(camera.resolvedFocusDistance());
 }
 
 } // namespace
@@ -590,6 +592,12 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
     convertCamera(scene.camera, u);
     u.flags = settings.jitter ? gpu::RENDER_FLAG_JITTER : 0u;
     u.backgroundColor = toFloat(scene.background.color);
+    if (scene.background.environment) {
+        const glm::dmat3& rotation = scene.background.environment->rotation;
+        u.environmentAxisX = toFloat(rotation[0]);
+        u.environmentAxisY = toFloat(rotation[1]);
+        u.environmentAxisZ = toFloat(rotation[2]);
+    }
     u.maxDepth = uint32_t(scene.render.maxDepth);
 #define VKRT_COUNT_RECORDS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     u.field##Count = uint32_t(data.array.size());

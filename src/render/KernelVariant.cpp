@@ -56,7 +56,9 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
         {meshes && f.fileMaterials, "VKRT_HAS_MESH_MATERIALS", int(gpu::BINDING_MESH_MATERIALS), "file-materials"});
     // The rough plastics' coating tables come with the plastic kind.
     list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
+    list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});
     list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});
+    list.push_back({f.latLong, "VKRT_HAS_LATLONG", int(gpu::BINDING_ENVIRONMENT), "lat-long"});
     list.push_back({f.environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
                     "environment-sampling"});
     list.push_back({v.variance, "VKRT_VARIANCE", int(gpu::BINDING_MOMENTS), "variance"});

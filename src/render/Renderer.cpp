@@ -197,11 +197,13 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
     bool glassShadows = whitted && featuresOf(scene).has(MaterialType::Dielectric);
     uint64_t shadowQuery = glassShadows ? gpu::MAX_SHADOW_CROSSINGS * (1 + hittables) : hittables;
     uint64_t lights = sampledLightCount(scene);
-    uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery);
+    // A ray that escapes looks for every sun (lib/lights/directional.glsl).
+    uint64_t escape = scene.directionalLights.size();
+    uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery) + escape;
     uint64_t depth = uint64_t(scene.render.maxDepth);
     if (whitted) return depth * perDepth;
     // Cubemap sampling: a binary search over 6 N^2 texels and a shadow query.
-    uint64_t environment = scene.background.cubemap ? 1 + 32 + hittables : 0;
+    uint64_t environment = scene.background.cubemap || scene.background.environment ? 1 + 32 + hittables : 0;
     return depth * (perDepth + environment) + 1 + hittables;
 }
 
@@ -234,8 +236,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
               MemoryUse::Device),
       m_frameRun(context, sizeof(gpu::FrameRun), kStorage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Device),
       m_kernel(context, m_compiled.spirv, checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants),
-               m_bands.count),
-      m_cubemap(scene.background.cubemap)
+               m_bands.count)
 {
     m_accumulation.clear(context);
     m_stats.clear(context);
@@ -291,18 +292,38 @@ void Renderer::uploadMeshBuffers()
 void Renderer::bindEnvironment()
 {
     if (!m_kernel.uses(gpu::BINDING_ENVIRONMENT)) return;
+    if (m_variant.features.latLong) bindLatLongMap();
+    else bindCubemap();
+}
+
+void Renderer::bindCubemap()
+{
     // The uber kernel samples a cubemap even for a constant background:
     // give it a 1x1 cube of that colour.
     std::array<Image, 6> faces;
-    if (m_cubemap) faces = loadCubemapFaces(*m_cubemap);
+    if (m_scene.background.cubemap) faces = loadCubemapFaces(*m_scene.background.cubemap);
     else faces.fill(constantFace(m_data.uniforms.backgroundColor));
     m_environment.emplace(m_context, faces);
     m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
-    m_environmentSize = faces[0].width;
+    m_environmentSizes.cubeSize = faces[0].width;
     if (m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) {
         m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), kStorage));
         m_kernel.bind(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
     }
+}
+
+void Renderer::bindLatLongMap()
+{
+    const Image map = loadEnvironmentMap(*m_scene.background.environment);
+    m_environment.emplace(m_context, map);
+    m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
+    m_environmentSizes.latLongExtent = {map.width, map.height};
+    if (!m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) return;
+    const LatLongDistribution distribution = latLongDistribution(map);
+    m_environmentSizes.latLongGrid = {distribution.columns, distribution.rows};
+    m_environmentSizes.latLongBlock = distribution.block;
+    m_environmentCdf.emplace(makeBufferFrom(m_context, distribution.cdf, kStorage));
+    m_kernel.bind(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
 }
 
 void Renderer::uploadSceneBuffers()
@@ -315,7 +336,10 @@ void Renderer::uploadSceneBuffers()
     };
     m_sceneBuffers.clear();
     m_sceneBuffers.reserve(gpu::BINDING_COUNT); // bind() keeps references: no reallocation
-    m_data.uniforms.environmentSize = m_environmentSize;
+    m_data.uniforms.environmentSize = m_environmentSizes.cubeSize;
+    m_data.uniforms.environmentExtent = m_environmentSizes.latLongExtent;
+    m_data.uniforms.environmentGrid = m_environmentSizes.latLongGrid;
+    m_data.uniforms.environmentBlock = m_environmentSizes.latLongBlock;
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
 #define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \

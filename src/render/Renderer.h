@@ -4,7 +4,7 @@
 // A dispatch runs several frames per invocation (RenderOptions::samplesPerInvocation).
 #include "gpu/Buffer.h"
 #include "gpu/ComputeKernel.h"
-#include "gpu/CubeTexture.h"
+#include "gpu/EnvironmentTexture.h"
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
 #include "render/GpuScene.h"
@@ -112,10 +112,14 @@ private:
     Buffer m_frameRun; ///< gpu::FrameRun of the run being dispatched
     std::optional<BandedBuffer> m_moments;
     ComputeKernel m_kernel;
-    std::optional<Cubemap> m_cubemap;
-    std::optional<CubeTexture> m_environment;
+    std::optional<EnvironmentTexture> m_environment;
     std::optional<Buffer> m_environmentCdf;
-    uint32_t m_environmentSize = 0;
+    /// The map's sizes, which every upload of the uniforms carries.
+    struct EnvironmentSizes {
+        uint32_t cubeSize = 0;
+        glm::uvec2 latLongExtent{0}, latLongGrid{0};
+        uint32_t latLongBlock = 1;
+    } m_environmentSizes;
     uint32_t m_frames = 0;
 
     FrameSettings frameSettings() const { return FrameSettings{m_options.jitter, m_bands.rowsPerBand}; }
@@ -123,6 +127,8 @@ private:
     Image varianceOfMeanFromBatches() const;
     Image meanOfBatchMeans() const;
     void bindEnvironment();
+    void bindCubemap();
+    void bindLatLongMap();
     void uploadSceneBuffers();
     void uploadMeshBuffers();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;

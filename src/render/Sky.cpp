@@ -2,7 +2,9 @@
 
 #include "render/CubeFaces.h"
 
+#include <algorithm>
 #include <cmath>
+#include <glm/gtc/constants.hpp>
 
 namespace vkrt {
 
@@ -43,6 +45,31 @@ std::array<Image, 6> renderSkyFaces(const SkyParameters& sky, uint32_t size)
         }
     }
     return faces;
+}
+
+Image renderSkyLatLong(const SkyParameters& sky, uint32_t width)
+{
+    constexpr int kSubsamples = 4;
+    const uint32_t height = width / 2 + 1;
+    Image map(width, height);
+    for (uint32_t y = 0; y < height; ++y) {
+        for (uint32_t x = 0; x < width; ++x) {
+            glm::dvec3 sum(0.0);
+            for (int j = 0; j < kSubsamples; ++j) {
+                for (int i = 0; i < kSubsamples; ++i) {
+                    double u = (x + (i + 0.5) / kSubsamples) / width;
+                    double v = std::clamp((y + (j + 0.5) / kSubsamples - 0.5) / (height - 1), 0.0, 1.0);
+                    double phi = 2.0 * glm::pi<double>() * u, theta = glm::pi<double>() * v;
+                    sum += skyRadiance(sky, {std::sin(phi) * std::sin(theta), std::cos(theta),
+                                             -std::cos(phi) * std::sin(theta)});
+                }
+            }
+            glm::dvec3 mean = sum / double(kSubsamples * kSubsamples);
+            float* texel = map.at(x, y);
+            texel[0] = float(mean.x), texel[1] = float(mean.y), texel[2] = float(mean.z);
+        }
+    }
+    return map;
 }
 
 } // namespace vkrt

@@ -31,4 +31,10 @@ glm::dvec3 skyRadiance(const SkyParameters& sky, const glm::dvec3& d);
 /// a 4x4 grid of directions inside it (so the small sun is not aliased away).
 std::array<Image, 6> renderSkyFaces(const SkyParameters& sky, uint32_t size);
 
+/// A width x (width / 2 + 1) lat-long map in the layout of [background.environment]
+/// (src/scene/Scene.h, EnvironmentMap: column i at u = (i + 0.5) / width, row j
+/// at v = j / (height - 1)), each texel the radiance averaged over a 4x4 grid
+/// of directions in the texel-sized patch around it.
+Image renderSkyLatLong(const SkyParameters& sky, uint32_t width);
+
 } // namespace vkrt

@@ -39,6 +39,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.textures = true;
     all.normalMaps = true;
     all.fileMaterials = true;
+    all.thinLens = true;
     all.integrator = integrator;
     return all;
 }
@@ -80,8 +81,12 @@ FeatureSet featuresOf(const Scene& scene)
     for (ShapeKind kind : kAllShapeKinds) set.shapes[size_t(kind)] = scene.count(kind) > 0;
     for (LightKind kind : kAllLightKinds) set.lights[size_t(kind)] = scene.count(kind) > 0;
     set.cubemap = scene.background.cubemap.has_value();
-    set.environmentSampling = set.cubemap && scene.render.integrator == Integrator::Path;
+    set.latLong = scene.background.environment.has_value();
+    // The Whitted integrator has always seen a cubemap only where its rays
+    // escape; a lat-long map (often with a small bright sun) is sampled by both.
+    set.environmentSampling = (set.cubemap && scene.render.integrator == Integrator::Path) || set.latLong;
     set.integrator = scene.render.integrator;
+    set.thinLens = scene.camera.thinLens();
     for (const TriangleLight& light : scene.triangleLights) set.emitters = set.emitters || emits(light);
     for (const Mesh& mesh : scene.meshes) {
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();

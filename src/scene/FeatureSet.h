@@ -15,12 +15,14 @@ struct FeatureSet {
     std::array<bool, kLightKindCount> lights{};           ///< indexed by LightKind
     std::array<bool, kMaterialKindCount> materialTypes{}; ///< indexed by MaterialType
     bool cubemap = false;
-    bool environmentSampling = false; ///< importance-sample the cubemap (path integrator)
+    bool latLong = false;             ///< a lat-long environment map
+    bool environmentSampling = false; ///< importance-sample the map (cubemap: path integrator only)
     bool meshNormals = false;         ///< some mesh has per-vertex shading normals
     bool emitters = false;            ///< some triangle light or mesh emits (the emitters array: shared/SceneTypes.h)
     bool textures = false;            ///< some material in use has a texture
     bool normalMaps = false;          ///< ... a normal map
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
+    bool thinLens = false;            ///< the camera has an aperture (depth of field)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).

@@ -40,7 +40,7 @@ struct RenderSettings {
     int maxDepth = 5; ///< longest path (camera ray = depth 1)
 };
 
-/// Pinhole camera; fovY is the full vertical field of view in degrees.
+/// Pinhole or thin-lens camera; fovY is the full vertical field of view in degrees.
 struct Camera {
     glm::dvec3 eye{0, 0, 0};
     glm::dvec3 target{0, 0, -1};
@@ -48,6 +48,14 @@ struct Camera {
     double fovY = 45.0;
     uint32_t width = 640;
     uint32_t height = 480;
+    /// Thin lens (Mitsuba 3's `thinlens`): the lens radius (0: a pinhole) and
+    /// the distance from the eye to the plane in focus, along the viewing
+    /// direction (unset: the distance to `target`, which moves with it).
+    double apertureRadius = 0.0;
+    std::optional<double> focusDistance;
+
+    bool thinLens() const { return apertureRadius > 0.0; }
+    double resolvedFocusDistance() const;
 };
 
 // ------------------------------------------------ kinds (shared/Kinds.h)
@@ -187,6 +195,11 @@ struct Material {
     bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
 };
 
+inline double Camera::resolvedFocusDistance() const
+{
+    return focusDistance.value_or(glm::length(target - eye));
+}
+
 inline bool Material::hasTextures() const
 {
     for (const auto& t : textures)
@@ -250,6 +263,27 @@ struct TriangleLight {
     bool twoSided = false;
 };
 
+/// A light from infinitely far away in one direction (a sun): `direction` is
+/// where its light travels (unit); `irradiance` is per channel on a surface
+/// facing it (W/m^2); `angle` is its apparent diameter in degrees, 0 for a
+/// delta light, else a disk of uniform radiance (a soft sun, sampled as a cone).
+struct DirectionalLight {
+    glm::dvec3 direction;
+    Color irradiance;
+    double angle = 0.0;
+};
+
+/// A spot light: a point light at `position` shining along unit `direction`,
+/// `intensity` (W/sr) on its axis, falling off between the cone half-angles
+/// (degrees) as glTF's KHR_lights_punctual says; inner == outer is a hard edge.
+struct SpotLight {
+    glm::dvec3 position;
+    glm::dvec3 direction;
+    Color intensity;
+    double innerConeAngle = 0.0;
+    double outerConeAngle = 45.0;
+};
+
 /// Six cubemap faces, paths resolved relative to the scene file.
 struct Cubemap {
     /// +x, -x, +y, -y, +z, -z (Vulkan cube face order)
@@ -257,9 +291,22 @@ struct Cubemap {
     SourceLocation where;
 };
 
+/// A lat-long (equirectangular) environment map, Mitsuba 3's `envmap`
+/// convention: column i at u = (i + 0.5) / width, row j at v = j / (height -
+/// 1) (row 0 looks up, +y), bilinear between texels; the map direction at
+/// (u, v) is (sin phi sin theta, cos theta, -cos phi sin theta), phi = 2 pi u,
+/// theta = pi v, and `rotation` turns it into the world's.
+struct EnvironmentMap {
+    std::string path; ///< .exr or .hdr, resolved relative to the scene file
+    Color scale{1.0};
+    glm::dmat3 rotation{1.0};
+    SourceLocation where; ///< the [background.environment] table
+};
+
 struct Background {
-    Color color{0.0};               ///< constant radiance when there is no cubemap
+    Color color{0.0};               ///< constant radiance when there is no map
     std::optional<Cubemap> cubemap; ///< environment radiance from six faces
+    std::optional<EnvironmentMap> environment; ///< ... or from a lat-long map
 };
 
 struct Scene {

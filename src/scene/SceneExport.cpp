@@ -31,6 +31,13 @@ Json rows(const glm::dmat4& m)
     return out;
 }
 
+Json rows(const glm::dmat3& m)
+{
+    Json out = Json::array();
+    for (int r = 0; r < 3; ++r) out.push_back(Json::array({m[0][r], m[1][r], m[2][r]}));
+    return out;
+}
+
 Json bounds(const Aabb& box) { return {{"min", vec(box.lower)}, {"max", vec(box.upper)}}; }
 
 /// Absolute and without `.` or `..` steps; symlinks are kept (the file vkrt opened by that name).
@@ -322,6 +329,20 @@ Json record(const Mesh& m)
 
 Json record(const PointLight& l) { return {{"position", vec(l.position)}, {"intensity", vec(l.intensity)}}; }
 
+Json record(const DirectionalLight& l)
+{
+    return {{"direction", vec(l.direction)}, {"irradiance", vec(l.irradiance)}, {"angle", l.angle}};
+}
+
+Json record(const SpotLight& l)
+{
+    return {{"position", vec(l.position)},
+            {"direction", vec(l.direction)},
+            {"intensity", vec(l.intensity)},
+            {"inner_cone_angle", l.innerConeAngle},
+            {"outer_cone_angle", l.outerConeAngle}};
+}
+
 Json record(const TriangleLight& l)
 {
     return {{"vertices", points(l.vertices)}, {"radiance", vec(l.radiance)}, {"two_sided", l.twoSided}};
@@ -358,8 +379,14 @@ Json lights(const Scene& scene)
 
 Json camera(const Camera& c)
 {
-    return {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)},
-            {"fov", c.fovY},     {"width", c.width},        {"height", c.height}};
+    return {{"eye", vec(c.eye)},
+            {"target", vec(c.target)},
+            {"up", vec(c.up)},
+            {"fov", c.fovY},
+            {"width", c.width},
+            {"height", c.height},
+            {"aperture_radius", c.apertureRadius},
+            {"focus_distance", c.resolvedFocusDistance()}};
 }
 
 Json renderSettings(const RenderSettings& r)
@@ -369,11 +396,15 @@ Json renderSettings(const RenderSettings& r)
 
 Json background(const Background& b)
 {
-    Json out = {{"color", vec(b.color)}, {"cubemap", nullptr}};
+    Json out = {{"color", vec(b.color)}, {"cubemap", nullptr}, {"environment", nullptr}};
     if (b.cubemap) {
         static constexpr const char* faces[] = {"px", "nx", "py", "ny", "pz", "nz"};
         for (size_t i = 0; i < 6; ++i) out["cubemap"][faces[i]] = absolutePath(b.cubemap->facePaths[i]);
     }
+    if (b.environment)
+        out["environment"] = {{"file", absolutePath(b.environment->path)},
+                              {"scale", vec(b.environment->scale)},
+                              {"matrix", rows(b.environment->rotation)}};
     return out;
 }
 

@@ -35,6 +35,18 @@ std::optional<std::string> upProblem(const Camera& camera)
     return "up: must not be parallel to the view direction (target - eye)";
 }
 
+std::optional<std::string> lensProblem(const Camera& camera)
+{
+    if (!(camera.apertureRadius >= 0 && std::isfinite(camera.apertureRadius)))
+        return "aperture_radius: must be finite and at least 0, got " + formatNumber(camera.apertureRadius);
+    if (camera.focusDistance && !(*camera.focusDistance > 0 && std::isfinite(*camera.focusDistance)))
+        return "focus_distance: must be finite and positive, got " + formatNumber(*camera.focusDistance);
+    // The default, the distance to the target, can overflow for far-apart finite points.
+    if (camera.thinLens() && !std::isfinite(camera.resolvedFocusDistance()))
+        return std::string("focus_distance: the distance from eye to target overflows; set focus_distance");
+    return std::nullopt;
+}
+
 } // namespace
 
 bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -82,6 +94,7 @@ std::optional<std::string> cameraProblem(const Camera& camera)
     if (auto problem = upProblem(camera)) return problem;
     if (!(camera.fovY > 0 && camera.fovY < 180))
         return "fov: must be strictly between 0 and 180 degrees, got " + formatNumber(camera.fovY);
+    if (auto problem = lensProblem(camera)) return problem;
     if (auto problem = sideProblem(camera.width)) return "width: " + *problem;
     if (auto problem = sideProblem(camera.height)) return "height: " + *problem;
     if (auto problem = pixelCountProblem(camera.width, camera.height)) return "height: " + *problem;

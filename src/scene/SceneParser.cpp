@@ -71,7 +71,8 @@ RenderSettings readRender(const TableField& table)
 
 // -------------------------------------------------------------------- camera
 
-constexpr std::array<std::string_view, 6> cameraKeys{"eye", "target", "up", "fov", "width", "height"};
+constexpr std::array<std::string_view, 8> cameraKeys{"eye",    "target", "up",          "fov",
+                                                    "width", "height", "aperture_radius", "focus_distance"};
 
 glm::dvec3 readTarget(const Field& field, const glm::dvec3& eye)
 {
@@ -116,6 +117,8 @@ Camera readCamera(const TableField& table)
     camera.up = readUp(table, *normalized(difference(camera.eye, camera.target)));
     camera.fovY = readFov(table.require("fov"));
     readResolution(table, camera);
+    camera.apertureRadius = readOr(table, "aperture_radius", 0.0, readNonNegative);
+    if (const auto focus = table.find("focus_distance")) camera.focusDistance = readPositive(*focus);
     // The same rules that check overrides (SceneOverrides.h): the two can never disagree.
     if (const auto problem = cameraProblem(camera)) table.field().fail(*problem);
     return camera;
@@ -448,7 +451,8 @@ void readLight(const TableField& table, ParseContext& context)
 
 // ---------------------------------------------------------------- background
 
-constexpr std::array<std::string_view, 2> backgroundKeys{"color", "cubemap"};
+constexpr std::array<std::string_view, 3> backgroundKeys{"color", "cubemap", "environment"};
+constexpr std::array<std::string_view, 3> environmentKeys{"file", "scale", "rotate"};
 /// Vulkan cube face order, matching Cubemap::facePaths.
 constexpr std::array<std::string_view, 6> faceKeys{"px", "nx", "py", "ny", "pz", "nz"};
 
@@ -476,17 +480,47 @@ Cubemap readCubemap(const TableField& table)
     return cubemap;
 }
 
+EnvironmentMap readEnvironmentMap(const TableField& table)
+{
+    table.rejectUnknownKeys(environmentKeys);
+    EnvironmentMap map;
+    map.where = table.field().location();
+    const Field fileField = table.require("file");
+    const fs::path path = readPath(fileField);
+    const std::string extension = lowercase(path.extension().string());
+    if (extension != ".exr" && extension != ".hdr")
+        fileField.fail("an environment map must be a lat-long .exr or .hdr file, got " + quote(path.string()));
+    checkRegularFile(fileField, path);
+    map.path = path.string();
+    map.scale = readOr(table, "scale", map.scale, readRadiance);
+    map.rotation = glm::dmat3(readOr(table, "rotate", glm::dmat4(1.0), readRotation));
+    return map;
+}
+
+/// The one key of a background that says where its radiance comes from.
+void refuseSecondSource(const TableField& table, const Field& second, std::string_view secondName)
+{
+    for (std::string_view first : {"color", "cubemap"}) {
+        if (first == secondName) return;
+        if (const auto other = table.find(first))
+            second.fail("cannot be combined with background." + std::string(first) + " (line " +
+                        std::to_string(other->location().line) + "); use one or the other");
+    }
+}
+
 Background readBackground(const TableField& table)
 {
     table.rejectUnknownKeys(backgroundKeys);
     Background background;
     background.color = readOr(table, "color", Color(0.0), readRadiance);
-    const std::optional<Field> cubemap = table.find("cubemap");
-    if (!cubemap) return background;
-    if (const auto color = table.find("color"))
-        cubemap->fail("cannot be combined with background.color (line " + std::to_string(color->location().line) +
-                      "); use one or the other");
-    background.cubemap = readCubemap(TableField(*cubemap));
+    if (const auto cubemap = table.find("cubemap")) {
+        refuseSecondSource(table, *cubemap, "cubemap");
+        background.cubemap = readCubemap(TableField(*cubemap));
+    }
+    if (const auto environment = table.find("environment")) {
+        refuseSecondSource(table, *environment, "environment");
+        background.environment = readEnvironmentMap(TableField(*environment));
+    }
     return background;
 }
 

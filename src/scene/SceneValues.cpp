@@ -1,6 +1,9 @@
 // Value readers the scene format shares (scene/SceneValues.h).
 #include "scene/SceneValues.h"
 
+#include "scene/SceneOverrides.h"
+
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
 namespace vkrt {
@@ -14,6 +17,18 @@ double readIor(const Field& field)
     if (value > SceneLimits::maxIor)
         field.fail("must be <= " + formatNumber(SceneLimits::maxIor) + ", got " + formatNumber(value));
     return value;
+}
+
+glm::dmat4 readRotation(const Field& field)
+{
+    static constexpr std::array<std::string_view, 2> rotateKeys{"axis", "angle"};
+    const TableField table(field);
+    table.rejectUnknownKeys(rotateKeys);
+    const Field axisField = table.require("axis");
+    const std::optional<glm::dvec3> axis = normalized(readVector(axisField));
+    if (!axis) axisField.fail("must not be zero-length");
+    const double angle = readNumber(table.require("angle"));
+    return glm::rotate(glm::dmat4(1.0), glm::radians(angle), *axis);
 }
 
 std::array<glm::dvec3, 3> readVertices(const Field& field) { return readTriple(field, "points", readVector); }

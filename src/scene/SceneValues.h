@@ -24,6 +24,10 @@ Color readColor(const Field& field, ColorRange range);
 Color readUnitColor(const Field& field);
 Color readRadiance(const Field& field);
 
+/// `rotate = { axis = [x, y, z], angle = degrees }`, right-handed about the
+/// axis (meshes, the environment map).
+glm::dmat4 readRotation(const Field& field);
+
 /// Fails at `field` unless `path` names an existing regular file.
 void checkRegularFile(const Field& field, const std::filesystem::path& path);
 

@@ -123,6 +123,13 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, cameraMedia),
         BLOCK_MEMBER(u, SceneUniforms, emitterCount),
         BLOCK_MEMBER(u, SceneUniforms, topNodeCount),
+        BLOCK_MEMBER(u, SceneUniforms, apertureRadius),
+        BLOCK_MEMBER(u, SceneUniforms, focusDistance),
+        BLOCK_MEMBER(u, SceneUniforms, environmentExtent),
+        BLOCK_MEMBER(u, SceneUniforms, environmentGrid),
+        BLOCK_MEMBER(u, SceneUniforms, environmentBlock),
+        BLOCK_MEMBER(u, SceneUniforms, environmentAxisX),
+        BLOCK_MEMBER(u, SceneUniforms, environmentAxisZ),
         BLOCK_MEMBER(frame, FrameConstants, firstFrame),
         BLOCK_MEMBER(frame, FrameConstants, seed),
     };

@@ -38,7 +38,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::array<std::string_view, 2> rotateKeys{"axis", "angle"};
 
 std::vector<uint32_t> fileMaterialsOf(const MeshGeometry& geometry, const Field& materialField, ParseContext& context)
 {
@@ -65,18 +64,6 @@ glm::dvec3 readScale(const Field& field)
     for (int axis = 0; axis < 3; ++axis)
         if (scale[axis] == 0.0) field.fail("must not be zero (it would flatten the mesh)");
     return scale;
-}
-
-/// `rotate = { axis = [x, y, z], angle = degrees }`, right-handed about the axis.
-glm::dmat4 readRotation(const Field& field)
-{
-    const TableField table(field);
-    table.rejectUnknownKeys(rotateKeys);
-    const Field axisField = table.require("axis");
-    const std::optional<glm::dvec3> axis = normalized(readVector(axisField));
-    if (!axis) axisField.fail("must not be zero-length");
-    const double angle = readNumber(table.require("angle"));
-    return glm::rotate(glm::dmat4(1.0), glm::radians(angle), *axis);
 }
 
 /// `matrix`: four rows of four numbers, an invertible affine transform.

@@ -1,0 +1,122 @@
+// Directional lights (`type = "directional"`, a sun): infinitely far away,
+// so never hit by a ray that has a surface to find (no records to
+// intersect). A delta sun is sampled on its own; a soft sun (a cone of
+// directions) is sampled uniformly in its cone and also found by rays that
+// escape towards it (directionalOnEscape), weighted against BSDF sampling
+// with the power heuristic in the path integrator.
+// Included twice: by lib/scene.glsl for what rays hit, and by lib/lights.glsl
+// (VKRT_LIGHT_SAMPLING) for the sampling, which needs the BSDFs and media.
+#ifndef VKRT_LIGHT_DIRECTIONAL_HITS
+#define VKRT_LIGHT_DIRECTIONAL_HITS
+
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+VKRT_SCENE_ARRAY(BINDING_DIRECTIONAL_LIGHTS, DirectionalLightBlock, DirectionalLight, directionalLights,
+                 UNIFORM_DIRECTIONAL_LIGHTS)
+#endif
+
+bool hitOneDirectionalLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }
+VKRT_NO_RECORDS(DirectionalLight)
+void describeDirectionalLight(Ray r, HitId id, inout SurfaceHit hit) {}
+
+#endif
+
+#if defined(VKRT_LIGHT_SAMPLING) && !defined(VKRT_LIGHT_DIRECTIONAL_SAMPLING)
+#define VKRT_LIGHT_DIRECTIONAL_SAMPLING
+
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+// Solid-angle density of uniform sampling of a soft sun's cone.
+float sunConePdf(DirectionalLight light) { return 1.0 / (2.0 * PI * light.oneMinusCos); }
+
+// Whether `dir` lies in a soft sun's cone: sin^2 of the angle to its axis,
+// from a cross product (accurate for small angles, where 1 - cos is not).
+bool insideSunCone(DirectionalLight light, vec3 dir)
+{
+    vec3 c = cross(dir, light.toLight);
+    return light.oneMinusCos > 0.0 && dot(dir, light.toLight) > 0.0 && dot(c, c) <= light.sin2Alpha;
+}
+
+// A direction uniform in the cone of half angle alpha around `axis`, with
+// t = 1 - cos(theta) drawn uniformly in [0, 1 - cos(alpha)].
+vec3 sampleSunCone(DirectionalLight light, vec2 rnd)
+{
+    float t = rnd.x * light.oneMinusCos;
+    float sinTheta = sqrt(max(0.0, t * (2.0 - t)));
+    float phi = 2.0 * PI * rnd.y;
+    return fromLocal(vec3(sinTheta * cos(phi), sinTheta * sin(phi), 1.0 - t), light.toLight);
+}
+
+// One sun's light at a surface point before visibility: f * E * cos for a
+// delta sun, f * L * cos / pdf (MIS-weighted in the path integrator) for a
+// direction drawn in a soft sun's cone. The shadow ray's target is far along
+// the direction (FAR_LIGHT_DISTANCE).
+LightSample sampleDirectionalLight(DirectionalLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo,
+                                   vec3 origin, vec2 rnd)
+{
+    bool soft = light.oneMinusCos > 0.0;
+    vec3 wi = soft ? sampleSunCone(light, rnd) : light.toLight;
+    vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
+    float cosTheta = dot(ns, wi);
+    if (cosTheta <= 0.0)
+        return LightSample(vec3(0.0), target);
+    vec3 contribution = evalBsdf(m, ns, wo, wi) * light.radiance * cosTheta;
+    if (soft) {
+        float lightPdf = sunConePdf(light);
+        contribution /= lightPdf;
+#ifdef VKRT_INTEGRATOR_PATH
+        contribution *= powerHeuristic(lightPdf, pdfBsdf(m, ns, wo, wi));
+#endif
+    }
+    return LightSample(contribution, target);
+}
+#endif
+
+// Every sun, each with its shadow ray (the Whitted integrator).
+vec3 directFromDirectionalLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
+                                inout Sampler rng)
+{
+    vec3 radiance = vec3(0.0);
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    for (uint i = 0u; i < u.directionalLightCount; ++i) {
+        ++g_loopIterations;
+        LightSample s = sampleDirectionalLight(directionalLights[i], m, hit, ns, wo, origin, sampleNext2D(rng));
+        if (s.unshadowed != vec3(0.0))
+            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
+    }
+#endif
+    return radiance;
+}
+
+// Every sun as a candidate of the path integrator's one shadow ray.
+void offerDirectionalLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                  inout Sampler rng)
+{
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+    for (uint i = 0u; i < u.directionalLightCount; ++i) {
+        ++g_loopIterations;
+        vec4 u4 = sampleNext4D(rng);
+        offerLightSample(r, sampleDirectionalLight(directionalLights[i], m, hit, ns, wo, origin, u4.xy), u4.z);
+    }
+#endif
+}
+
+// The soft suns a ray that escaped along `dir` sees: each with weight 1 after
+// a specular bounce or from the camera (`specular`), else its MIS weight
+// against the BSDF sample of density bsdfPdf (path integrator).
+vec3 directionalOnEscape(vec3 dir, bool specular, float bsdfPdf)
+{
+    vec3 radiance = vec3(0.0);
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+    for (uint i = 0u; i < u.directionalLightCount; ++i) {
+        ++g_loopIterations;
+        DirectionalLight light = directionalLights[i];
+        if (!insideSunCone(light, dir))
+            continue;
+        float weight = specular ? 1.0 : powerHeuristic(bsdfPdf, sunConePdf(light));
+        radiance += light.radiance * weight;
+    }
+#endif
+    return radiance;
+}
+
+#endif

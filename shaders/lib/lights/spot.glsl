@@ -1,0 +1,77 @@
+// Spot lights (`type = "spot"`): point lights whose intensity falls off away
+// from their axis (glTF KHR_lights_punctual's falloff, shared/SceneTypes.h).
+// No area, so never hit; each is sampled on its own, like a point light.
+// Included twice: by lib/scene.glsl for what rays hit, and by lib/lights.glsl
+// (VKRT_LIGHT_SAMPLING) for the sampling, which needs the BSDFs and media.
+#ifndef VKRT_LIGHT_SPOT_HITS
+#define VKRT_LIGHT_SPOT_HITS
+
+#ifdef VKRT_HAS_SPOT_LIGHTS
+VKRT_SCENE_ARRAY(BINDING_SPOT_LIGHTS, SpotLightBlock, SpotLight, spotLights, UNIFORM_SPOT_LIGHTS)
+#endif
+
+bool hitOneSpotLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }
+VKRT_NO_RECORDS(SpotLight)
+void describeSpotLight(Ray r, HitId id, inout SurfaceHit hit) {}
+
+#endif
+
+#if defined(VKRT_LIGHT_SAMPLING) && !defined(VKRT_LIGHT_SPOT_SAMPLING)
+#define VKRT_LIGHT_SPOT_SAMPLING
+
+#ifdef VKRT_HAS_SPOT_LIGHTS
+// The fraction of the axis intensity emitted towards `toPoint` (unit, from the light).
+float spotFalloff(SpotLight light, vec3 toPoint)
+{
+    float cosAngle = dot(light.axis, toPoint);
+    if (light.falloffScale == 0.0)
+        return cosAngle >= light.cosOuter ? 1.0 : 0.0;
+    float t = clamp((cosAngle - light.cosOuter) * light.falloffScale, 0.0, 1.0);
+    return t * t;
+}
+
+// One spot light: f * I * falloff * cos / d^2, as a point light
+// (lib/lights/point.glsl: geometry from the surface point itself).
+LightSample sampleSpotLight(SpotLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo)
+{
+    vec3 toLight = light.position - hit.position;
+    float distSq = dot(toLight, toLight);
+    vec3 wi = toLight * inversesqrt(distSq);
+    float cosTheta = dot(ns, wi);
+    float falloff = spotFalloff(light, -wi);
+    if (cosTheta <= 0.0 || falloff == 0.0)
+        return LightSample(vec3(0.0), light.position);
+    vec3 f = evalBsdf(m, ns, wo, wi);
+    return LightSample(f * light.intensity * (falloff * cosTheta / distSq), light.position);
+}
+#endif
+
+// Every spot light, each with its shadow ray (the Whitted integrator).
+vec3 directFromSpotLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+{
+    vec3 radiance = vec3(0.0);
+#ifdef VKRT_HAS_SPOT_LIGHTS
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    for (uint i = 0u; i < u.spotLightCount; ++i) {
+        ++g_loopIterations;
+        LightSample s = sampleSpotLight(spotLights[i], m, hit, ns, wo);
+        if (s.unshadowed != vec3(0.0))
+            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
+    }
+#endif
+    return radiance;
+}
+
+// Every spot light as a candidate of the path integrator's one shadow ray.
+void offerSpotLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                           inout Sampler rng)
+{
+#ifdef VKRT_HAS_SPOT_LIGHTS
+    for (uint i = 0u; i < u.spotLightCount; ++i) {
+        ++g_loopIterations;
+        offerLightSample(r, sampleSpotLight(spotLights[i], m, hit, ns, wo), sampleNext1D(rng));
+    }
+#endif
+}
+
+#endif
