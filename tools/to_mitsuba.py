@@ -23,7 +23,9 @@ The conversion follows the semantics of vkrt's path integrator
 
 * camera: `perspective`, vertical `fov`, `look_at(eye, target, up)`, `hdrfilm`
   with a one-pixel `box` reconstruction filter (each sample lands in its own
-  pixel, as in vkrt);
+  pixel, as in vkrt); a camera with aperture_radius > 0 -> `thinlens` with
+  the same aperture_radius and focus_distance (both measure as Mitsuba's: a
+  disc across the viewing direction, the distance to the plane in focus along it);
 * `max_depth`: Mitsuba's max_depth = vkrt's max_depth + 1 (vkrt counts surface
   interactions, Mitsuba counts path segments);
 * lambert -> `diffuse`; mirror (fresnel = "none") -> `conductor`, material
@@ -35,13 +37,21 @@ The conversion follows the semantics of vkrt's path integrator
   them); rough_dielectric -> `roughdielectric`;
   plastic -> `plastic` / `roughplastic` (nonlinear = false). vkrt shades both sides of
   every surface, so diffuse and conductor BSDFs are wrapped in `twosided`;
-* point light -> `point` (intensity, W/sr); triangle light -> a one-triangle
-  mesh with an `area` emitter and a black diffuse BSDF; a two-sided light is two
-  such triangles with opposite windings, the back one displaced by 1e-5 of the
-  light's size behind the front one so that each side of the light hits the
-  triangle that emits towards it;
+* point light -> `point` (intensity, W/sr); directional light with angle 0 ->
+  `directional` (the direction light travels, irradiance); spot light with
+  inner_cone_angle = outer_cone_angle -> `spot` with beam_width =
+  cutoff_angle = the cone angle (a hard cone in both), to_world along its
+  direction; triangle light -> a one-triangle mesh with an `area` emitter and
+  a black diffuse BSDF; a two-sided light is two such triangles with opposite
+  windings, the back one displaced by 1e-5 of the light's size behind the
+  front one so that each side of the light hits the triangle that emits
+  towards it;
 * background colour -> `constant`; cubemap -> an equirectangular `envmap`
   resampled from the six faces with Vulkan's seamless bilinear cube lookup;
+  lat-long environment -> `envmap` of the same file (vkrt's lat-long
+  convention is Mitsuba's), to_world = its rotation, a grey scale as `scale`,
+  a coloured one applied to the image (written as an EXR: Mitsuba's scale is
+  one number);
 * sphere -> `sphere`; box -> `cube` with a scale+translate to_world; triangle ->
   a one-triangle PLY mesh; infinite plane -> a large `rectangle` (an
   approximation: see --plane-half-size).
@@ -72,10 +82,11 @@ The conversion follows the semantics of vkrt's path integrator
   texture coordinates on every face corner can carry textured materials.
 
 What has no Mitsuba equivalent (phong, glossy, pbr, anisotropic conductors, Schlick Fresnel, the Whitted
-integrator, normal maps, plastic roughness textures, different wrap modes for u and v, textured materials on
-spheres, boxes, planes and triangles, whose uvs are vkrt's own, 16-bit PNG textures, whose `linear` flag
-the export does not carry) is refused with an error naming the scene file and the table and key, or the
-object's position in the file.
+integrator, directional lights with an angle (sun discs), spot lights with a soft edge (glTF's falloff
+between the inner and outer cone; Mitsuba's is linear in the angle), normal maps, plastic roughness
+textures, different wrap modes for u and v, textured materials on spheres, boxes, planes and triangles,
+whose uvs are vkrt's own, 16-bit PNG textures, whose `linear` flag the export does not carry) is refused
+with an error naming the scene file and the table and key, or the object's position in the file.
 """
 from __future__ import annotations
 
@@ -610,9 +621,9 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
     """Convert the vkrt scene at `path` to a Mitsuba 3 scene dict.
 
     vkrt (`vkrt`, default: default_vkrt()) reads and validates the scene.
-    Triangles are written as PLY files and a cubemap as an equirectangular EXR
-    into `files_dir` (a temporary folder removed at exit when None); the dict
-    refers to them by absolute path.
+    Triangles are written as PLY files and a cubemap (or a lat-long map with a
+    coloured scale) as an equirectangular EXR into `files_dir` (a temporary
+    folder removed at exit when None); the dict refers to them by absolute path.
     """
     path = Path(path)
     exported = read_scene_json(path, vkrt)
@@ -751,6 +762,9 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                       "for a Mitsuba reference")
     for k, o in enumerate(shapes.get("mesh", [])):
         _check_mesh(_origin(path, o), _shape_where("mesh", k), o)
+    for kind, records_of_kind in lights.items():
+        for k, light in enumerate(records_of_kind):
+            _check_light(_origin(path, light), f"lights.{kind}[{k}]", kind, light)
 
     # Everything above is plain Python: scenes that cannot be converted are
     # refused without Mitsuba.
@@ -842,12 +856,7 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 extent_points += points
             elif kind == "plane":
                 p, nrm = o["point"], o["normal"]  # vkrt's normal is unit already
-                # Orthonormal basis (t, b, n) (Duff et al. 2017).
-                sign = 1.0 if nrm[2] >= 0 else -1.0
-                a = -1.0 / (sign + nrm[2])
-                b = nrm[0] * nrm[1] * a
-                t = [1.0 + sign * nrm[0] * nrm[0] * a, sign * b, -sign * nrm[0]]
-                bt = [b, sign + nrm[1] * nrm[1] * a, -nrm[1]]
+                t, bt = _orthonormal_basis(nrm)
                 hs = plane_half_size
                 m4 = [[t[0] * hs, bt[0] * hs, nrm[0], p[0]], [t[1] * hs, bt[1] * hs, nrm[1], p[1]],
                       [t[2] * hs, bt[2] * hs, nrm[2], p[2]], [0, 0, 0, 1]]
@@ -875,11 +884,18 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 extent_points.append(pos)
             elif kind == "triangle":
                 _triangle_light(scene, light, f"light{n}", mesh, black_bsdf, extent_points, f"{path}: {where}")
+            elif kind == "directional":
+                scene[f"light{n}"] = directional_light(light)
+            elif kind == "spot":
+                scene[f"light{n}"] = spot_light(mi, light)
+                extent_points.append(light["position"])
             else:
                 _fail(path, where, f"light kind '{kind}' has no Mitsuba conversion")
 
     bg = exported["background"]
-    if bg["cubemap"] is not None:
+    if bg.get("environment") is not None:
+        scene["environment"] = environment_map(mi, bg["environment"], files_dir, path)
+    elif bg["cubemap"] is not None:
         faces = load_cubemap_faces(path, [Path(bg["cubemap"][key]) for key in FACE_KEYS])
         n = faces.shape[1]
         # Mitsuba interpolates the equirectangular map bilinearly once more;
@@ -898,8 +914,10 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
     for p in extent_points:
         far = max(far, 2.0 * _norm(_sub(p, eye)))
     scene["integrator"] = {"type": "volpath" if needs_volpath else "path", "max_depth": max_depth + 1}
+    lens = _lens(cam)  # {} for a pinhole camera
     scene["sensor"] = {
-        "type": "perspective",
+        "type": "thinlens" if lens else "perspective",
+        **lens,
         "fov": cam["fov"],
         "fov_axis": "y",
         "near_clip": 1e-3,
@@ -910,6 +928,95 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
         "sampler": {"type": "independent", "sample_count": spp},
     }
     return scene
+
+
+def _orthonormal_basis(n):
+    """Unit vectors t, b with (t, b, n) a right-handed orthonormal basis, for a
+    unit vector n (Duff et al. 2017)."""
+    sign = 1.0 if n[2] >= 0 else -1.0
+    a = -1.0 / (sign + n[2])
+    b = n[0] * n[1] * a
+    return [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]], [b, sign + n[1] * n[1] * a, -n[1]]
+
+
+def _lens(cam: dict) -> dict:
+    """The thin lens keys of the sensor: {} for a pinhole camera (aperture_radius 0,
+    or an export without the key). vkrt's focus_distance is Mitsuba's `thinlens`
+    one: the distance from the eye to the plane in focus along the viewing
+    direction; the aperture is a disc of aperture_radius perpendicular to it."""
+    aperture = float(cam.get("aperture_radius", 0.0))
+    if aperture <= 0:
+        return {}
+    return {"aperture_radius": aperture, "focus_distance": float(cam["focus_distance"])}
+
+
+def _check_light(path, where: str, kind: str, light: dict) -> None:
+    """Lights that Mitsuba cannot render as vkrt does (refused before Mitsuba is needed)."""
+    if kind == "directional" and light["angle"] > 0:
+        _fail(path, f"{where}.angle", f"a directional light with angle = {light['angle']:g} (a disc of that "
+                                      "apparent diameter in degrees) has no Mitsuba equivalent: Mitsuba's "
+                                      "`directional` emitter is a delta light; use angle = 0 for a Mitsuba "
+                                      "reference")
+    if kind == "spot" and light["inner_cone_angle"] != light["outer_cone_angle"]:
+        _fail(path, f"{where}.inner_cone_angle",
+              f"a spot light with inner_cone_angle = {light['inner_cone_angle']:g} and outer_cone_angle = "
+              f"{light['outer_cone_angle']:g} has no Mitsuba equivalent: between the cones vkrt's falloff is "
+              "glTF's (t², t linear in the cosine of the angle), Mitsuba's `spot` ramps linearly in the angle "
+              "itself; only a hard cone (inner_cone_angle = outer_cone_angle) converts")
+
+
+def directional_light(light: dict) -> dict:
+    """A delta directional light (angle 0): Mitsuba's `directional` takes the
+    direction the light travels and the irradiance on a surface facing it, as vkrt."""
+    return {"type": "directional", "direction": [float(x) for x in light["direction"]],
+            "irradiance": _rgb(light["irradiance"])}
+
+
+def spot_light(mi, light: dict) -> dict:
+    """A hard-cone spot light (inner = outer cone angle): Mitsuba's `spot` with
+    beam_width = cutoff_angle is 1 inside the cone and 0 outside (its ramp
+    between them is empty), times the intensity on the axis. It points along its
+    local +z: to_world's columns are a basis around the axis and the position
+    (built in double, not with a float look_at, which would round position +
+    direction)."""
+    p = [float(x) for x in light["position"]]
+    d = [float(x) for x in light["direction"]]
+    length = _norm(d)
+    d = [x / length for x in d]
+    t, b = _orthonormal_basis(d)
+    m4 = [[t[0], b[0], d[0], p[0]], [t[1], b[1], d[1], p[1]], [t[2], b[2], d[2], p[2]], [0, 0, 0, 1]]
+    outer = float(light["outer_cone_angle"])
+    return {"type": "spot", "intensity": _rgb(light["intensity"]), "cutoff_angle": outer, "beam_width": outer,
+            "to_world": _matrix_transform(mi, m4)}
+
+
+def environment_map(mi, env: dict, files_dir: Path, path) -> dict:
+    """A lat-long environment ({file, scale, matrix}) as an `envmap`: vkrt's
+    lat-long convention is that of Mitsuba's envmap with identity to_world, and
+    vkrt's world direction = matrix · map direction is Mitsuba's to_world. A
+    grey scale is the envmap's `scale`; a coloured one (Mitsuba's scale is one
+    number) is applied to the image, written as a float EXR to
+    files_dir/environment_scaled.exr (exact: float32 in, float32 out)."""
+    import numpy as np
+
+    file = Path(env["file"])
+    scale = [float(x) for x in env["scale"]]
+    m = [[float(x) for x in row] for row in env["matrix"]]
+    to_world = _matrix_transform(mi, [m[0] + [0.0], m[1] + [0.0], m[2] + [0.0], [0.0, 0.0, 0.0, 1.0]])
+    if scale[0] == scale[1] == scale[2]:
+        return {"type": "envmap", "filename": str(file), "scale": scale[0], "to_world": to_world}
+    try:
+        bmp = mi.Bitmap(str(file))
+    except Exception as e:  # noqa: BLE001 (Mitsuba raises RuntimeError and friends)
+        _fail(path, "background.environment", f"cannot read '{file}': {e}")
+    # The conversion the envmap plugin makes of a file it loads: linear RGB float.
+    rgb = bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
+    data = np.array(rgb, dtype=np.float32).reshape(rgb.height(), rgb.width(), 3) * np.array(scale, np.float32)
+    out = files_dir / "environment_scaled.exr"
+    mi.Bitmap(data, mi.Bitmap.PixelFormat.RGB).write(str(out))
+    _note(f"{path}: background.environment: scale = [{', '.join(f'{x:g}' for x in scale)}] applied to "
+          f"{file.name}, written to {out}")
+    return {"type": "envmap", "filename": str(out.resolve()), "to_world": to_world}
 
 
 def _check_mesh(path, where: str, o: dict) -> None:
@@ -953,9 +1060,9 @@ _PLUGIN_TAGS = {
     "twosided": "bsdf", "diffuse": "bsdf", "conductor": "bsdf", "dielectric": "bsdf",
     "roughconductor": "bsdf", "roughdielectric": "bsdf", "plastic": "bsdf", "roughplastic": "bsdf",
     "bitmap": "texture", "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape", "obj": "shape",
-    "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter",
-    "homogeneous": "medium", "perspective": "sensor", "hdrfilm": "film", "independent": "sampler",
-    "box": "rfilter", "path": "integrator", "volpath": "integrator",
+    "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter", "directional": "emitter",
+    "spot": "emitter", "homogeneous": "medium", "perspective": "sensor", "thinlens": "sensor", "hdrfilm": "film",
+    "independent": "sampler", "box": "rfilter", "path": "integrator", "volpath": "integrator",
 }
 
 

@@ -14,6 +14,7 @@ them with closed forms (a few seconds each).
 from __future__ import annotations
 
 import atexit
+import copy
 import math
 import shutil
 import sys
@@ -676,6 +677,8 @@ def test_single_glass_interface_scales_radiance_by_inverse_eta_squared():
 def test_metals_are_vkrts():
     """A named metal converts to exactly the numbers of src/material/Metals.cpp (vkrt exports them)."""
     import re
+
+    _need(mi, "mitsuba")
     source = (REPO / "src" / "material" / "Metals.cpp").read_text()
     rows = re.findall(r'\{"(\w+)", \{([^}]*)\}, \{([^}]*)\}\}', source)
     assert len(rows) >= 5, rows
@@ -727,7 +730,7 @@ def _vkrt_lookup(texels, uv, scale=(1.0, 1.0), wrap="repeat"):
 
 # A unit quad in z = 0 facing +z whose uvs run from UV_LO to UV_HI, so that
 # lookups leave [0, 1] and the wrap modes show. Mesh uv = UV_LO + (x, y) * (UV_HI - UV_LO).
-UV_LO, UV_HI = np.array([-0.7, -0.4]), np.array([1.6, 1.9])
+UV_LO, UV_HI = (np.array([-0.7, -0.4]), np.array([1.6, 1.9])) if np is not None else (None, None)
 
 
 def _uv_quad_obj():
@@ -1030,6 +1033,404 @@ def test_textured_quad_renders_upright():
         for col, cols in enumerate(((0, 2), (6, 8))):
             mean = img[rows[0]:rows[1], cols[0]:cols[1]].mean((0, 1))
             assert np.allclose(mean, colours[row, col], atol=0.03), (row, col, mean)
+
+
+# ----------------------------------------------------------------------------
+# Thin lens, directional and spot lights, lat-long environments. The scenes are
+# hand-made exports (docs/scene-json.md and the keys these features add),
+# given to convert() in place of `vkrt info SCENE --scene-json -`.
+# ----------------------------------------------------------------------------
+
+def _export(**parts):
+    """An export of an empty 8 x 6 scene whose camera at z = 5 looks at the
+    origin; `parts` replace top-level keys."""
+    scene = {
+        "format": "vkrt-scene", "version": 1,
+        "scene": {"path": "/nowhere/scene.toml", "hash": "fnv1a64:0000000000000000"},
+        "render": {"integrator": "path", "max_depth": 1},
+        "camera": {"eye": [0.0, 0.0, 5.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0], "fov": 30.0,
+                   "width": 8, "height": 6, "aperture_radius": 0.0, "focus_distance": 5.0},
+        "materials": [],
+        "shapes": {"sphere": [], "box": [], "triangle": [], "plane": [], "mesh": []},
+        "lights": {"point": [], "triangle": [], "directional": [], "spot": []},
+        "background": {"color": [0.0, 0.0, 0.0], "cubemap": None, "environment": None},
+        "textures": [],
+        "warnings": [],
+    }
+    scene.update(copy.deepcopy(parts))
+    return scene
+
+
+def _lights(**kinds):
+    return dict(_export()["lights"], **kinds)
+
+
+def _convert_export(export: dict, tmp: Path) -> dict:
+    """convert() of tmp/scene.toml as if vkrt exported `export` for it."""
+    real = to_mitsuba.read_scene_json
+    to_mitsuba.read_scene_json = lambda path, vkrt=None: copy.deepcopy(export)
+    try:
+        return to_mitsuba.convert(tmp / "scene.toml", files_dir=tmp / "files")
+    finally:
+        to_mitsuba.read_scene_json = real
+
+
+def _export_refusal(export: dict, key: str, fragment: str = "") -> str:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "scene.toml"
+        try:
+            _convert_export(export, Path(tmp))
+        except to_mitsuba.ConversionError as e:
+            message = str(e)
+        else:
+            raise AssertionError(f"converted: {key}")
+    assert f"{path}: {key}: " in message and fragment in message, message
+    return message
+
+
+# A lambert floor (the top of a box at y = 0) that fills the view of FLOOR_CAMERA.
+FLOOR_ALBEDO = [0.8, 0.5, 0.25]
+FLOOR = {"materials": [{"name": "floor", "type": "lambert", "albedo": FLOOR_ALBEDO, "textures": {},
+                        "where": "scene.toml:10:1"}],
+         "shapes": {"sphere": [], "box": [{"min": [-50.0, -1.0, -50.0], "max": [50.0, 0.0, 50.0], "material": 0}],
+                    "triangle": [], "plane": [], "mesh": []},
+         "camera": {"eye": [0.5, 4.0, 1.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0], "fov": 30.0,
+                    "width": 8, "height": 6, "aperture_radius": 0.0, "focus_distance": 4.15}}
+
+
+def _mitsuba_scalar():
+    _need(mi, "mitsuba")
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+
+
+def _unit(v):
+    v = np.asarray(v, np.float64)
+    return v / np.linalg.norm(v)
+
+
+def test_thin_lens_camera_is_mitsubas_thinlens():
+    """aperture_radius > 0: `thinlens` with vkrt's aperture_radius and
+    focus_distance, which Mitsuba measures as vkrt does: the rays through one
+    film point leave a disc of that radius across the viewing direction and
+    meet the pinhole ray on the plane focus_distance ahead along it, off axis
+    too. aperture_radius 0, or an export without the keys: `perspective`."""
+    _mitsuba_scalar()
+    cam = dict(_export()["camera"], eye=[1.0, 2.0, 3.0], target=[2.0, 1.0, -4.0], fov=60.0, aperture_radius=0.25,
+               focus_distance=4.0)
+    old = _export()
+    del old["camera"]["aperture_radius"], old["camera"]["focus_distance"]
+    with tempfile.TemporaryDirectory() as tmp:
+        sensor = _convert_export(_export(camera=cam), Path(tmp))["sensor"]
+        pinhole = _convert_export(_export(), Path(tmp))["sensor"]
+        older = _convert_export(old, Path(tmp))["sensor"]
+        xml_scene = _convert_export(_export(camera=cam), Path(tmp))
+        to_mitsuba.write_xml(xml_scene, Path(tmp) / "scene.xml")
+        from_xml = mi.load_file(str(Path(tmp) / "scene.xml")).sensors()[0]
+    assert sensor["type"] == "thinlens" and sensor["aperture_radius"] == 0.25 and sensor["focus_distance"] == 4.0
+    assert sensor["fov"] == 60.0 and sensor["fov_axis"] == "y", sensor
+    for s in (pinhole, older):
+        assert s["type"] == "perspective" and "aperture_radius" not in s and "focus_distance" not in s, s
+    camera = mi.load_dict(sensor)
+    reference = mi.load_dict({k: v for k, v in sensor.items() if k not in ("aperture_radius", "focus_distance")}
+                             | {"type": "perspective"})
+    eye = np.array(cam["eye"])
+    forward = _unit(np.array(cam["target"]) - eye)
+    lens_samples = np.random.default_rng(4).uniform(0, 1, (12, 2))
+    widest = 0.0
+    for film in ((0.5, 0.5), (0.05, 0.9), (0.8, 0.2)):
+        ray, _ = reference.sample_ray(0.0, 0.5, mi.Point2f(*film), mi.Point2f(0.5, 0.5))
+        d = np.array(ray.d, np.float64)
+        in_focus = eye + d * 4.0 / (d @ forward)
+        for cam_ in (camera, from_xml):
+            for lens in lens_samples:
+                ray, _ = cam_.sample_ray(0.0, 0.5, mi.Point2f(*film), mi.Point2f(*lens))
+                o, d = np.array(ray.o, np.float64), np.array(ray.d, np.float64)
+                on_lens = o - d * ((o - eye) @ forward) / (d @ forward)  # Mitsuba starts rays at the near clip
+                radius = np.linalg.norm(on_lens - eye)
+                assert radius <= 0.25 + 1e-6, radius
+                widest = max(widest, radius)
+                hit = o + d * (4.0 - (o - eye) @ forward) / (d @ forward)
+                assert np.allclose(hit, in_focus, atol=1e-5), (film, lens, hit, in_focus)
+    assert widest > 0.2, widest
+
+
+def test_directional_light_is_mitsubas_directional():
+    """angle 0: `directional`, the direction light travels and the irradiance.
+    A lambert floor lit at 36.87 degrees from its normal shows
+    albedo · E · cos / pi in every pixel (dict and XML)."""
+    _mitsuba_scalar()
+    direction, irradiance = [0.6, -0.8, 0.0], [2.0, 1.0, 0.5]
+    export = _export(**FLOOR, lights=_lights(directional=[{"direction": direction, "irradiance": irradiance,
+                                                          "angle": 0.0}]))
+    with tempfile.TemporaryDirectory() as tmp:
+        d = _convert_export(export, Path(tmp))
+        assert d["light0"] == {"type": "directional", "direction": direction,
+                               "irradiance": {"type": "rgb", "value": irradiance}}, d["light0"]
+        img = np.array(mi.render(mi.load_dict(d), spp=4), np.float64)
+        to_mitsuba.write_xml(d, Path(tmp) / "scene.xml")
+        img_xml = np.array(mi.render(mi.load_file(str(Path(tmp) / "scene.xml")), spp=4), np.float64)
+    expected = np.array(FLOOR_ALBEDO) * np.array(irradiance) * 0.8 / math.pi
+    for image in (img, img_xml):
+        assert np.allclose(image, expected, rtol=1e-4, atol=0), (image.min((0, 1)), image.max((0, 1)), expected)
+
+
+def test_soft_directional_light_is_refused():
+    """A sun disc (angle > 0) has no Mitsuba emitter; refused before Mitsuba is needed."""
+    sun = {"direction": [0.0, -1.0, 0.0], "irradiance": [1.0, 1.0, 1.0], "angle": 0.53}
+    message = _export_refusal(_export(lights=_lights(directional=[dict(sun, angle=0.0), sun])),
+                              "lights.directional[1].angle", "angle = 0.53")
+    assert "delta" in message, message
+
+
+def _spot_factor(emitter, position, point):
+    """The spot's intensity towards `point`, times distance² (W/sr)."""
+    it = mi.Interaction3f()
+    it.p = mi.Point3f(*[float(x) for x in point])
+    ds, weight = emitter.sample_direction(it, mi.Point2f(0.5, 0.5))
+    assert np.allclose(np.array(ds.p, np.float64), position, atol=1e-6)
+    return np.array(weight, np.float64).ravel() * float(np.sum((np.asarray(point) - position) ** 2))
+
+
+def test_spot_light_hard_cone_is_mitsubas_spot():
+    """inner = outer cone angle: `spot` with beam_width = cutoff_angle, which in
+    Mitsuba is a hard cone (its linear ramp from beam_width to cutoff_angle is
+    empty): the full intensity up to the cone angle, nothing beyond, around an
+    axis along `direction` from `position` (dict and XML)."""
+    _mitsuba_scalar()
+    position, axis, intensity, cone = np.array([1.0, 2.0, -0.5]), _unit([0.3, -1.0, 0.2]), [3.0, 2.0, 1.0], 25.0
+    spot = {"position": position.tolist(), "direction": axis.tolist(), "intensity": intensity,
+            "inner_cone_angle": cone, "outer_cone_angle": cone}
+    with tempfile.TemporaryDirectory() as tmp:
+        d = _convert_export(_export(lights=_lights(spot=[spot])), Path(tmp))
+        to_mitsuba.write_xml(d, Path(tmp) / "scene.xml")
+        from_xml = mi.load_file(str(Path(tmp) / "scene.xml")).emitters()[0]
+    light = d["light0"]
+    assert light["type"] == "spot" and light["cutoff_angle"] == light["beam_width"] == cone, light
+    assert light["intensity"] == {"type": "rgb", "value": intensity}, light
+    m = np.array(light["to_world"].matrix, np.float64)
+    assert np.allclose(m[:3, :3].T @ m[:3, :3], np.eye(3), atol=1e-6) and np.linalg.det(m[:3, :3]) > 0, m
+    assert np.allclose(m[:3, 2], axis, atol=1e-6) and np.allclose(m[:3, 3], position), m
+    across = (_unit(np.cross(axis, [1.0, 0.0, 0.0])), _unit(np.cross(axis, [0.0, 0.0, 1.0])))
+    for emitter in (mi.load_dict(light), from_xml):
+        for angle, inside in ((0.0, 1), (10.0, 1), (24.9, 1), (24.99, 1), (25.01, 0), (26.0, 0), (60.0, 0),
+                              (120.0, 0)):
+            for side in across:
+                a = math.radians(angle)
+                point = position + 2.5 * (math.cos(a) * axis + math.sin(a) * side)
+                got = _spot_factor(emitter, position, point)
+                assert np.allclose(got, np.array(intensity) * inside, rtol=1e-4, atol=1e-6), (angle, got)
+
+
+def test_spot_light_with_soft_edge_is_refused():
+    """inner < outer cone angle: vkrt's falloff between the cones is glTF's,
+    t² with t linear in the cosine; Mitsuba's spot ramps linearly in the angle.
+    Refused before Mitsuba is needed; where Mitsuba is installed, the two
+    falloffs are shown to differ."""
+    spot = {"position": [0.0, 1.0, 0.0], "direction": [0.0, -1.0, 0.0], "intensity": [1.0, 1.0, 1.0],
+            "inner_cone_angle": 20.0, "outer_cone_angle": 30.0}
+    hard = dict(spot, inner_cone_angle=30.0)
+    _export_refusal(_export(lights=_lights(spot=[hard, spot])), "lights.spot[1].inner_cone_angle", "glTF")
+    if mi is None:
+        return
+    _mitsuba_scalar()
+    emitter = mi.load_dict({"type": "spot", "cutoff_angle": 30.0, "beam_width": 20.0})  # looks along +z
+    a = math.radians(25.0)
+    mitsuba = _spot_factor(emitter, np.zeros(3), [math.sin(a), 0.0, math.cos(a)])[0]
+    c = [math.cos(math.radians(x)) for x in (25.0, 20.0, 30.0)]
+    gltf = ((c[0] - c[2]) / (c[1] - c[2])) ** 2
+    assert abs(mitsuba - 0.5) < 1e-4 and abs(gltf - 0.299) < 1e-3, (mitsuba, gltf)
+
+
+def _latlong_lookup(texels, d):
+    """vkrt's lat-long lookup of texels (h x w x 3, row 0 the +y pole) in map
+    directions d[..., 3]: column i at u = (i + 0.5) / w, row j at v = j / (h - 1),
+    direction (sin φ sin θ, cos θ, −cos φ sin θ) for φ = 2πu, θ = πv, bilinear,
+    wrapping in u."""
+    h, w = texels.shape[:2]
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    u = np.mod(np.arctan2(d[..., 0], -d[..., 2]) / (2 * np.pi), 1.0)
+    v = np.arccos(np.clip(d[..., 1], -1.0, 1.0)) / np.pi
+    x = u * w - 0.5
+    y = v * (h - 1)
+    x0 = np.floor(x).astype(np.int64)
+    y0 = np.minimum(np.floor(y).astype(np.int64), h - 2)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    xa, xb = np.mod(x0, w), np.mod(x0 + 1, w)
+    top = (1 - fx) * texels[y0, xa] + fx * texels[y0, xb]
+    bottom = (1 - fx) * texels[y0 + 1, xa] + fx * texels[y0 + 1, xb]
+    return (1 - fy) * top + fy * bottom
+
+
+def _rotation(axis, degrees):
+    """Right-handed rotation about `axis` (rows)."""
+    k = _unit(axis)
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    a = math.radians(degrees)
+    return np.eye(3) + math.sin(a) * kx + (1 - math.cos(a)) * kx @ kx
+
+
+def test_latlong_environment_is_mitsubas_envmap():
+    """A lat-long map: `envmap` of the file with to_world = vkrt's rotation; a
+    grey scale is its `scale`, a coloured one is applied to the image. The
+    converted emitter's radiance in a world direction w is scale times vkrt's
+    bilinear lookup of the map at matrix⁻¹ w (random texels on an odd,
+    non-square map: a half-texel or row convention error shows), from the dict
+    and from the XML."""
+    _mitsuba_scalar()
+    rng = np.random.default_rng(8)
+    texels = rng.uniform(0.1, 1.0, (5, 7, 3)).astype(np.float32)
+    texels[0], texels[-1] = texels[0, 0], texels[-1, 0]  # a pole is one direction: its row is one colour
+    rotation = _rotation([1.0, 2.0, 3.0], 40.0)
+    directions = [_unit(v) for v in rng.normal(size=(300, 3))]
+    # The poles, and the seam u = 0 (between the last column and the first).
+    directions += [rotation @ [0.0, 1.0, 0.0], rotation @ [0.0, -1.0, 0.0], rotation @ [0.0, 0.0, -1.0]]
+    directions = np.array(directions)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        sky = tmp / "sky.exr"
+        mi.Bitmap(texels, mi.Bitmap.PixelFormat.RGB).write(str(sky))
+        for scale in ([2.0, 2.0, 2.0], [0.5, 1.0, 3.0]):
+            environment = {"file": str(sky), "scale": scale, "matrix": rotation.tolist()}
+            d = _convert_export(_export(background={"color": [0.0, 0.0, 0.0], "cubemap": None,
+                                                    "environment": environment}), tmp)
+            env = d["environment"]
+            assert env["type"] == "envmap" and sum(v.get("type") in ("envmap", "constant") for v in d.values()
+                                                   if isinstance(v, dict)) == 1, d
+            if scale[0] == scale[1] == scale[2]:
+                assert env["filename"] == str(sky) and env["scale"] == 2.0, env
+            else:
+                assert "scale" not in env and Path(env["filename"]).parent == (tmp / "files").resolve(), env
+            m = np.array(env["to_world"].matrix, np.float64)
+            assert np.allclose(m[:3, :3], rotation, atol=1e-6) and np.allclose(m[:3, 3], 0) and m[3, 3] == 1, m
+            to_mitsuba.write_xml(d, tmp / "scene.xml")
+            from_xml = mi.load_file(str(tmp / "scene.xml")).emitters()[0]
+            expected = np.array(scale) * _latlong_lookup(texels.astype(np.float64), directions @ rotation)
+            for emitter in (mi.load_dict(env), from_xml):
+                got = []
+                for w in directions:
+                    si = mi.SurfaceInteraction3f()
+                    si.wi = mi.Vector3f(*(-w))
+                    got.append(np.array(emitter.eval(si), np.float64).ravel())
+                err = np.abs(np.array(got) - expected).max()
+                assert err < 2e-5 * max(scale), (scale, err)
+
+
+def test_latlong_hdr_reads_as_stb_image_decodes_it():
+    """A Radiance .hdr map: Mitsuba decodes RGBE as stb_image (vkrt's decoder)
+    does, mantissa · 2^(exponent − 136) without Ward's + 0.5, whether the
+    envmap reads the file (grey scale) or the converter does (coloured scale).
+    Checked at texel centres, where the lookup is the texel itself."""
+    _mitsuba_scalar()
+    w, h = 6, 4
+    rng = np.random.default_rng(9)
+    # Ward's + 0.5 would change these mantissas by 0.2 % or more.
+    rgbe = np.concatenate([rng.integers(64, 256, (h, w, 3)), rng.integers(127, 131, (h, w, 1))], -1).astype(np.uint8)
+    rgbe[0], rgbe[-1] = rgbe[0, 0], rgbe[-1, 0]  # one colour per pole
+    stb = rgbe[..., :3] * np.exp2(rgbe[..., 3:].astype(np.float64) - 136)
+    phi = 2 * np.pi * (np.arange(w) + 0.5) / w
+    theta = np.pi * np.arange(h) / (h - 1)
+    d = np.stack(np.broadcast_arrays(np.sin(phi) * np.sin(theta[:, None]), np.cos(theta[:, None]) + 0 * phi,
+                                     -np.cos(phi) * np.sin(theta[:, None])), -1)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        sky = tmp / "sky.hdr"
+        # Flat (uncompressed) scanlines: width < 8.
+        sky.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (h, w) + rgbe.tobytes())
+        for scale in ([1.5, 1.5, 1.5], [0.5, 1.0, 3.0]):
+            environment = {"file": str(sky), "scale": scale, "matrix": np.eye(3).tolist()}
+            d_env = _convert_export(_export(background={"color": [0.0, 0.0, 0.0], "cubemap": None,
+                                                        "environment": environment}), tmp)["environment"]
+            emitter = mi.load_dict(d_env)
+            for j in range(h):
+                for i in range(w):
+                    si = mi.SurfaceInteraction3f()
+                    si.wi = mi.Vector3f(*(-d[j, i]))
+                    got = np.array(emitter.eval(si), np.float64).ravel()
+                    expected = np.array(scale) * stb[j, i]
+                    assert np.allclose(got, expected, rtol=1e-4, atol=0), (scale, j, i, got, expected)
+
+
+def test_latlong_environment_lights_a_lambert_floor():
+    """A constant-colour lat-long map c with a coloured scale s over a lambert
+    floor (max_depth = 1: direct light only): the floor shows albedo · c · s,
+    whatever the rotation."""
+    _mitsuba_scalar()
+    c, s = np.array([0.2, 0.4, 0.8]), np.array([0.5, 1.0, 3.0])
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        sky = tmp / "sky.exr"
+        mi.Bitmap(np.broadcast_to(c, (9, 16, 3)).astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(str(sky))
+        environment = {"file": str(sky), "scale": s.tolist(), "matrix": _rotation([0.0, 1.0, 1.0], 70.0).tolist()}
+        d = _convert_export(_export(**FLOOR, background={"color": [0.0, 0.0, 0.0], "cubemap": None,
+                                                          "environment": environment}), tmp)
+        runs = np.array([np.array(mi.render(mi.load_dict(d), spp=256, seed=k), np.float64).mean((0, 1))
+                         for k in range(4)])
+    expected = np.array(FLOOR_ALBEDO) * c * s
+    got = runs.mean(0)
+    tol = 5 * runs.std(0, ddof=1) / np.sqrt(len(runs)) + 1e-4 * expected
+    assert np.all(np.abs(got - expected) < tol) and np.all(tol < 0.01 * expected), (got, expected, tol)
+
+
+def test_thin_lens_lights_and_environment_through_vkrt():
+    """The same conversions from a scene file, as vkrt exports it (its key
+    names, the rotation as rows), and its refusals located in the file."""
+    _mitsuba_scalar()
+    header = HEADER.replace("height = 6\n", "height = 6\naperture_radius = 0.1\nfocus_distance = 4\n")
+    lights = textwrap.dedent("""
+        [[lights]]
+        type = "directional"
+        direction = [0.0, -1.0, 0.0]
+        irradiance = [2.0, 1.0, 0.5]
+        [[lights]]
+        type = "spot"
+        position = [0.0, 3.0, 0.0]
+        direction = [0.0, -1.0, 0.0]
+        intensity = 5
+        inner_cone_angle = 20
+        outer_cone_angle = 20
+        """)
+    environment = textwrap.dedent("""
+        [background.environment]
+        file = "sky.exr"
+        scale = [1.0, 2.0, 3.0]
+        rotate = { axis = [0, 1, 0], angle = 90 }
+        """)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        mi.Bitmap(np.ones((4, 8, 3), np.float32), mi.Bitmap.PixelFormat.RGB).write(str(tmp / "sky.exr"))
+        d = to_mitsuba.convert(_write(tmp, header + lights + environment), files_dir=tmp / "files")
+        sensor, sun, spot, env = d["sensor"], d["light0"], d["light1"], d["environment"]
+        assert sensor["type"] == "thinlens" and sensor["aperture_radius"] == 0.1 and sensor["focus_distance"] == 4.0
+        assert sun == {"type": "directional", "direction": [0.0, -1.0, 0.0],
+                       "irradiance": {"type": "rgb", "value": [2.0, 1.0, 0.5]}}, sun
+        assert spot["type"] == "spot" and spot["cutoff_angle"] == spot["beam_width"] == 20.0, spot
+        m = np.array(spot["to_world"].matrix, np.float64)
+        assert np.allclose(m[:3, 2], [0, -1, 0]) and np.allclose(m[:3, 3], [0, 3, 0]), m
+        # 90 degrees about +y: the map's +x is the world's -z, its +z the world's +x.
+        m = np.array(env["to_world"].matrix, np.float64)
+        assert np.allclose(m[:3, :3], [[0, 0, 1], [0, 1, 0], [-1, 0, 0]], atol=1e-12), m
+        assert env["type"] == "envmap" and "scale" not in env, env
+        scaled = mi.Bitmap(env["filename"])
+        assert np.allclose(np.array(scaled), [1.0, 2.0, 3.0]), np.array(scaled)[0, 0]
+        # Pinhole by default; no environment, no emitter.
+        d = to_mitsuba.convert(_write(tmp, HEADER + lights), files_dir=tmp / "files")
+        assert d["sensor"]["type"] == "perspective" and "environment" not in d
+        soft_sun = lights.replace("irradiance = [2.0, 1.0, 0.5]\n", "irradiance = [2.0, 1.0, 0.5]\nangle = 0.5\n")
+        _expect_refusal(_write(tmp, HEADER + soft_sun), "lights.directional[0].angle")
+        soft_spot = lights.replace("inner_cone_angle = 20", "inner_cone_angle = 10")
+        _expect_refusal(_write(tmp, HEADER + soft_spot), "lights.spot[0].inner_cone_angle")
+
+
+def _expect_refusal(path: Path, key: str) -> str:
+    try:
+        to_mitsuba.convert(path, files_dir=path.parent / "files")
+    except to_mitsuba.ConversionError as e:
+        message = str(e)
+    else:
+        raise AssertionError(f"converted {path.read_text()}")
+    assert f"{path}: {key}: " in message, message
+    return message
 
 
 if __name__ == "__main__":
