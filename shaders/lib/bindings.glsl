@@ -7,6 +7,12 @@
 #include "shared/Bindings.h"
 #include "shared/SceneTypes.h"
 
+#ifdef VKRT_TEST_NO_ENVIRONMENT_SAMPLING
+// Measurement hook: the environment found by BSDF sampling alone, to show
+// what importance sampling it gains (tests/render/latlong_environment_test.cpp).
+#undef VKRT_ENVIRONMENT_SAMPLING
+#endif
+
 layout(scalar, binding = BINDING_UNIFORMS) uniform UniformBlock { SceneUniforms u; };
 layout(scalar, binding = BINDING_ACCUMULATION) buffer AccumBlock { AccumPixel accum[]; };
 layout(scalar, binding = BINDING_STATS) buffer StatsBlock { RenderStats stats; };

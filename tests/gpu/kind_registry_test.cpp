@@ -116,6 +116,8 @@ std::string meshFileExample()
 const std::map<std::string_view, std::string> kLightExamples{
     {"point", "position = [0, 3, 0]\nintensity = 1\n"},
     {"triangle", "vertices = [[0, 2, 0], [1, 2, 0], [0, 2, 1]]\nradiance = 1\n"},
+    {"directional", "direction = [0, -1, 0]\nirradiance = 1\n"},
+    {"spot", "position = [0, 3, 0]\ndirection = [0, -1, 0]\nintensity = 1\n"},
 };
 
 TEST(KindRegistry, ParserAcceptsEveryMaterialKind)

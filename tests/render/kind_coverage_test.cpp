@@ -95,6 +95,59 @@ TEST_F(KindCoverage, EveryShapeKindIsSeenWithAndWithoutAMesh)
     EXPECT_EQ(tested, int(kShapeKindCount));
 }
 
+/// Every light kind without area, shining on a white plane at the centre of
+/// the view from in front of it (the point light at the eye is left out).
+const std::map<std::string, std::string>& unboundedLightFixtures()
+{
+    static const std::map<std::string, std::string> fixtures{
+        {"point", "type = \"point\"\nposition = [0, 0, 3]\nintensity = 5\n"},
+        {"directional", "type = \"directional\"\ndirection = [0, -1, -1]\nirradiance = 2\nangle = 1\n"},
+        {"spot", "type = \"spot\"\nposition = [0, 0, 3]\ndirection = [0, 0, -1]\nintensity = 5\n"},
+    };
+    return fixtures;
+}
+
+/// The centre radiance of a white plane through the origin facing +z lit only
+/// by `light`, with either integrator, with and without the decoy mesh.
+void expectLightsThePlane(const fs::path& dir, const std::string& light, const std::string& what)
+{
+    for (const char* integrator : {"whitted", "path"}) {
+        for (bool decoy : {false, true}) {
+            std::string text = std::string("[render]\nintegrator = \"") + integrator +
+                               "\"\nmax_depth = 2\n"
+                               "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov = 30\nwidth = 9\nheight = 9\n"
+                               "[materials.white]\ntype = \"lambert\"\nalbedo = 0.8\n"
+                               "[[objects]]\nshape = \"plane\"\nmaterial = \"white\"\npoint = [0, 0, 0]\n"
+                               "normal = [0, 0, 1]\n[[lights]]\n" +
+                               light;
+            if (decoy)
+                text += "[[objects]]\nshape = \"mesh\"\nfile = \"quad.obj\"\ntranslate = [40, 40, -40]\n"
+                        "material = \"white\"\n";
+            EXPECT_GT(centreRadiance(dir, text), 0.0)
+                << what << " lights nothing with " << integrator << (decoy ? " and a mesh" : "");
+        }
+    }
+}
+
+TEST_F(KindCoverage, EveryLightKindWithoutAreaLightsASurface)
+{
+    const fs::path dir = freshTempDir("kind-coverage-unbounded");
+    writeText(dir / "quad.obj", kQuadObj);
+    int tested = 0;
+#define VKRT_TEST_UNBOUNDED_LIGHT(KIND, Type, name, value, field, array, ARRAY, capacity, bounded)   \
+    if (bounded == 0) {                                                                             \
+        if (const auto f = unboundedLightFixtures().find(#name); f == unboundedLightFixtures().end()) { \
+            ADD_FAILURE() << "light kind " #name " has no fixture here";                            \
+        } else {                                                                                    \
+            expectLightsThePlane(dir, f->second, "light kind " #name);                               \
+            ++tested;                                                                               \
+        }                                                                                           \
+    }
+    VKRT_LIGHT_KINDS(VKRT_TEST_UNBOUNDED_LIGHT)
+#undef VKRT_TEST_UNBOUNDED_LIGHT
+    EXPECT_GT(tested, 0);
+}
+
 TEST_F(KindCoverage, EveryLightKindWithAreaIsSeenWithAndWithoutAMesh)
 {
     const fs::path dir = freshTempDir("kind-coverage-lights");

@@ -126,6 +126,17 @@ type = "triangle"
 vertices = [[-1, 4, -1], [1, 4, -1], [0, 4, 1]]
 radiance = 20
 two_sided = true
+[[lights]]
+type = "directional"
+direction = [0, -2, 0]
+irradiance = [1, 2, 3]
+angle = 0.5
+[[lights]]
+type = "spot"
+position = [0, 3, 0]
+direction = [0, 0, -3]
+intensity = 7
+inner_cone_angle = 10
 [background.cubemap]
 px = "grey.png"
 nx = "grey.png"
@@ -302,6 +313,40 @@ TEST_F(SceneExport, ShapesAndLightsEqualTheScene)
     expectSamePoints(j["lights"]["triangle"][0]["vertices"], scene.triangleLights[0].vertices, "light.vertices");
     expectSameVector(j["lights"]["triangle"][0]["radiance"], glm::dvec3(20.0), "light.radiance");
     EXPECT_EQ(j["lights"]["triangle"][0]["two_sided"], true);
+    const Json& sun = j["lights"]["directional"][0];
+    expectSameVector(sun["direction"], glm::dvec3(0, -1, 0), "sun.direction"); // unit
+    expectSameVector(sun["irradiance"], glm::dvec3(1, 2, 3), "sun.irradiance");
+    EXPECT_EQ(sun["angle"], 0.5);
+    const Json& spot = j["lights"]["spot"][0];
+    expectSameVector(spot["direction"], glm::dvec3(0, 0, -1), "spot.direction");
+    expectSameVector(spot["intensity"], glm::dvec3(7), "spot.intensity");
+    EXPECT_EQ(spot["inner_cone_angle"], 10.0);
+    EXPECT_EQ(spot["outer_cone_angle"], 45.0); // glTF's default
+}
+
+TEST_F(SceneExport, ThinLensAndTheFocusDistanceDefault)
+{
+    const Json pinhole = exported(parse(kEveryKind))["camera"];
+    EXPECT_EQ(pinhole["aperture_radius"], 0.0);
+    const std::string lens = "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, -1]\nfov = 30\naperture_radius = 0.25\n";
+    const Json defaulted = exported(parse(lens))["camera"];
+    EXPECT_EQ(defaulted["aperture_radius"], 0.25);
+    EXPECT_EQ(defaulted["focus_distance"], 4.0); // the distance to the target
+    EXPECT_EQ(exported(parse(lens + "focus_distance = 2.5\n"))["camera"]["focus_distance"], 2.5);
+}
+
+TEST_F(SceneExport, LatLongEnvironmentHasItsFileScaleAndRotation)
+{
+    std::ofstream(m_dir / "sky.exr") << "the parser checks only that it is a file";
+    const Json e = exported(parse("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 30\n"
+                                  "[background.environment]\nfile = \"sky.exr\"\nscale = [1, 2, 3]\n"
+                                  "rotate = { axis = [0, 1, 0], angle = 90 }\n"))["background"]["environment"];
+    EXPECT_EQ(e["file"], (m_dir / "sky.exr").string());
+    expectSameVector(e["scale"], glm::dvec3(1, 2, 3), "scale");
+    // 90 degrees about +y: the map's +x becomes the world's -z (column 0, row by row).
+    EXPECT_NEAR(e["matrix"][2][0].get<double>(), -1.0, 1e-15);
+    EXPECT_NEAR(e["matrix"][0][2].get<double>(), 1.0, 1e-15);
+    EXPECT_NEAR(e["matrix"][1][1].get<double>(), 1.0, 1e-15);
 }
 
 TEST_F(SceneExport, MeshesHaveTheirResolvedFileMatrixAndGeometry)

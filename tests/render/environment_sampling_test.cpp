@@ -1,0 +1,82 @@
+// The lat-long map's sampling distribution (render/EnvironmentSampling.h):
+// CDFs that are valid (non-decreasing from 0 to 1), weights where the map
+// has light, and a grid that stays bounded for the largest maps.
+#include "render/EnvironmentSampling.h"
+
+#include <gtest/gtest.h>
+
+namespace vkrt {
+namespace {
+
+void expectValidCdf(const float* cdf, size_t entries)
+{
+    EXPECT_EQ(cdf[0], 0.0f);
+    EXPECT_EQ(cdf[entries - 1], 1.0f);
+    for (size_t i = 1; i < entries; ++i) EXPECT_GE(cdf[i], cdf[i - 1]) << i;
+}
+
+TEST(LatLongDistribution, OneBrightTexelCarriesItsFourBilinearCells)
+{
+    Image map(16, 9);
+    std::fill(map.rgb.begin(), map.rgb.end(), 1e-3f);
+    float* sun = map.at(5, 3);
+    sun[0] = sun[1] = sun[2] = 1e4f;
+    const LatLongDistribution d = latLongDistribution(map);
+    ASSERT_EQ(d.block, 1u);
+    ASSERT_EQ(d.columns, 16u);
+    ASSERT_EQ(d.rows, 8u);
+    ASSERT_EQ(d.cdf.size(), size_t(9 + 8 * 17));
+    expectValidCdf(d.cdf.data(), 9);
+    // Texel (5, 3) is a corner of bilinear cells i in {4, 5}, j in {2, 3}.
+    auto cellProbability = [&](uint32_t i, uint32_t j) {
+        const float* row = d.cdf.data() + 9 + j * 17;
+        return double(d.cdf[j + 1] - d.cdf[j]) * (row[i + 1] - row[i]);
+    };
+    double sunCells = 0.0;
+    for (uint32_t j = 0; j < 8; ++j) {
+        expectValidCdf(d.cdf.data() + 9 + j * 17, 17);
+        for (uint32_t i = 0; i < 16; ++i) {
+            EXPECT_GT(cellProbability(i, j), 0.0) << "every cell with light must be reachable";
+            if ((i == 4 || i == 5) && (j == 2 || j == 3)) sunCells += cellProbability(i, j);
+        }
+    }
+    EXPECT_GT(sunCells, 0.999);
+}
+
+TEST(LatLongDistribution, ColumnsWrapAroundTheSeam)
+{
+    Image map(8, 5);
+    float* texel = map.at(0, 2); // its cells are i = 7 (with column 0 as its right corner) and i = 0
+    texel[1] = 1.0f;
+    const LatLongDistribution d = latLongDistribution(map);
+    const float* row = d.cdf.data() + 5 + 2 * 9;
+    EXPECT_GT(row[8] - row[7], 0.4f);
+    EXPECT_GT(row[1] - row[0], 0.4f);
+}
+
+TEST(LatLongDistribution, ABlackMapIsSampledUniformly)
+{
+    const LatLongDistribution d = latLongDistribution(Image(4, 3));
+    EXPECT_FLOAT_EQ(d.cdf[1], 0.5f);
+    EXPECT_FLOAT_EQ(d.cdf[3 + 1], 0.25f);
+}
+
+TEST(LatLongDistribution, LargeMapsGroupCellsIntoBlocks)
+{
+    // 4097 x 2050 has 4097 x 2049 bilinear cells, just over kMaxLatLongCells:
+    // blocks of 2 x 2, the last column and row of blocks holding one cell across.
+    Image map(4097, 2050);
+    std::fill(map.rgb.begin(), map.rgb.end(), 1.0f);
+    const LatLongDistribution d = latLongDistribution(map);
+    EXPECT_EQ(d.block, 2u);
+    EXPECT_EQ(d.columns, 2049u);
+    EXPECT_EQ(d.rows, 1025u);
+    EXPECT_LE(uint64_t(d.columns) * d.rows, kMaxLatLongCells);
+    ASSERT_EQ(d.cdf.size(), size_t(1026) + size_t(1025) * 2050);
+    // A constant map: the last column of blocks holds half a block's weight.
+    const float* row = d.cdf.data() + 1026 + 512 * 2050;
+    EXPECT_NEAR((row[2049] - row[2048]) / (row[1] - row[0]), 0.5, 1e-3);
+}
+
+} // namespace
+} // namespace vkrt
