@@ -370,9 +370,12 @@ class _Texture:
     `bitmap` (_bitmap_texture). `alpha`: the texel is a GGX roughness, whose
     alpha = roughness² Mitsuba needs as a one-channel image."""
 
-    def __init__(self, file: Path, scale, linear: bool, wrap: str, channel: int, where: str, alpha: bool):
+    def __init__(self, file: Path, scale, linear: bool, wrap: str, channel: int, where: str, alpha: bool,
+                 offset=(0.0, 0.0), rotation: float = 0.0):
         self.file = file  # where: "scene.toml: materials.x.key"
         self.scale = scale
+        self.offset = [float(x) for x in offset]  # glTF KHR_texture_transform (vkrt's scene export)
+        self.rotation = float(rotation)
         self.linear = linear
         self.wrap = wrap
         self.channel = channel
@@ -402,18 +405,22 @@ def exported_texture(slot: dict, records: list, where: str, *, alpha: bool = Fal
         raise ConversionError(f"{where}.texture: '{file}' is a 16-bit image, whose `linear` flag vkrt's scene export "
                               "does not carry; use an 8-bit PNG or an EXR for a Mitsuba reference")
     return _Texture(file, [float(x) for x in slot["scale"]], record["encoding"] == "rgba8_linear", wrap_u,
-                    TEXTURE_CHANNELS.index(slot["channel"]), where, alpha)
+                    TEXTURE_CHANNELS.index(slot["channel"]), where, alpha, slot.get("offset", (0.0, 0.0)),
+                    slot.get("rotation", 0.0))
 
 
-def uv_transform_matrix(scale):
-    """Mitsuba's bitmap `to_uv` (3 x 3) for vkrt's uv scale [su, sv], on meshes
+def uv_transform_matrix(scale, offset=(0.0, 0.0), rotation: float = 0.0):
+    """Mitsuba's bitmap `to_uv` (3 x 3) for vkrt's uv transform, on meshes
     loaded with flip_tex_coords = true (Mitsuba's uv = (u, 1 - v) of the
     file's (u, v); its bitmap puts uv.y = 0 at the image's top row). vkrt
-    reads the image at (su u, sv v) with v up from the bottom row, i.e. at
-    Mitsuba image coordinates (su u, 1 - sv v) = (su u', (1 - sv) + sv v') for
-    u' = u, v' = 1 - v."""
+    reads the image at (a, b) = R (su u, sv v) + (ou, ov), R = [c s; -s c]
+    (glTF KHR_texture_transform's rotation), with b up from the bottom row,
+    i.e. at Mitsuba image coordinates (a, 1 - b); with u = u', v = 1 - v' that
+    is the affine map below (for c = 1, s = 0, o = 0: (su u', (1 - sv) + sv v'))."""
     su, sv = scale
-    return [[su, 0.0, 0.0], [0.0, sv, 1.0 - sv], [0.0, 0.0, 1.0]]
+    ou, ov = offset
+    c, s = math.cos(rotation), math.sin(rotation)
+    return [[c * su, -s * sv, s * sv + ou], [s * su, c * sv, 1.0 - c * sv - ov], [0.0, 0.0, 1.0]]
 
 
 ALPHA_UPSAMPLING = 7  # odd: see _alpha_texture_file
@@ -498,8 +505,9 @@ def _bitmap_texture(mi, tex: _Texture, files_dir: Path, name: str) -> dict:
         file, raw = tex.file, tex.is_linear
     bitmap = {"type": "bitmap", "filename": str(Path(file).resolve()), "raw": raw, "filter_type": "bilinear",
               "wrap_mode": tex.wrap}
-    if tex.scale != [1.0, 1.0]:
-        bitmap["to_uv"] = mi.ScalarTransform3f(mi.ScalarMatrix3f(uv_transform_matrix(tex.scale)))
+    if tex.scale != [1.0, 1.0] or tex.offset != [0.0, 0.0] or tex.rotation != 0.0:
+        bitmap["to_uv"] = mi.ScalarTransform3f(
+            mi.ScalarMatrix3f(uv_transform_matrix(tex.scale, tex.offset, tex.rotation)))
     return bitmap
 
 

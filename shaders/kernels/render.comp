@@ -27,6 +27,7 @@ layout(local_size_x = WORKGROUP_SIZE_X, local_size_y = WORKGROUP_SIZE_Y) in;
 #include "lib/environment.glsl"
 #include "lib/media.glsl"
 #include "lib/lights.glsl"
+#include "lib/aov.glsl"
 #ifdef VKRT_INTEGRATOR_PATH
 #include "lib/path.glsl"
 #else
@@ -123,12 +124,20 @@ uint g_sampleStart = 0u;
 bool finishSample(inout AccumPixel sum, uint pixelIndex, uint slot, inout uint frameIndex, uint frameEnd,
                   vec3 radiance, inout Sampler rng)
 {
+#ifdef VKRT_AOV
+    uint accepted = sum.count;
+#endif
     accumulateSample(sum, slot, frameIndex, testedSample(radiance, pixelIndex, frameIndex));
+#ifdef VKRT_AOV
+    if (sum.count != accepted)
+        accumulateAov(slot, sum.count); // the sample's AOVs count where its radiance does
+#endif
     g_longestSample = max(g_longestSample, g_loopIterations - g_sampleStart);
     g_sampleStart = g_loopIterations;
     if (++frameIndex == frameEnd)
         return false;
     rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
+    aovStartSample();
     return true;
 }
 
@@ -147,6 +156,7 @@ void main()
         return;
     AccumPixel sum = accum[slot];
     Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
+    aovStartSample();
 #ifdef VKRT_INTEGRATOR_PATH
     // Path regeneration (Novak et al. 2010): 8 lanes run in lockstep, so a
     // lane whose path has ended starts its next sample at once instead of

@@ -24,6 +24,9 @@ layout(scalar, binding = BINDING_MOMENTS) buffer BatchBlock { AccumPixel batchSu
 #elif defined(VKRT_VARIANCE)
 layout(scalar, binding = BINDING_MOMENTS) buffer MomentBlock { MomentPixel moments[]; };
 #endif
+#ifdef VKRT_AOV
+layout(scalar, binding = BINDING_AOVS) buffer AovBlock { AovPixel aovs[]; };
+#endif
 
 // Scene arrays: fixed-size uniform blocks in the uniform-scene variant,
 // runtime-sized storage buffers otherwise (shared/SceneTypes.h). Each shape

@@ -145,7 +145,11 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 
 // Next-event estimation of the environment map, MIS-weighted against BSDF
 // sampling (which finds the same light when a ray escapes: environmentOnEscape).
-vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+// `bsdfFollows`: a BSDF-sampled continuation will look for the environment
+// too (MIS weights); false at a vertex no ray leaves (the Whitted
+// integrator's last), where the light sample is all the estimate has.
+vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, bool bsdfFollows,
+                           inout Sampler rng)
 {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     float pdf;
@@ -156,7 +160,7 @@ vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
     vec3 f = evalBsdf(m, ns, wo, wi);
     if (f == vec3(0.0))
         return vec3(0.0);
-    float weight = powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi));
+    float weight = bsdfFollows ? powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi)) : 1.0;
 #ifdef VKRT_HAS_SHADING_NORMALS
     // Behind the geometric surface (shading normals): blocked by it (lib/lights.glsl).
     if (ns != n && dot(wi, n) <= 0.0)

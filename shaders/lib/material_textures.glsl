@@ -20,7 +20,9 @@ vec4 lookupSlot(TextureSlot slot, SurfaceHit hit, float coneWidth, float cosThet
 {
     float density = hit.uvDensity * abs(slot.scale.x * slot.scale.y);
     float lod = rayConeTextureLod(slot.record, coneWidth, cosTheta, density);
-    return sampleTexture(slot.record, hit.uv * slot.scale, lod);
+    vec2 s = hit.uv * slot.scale;
+    vec2 uv = vec2(slot.rotation.x * s.x + slot.rotation.y * s.y, slot.rotation.x * s.y - slot.rotation.y * s.x);
+    return sampleTexture(slot.record, uv + slot.offset, lod);
 }
 
 float channelOf(vec4 texel, uint channel) { return clamp(texel[channel], 0.0, 1.0); }

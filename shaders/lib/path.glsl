@@ -81,6 +81,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     bool missed = !traceClosest(p.ray, FLT_MAX, hit);
     p.path.throughput *= beerLambert(mediumAbsorption(p.path.media), missed ? FLT_MAX : hit.t);
     if (missed) {
+        aovEnd();
         p.path.radiance += p.path.throughput * (environmentOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf) +
                                                 directionalOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf));
         return false;
@@ -89,8 +90,11 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     if (hit.emitter != NO_EMITTER)
         p.path.radiance += p.path.throughput * emitterOnHit(p.path, p.ray, hit);
 #endif
-    if (hitsLight(hit))
+    aovSurfaceHit(hit);
+    if (hitsLight(hit)) {
+        aovEnd();
         return false; // a light is black: its emission, just added, is all it gives
+    }
     if (p.depth == u.maxDepth + 1u)
         return false; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
@@ -105,9 +109,10 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
 #ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
     m = withInterfaceEta(m, surfaceEta(p.path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
+    aovScatter(m, ns);
     if (!scattersIntoDeltasOnly(m)) {
         p.path.radiance += p.path.throughput * (directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng) +
-                                                directFromEnvironment(m, hit, n, ns, wo, p.path.media, rng));
+                                                directFromEnvironment(m, hit, n, ns, wo, p.path.media, true, rng));
     }
     vec4 u4 = sampleNext4D(rng);
     float eta = surfaceEta(p.path.media, hit);

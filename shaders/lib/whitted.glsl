@@ -49,6 +49,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         // Beer-Lambert over the segment just travelled inside a dielectric.
         path.throughput *= beerLambert(mediumAbsorption(path.media), missed ? FLT_MAX : hit.t);
         if (missed) {
+            aovEnd();
 #ifdef VKRT_ENVIRONMENT_SAMPLING
             // The map is also sampled at every vertex: MIS as in the path integrator.
             path.radiance += path.throughput * environmentOnEscape(ray.dir, path.specular, path.bsdfPdf);
@@ -61,8 +62,11 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
             break;
         }
         addEmitterRadiance(path, ray, hit);
-        if (hitsLight(hit))
+        aovSurfaceHit(hit);
+        if (hitsLight(hit)) {
+            aovEnd();
             break;
+        }
 #ifdef VKRT_HAS_MATERIALS
         Material m = materials[hit.material];
 #ifdef VKRT_HAS_TEXTURES
@@ -75,11 +79,13 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
 #ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
         m = withInterfaceEta(m, surfaceEta(path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
+        aovScatter(m, ns);
         if (!scattersIntoDeltasOnly(m)) {
             path.radiance += path.throughput * directFromLights(m, hit, n, ns, wo, path.media, rng);
             path.radiance += path.throughput * directFromEmitters(m, hit, n, ns, wo, path.media, rng);
 #ifdef VKRT_ENVIRONMENT_SAMPLING
-            path.radiance += path.throughput * directFromEnvironment(m, hit, n, ns, wo, path.media, rng);
+            path.radiance +=
+                path.throughput * directFromEnvironment(m, hit, n, ns, wo, path.media, depth < u.maxDepth, rng);
 #endif
         }
         if (depth == u.maxDepth)

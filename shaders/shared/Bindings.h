@@ -51,7 +51,9 @@ VKRT_CONSTANT(uint, BINDING_MESH_TANGENTS, BINDING_ENVIRONMENT + 14)
 VKRT_CONSTANT(uint, BINDING_MESH_MATERIALS, BINDING_ENVIRONMENT + 15)
 // FrameRun: which frames the dispatches of the current run add.
 VKRT_CONSTANT(uint, BINDING_FRAME_RUN, BINDING_ENVIRONMENT + 16)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 17)
+// AovPixel[width*height]: the arbitrary output values (render --aov).
+VKRT_CONSTANT(uint, BINDING_AOVS, BINDING_ENVIRONMENT + 17)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 18)
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);
 // the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).

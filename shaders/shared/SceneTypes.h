@@ -303,6 +303,21 @@ struct MomentPixel {
     vec3 m2Compensation;
 };
 
+/// One pixel's arbitrary output values (`vkrt render --aov`): running means
+/// over the pixel's accepted samples (AccumPixel::count) of the albedo and
+/// world-space shading normal of each sample's first non-specular surface
+/// (through perfect mirrors and glass; zero where the path escapes or ends
+/// first), and over the `hits` samples whose camera ray found a surface of
+/// that first hit's camera-space depth (along the viewing direction) and
+/// camera-relative position.
+struct AovPixel {
+    vec3 albedo;
+    vec3 normal;
+    vec3 position;
+    float depth;
+    uint hits;
+};
+
 /// Counters written by kernels with atomics.
 struct RenderStats {
     uint maxLoopIterations; // largest loop count of one sample seen

@@ -57,10 +57,14 @@ VKRT_CONSTANT(uint, NO_TEXTURE, 4294967295u)
 /// uv * scale. Colours use the texel's rgb, scalars its component `channel`
 /// (0 = r ... 3 = a). The texel multiplies the material's constant (which the
 /// scene sets to 1, and a glTF file to its factor).
+// The lookup is at uv' = R (uv * scale) + offset, R the rotation whose
+// (cos, sin) is `rotation`: [c s; -s c] (glTF KHR_texture_transform).
 struct TextureSlot {
     uint record; // NO_TEXTURE: the constant alone
     uint channel;
     vec2 scale;
+    vec2 offset;
+    vec2 rotation;
 };
 
 // MaterialTextures::slots, by parameter:

@@ -39,6 +39,8 @@ std::vector<NamedFile> filesTheSceneRead(const Scene& scene)
     if (scene.background.cubemap)
         for (const std::string& face : scene.background.cubemap->facePaths)
             files.push_back({"a cube face the scene loads", face});
+    if (scene.background.environment)
+        files.push_back({"the environment map the scene loads", scene.background.environment->path});
     return files;
 }
 

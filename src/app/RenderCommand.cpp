@@ -11,11 +11,14 @@
 #include "render/Progress.h"
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
+#include "scene/TomlReader.h"
 #include "util/Error.h"
 #include "util/Hash.h"
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -54,6 +57,8 @@ struct RenderCommandOptions {
     uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
     uint64_t maxBandBytes = 0;              ///< test hook: bands of at most this many bytes per buffer
+    std::vector<std::string> aovs;          ///< --aov albedo,normal,depth,position
+    GltfSceneOptions gltf;                  ///< --camera, --environment (a glTF scene)
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
@@ -105,6 +110,52 @@ std::optional<ShardRange> shardRange(const RenderCommandOptions& options)
     return range;
 }
 
+// ------------------------------------------------------------------- AOVs
+
+/// The AOVs `--aov` may name, in the order their layers are written.
+constexpr std::array<std::string_view, 4> kAovNames{"albedo", "normal", "depth", "position"};
+
+/// --aov's names, checked: each known, none twice, not with --shard (a
+/// merge adds sums; AOVs are means).
+std::vector<std::string> checkedAovs(const RenderCommandOptions& options)
+{
+    std::vector<std::string> names;
+    for (const std::string& name : options.aovs) {
+        if (std::find(kAovNames.begin(), kAovNames.end(), name) == kAovNames.end()) {
+            const std::vector<std::string_view> known(kAovNames.begin(), kAovNames.end());
+            throw InputError("--aov: unknown AOV " + quote(name) + didYouMean(name, known) + " (" +
+                             joinList(known) + ")");
+        }
+        if (std::find(names.begin(), names.end(), name) != names.end())
+            throw InputError("--aov: " + quote(name) + " is named twice");
+        names.push_back(name);
+    }
+    if (!names.empty() && !options.shard.empty())
+        throw InputError("--aov cannot be combined with --shard: a merge adds the shards' sums, and AOVs are "
+                         "means; render the AOVs in one run");
+    return names;
+}
+
+/// The EXR layers of the AOVs asked for, in compositors' conventions (Open
+/// Image Denoise reads albedo.R/G/B and N.X/Y/Z; depth is Z, position P.X/Y/Z).
+void addAovLayers(const std::vector<std::string>& names, const AovImages& aovs, std::map<std::string, Image>& layers,
+                  std::vector<ExrChannels>& channels)
+{
+    for (const std::string& name : names) {
+        if (name == "albedo") layers["albedo"] = aovs.albedo;
+        if (name == "normal") channels.push_back({{"N.X", "N.Y", "N.Z"}, aovs.normal.rgb});
+        if (name == "position") channels.push_back({{"P.X", "P.Y", "P.Z"}, aovs.position.rgb});
+        if (name == "depth") channels.push_back({{"Z"}, aovs.depth});
+    }
+}
+
+std::string joinedAovs(const std::vector<std::string>& names)
+{
+    std::string text;
+    for (const std::string& name : names) text += (text.empty() ? "" : ",") + name;
+    return text;
+}
+
 SessionConfig sessionConfig(const RenderCommandOptions& options, const std::optional<ShardRange>& shard)
 {
     SessionConfig config;
@@ -117,6 +168,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
     config.uber = options.uber;
     config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
     config.variance = options.varianceNeeds();
+    config.aov = !options.aovs.empty();
     config.stop = {shard ? shard->end - shard->begin : options.maxSpp(), options.timeBudget, options.targetError,
                    &interruptFlag()};
     return config;
@@ -335,9 +387,10 @@ Outcome runRender(const RenderCommandOptions& options)
     InterruptGuard interrupt;
     auto start = std::chrono::steady_clock::now();
     const std::optional<ShardRange> shard = shardRange(options);
+    const std::vector<std::string> aovNames = checkedAovs(options);
     std::string output = options.output.empty() ? defaultOutputFor(options.scenePath) : options.output;
     checkRenderFiles(options, output);
-    Scene scene = loadScene(options.scenePath, {options.width, options.height});
+    Scene scene = loadScene(options.scenePath, {options.width, options.height}, options.gltf);
     refuseOverlappingFiles(filesTheSceneRead(scene), renderOutputs(options, output));
 
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
@@ -366,7 +419,12 @@ Outcome runRender(const RenderCommandOptions& options)
         if (options.variance) layers["variance"] = std::move(*film.variance);
     }
     if (shard) addShard(*shard, options.spp, renderer, metadata, layers);
-    writeExr(output, film.mean, metadata, layers);
+    std::vector<ExrChannels> aovChannels;
+    if (!aovNames.empty()) {
+        addAovLayers(aovNames, renderer.aovs(), layers, aovChannels);
+        metadata["aovs"] = joinedAovs(aovNames);
+    }
+    writeExr(output, film.mean, metadata, layers, aovChannels);
     if (!options.png.empty()) writePng(options.png, film.mean, options.exposure);
     const RenderFacts facts = renderFacts(session, loop, startupSeconds, output);
     printSummary(facts);
@@ -404,7 +462,9 @@ CommandRunner addRenderCommand(CLI::App& app)
         "FINITE");
     auto options = std::make_shared<RenderCommandOptions>();
     CLI::App* cmd = app.add_subcommand("render", "Render a scene file to an OpenEXR image");
-    cmd->add_option("scene", options->scenePath, "Scene file (TOML, see docs/scene-format.md)")->required();
+    cmd->add_option("scene", options->scenePath,
+                    "Scene file (TOML, see docs/scene-format.md; or a glTF .gltf/.glb file as a scene)")
+        ->required();
     cmd->add_option("-o,--output", options->output, "Output EXR (default: SCENE's name with .exr, here)");
     cmd->add_option("--spp", options->spp,
                     "Samples per pixel (default 64; with --time-budget or --target-error: no limit)")
@@ -442,6 +502,17 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "(Owen-scrambled Sobol' points: lower error; any variance estimate comes from " +
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
+    cmd->add_option("--camera", options->gltf.camera,
+                    "A glTF scene's camera to render through: its or its node's name, or its index (default: the "
+                    "first)");
+    cmd->add_option("--environment", options->gltf.environment,
+                    "A lat-long .exr or .hdr map lighting a glTF scene (default: white for a file without lights, "
+                    "else black)");
+    cmd->add_option("--aov", options->aovs,
+                    "Also write arbitrary output values as EXR layers, comma-separated: albedo (albedo.R/G/B), "
+                    "normal (N.X/Y/Z, world space), depth (Z, camera space), position (P.X/Y/Z, world space); "
+                    "albedo and normal of the first non-specular surface, as Open Image Denoise expects")
+        ->delimiter(',');
     cmd->add_option("--shard", options->shard,
                     "Render only shard i of n (0 <= i < n): samples [i S/n, (i+1) S/n) of --spp S, seeded as in one "
                     "run; `vkrt merge` adds the shards (docs/farm.md)");

@@ -16,7 +16,9 @@ CommandRunner addViewCommand(CLI::App& app)
 {
     auto o = std::make_shared<ViewOptions>();
     CLI::App* cmd = app.add_subcommand("view", "Watch a scene converge in a window (keys: press H)");
-    cmd->add_option("scene", o->scenePath, "Scene file")->required();
+    cmd->add_option("scene", o->scenePath, "Scene file (TOML, or a glTF .gltf/.glb file as a scene)")->required();
+    cmd->add_option("--camera", o->gltf.camera, "glTF scene: the camera to look through (name or index)");
+    cmd->add_option("--environment", o->gltf.environment, "glTF scene: a lat-long .exr/.hdr map lighting it");
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--seed", o->seed, "Random seed");
     // Checked with the scene parser's limits (SceneOverrides.h) once the scene is read.

@@ -40,7 +40,7 @@ constexpr bool bindingsDistinct()
                               BINDING_TOP_NODES,         BINDING_TOP_REFS,       BINDING_EMITTERS,
                               BINDING_MATERIAL_TABLES,   BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
                               BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS,       BINDING_MESH_TANGENTS,
-                              BINDING_MESH_MATERIALS,    BINDING_FRAME_RUN};
+                              BINDING_MESH_MATERIALS,    BINDING_FRAME_RUN,      BINDING_AOVS};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -67,6 +67,7 @@ static_assert(offsetof(Mesh, emission) == 96 && offsetof(Mesh, firstEmitter) == 
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);
 static_assert(sizeof(MomentPixel) == 36);
+static_assert(sizeof(AovPixel) == 44 && offsetof(AovPixel, hits) == 40);
 // The per-kind counts sit before tileStride, so a new kind moves it (and needs no edit here).
 static_assert(offsetof(SceneUniforms, tileStride) == 68 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT));
 static_assert(offsetof(Material, fresnel) == 48 && offsetof(Material, eta) == 64 && offsetof(Material, k) == 80);

@@ -12,7 +12,7 @@ static_assert(sizeof(TextureRecord) == 4 * (6 + TEXTURE_MAX_LEVELS));
 static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, levelOffset) == 24);
 // Level sizes: the largest side has floor(log2(TEXTURE_MAX_SIZE)) + 1 levels.
 static_assert((1u << (TEXTURE_MAX_LEVELS - 1)) == TEXTURE_MAX_SIZE);
-static_assert(sizeof(TextureSlot) == 16);
-static_assert(sizeof(MaterialTextures) == 16 * TEXTURE_SLOT_COUNT + 4);
+static_assert(sizeof(TextureSlot) == 32);
+static_assert(sizeof(MaterialTextures) == 32 * TEXTURE_SLOT_COUNT + 4);
 
 } // namespace vkrt::gpu

@@ -151,11 +151,18 @@ private:
     Imf::Header m_header;
 };
 
+/// The layers with R, G and B channels (others, such as an AOV's "N.X",
+/// "N.Y", "N.Z", are not vkrt's to read).
 std::vector<std::string> layerNamesOf(const Imf::Header& header)
 {
     std::set<std::string> names;
     header.channels().layers(names);
-    return {names.begin(), names.end()};
+    std::vector<std::string> rgb;
+    for (const std::string& name : names)
+        if (header.channels().findChannel(name + ".R") && header.channels().findChannel(name + ".G") &&
+            header.channels().findChannel(name + ".B"))
+            rgb.push_back(name);
+    return rgb;
 }
 
 /// OpenEXR (de)compresses blocks of lines on its own thread pool, which is
@@ -216,7 +223,19 @@ size_t encodedSizeBound(const Image& image, const Metadata& metadata, size_t lay
 /// checking its last buffered flush (a full disk gave an empty file and
 /// success), so vkrt encodes first and writes with writeBytesAtomically,
 /// which checks every write. Costs the encoded file's size in memory once.
-std::string encodeExr(const Image& image, const Metadata& metadata, const std::map<std::string, Image>& layers)
+void addChannels(Imf::Header& header, Imf::FrameBuffer& frame, const ExrChannels& channels, uint32_t width)
+{
+    const size_t stride = channels.names.size();
+    for (size_t c = 0; c < stride; ++c) {
+        header.channels().insert(channels.names[c], Imf::Channel(Imf::FLOAT));
+        char* base = reinterpret_cast<char*>(const_cast<float*>(channels.values.data() + c));
+        frame.insert(channels.names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float) * stride,
+                                                   sizeof(float) * stride * width));
+    }
+}
+
+std::string encodeExr(const Image& image, const Metadata& metadata, const std::map<std::string, Image>& layers,
+                      const std::vector<ExrChannels>& channels)
 {
     Imf::Header header(int(image.width), int(image.height));
     header.compression() = Imf::ZIP_COMPRESSION;
@@ -224,7 +243,13 @@ std::string encodeExr(const Image& image, const Metadata& metadata, const std::m
     Imf::FrameBuffer frame;
     addChannels(header, frame, "", image);
     for (const auto& [name, layer] : layers) addChannels(header, frame, name, layer);
-    MemoryOStream stream(encodedSizeBound(image, metadata, layers.size()));
+    size_t extraLayers = layers.size();
+    for (const ExrChannels& set : channels) {
+        VKRT_CHECK(set.values.size() == set.names.size() * image.pixelCount());
+        addChannels(header, frame, set, image.width);
+        extraLayers += 1; // at most three channels each
+    }
+    MemoryOStream stream(encodedSizeBound(image, metadata, extraLayers));
     {
         // The offset table is written when the file is destroyed: the bytes are whole only after this block.
         Imf::OutputFile file(stream, header);
@@ -237,13 +262,13 @@ std::string encodeExr(const Image& image, const Metadata& metadata, const std::m
 } // namespace
 
 void writeExr(const std::filesystem::path& path, const Image& image, const Metadata& metadata,
-              const std::map<std::string, Image>& layers)
+              const std::map<std::string, Image>& layers, const std::vector<ExrChannels>& channels)
 {
     if (resolveOutputTarget(path).kind == OutputTargetKind::Discarded) return; // before the encode's cost
     useEveryCoreForExr();
     std::string encoded;
     try {
-        encoded = encodeExr(image, metadata, layers);
+        encoded = encodeExr(image, metadata, layers, channels);
     } catch (const std::exception& e) {
         throw InputError(path.string() + ": cannot write EXR: " + e.what());
     }

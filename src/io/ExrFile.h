@@ -23,12 +23,20 @@ struct ExrContents {
     Metadata metadata;                   ///< vkrt's attributes (standard ones omitted)
 };
 
+/// Channels in other conventions than a layer's R, G, B: compositors' AOVs
+/// such as "N.X", "N.Y", "N.Z" or a lone "Z". `values` holds names.size()
+/// floats per pixel, pixel-major. Readers of vkrt (readExr) skip them.
+struct ExrChannels {
+    std::vector<std::string> names;
+    std::vector<float> values;
+};
+
 /// Encodes the whole file in memory (ZIP, one part), then writes it with
 /// writeBytesAtomically, so a full disk is an InputError naming the path and
 /// the old file stays; costs the encoded file's size in memory, once. A path
 /// that is /dev/null is neither encoded nor written.
 void writeExr(const std::filesystem::path& path, const Image& image, const Metadata& metadata,
-              const std::map<std::string, Image>& layers = {});
+              const std::map<std::string, Image>& layers = {}, const std::vector<ExrChannels>& channels = {});
 
 /// A size a caller knows the file must have, and why: `source` ends in a
 /// verb, as in "a.exr is" or "the case renders".

@@ -285,7 +285,13 @@ void listTextureProblems(const json& material, std::vector<std::string>& out)
         const json* info = textureInfo(material, slot);
         if (!info || !slot.honoured) continue;
         for (const std::string& name : extensionNames(*info))
-            out.push_back(name + " on " + slot.name + ": not applied");
+            if (name != "KHR_texture_transform") out.push_back(name + " on " + slot.name + ": not applied");
+        const json* extensions = member(*info, "extensions");
+        const json* transform = extensions ? member(*extensions, "KHR_texture_transform") : nullptr;
+        if (const json* texCoord = transform ? member(*transform, "texCoord") : nullptr;
+            texCoord && texCoord->is_number_integer() && texCoord->get<int64_t>() != 0)
+            out.push_back(std::string("KHR_texture_transform on ") + slot.name + " reads TEXCOORD_" +
+                          std::to_string(texCoord->get<int64_t>()) + ": vkrt reads only TEXCOORD_0");
         if (const json* texCoord = member(*info, "texCoord");
             texCoord && texCoord->is_number_integer() && texCoord->get<int64_t>() != 0)
             out.push_back(std::string(slot.name) + " reads TEXCOORD_" + std::to_string(texCoord->get<int64_t>()) +
@@ -293,11 +299,23 @@ void listTextureProblems(const json& material, std::vector<std::string>& out)
     }
 }
 
+/// Material extensions vkrt honours (readHonouredExtensions).
+bool honouredMaterialExtension(const std::string& name)
+{
+    return name == "KHR_materials_emissive_strength" || name == "KHR_materials_transmission" ||
+           name == "KHR_materials_ior";
+}
+
 /// The unsupported list of one file material (before the file's own extensions).
 std::vector<std::string> materialProblems(const json& material)
 {
     std::vector<std::string> out;
-    for (const std::string& name : extensionNames(material)) out.push_back(name + ": material extension not supported");
+    for (const std::string& name : extensionNames(material))
+        if (!honouredMaterialExtension(name)) out.push_back(name + ": material extension not supported");
+    if (const json* extensions = member(material, "extensions"))
+        if (const json* transmission = member(*extensions, "KHR_materials_transmission"))
+            if (member(*transmission, "transmissionTexture"))
+                out.push_back("KHR_materials_transmission's transmissionTexture: not applied (its factor is)");
     if (const json* pbr = member(material, "pbrMetallicRoughness"))
         for (const std::string& name : extensionNames(*pbr))
             out.push_back(name + " on pbrMetallicRoughness: not supported");
@@ -872,6 +890,75 @@ void checkGltfBeforeImport(const fs::path& file, const ReferencePolicy& referenc
     checkFileReferences(file, doc, references);
 }
 
+namespace {
+
+/// A number of an extension object, checked to lie in [low, high], or `fallback`.
+float extensionNumber(const fs::path& file, const json& extension, const char* extensionName, const char* key,
+                      float fallback, float low, float high)
+{
+    const json* value = member(extension, key);
+    if (!value) return fallback;
+    if (!value->is_number() || !(value->get<double>() >= low && value->get<double>() <= high))
+        fail(file, std::string(extensionName) + "." + key + ": must be a number in [" + std::to_string(low) + ", " +
+                       std::to_string(high) + "]");
+    return float(value->get<double>());
+}
+
+/// A texture's KHR_texture_transform (offset, rotation, scale), checked finite.
+void readTextureTransform(const fs::path& file, const json* info, const char* slotName,
+                          std::optional<FileTexture>& texture)
+{
+    const json* extensions = info ? member(*info, "extensions") : nullptr;
+    const json* transform = extensions ? member(*extensions, "KHR_texture_transform") : nullptr;
+    if (!transform || !texture) return;
+    const std::string where = std::string(slotName) + ".extensions.KHR_texture_transform";
+    auto pair = [&](const char* key, glm::dvec2 fallback) {
+        const json* value = member(*transform, key);
+        if (!value) return fallback;
+        if (!value->is_array() || value->size() != 2 || !(*value)[0].is_number() || !(*value)[1].is_number() ||
+            !std::isfinite((*value)[0].get<double>()) || !std::isfinite((*value)[1].get<double>()))
+            fail(file, where + "." + key + ": expected two finite numbers");
+        return glm::dvec2((*value)[0].get<double>(), (*value)[1].get<double>());
+    };
+    texture->offset = pair("offset", glm::dvec2(0.0));
+    texture->scale = pair("scale", glm::dvec2(1.0));
+    if (const json* rotation = member(*transform, "rotation")) {
+        if (!rotation->is_number() || !std::isfinite(rotation->get<double>()))
+            fail(file, where + ".rotation: expected a finite number");
+        texture->rotation = rotation->get<double>();
+    }
+}
+
+/// KHR_materials_emissive_strength, _transmission and _ior from the
+/// material's JSON, and its textures' KHR_texture_transform.
+void readHonouredExtensions(const fs::path& file, const json& material, FileMaterial& out)
+{
+    const json* pbr = member(material, "pbrMetallicRoughness");
+    readTextureTransform(file, pbr ? member(*pbr, "baseColorTexture") : nullptr, "baseColorTexture",
+                         out.baseColorTexture);
+    readTextureTransform(file, pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr, "metallicRoughnessTexture",
+                         out.metallicRoughnessTexture);
+    readTextureTransform(file, member(material, "normalTexture"), "normalTexture", out.normalTexture);
+    const json* extensions = member(material, "extensions");
+    if (!extensions) return;
+    if (const json* e = member(*extensions, "KHR_materials_emissive_strength"))
+        out.emissiveFactor *= extensionNumber(file, *e, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f,
+                                              0.0f, std::numeric_limits<float>::max());
+    if (const json* e = member(*extensions, "KHR_materials_transmission"))
+        out.transmission =
+            extensionNumber(file, *e, "KHR_materials_transmission", "transmissionFactor", 0.0f, 0.0f, 1.0f);
+    if (const json* e = member(*extensions, "KHR_materials_ior")) {
+        out.ior = extensionNumber(file, *e, "KHR_materials_ior", "ior", 1.5f, 0.0f, 1e30f);
+        if (out.ior != 0.0f && out.ior < 1.0f)
+            fail(file, "KHR_materials_ior.ior: must be 0 or at least 1, got " + std::to_string(out.ior));
+        if (out.ior == 0.0f) out.ior = 1.5f; // glTF: 0 means the default dielectric; vkrt has no ideal metal here
+    }
+    if (!std::isfinite(out.emissiveFactor.r + out.emissiveFactor.g + out.emissiveFactor.b))
+        fail(file, "emissiveFactor x KHR_materials_emissive_strength is beyond 32-bit float range");
+}
+
+} // namespace
+
 std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path& file,
                                             const ReferencePolicy& references)
 {
@@ -900,7 +987,11 @@ std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path
         const MaterialReader reader{scene, file, describeMaterial(isDefault, fileIndex, name), references};
         FileMaterial material = scene.mMaterials[i] ? reader.convert(*scene.mMaterials[i]) : FileMaterial{};
         material.fileIndex = fileIndex;
-        if (fileIndex >= 0) material.unsupported = materialProblems(*element(fileMaterials, uint32_t(fileIndex)));
+        if (fileIndex >= 0) {
+            const json& source = *element(fileMaterials, uint32_t(fileIndex));
+            material.unsupported = materialProblems(source);
+            readHonouredExtensions(file, source, material);
+        }
         if (!isDefault) appendUnique(material.unsupported, anyMaterial);
         appendUnique(material.unsupported, fileLevel);
         materials.push_back(std::move(material));

@@ -8,7 +8,11 @@
 //
 // Honoured: baseColorFactor/Texture, metallicFactor, roughnessFactor,
 // metallicRoughnessTexture (G = roughness, B = metallic), normalTexture and
-// its scale, emissiveFactor/Texture, doubleSided, the samplers' wrap modes.
+// its scale, emissiveFactor/Texture, doubleSided, the samplers' wrap modes,
+// KHR_materials_emissive_strength, KHR_materials_transmission's factor,
+// KHR_materials_ior (scene/FileMaterialImport.cpp makes glass of them) and
+// KHR_texture_transform on TEXCOORD_0 (a normal map's tangent frame is not
+// turned with its uvs).
 // Listed in `unsupported`: every extension the material or its textures use
 // (KHR_texture_transform, KHR_materials_*, ...), extensions the file uses
 // outside its materials, textures read through a TEXCOORD other than 0,
@@ -37,6 +41,10 @@ struct FileTexture {
     std::string name;              ///< for messages: the URI, or "embedded image N of FILE"
     TextureWrap wrapU = TextureWrap::Repeat;
     TextureWrap wrapV = TextureWrap::Repeat;
+    /// KHR_texture_transform (MaterialTexture's convention): offset, rotation (radians), scale.
+    glm::dvec2 offset{0.0};
+    double rotation = 0.0;
+    glm::dvec2 scale{1.0};
 };
 
 /// glTF's alphaMode. vkrt renders every mode opaque (MASK and BLEND are listed as unsupported).
@@ -58,6 +66,10 @@ struct FileMaterial {
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f; ///< for MASK
     bool doubleSided = false;
+    /// KHR_materials_transmission's transmissionFactor and KHR_materials_ior's
+    /// ior (glTF's defaults 0 and 1.5): a transmitting material is glass.
+    float transmission = 0.0f;
+    float ior = 1.5f;
     std::vector<std::string> unsupported; ///< what vkrt will not honour, one readable phrase each
 };
 

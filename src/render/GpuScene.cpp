@@ -24,10 +24,11 @@ glm::vec3 toFloat(const glm::dvec3& v) { return glm::vec3(v); }
 /// GGX alphas from perceptual roughness (alpha = roughness^2) and anisotropy
 /// (Burley 2012: aspect = sqrt(1 - 0.9 anisotropy), alphaX = alpha / aspect,
 /// alphaY = alpha * aspect), never below MIN_GGX_ALPHA; roughness 0 keeps 0
-/// (the smooth kinds).
+/// (the smooth kinds), except for `pbr`, which has no smooth form: its GGX
+/// lobe at alpha 0 divided by zero (a glTF mirror rendered black).
 glm::vec2 ggxAlphas(const Material& m)
 {
-    if (m.roughness == 0.0) return glm::vec2(0.0f);
+    if (m.roughness == 0.0 && m.type != MaterialType::Pbr) return glm::vec2(0.0f);
     const double alpha = m.roughness * m.roughness;
     const double aspect = std::sqrt(1.0 - 0.9 * m.anisotropy);
     const double minimum = gpu::MIN_GGX_ALPHA;
@@ -58,9 +59,11 @@ gpu::MaterialTextures convertMaterialTextures(const Material& m)
 {
     gpu::MaterialTextures g{};
     for (size_t slot = 0; slot < kTextureSlotCount; ++slot) {
-        g.slots[slot] = gpu::TextureSlot{gpu::NO_TEXTURE, 0u, glm::vec2(1.0f)};
+        g.slots[slot] = gpu::TextureSlot{gpu::NO_TEXTURE, 0u, glm::vec2(1.0f), glm::vec2(0.0f), glm::vec2(1.0f, 0.0f)};
         if (const auto& texture = m.textures[slot])
-            g.slots[slot] = gpu::TextureSlot{texture->record, texture->channel, glm::vec2(texture->scale)};
+            g.slots[slot] = gpu::TextureSlot{
+                texture->record, texture->channel, glm::vec2(texture->scale), glm::vec2(texture->offset),
+                glm::vec2(std::cos(texture->rotation), std::sin(texture->rotation))};
     }
     g.normalStrength = float(m.normalStrength);
     return g;

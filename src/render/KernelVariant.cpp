@@ -62,6 +62,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({f.environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),
                     "environment-sampling"});
     list.push_back({v.variance, "VKRT_VARIANCE", int(gpu::BINDING_MOMENTS), "variance"});
+    list.push_back({v.aov, "VKRT_AOV", int(gpu::BINDING_AOVS), "aov"});
     list.push_back({v.sobolSampler, "VKRT_SAMPLER_SOBOL", -1, "sobol"});
     return list;
 }

@@ -27,6 +27,7 @@ struct KernelVariant {
 
     FeatureSet features;
     bool variance = false;     ///< per-pixel variance estimation (a render option)
+    bool aov = false;          ///< arbitrary output values: albedo, normal, depth, position (a render option)
     bool sobolSampler = false; ///< Owen-scrambled Sobol' points instead of independent ones (a render option)
     bool uniformScene = false; ///< scene arrays in uniform buffers: every array fits (shared/SceneTypes.h)
     /// Count loop passes per subgroup (the unit a capping driver counts in),

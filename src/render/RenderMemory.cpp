@@ -84,6 +84,7 @@ RenderMemory renderMemoryOf(const Scene& scene, const RenderOptions& options)
     need.deviceBytesPerPixel = sizeof(gpu::AccumPixel);
     need.errorEstimate = options.variance;
     if (options.variance) need.deviceBytesPerPixel += varianceBytesPerPixel(options.sobol);
+    if (options.aov) need.deviceBytesPerPixel += sizeof(gpu::AovPixel);
     // Each buffer is downloaded whole (Buffer::download) and turned into the
     // mean image, the variance image and a shard's tally; the EXR writer
     // holds one more RGB copy. Measured (docs/robustness.md) 54, 162 and 496
@@ -91,6 +92,7 @@ RenderMemory renderMemoryOf(const Scene& scene, const RenderOptions& options)
     // these sums because not all of it is live at once.
     need.hostBytesPerPixel = need.deviceBytesPerPixel + 2 * kRgbFloatBytes;
     if (options.variance) need.hostBytesPerPixel += kRgbFloatBytes + kTallyBytes;
+    if (options.aov) need.hostBytesPerPixel += 3 * kRgbFloatBytes + sizeof(float); // AovImages, then the EXR's copy
     return need;
 }
 

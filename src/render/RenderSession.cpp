@@ -1,5 +1,6 @@
 #include "render/RenderSession.h"
 
+#include "scene/GltfScene.h"
 #include "scene/SceneParser.h"
 #include "util/Hash.h"
 
@@ -31,9 +32,12 @@ Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixel
 
 // ---------------------------------------------------------------- scene
 
-Scene loadScene(const std::string& path, const ResolutionOverride& resolution)
+Scene loadScene(const std::string& path, const ResolutionOverride& resolution, const GltfSceneOptions& gltf)
 {
-    Scene scene = parseSceneFile(path);
+    if (!isGltfPath(path) && (gltf.camera || gltf.environment))
+        throw InputError(std::string(gltf.camera ? "--camera" : "--environment") +
+                         " applies to a glTF scene (.gltf, .glb); " + path + " is a TOML scene");
+    Scene scene = isGltfPath(path) ? parseGltfScene(path, gltf) : parseSceneFile(path);
     applyResolution(scene.camera, resolution);
     // What the scene asks for that vkrt cannot honour exactly (glTF extensions, ...): said, never silent.
     for (const std::string& warning : scene.warnings) std::fprintf(stderr, "vkrt: warning: %s\n", warning.c_str());
@@ -55,6 +59,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     options.jitter = config.jitter;
     options.uber = config.uber;
     options.variance = config.variance.any();
+    options.aov = config.aov;
     options.extraDefines = config.extraDefines;
     options.maxBandBytes = config.maxBandBytes;
     options.cacheDirectory = config.cacheDirectory;

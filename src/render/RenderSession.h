@@ -9,6 +9,7 @@
 #include "render/Outcome.h"
 #include "render/RenderLoop.h"
 #include "render/Renderer.h"
+#include "scene/GltfScene.h"
 #include "scene/SceneOverrides.h"
 #include "util/Signals.h"
 
@@ -49,7 +50,10 @@ Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixel
 
 /// Parses and validates a scene file, then applies and checks `resolution`
 /// with the parser's limits. Throws SceneError / InputError.
-Scene loadScene(const std::string& path, const ResolutionOverride& resolution = {});
+/// A TOML scene, or a glTF file as a scene (scene/GltfScene.h, with `gltf`'s
+/// choices); prints the scene's warnings.
+Scene loadScene(const std::string& path, const ResolutionOverride& resolution = {},
+                const GltfSceneOptions& gltf = {});
 
 // ---------------------------------------------------------------- session
 
@@ -63,6 +67,7 @@ struct SessionConfig {
     bool warmUp = true; ///< render and discard a frame first, so timing excludes the driver's shader compile
     SamplerChoice sampler = SamplerChoice::Auto;
     VarianceNeeds variance;
+    bool aov = false; ///< average the AOVs too (RenderOptions::aov)
     std::vector<Define> extraDefines; ///< test hooks
     uint64_t maxBandBytes = 0;        ///< RenderOptions::maxBandBytes (a test hook; 0: the device's limit)
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();

@@ -38,6 +38,7 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
     KernelVariant variant;
     variant.features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
     variant.variance = options.variance;
+    variant.aov = options.aov;
     variant.sobolSampler = options.sobol;
     // The batch sums are laid out for VARIANCE_BATCHES batches; a different
     // sampler batch count would make the estimate describe other batches.
@@ -124,6 +125,7 @@ uint64_t largestBytesPerPixel(const RenderOptions& options)
 {
     uint64_t bytes = sizeof(gpu::AccumPixel);
     if (options.variance) bytes = std::max<uint64_t>(bytes, varianceBytesPerPixel(options.sobol));
+    if (options.aov) bytes = std::max<uint64_t>(bytes, sizeof(gpu::AovPixel));
     return bytes;
 }
 
@@ -249,6 +251,10 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
         else m_moments.emplace(context, m_bands, varianceBytesPerPixel(false), scene.path, "the variance estimate");
         m_moments->clear(context);
     }
+    if (m_variant.aov) {
+        m_aovs.emplace(context, m_bands, sizeof(gpu::AovPixel), scene.path, "the AOVs");
+        m_aovs->clear(context);
+    }
     bindPerPixelBuffers();
     m_kernel.bind(gpu::BINDING_STATS, m_stats);
     m_kernel.bind(gpu::BINDING_FRAME_RUN, m_frameRun);
@@ -266,6 +272,7 @@ void Renderer::bindPerPixelBuffers()
     for (uint32_t b = 0; b < m_bands.count; ++b) {
         m_kernel.bindInSet(b, gpu::BINDING_ACCUMULATION, m_accumulation.band(b));
         if (m_moments) m_kernel.bindInSet(b, gpu::BINDING_MOMENTS, m_moments->band(b));
+        if (m_aovs) m_kernel.bindInSet(b, gpu::BINDING_AOVS, m_aovs->band(b));
     }
 }
 
@@ -364,6 +371,7 @@ void Renderer::reset()
     m_accumulation.clear(m_context);
     m_stats.clear(m_context);
     if (m_moments) m_moments->clear(m_context);
+    if (m_aovs) m_aovs->clear(m_context);
 }
 
 void Renderer::moveCamera(const Camera& camera)
@@ -451,6 +459,26 @@ void Renderer::warmUp()
         m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, 0), 0, vk::Extent2D(1, 1));
     });
     reset();
+}
+
+AovImages Renderer::aovs() const
+{
+    VKRT_CHECK(m_aovs.has_value());
+    auto bytes = m_aovs->download(m_context);
+    const auto* pixels = reinterpret_cast<const gpu::AovPixel*>(bytes.data());
+    AovImages out{Image(width(), height()), Image(width(), height()), Image(width(), height()),
+                  std::vector<float>(size_t(width()) * height(), std::numeric_limits<float>::infinity())};
+    const glm::dvec3 eye = m_scene.camera.eye;
+    for (size_t i = 0; i < out.albedo.pixelCount(); ++i) {
+        const gpu::AovPixel& p = pixels[i];
+        std::copy_n(&p.albedo.x, 3, &out.albedo.rgb[i * 3]);
+        std::copy_n(&p.normal.x, 3, &out.normal.rgb[i * 3]);
+        if (p.hits == 0) continue;
+        const glm::dvec3 world = glm::dvec3(p.position) + eye;
+        for (int c = 0; c < 3; ++c) out.position.rgb[i * 3 + c] = float(world[c]);
+        out.depth[i] = p.depth;
+    }
+    return out;
 }
 
 Image Renderer::mean() const

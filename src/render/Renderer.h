@@ -23,6 +23,7 @@ struct RenderOptions {
     bool jitter = true;
     bool uber = false;         ///< all-features kernel instead of the scene's variant
     bool variance = false;     ///< also estimate per-pixel variance (a kernel-variant flag)
+    bool aov = false;          ///< also average the AOVs (albedo, normal, depth, position; a kernel-variant flag)
     bool sobol = false;        ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
     bool storageScene = false; ///< scene arrays in storage buffers even when they fit uniform ones
     uint32_t firstFrame = 0;   ///< index of the first frame (sample) rendered: a shard's start
@@ -41,6 +42,16 @@ struct RenderOptions {
     std::optional<uint64_t> availableMemory;
     std::filesystem::path shaderRoot = defaultShaderRoot();
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
+};
+
+/// The arbitrary output values (RenderOptions::aov), per pixel: the means of
+/// shared/SceneTypes.h's AovPixel, positions in world space (the eye added in
+/// double); depth is +inf and position 0 where no camera ray hit anything.
+struct AovImages {
+    Image albedo;
+    Image normal;
+    Image position;
+    std::vector<float> depth;
 };
 
 struct RenderCounters {
@@ -86,6 +97,8 @@ public:
     /// Degrees of freedom of each pixel's variance estimate (0: none made yet).
     uint64_t varianceDegreesOfFreedom() const;
     RenderCounters counters() const;
+    /// The AOVs; needs RenderOptions::aov.
+    AovImages aovs() const;
     /// The per-pixel sums a merge adds up (render/Tally.h).
     Tally tally() const;
 
@@ -111,6 +124,7 @@ private:
     Buffer m_stats;
     Buffer m_frameRun; ///< gpu::FrameRun of the run being dispatched
     std::optional<BandedBuffer> m_moments;
+    std::optional<BandedBuffer> m_aovs;
     ComputeKernel m_kernel;
     std::optional<EnvironmentTexture> m_environment;
     std::optional<Buffer> m_environmentCdf;

@@ -3,6 +3,8 @@
 #include "mesh/FileMaterials.h"
 #include "mesh/MeshGeometry.h"
 
+#include <cmath>
+
 namespace vkrt {
 namespace {
 
@@ -22,9 +24,16 @@ uint32_t addFileTexture(const FileTexture& texture, bool linear, const MeshGeome
     }
 }
 
-MaterialTexture slot(uint32_t record, uint32_t channel = 0)
+/// The texture's KHR_texture_transform in vkrt's uv space. glTF transforms
+/// g = (u, v) with v down from the image's top row: g' = R(theta) S g + o,
+/// R(theta) = [c s; -s c]. vkrt's uvs have v up from the bottom row (the mesh
+/// loader's uv = (u, 1 - v); lib/texture.glsl reads row 1 - v), so in its
+/// space the same lookup is R(-theta) S uv + (ox + s sy, 1 - oy - c sy).
+MaterialTexture slot(uint32_t record, const FileTexture& texture, uint32_t channel = 0)
 {
-    return MaterialTexture{record, channel, glm::dvec2(1.0)};
+    const double c = std::cos(texture.rotation), s = std::sin(texture.rotation);
+    const glm::dvec2 offset(texture.offset.x + s * texture.scale.y, 1.0 - texture.offset.y - c * texture.scale.y);
+    return MaterialTexture{record, channel, texture.scale, offset, -texture.rotation};
 }
 
 std::string displayName(const FileMaterial& f, size_t index)
@@ -49,16 +58,35 @@ Material toPbr(const FileMaterial& f, size_t index, const MeshGeometry& geometry
     m.emission = Color(f.emissiveFactor);
     auto set = [&](TextureSlot which, MaterialTexture texture) { m.textures[size_t(which)] = texture; };
     if (f.baseColorTexture)
-        set(TextureSlot::Color, slot(addFileTexture(*f.baseColorTexture, false, geometry, where, atlas)));
+        set(TextureSlot::Color,
+            slot(addFileTexture(*f.baseColorTexture, false, geometry, where, atlas), *f.baseColorTexture));
     if (f.metallicRoughnessTexture) {
         const uint32_t record = addFileTexture(*f.metallicRoughnessTexture, true, geometry, where, atlas);
-        set(TextureSlot::Roughness, slot(record, 1));
-        set(TextureSlot::Metallic, slot(record, 2));
+        set(TextureSlot::Roughness, slot(record, *f.metallicRoughnessTexture, 1));
+        set(TextureSlot::Metallic, slot(record, *f.metallicRoughnessTexture, 2));
     }
     if (f.normalTexture) {
-        set(TextureSlot::Normal, slot(addFileTexture(*f.normalTexture, true, geometry, where, atlas)));
+        set(TextureSlot::Normal, slot(addFileTexture(*f.normalTexture, true, geometry, where, atlas), *f.normalTexture));
         m.normalStrength = f.normalScale;
     }
+    return m;
+}
+
+/// Glass when KHR_materials_transmission says the surface transmits: a
+/// dielectric of KHR_materials_ior's index, rough (GGX, the material's
+/// roughness) unless the roughness is 0. Only its normal map carries over.
+bool transmits(const FileMaterial& f) { return f.transmission >= 0.5f; }
+
+Material toGlass(const FileMaterial& f, Material pbr)
+{
+    Material m;
+    m.type = pbr.roughness > 0.0 ? MaterialType::RoughDielectric : MaterialType::Dielectric;
+    m.name = pbr.name;
+    m.where = pbr.where;
+    m.ior = f.ior;
+    m.roughness = pbr.roughness;
+    m.textures[size_t(TextureSlot::Normal)] = pbr.texture(TextureSlot::Normal);
+    m.normalStrength = pbr.normalStrength;
     return m;
 }
 
@@ -68,6 +96,20 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
 {
     const std::string prefix = where.str() + ": " + m.name + ": ";
     for (const std::string& phrase : f.unsupported) warnings.push_back(prefix + phrase);
+    if (f.normalTexture && f.normalTexture->rotation != 0.0)
+        warnings.push_back(prefix + "normalTexture's KHR_texture_transform rotation turns its uvs, not its tangent "
+                                    "frame: the normals are tilted the wrong way");
+    if (f.transmission > 0.0f && f.transmission < 1.0f)
+        warnings.push_back(prefix + "transmissionFactor " + std::to_string(f.transmission) + " rendered as " +
+                           (transmits(f) ? "1 (glass)" : "0 (opaque)") +
+                           ": vkrt does not mix transmission with the base material");
+    if (transmits(f)) {
+        const glm::vec3 base(f.baseColorFactor);
+        if (base != glm::vec3(1.0f) || f.baseColorTexture)
+            warnings.push_back(prefix + "the base colour does not tint transmitted light (vkrt's glass is clear)");
+        if (f.metallicRoughnessTexture)
+            warnings.push_back(prefix + "metallicRoughnessTexture is not applied to glass (its roughness factor is)");
+    }
     if (f.emissiveTexture)
         warnings.push_back(prefix + "emissiveTexture is not supported: the emission is the constant emissiveFactor");
     if (f.baseColorFactor.a < 1.0f && f.alphaMode == AlphaMode::Opaque)
@@ -87,6 +129,7 @@ std::vector<uint32_t> importFileMaterials(const MeshGeometry& geometry, const So
     std::vector<uint32_t> indices;
     for (size_t i = 0; i < fileMaterials.size(); ++i) {
         Material m = toPbr(fileMaterials[i], i, geometry, where, atlas);
+        if (transmits(fileMaterials[i])) m = toGlass(fileMaterials[i], std::move(m));
         warnAbout(fileMaterials[i], m, where, warnings);
         indices.push_back(uint32_t(materials.size()));
         materials.push_back(std::move(m));

@@ -154,6 +154,10 @@ struct MaterialTexture {
     uint32_t record = 0;
     uint32_t channel = 0;
     glm::dvec2 scale{1.0};
+    /// glTF KHR_texture_transform: uv' = R(rotation) (uv * scale) + offset,
+    /// rotation in radians, counter-clockwise in uv.
+    glm::dvec2 offset{0.0};
+    double rotation = 0.0;
 };
 
 /// Which parameter a texture drives (gpu::TEXTURE_SLOT_*).

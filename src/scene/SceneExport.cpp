@@ -164,6 +164,8 @@ public:
         entry["record"] = t->record;
         entry["channel"] = channels[t->channel & 3];
         entry["scale"] = vec(t->scale);
+        entry["offset"] = vec(t->offset);
+        entry["rotation"] = t->rotation;
         m_out["textures"][key] = std::move(entry);
     }
 

@@ -11,6 +11,7 @@
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "scene/FileMaterialImport.h"
+#include "scene/GltfScene.h"
 #include "scene/SceneOverrides.h"
 
 #include "scene/ParseContext.h"
@@ -485,6 +486,8 @@ EnvironmentMap readEnvironmentMap(const TableField& table)
     table.rejectUnknownKeys(environmentKeys);
     EnvironmentMap map;
     map.where = table.field().location();
+    map.scale = readOr(table, "scale", map.scale, readRadiance);
+    map.rotation = glm::dmat3(readOr(table, "rotate", glm::dmat4(1.0), readRotation));
     const Field fileField = table.require("file");
     const fs::path path = readPath(fileField);
     const std::string extension = lowercase(path.extension().string());
@@ -492,8 +495,6 @@ EnvironmentMap readEnvironmentMap(const TableField& table)
         fileField.fail("an environment map must be a lat-long .exr or .hdr file, got " + quote(path.string()));
     checkRegularFile(fileField, path);
     map.path = path.string();
-    map.scale = readOr(table, "scale", map.scale, readRadiance);
-    map.rotation = glm::dmat3(readOr(table, "rotate", glm::dmat4(1.0), readRotation));
     return map;
 }
 
@@ -526,15 +527,36 @@ Background readBackground(const TableField& table)
 
 // --------------------------------------------------------------------- scene
 
-constexpr std::array<std::string_view, 6> topLevelKeys{"render",  "camera", "materials",
-                                                       "objects", "lights", "background"};
+constexpr std::array<std::string_view, 7> topLevelKeys{"render", "camera",     "materials", "objects",
+                                                       "lights", "background", "import"};
+constexpr std::array<std::string_view, 1> importKeys{"gltf"};
+
+/// `[import] gltf = "model.glb"`: the file's meshes and lights join the
+/// scene, and its camera unless the scene has a [camera].
+void readImport(const TableField& table, bool hasCamera, ParseContext& context)
+{
+    table.rejectUnknownKeys(importKeys);
+    const Field field = table.require("gltf");
+    const fs::path path = readPath(field);
+    if (!isGltfPath(path)) field.fail("expected a glTF file (.gltf or .glb), got " + quote(path.string()));
+    checkRegularFile(field, path);
+    try {
+        importGltf(path, {}, !hasCamera, context);
+    } catch (const SceneError&) {
+        throw;
+    } catch (const InputError& error) {
+        field.fail(std::string("cannot import the glTF scene: ") + error.what());
+    }
+}
 
 void readScene(const TableField& top, ParseContext& context)
 {
     top.rejectUnknownKeys(topLevelKeys);
     Scene& scene = context.scene;
     if (const auto render = top.find("render")) scene.render = readRender(TableField(*render));
-    scene.camera = readCamera(TableField(top.require("camera")));
+    const std::optional<Field> import = top.find("import");
+    const std::optional<Field> camera = top.find("camera");
+    if (camera || !import) scene.camera = readCamera(TableField(top.require("camera")));
     if (const auto materials = top.find("materials")) scene.materials = readMaterials(TableField(*materials), context);
     const MaterialIndex materialIndex(scene.materials);
     const auto object = [&](const TableField& table) { readObject(table, materialIndex, context); };
@@ -542,6 +564,8 @@ void readScene(const TableField& top, ParseContext& context)
     const auto light = [&](const TableField& table) { readLight(table, context); };
     if (const auto lights = top.find("lights")) forEachTable(*lights, light);
     if (const auto background = top.find("background")) scene.background = readBackground(TableField(*background));
+    // After the scene's own materials and objects: the file's materials are appended to them.
+    if (import) readImport(TableField(*import), camera.has_value(), context);
 }
 
 } // namespace

@@ -163,7 +163,7 @@ SessionConfig sessionConfig(const ViewOptions& options)
 
 Viewer::Viewer(const ViewOptions& options)
     : m_options(options),
-      m_parsed(loadScene(options.scenePath, {options.width, options.height})),
+      m_parsed(loadScene(options.scenePath, {options.width, options.height}, options.gltf)),
       m_window(m_parsed.camera.width, m_parsed.camera.height, "vkrt view - " + options.scenePath),
       m_context(ContextOptions{options.device, options.validation, presentationFor(m_window.get())}),
       m_exposure(options.exposure),

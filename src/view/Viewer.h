@@ -2,6 +2,7 @@
 // `vkrt view`: a GLFW window showing the progressive render as it converges,
 // with camera controls, and scripted sessions for tests.
 #include "render/Outcome.h"
+#include "scene/GltfScene.h"
 
 #include <cstdint>
 #include <optional>
@@ -11,6 +12,7 @@ namespace vkrt {
 
 struct ViewOptions {
     std::string scenePath;
+    GltfSceneOptions gltf; ///< --camera, --environment for a glTF scene
     std::string device;
     uint32_t seed = 0;
     std::optional<uint32_t> width; ///< render size (default: the scene's)

@@ -8,6 +8,7 @@
 // assimp (FileMaterials.h).
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
+#include "scene/GltfScene.h"
 #include "util/Error.h"
 
 #include <unistd.h>
@@ -50,8 +51,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
     }
     try {
-        // The whole mesh path of a scene: load, smooth normals, BVH, leaf order.
-        vkrt::makeMeshGeometry(file, vkrt::NormalMode::Smooth);
+        // The whole mesh path of a scene: load, smooth normals, BVH, leaf
+        // order; a glTF file as a whole scene (its camera, lights, materials).
+        if (vkrt::isGltfPath(file)) vkrt::parseGltfScene(file.string());
+        else vkrt::makeMeshGeometry(file, vkrt::NormalMode::Smooth);
     } catch (const vkrt::InputError&) {
         // the expected outcome for almost every input
     }

@@ -166,7 +166,9 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
     EXPECT_EQ(offsets.at("materials[0].internalReflectance") + 4, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].v2") + 12, int(sizeof(gpu::TriangleLight)));
-    EXPECT_EQ(offsets.at("u.topNodeCount") + 4, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("u.environmentAxisZ") + 12, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("directionalLights[0].sin2Alpha") + 4, int(sizeof(gpu::DirectionalLight)));
+    EXPECT_EQ(offsets.at("spotLights[0].axis") + 12, int(sizeof(gpu::SpotLight)));
     EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));
     EXPECT_EQ(offsets.at("emitters[0].alias") + 4, int(sizeof(gpu::Emitter)));
 }

@@ -194,7 +194,7 @@ std::string halfPlaneScene(double depth)
 {
     const std::string z = std::to_string(-depth);
     return "[render]\nintegrator = \"whitted\"\nmax_depth = 1\n"
-           "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, -1]\nfov = 30\nwidth = 64\nheight = 4\n"
+           "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, -1]\nfov = 2\nwidth = 64\nheight = 4\n"
            "aperture_radius = 0.2\nfocus_distance = 2\n"
            "[[lights]]\ntype = \"triangle\"\ntwo_sided = true\nradiance = 1\nvertices = [[0, -100, " +
            z + "], [100, -100, " + z + "], [100, 100, " + z +

@@ -619,8 +619,10 @@ const std::vector<BadScene> kBadScenes = {
      kCamera + "[materials.m]\ntype = \"mirror\"\n[[objects]]\nshape = \"triangle\"\nmaterial = \"m\"\n"
                "vertices = [[0, 0, 0], [1, 0, 0], [0, 1]]\n",
      10, 35, "objects[0].vertices[2]: expected an array of 3 numbers, got 2 element(s)"},
-    {"UnknownLightType", kCamera + "[[lights]]\ntype = \"spot\"\n", 6, 8,
-     "lights[0].type: unknown light type 'spot' (expected one of: point, triangle)"},
+    {"UnknownLightType", kCamera + "[[lights]]\ntype = \"spto\"\n", 6, 8,
+     "lights[0].type: unknown light type 'spto'; did you mean 'spot'?"},
+    {"UnknownLightTypeListsTheKinds", kCamera + "[[lights]]\ntype = \"laser\"\n", 6, 8,
+     "lights[0].type: unknown light type 'laser' (expected one of: point, triangle, directional, spot)"},
     {"PointLightMissingIntensity", kCamera + "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\n", 5, 1,
      "lights[0]: missing required key 'intensity'"},
     {"NegativeIntensity", kCamera + "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n", 8, 13,
