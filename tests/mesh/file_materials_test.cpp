@@ -146,7 +146,8 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
   "extensionsUsed": ["KHR_texture_transform", "KHR_materials_clearcoat", "KHR_lights_punctual"],
   "materials": [{"name": "Coated", "alphaMode": "BLEND", "doubleSided": true, "emissiveFactor": [1, 0.5, 0],
     "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 0.75], "metallicFactor": 0.25, "roughnessFactor": 0.5,
-      "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}},
+      "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 3], "offset": [0.5, 0.25],
+                                                                                 "rotation": 0.125}}}},
     "normalTexture": {"index": 1, "scale": 0.5, "texCoord": 1},
     "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0}}}],
   "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
@@ -175,13 +176,17 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     EXPECT_EQ(m.normalTexture->wrapU, TextureWrap::Repeat);
     const TextureImage decoded = decodeTextureImage(m.normalTexture->embedded, m.normalTexture->name, true);
     EXPECT_EQ(decoded.pixels.rgba, loadTextureImage(cubeDir() / "Cube_MetallicRoughness.png", true).pixels.rgba);
+    // KHR_texture_transform is read (scene/FileMaterialImport.cpp turns it into vkrt's uv space).
+    EXPECT_EQ(m.baseColorTexture->scale, glm::dvec2(2.0, 3.0));
+    EXPECT_EQ(m.baseColorTexture->offset, glm::dvec2(0.5, 0.25));
+    EXPECT_EQ(m.baseColorTexture->rotation, 0.125);
+    EXPECT_FALSE(mentions(m.unsupported, "KHR_texture_transform")) << joined(m.unsupported);
     // Each unsupported feature named.
-    EXPECT_TRUE(mentions(m.unsupported, "KHR_texture_transform")) << joined(m.unsupported);
     EXPECT_TRUE(mentions(m.unsupported, "KHR_materials_clearcoat")) << joined(m.unsupported);
     EXPECT_TRUE(mentions(m.unsupported, "alphaMode BLEND")) << joined(m.unsupported);
     EXPECT_TRUE(mentions(m.unsupported, "TEXCOORD_1")) << joined(m.unsupported);
     EXPECT_TRUE(mentions(m.unsupported, "KHR_lights_punctual")) << joined(m.unsupported);
-    EXPECT_EQ(m.unsupported.size(), 5u) << joined(m.unsupported);
+    EXPECT_EQ(m.unsupported.size(), 4u) << joined(m.unsupported);
 }
 
 TEST(MeshFileMaterials, MaskIsUnsupportedAndOpaqueIsNot)

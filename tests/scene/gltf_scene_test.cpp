@@ -86,11 +86,16 @@ TEST(GltfScene, AnotherCameraByIndexOrNameAndAClearErrorForNone)
 }
 
 /// The one-triangle glTF of the test support in a fresh folder, with `rest`
-/// added to its top-level object.
-fs::path writeTriangle(const std::string& name, const std::string& rest)
+/// added to its top-level object and `nodes` (JSON of the scene's roots and
+/// its nodes array; node 0 must be the triangle's) in place of its own.
+fs::path writeTriangle(const std::string& name, const std::string& rest,
+                       const std::string& nodes = R"("scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}])")
 {
     const fs::path dir = freshTempDir(name);
-    writeText(dir / "scene.gltf", triangleGltf(rest, ""));
+    std::string text = triangleGltf(rest.empty() ? R"("extras": {})" : rest, "");
+    const std::string own = R"("scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}])";
+    text.replace(text.find(own), own.size(), nodes);
+    writeText(dir / "scene.gltf", text);
     return dir / "scene.gltf";
 }
 
@@ -106,22 +111,23 @@ TEST(GltfScene, WithoutCameraOrLightsItFramesTheBoxUnderAWhiteSky)
 
 TEST(GltfScene, BadCamerasAndLightsNameTheFile)
 {
-    const std::string zeroFov = R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}],
-        "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}])";
-    const fs::path a = writeTriangle("gltf-zero-fov", zeroFov);
+    const fs::path a = writeTriangle("gltf-zero-fov",
+                                     R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}])",
+                                     R"("scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}])");
     std::string error = errorOf([&] { parseGltfScene(a.string()); });
     EXPECT_NE(error.find(a.string() + ": cameras[0].perspective.yfov: must be strictly between 0 and pi"),
               std::string::npos)
         << error;
 
-    const std::string badLight = R"("extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "laser"}]}},
-        "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 0}}}])";
-    const fs::path b = writeTriangle("gltf-bad-light", badLight);
+    const fs::path b = writeTriangle("gltf-bad-light", R"("extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": -1}]}})",
+                                     R"("scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 0}}}])");
     error = errorOf([&] { parseGltfScene(b.string()); });
-    EXPECT_NE(error.find("lights[0].type: unknown light type 'laser'"), std::string::npos) << error;
+    EXPECT_NE(error.find(b.string() + ": extensions.KHR_lights_punctual.lights[0]: color and intensity must be >= 0"),
+              std::string::npos)
+        << error;
 
     const fs::path c = freshTempDir("gltf-broken") / "broken.gltf";
     writeText(c, "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [");
@@ -134,11 +140,11 @@ TEST(GltfScene, SpotAndRangeFromTheFile)
     const std::string spot = R"("extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {"KHR_lights_punctual": {"lights": [
             {"type": "spot", "color": [1, 0.5, 0.25], "intensity": 8, "range": 10,
-             "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}]}},
-        "scenes": [{"nodes": [0, 1]}],
+             "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}]}})";
+    const std::string nodes = R"("scenes": [{"nodes": [0, 1]}],
         "nodes": [{"mesh": 0}, {"translation": [0, 4, 0], "rotation": [-0.70710678118654752, 0, 0, 0.70710678118654752],
                    "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
-    const Scene scene = parseGltfScene(writeTriangle("gltf-spot", spot).string());
+    const Scene scene = parseGltfScene(writeTriangle("gltf-spot", spot, nodes).string());
     ASSERT_EQ(scene.spotLights.size(), 1u);
     const SpotLight& s = scene.spotLights[0];
     expectNear(s.position, {0, 4, 0}, 1e-12, "position");
