@@ -74,14 +74,17 @@ void reportLoopIterations(uint longestSample)
 Ray cameraSample(uvec2 pixel, inout Sampler rng)
 {
 #ifdef VKRT_THIN_LENS
-    // One 4-D sample: the point in the pixel and the point on the lens.
-    vec4 s = sampleNext4D(rng);
-    vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? s.xy : vec2(0.5);
-    return thinLensRay(pixel, subpixel, s.zw);
-#else
+    // One 4-D sample: the point in the pixel and the point on the lens. (A
+    // pinhole scene in the uber kernel takes the pinhole's path below: the
+    // same rays and random numbers, so the same image bit for bit.)
+    if (u.apertureRadius > 0.0) {
+        vec4 s = sampleNext4D(rng);
+        vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? s.xy : vec2(0.5);
+        return thinLensRay(pixel, subpixel, s.zw);
+    }
+#endif
     vec2 subpixel = (u.flags & RENDER_FLAG_JITTER) != 0u ? sampleNext2D(rng) : vec2(0.5);
     return cameraRay(pixel, subpixel);
-#endif
 }
 
 // Measurement hook (path integrator): a sample's radiance becomes the number

@@ -14,7 +14,11 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <optional>
+#include <utility>
 #include <cstdio>
 #include <deque>
 #include <memory>
@@ -90,6 +94,8 @@ const char* viewerHelp()
 {
     return "vkrt view keys:\n"
            "  left drag          orbit around the target   scroll  zoom (field of view)\n"
+           "  left click         focus there (a camera with aperture_radius)\n"
+           "  drop a file        open that scene (TOML, .gltf, .glb)\n"
            "  right button held  W A S D fly forward/left/back/right, Q E fly down/up\n"
            "  S                  save EXR + PNG            R       reset the accumulation\n"
            "  I                  switch whitted/path       P       pause\n"
@@ -126,6 +132,9 @@ private:
     std::deque<std::string> m_keys;    ///< pressed keys not yet handled
     bool m_dragging = false;
     double m_lastX = 0, m_lastY = 0;
+    double m_pressX = 0, m_pressY = 0;                          ///< where the left button went down
+    std::optional<std::pair<double, double>> m_pendingFocus;    ///< a click, as fractions of the window
+    std::optional<std::string> m_pendingOpen;                   ///< a scene file dropped on the window
     double m_pendingYaw = 0, m_pendingPitch = 0, m_pendingZoom = 1;
     Clock::time_point m_rateStart = Clock::now();
     uint64_t m_rateSamples = 0;
@@ -144,6 +153,8 @@ private:
     bool flying() const { return glfwGetMouseButton(m_window.get(), GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS; }
     void applyCameraInput(double dt);
     void setCamera(const Camera& camera, const char* move);
+    void focusAt(double fx, double fy);
+    void openScene(const std::string& path);
     void updateTitle(bool force = false);
     void save(const std::string& exrPath);
     void screenshot(const std::string& pngPath);
@@ -151,10 +162,12 @@ private:
     void runInteractive();
 };
 
-SessionConfig sessionConfig(const ViewOptions& options)
+SessionConfig sessionConfig(const ViewOptions& options, const Scene& scene)
 {
     SessionConfig config;
     config.seed = options.seed;
+    // A click focuses a thin lens at the depth the AOVs measure under it.
+    config.aov = scene.camera.thinLens();
     config.variance.layer = options.variance;
     config.maxBandBytes = options.maxBandBytes;
     config.warmUp = false; // the first frames show at once
@@ -169,7 +182,8 @@ Viewer::Viewer(const ViewOptions& options)
       m_exposure(options.exposure),
       m_filmic(options.filmic)
 {
-    m_session = std::make_unique<RenderSession>(m_context, std::move(m_parsed), sessionConfig(options));
+    SessionConfig config = sessionConfig(options, m_parsed);
+    m_session = std::make_unique<RenderSession>(m_context, std::move(m_parsed), std::move(config));
     createDisplay();
     recreateSwapchain();
     m_imageAvailable = vk::raii::Semaphore(m_context.device(), vk::SemaphoreCreateInfo());
@@ -213,6 +227,13 @@ void Viewer::installCallbacks()
         if (button != GLFW_MOUSE_BUTTON_LEFT) return;
         self->m_dragging = action == GLFW_PRESS;
         glfwGetCursorPos(window, &self->m_lastX, &self->m_lastY);
+        if (action == GLFW_PRESS) self->m_pressX = self->m_lastX, self->m_pressY = self->m_lastY;
+        // A click that did not drag: focus where it points.
+        int width = 0, height = 0;
+        glfwGetWindowSize(window, &width, &height);
+        if (action == GLFW_RELEASE && std::hypot(self->m_lastX - self->m_pressX, self->m_lastY - self->m_pressY) < 3 &&
+            width > 0 && height > 0)
+            self->m_pendingFocus = std::make_pair(self->m_lastX / width, self->m_lastY / height);
     });
     glfwSetCursorPosCallback(w, [](GLFWwindow* window, double x, double y) {
         auto* self = static_cast<Viewer*>(glfwGetWindowUserPointer(window));
@@ -220,6 +241,9 @@ void Viewer::installCallbacks()
         self->m_pendingYaw -= 0.3 * (x - self->m_lastX);
         self->m_pendingPitch += 0.3 * (y - self->m_lastY);
         self->m_lastX = x, self->m_lastY = y;
+    });
+    glfwSetDropCallback(w, [](GLFWwindow* window, int count, const char** paths) {
+        if (count > 0) static_cast<Viewer*>(glfwGetWindowUserPointer(window))->m_pendingOpen = std::string(paths[0]);
     });
     glfwSetScrollCallback(w, [](GLFWwindow* window, double, double dy) {
         static_cast<Viewer*>(glfwGetWindowUserPointer(window))->m_pendingZoom *= std::pow(0.9, dy);
@@ -233,6 +257,51 @@ void Viewer::setCamera(const Camera& camera, const char* move)
     m_context.device().waitIdle();
     if (auto problem = m_session->moveCamera(camera))
         std::fprintf(stderr, "vkrt view: %s ignored: the camera would be invalid (%s)\n", move, problem->c_str());
+}
+
+/// Replaces the scene with the one in `path` (a TOML scene, or a glTF file
+/// dropped on the window) at the window's image size; a file vkrt refuses
+/// leaves the view as it was, with the reason.
+void Viewer::openScene(const std::string& path)
+{
+    std::optional<Scene> scene;
+    try {
+        scene = loadScene(path, {renderer().width(), renderer().height()});
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "vkrt view: cannot open %s: %s\n", path.c_str(), e.what());
+        return;
+    }
+    m_context.device().waitIdle();
+    m_display.reset(); // it reads the old renderer's accumulation buffer
+    SessionConfig config = sessionConfig(m_options, *scene);
+    m_session = std::make_unique<RenderSession>(m_context, std::move(*scene), std::move(config));
+    createDisplay();
+    glfwSetWindowTitle(m_window.get(), ("vkrt view - " + path).c_str());
+    std::printf("vkrt view: opened %s\n", path.c_str());
+    std::fflush(stdout);
+}
+
+/// Focuses the thin lens on the surface at (fx, fy) (fractions of the image):
+/// the mean camera-space depth of the first hits there, from the AOVs.
+void Viewer::focusAt(double fx, double fy)
+{
+    if (!scene().camera.thinLens()) {
+        std::fprintf(stderr, "vkrt view: focus ignored: the camera is a pinhole (give it an aperture_radius)\n");
+        return;
+    }
+    m_context.device().waitIdle();
+    const uint32_t x = std::min(uint32_t(std::max(fx, 0.0) * renderer().width()), renderer().width() - 1);
+    const uint32_t y = std::min(uint32_t(std::max(fy, 0.0) * renderer().height()), renderer().height() - 1);
+    const float depth = renderer().aovs().depth[size_t(y) * renderer().width() + x];
+    if (!std::isfinite(depth) || !(depth > 0)) {
+        std::fprintf(stderr, "vkrt view: focus ignored: nothing is seen at pixel %u,%u yet\n", x, y);
+        return;
+    }
+    Camera camera = scene().camera;
+    camera.focusDistance = double(depth);
+    setCamera(camera, "focus");
+    std::printf("vkrt view: focus distance %.6g (pixel %u,%u)\n", double(depth), x, y);
+    std::fflush(stdout);
 }
 
 void Viewer::applyCameraInput(double dt)
@@ -382,6 +451,8 @@ void Viewer::runScript(const std::vector<ViewerCommand>& commands)
         } else if (c.name == "orbit") setCamera(orbit(scene().camera, c.numbers[0], c.numbers[1]), "orbit");
         else if (c.name == "fly") setCamera(fly(scene().camera, c.numbers[0], c.numbers[1], c.numbers[2]), "fly");
         else if (c.name == "zoom") setCamera(zoom(scene().camera, c.numbers[0]), "zoom");
+        else if (c.name == "focus") focusAt(c.numbers[0], c.numbers[1]);
+        else if (c.name == "open") openScene(c.text);
         else if (c.name == "exposure") m_exposure = float(c.numbers[0]);
         else if (c.name == "key") handleKey(c.text);
         else if (c.name == "save") save(c.text);
@@ -399,6 +470,8 @@ void Viewer::runInteractive()
         auto now = Clock::now();
         applyCameraInput(std::chrono::duration<double>(now - last).count());
         last = now;
+        if (m_pendingFocus) focusAt(m_pendingFocus->first, m_pendingFocus->second), m_pendingFocus.reset();
+        if (m_pendingOpen) openScene(*m_pendingOpen), m_pendingOpen.reset();
         while (!m_keys.empty()) {
             std::string key = m_keys.front();
             m_keys.pop_front();

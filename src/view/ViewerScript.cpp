@@ -17,7 +17,8 @@ struct Signature {
 
 const std::map<std::string, Signature> kCommands = {
     {"frames", {1}},   {"orbit", {2}}, {"fly", {3}},   {"zoom", {1}},
-    {"exposure", {1}}, {"key", {-1}},  {"save", {-1}}, {"screenshot", {-1}},
+    {"exposure", {1}}, {"key", {-1}},  {"save", {-1}}, {"screenshot", {-1}}, {"focus", {2}},
+    {"open", {-1}},
 };
 
 const char* const kKeys[] = {"S", "R", "I", "P", "H", "+", "-", "F"};
@@ -61,7 +62,7 @@ ViewerCommand parseLine(const std::vector<std::pair<std::string, size_t>>& w, co
     auto it = kCommands.find(w[0].first);
     if (it == kCommands.end())
         fail(path, line, w[0].second,
-             "unknown command '" + w[0].first + "' (frames, orbit, fly, zoom, exposure, key, save, screenshot)");
+             "unknown command '" + w[0].first + "' (frames, orbit, fly, zoom, exposure, key, save, screenshot, focus, open)");
     int expected = it->second.numbers < 0 ? 1 : it->second.numbers;
     if (int(w.size()) - 1 != expected)
         fail(path, line, w[0].second,
@@ -75,6 +76,10 @@ ViewerCommand parseLine(const std::vector<std::pair<std::string, size_t>>& w, co
         (command.numbers[0] < 0 || command.numbers[0] != std::floor(command.numbers[0]) || command.numbers[0] > 1e6))
         fail(path, line, w[1].second, "frames needs a whole number from 0 to 1000000");
     if (command.name == "zoom" && !(command.numbers[0] > 0)) fail(path, line, w[1].second, "zoom factor must be > 0");
+    if (command.name == "focus")
+        for (size_t i = 0; i < 2; ++i)
+            if (!(command.numbers[i] >= 0 && command.numbers[i] < 1))
+                fail(path, line, w[i + 1].second, "focus takes the point as fractions of the image in [0, 1)");
     if (command.name == "key" && std::find(std::begin(kKeys), std::end(kKeys), command.text) == std::end(kKeys))
         fail(path, line, w[1].second, "unknown key '" + command.text + "' (S R I P H + - F)");
     return command;

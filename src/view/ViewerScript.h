@@ -9,6 +9,9 @@
 //   key NAME            press a key: S R I P H + - F
 //   save PATH.exr       save the accumulation (EXR) and the displayed PNG beside it
 //   screenshot PATH.png save the displayed image
+//   focus X Y           click there: focus a thin lens on what is seen at (X, Y),
+//                       fractions of the image in [0, 1) from its top left
+//   open PATH           open another scene, as dropping its file on the window does
 #include <filesystem>
 #include <string>
 #include <vector>

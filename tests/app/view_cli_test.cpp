@@ -133,6 +133,49 @@ TEST_F(ViewCli, InvalidCameraMoveIsIgnoredWithAMessage)
     EXPECT_EQ(std::get<std::string>(readExr(m_dir / "kept.exr").metadata.at("savedBy")), "vkrt view");
 }
 
+// A click (here the script's `focus`) focuses a thin lens on the surface it
+// points at: a wall 7 units ahead of an eye focused at 2 is refocused at 7,
+// the accumulation starts afresh, and a pinhole camera says why it cannot.
+TEST_F(ViewCli, FocusSetsTheThinLensOnTheSurfaceUnderThePoint)
+{
+    const fs::path scene = m_dir / "lens.toml";
+    writeText(scene, "[render]\nintegrator = \"path\"\nmax_depth = 2\n"
+                     "[camera]\neye = [0, 0, 7]\ntarget = [0, 0, 0]\nfov = 30\nwidth = 48\nheight = 36\n"
+                     "aperture_radius = 0.1\nfocus_distance = 2\n"
+                     "[materials.white]\ntype = \"lambert\"\nalbedo = 0.5\n"
+                     "[[objects]]\nshape = \"plane\"\nmaterial = \"white\"\npoint = [0, 0, 0]\nnormal = [0, 0, 1]\n"
+                     "[background]\ncolor = 1\n");
+    fs::path script = m_dir / "focus.txt";
+    writeText(script, "frames 2\nfocus 0.5 0.5\nframes 3\nsave " + (m_dir / "focused.exr").string() + "\n");
+    ProcessResult r = runViewer({scene.string(), "--script", script.string(), "--validation"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("vkrt view: focus distance 7 (pixel 24,18)"), std::string::npos) << r.output;
+    EXPECT_EQ(std::get<int64_t>(readExr(m_dir / "focused.exr").metadata.at("spp")), 3) << "focusing restarts";
+
+    writeText(script, "frames 1\nfocus 0.5 0.5\n");
+    ProcessResult pinhole = runViewer({kScene, "--script", script.string(), "--width", "48", "--height", "36"});
+    ASSERT_EQ(pinhole.exitCode, 0) << pinhole.output;
+    EXPECT_NE(pinhole.output.find("focus ignored: the camera is a pinhole"), std::string::npos) << pinhole.output;
+}
+
+// Dropping a file on the window (here the script's `open`) opens it: a glTF
+// file as a scene; a file vkrt refuses leaves the view with the reason.
+TEST_F(ViewCli, OpeningAGltfFileReplacesTheScene)
+{
+    const std::string gltf = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/gltf/lights-camera.gltf";
+    fs::path script = m_dir / "open.txt";
+    writeText(script, "frames 1\nopen " + (m_dir / "missing.glb").string() + "\nopen " + gltf + "\nframes 2\nsave " +
+                          (m_dir / "opened.exr").string() + "\n");
+    ProcessResult r = runViewer({kScene, "--script", script.string(), "--width", "48", "--height", "36"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("cannot open " + (m_dir / "missing.glb").string()), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("vkrt view: opened " + gltf), std::string::npos) << r.output;
+    const ExrContents saved = readExr(m_dir / "opened.exr");
+    EXPECT_EQ(std::get<int64_t>(saved.metadata.at("spp")), 2);
+    EXPECT_EQ(saved.image.width, 48u); // the window's size
+    EXPECT_EQ(std::get<std::string>(saved.metadata.at("scene")), gltf);
+}
+
 TEST_F(ViewCli, BadScriptNamesFileLineAndColumn)
 {
     fs::path script = m_dir / "bad.txt";
