@@ -203,9 +203,11 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
     uint64_t escape = scene.directionalLights.size();
     uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery) + escape;
     uint64_t depth = uint64_t(scene.render.maxDepth);
-    if (whitted) return depth * perDepth;
-    // Cubemap sampling: a binary search over 6 N^2 texels and a shadow query.
-    uint64_t environment = scene.background.cubemap || scene.background.environment ? 1 + 32 + hittables : 0;
+    // Sampling the map (featuresOf: a lat-long map in both integrators, a
+    // cubemap in the path integrator): binary searches over at most 2^32
+    // entries in all and a shadow query (through glass for Whitted).
+    uint64_t environment = featuresOf(scene).environmentSampling ? 1 + 32 + shadowQuery : 0;
+    if (whitted) return depth * (perDepth + environment);
     return depth * (perDepth + environment) + 1 + hittables;
 }
 

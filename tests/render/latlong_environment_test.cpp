@@ -71,16 +71,6 @@ std::string environmentTable(const std::string& extra)
     return "[background.environment]\nfile = \"map.exr\"\n" + extra;
 }
 
-double pooledZ(const Image& mean, const Image& variance, int channel, double expected)
-{
-    double difference = 0.0, var = 0.0;
-    for (size_t i = 0; i < mean.pixelCount(); ++i) {
-        difference += mean.rgb[i * 3 + channel] - expected;
-        var += variance.rgb[i * 3 + channel];
-    }
-    return difference / std::sqrt(var);
-}
-
 TEST_F(LatLongEnvironment, CameraRaysSeeTheMapInMitsubasConventionAndRotation)
 {
     const fs::path dir = freshTempDir("latlong-convention");

@@ -137,18 +137,6 @@ TEST_F(LensAndLights, SpotLightWithEqualConesHasAHardEdge)
     EXPECT_GT(dark, 20);
 }
 
-/// The pooled z of every pixel of `image` against `expected` (one channel),
-/// with each pixel's variance of the mean.
-double pooledZ(const Image& mean, const Image& variance, int channel, double expected)
-{
-    double difference = 0.0, var = 0.0;
-    for (size_t i = 0; i < mean.pixelCount(); ++i) {
-        difference += mean.rgb[i * 3 + channel] - expected;
-        var += variance.rgb[i * 3 + channel];
-    }
-    return difference / std::sqrt(var);
-}
-
 TEST_F(LensAndLights, SoftSunGivesTheIrradianceOfADeltaSunInBothIntegrators)
 {
     // theta0 = 40 degrees from the plane's normal, a 5-degree-wide sun: the

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -158,6 +159,16 @@ std::array<uint32_t, 4> pcg4dReference(std::array<uint32_t, 4> v)
     v[2] += v[0] * v[1];
     v[3] += v[1] * v[2];
     return v;
+}
+
+double pooledZ(const Image& mean, const Image& variance, int channel, double expected)
+{
+    double difference = 0.0, var = 0.0;
+    for (size_t i = 0; i < mean.pixelCount(); ++i) {
+        difference += mean.rgb[i * 3 + channel] - expected;
+        var += variance.rgb[i * 3 + channel];
+    }
+    return difference / std::sqrt(var);
 }
 
 double channelMean(const Image& image, int channel)

@@ -69,6 +69,11 @@ std::string shellQuote(const std::string& arg);
 /// Writes text to a file (creating parent directories).
 void writeText(const std::filesystem::path& path, const std::string& text);
 
+/// The pooled z of one channel of every pixel of `mean` against the constant
+/// `expected`: the summed differences over the root of the summed variances
+/// of the means.
+double pooledZ(const Image& mean, const Image& variance, int channel, double expected);
+
 /// Mean of one channel over all pixels.
 double channelMean(const Image& image, int channel);
 
