@@ -65,6 +65,11 @@ sed "s|\"uri\" *: *\"Cube.bin\"|\"uri\": \"data:application/octet-stream;base64,
   "$assets/gltf/Cube/Cube.gltf" >"$work/Cube.gltf"
 seed 2 "$work/Cube.gltf"
 for file in "$assets"/gltf/bad/*.gltf; do seed 2 "$file"; done
+# glTF scenes with cameras, KHR_lights_punctual lights, material extensions
+# and texture transforms (read as whole scenes: scene/GltfScene.h).
+for file in "$root"/scenes/gltf/*.gltf; do
+  [[ $(stat -c %s "$file") -le 65536 ]] && seed 2 "$file"
+done
 # Node hierarchies at the bound (kMaxGltfNodeDepth, 1024 levels) and one past
 # it, a cycle, and JSON nesting at kMaxGltfJsonNesting (1024) and past it
 # (src/mesh/FileMaterials.h): 1024 '[' inside the top-level object are 1025 levels.

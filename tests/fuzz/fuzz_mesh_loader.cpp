@@ -1,5 +1,6 @@
-// libFuzzer target for the mesh path (loadMeshFile, normals, BVH build): the first byte picks the format, the rest
-// is the file. Any outcome but a MeshData or an InputError (another exception,
+// libFuzzer target for the mesh path (loadMeshFile, normals, BVH build; a glTF
+// file read as a whole scene: its cameras, lights and material extensions
+// too): the first byte picks the format, the rest is the file. Any outcome but a MeshData or an InputError (another exception,
 // a crash, a sanitizer report, a hang) is a bug. tools/fuzz.sh runs it. The
 // default MeshLoadOptions apply: a glTF's buffer or image URI, or an OBJ's
 // mtllib, that leaves the fuzzer's folder is refused (ReferencePolicy.h), so no

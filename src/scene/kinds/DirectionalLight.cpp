@@ -6,6 +6,7 @@
 #include "scene/SceneValues.h"
 #include "scene/kinds/Kinds.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
 #include <limits>
