@@ -143,34 +143,41 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 #define VKRT_OFFER_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     offer##Type##Samples(r, m, hit, ns, wo, origin, rng);
 
-// Next-event estimation of the environment map, MIS-weighted against BSDF
-// sampling (which finds the same light when a ray escapes: environmentOnEscape).
-// `bsdfFollows`: a BSDF-sampled continuation will look for the environment
-// too (MIS weights); false at a vertex no ray leaves (the Whitted
-// integrator's last), where the light sample is all the estimate has.
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+// One direction drawn from the environment map and its light at a surface
+// before visibility, MIS-weighted against BSDF sampling (which finds the same
+// light when a ray escapes: environmentOnEscape) when `bsdfFollows`; false at
+// a vertex no ray leaves (the Whitted integrator's last), where the light
+// sample is all the estimate has. The shadow ray's target is far along the
+// direction (FAR_LIGHT_DISTANCE).
+LightSample sampleEnvironmentLight(Material m, vec3 ns, vec3 wo, vec3 origin, bool bsdfFollows, vec3 rnd)
+{
+    float pdf;
+    vec3 wi = sampleEnvironment(rnd, pdf);
+    vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
+    float cosI = dot(ns, wi);
+    if (pdf <= 0.0 || cosI <= 0.0)
+        return LightSample(vec3(0.0), target);
+    vec3 f = evalBsdf(m, ns, wo, wi);
+    if (f == vec3(0.0))
+        return LightSample(vec3(0.0), target);
+    float weight = bsdfFollows ? powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi)) : 1.0;
+    return LightSample(f * environmentRadiance(wi) * (cosI * weight / pdf), target);
+}
+#endif
+
+// The environment map with a shadow ray of its own (the Whitted integrator;
+// the path integrator offers it to its one shadow ray with the lights).
 vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, bool bsdfFollows,
                            inout Sampler rng)
 {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
-    float pdf;
-    vec3 wi = sampleEnvironment(sampleNext4D(rng).xyz, pdf);
-    float cosI = dot(ns, wi);
-    if (pdf <= 0.0 || cosI <= 0.0)
-        return vec3(0.0);
-    vec3 f = evalBsdf(m, ns, wo, wi);
-    if (f == vec3(0.0))
-        return vec3(0.0);
-    float weight = bsdfFollows ? powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi)) : 1.0;
-#ifdef VKRT_HAS_SHADING_NORMALS
-    // Behind the geometric surface (shading normals): blocked by it (lib/lights.glsl).
-    if (ns != n && dot(wi, n) <= 0.0)
-        return vec3(0.0);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightSample s = sampleEnvironmentLight(m, ns, wo, origin, bsdfFollows, sampleNext4D(rng).xyz);
+    if (s.unshadowed != vec3(0.0))
+        return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
 #endif
-    vec3 visible = shadowTransmittance(offsetRayOrigin(hit.position, hit.error, n), wi, FLT_MAX, media);
-    return f * environmentRadiance(wi) * (cosI * weight / pdf) * visible;
-#else
     return vec3(0.0);
-#endif
 }
 
 // Environment radiance found by a ray that escaped after a scattering of
@@ -193,8 +200,8 @@ vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Medi
     return vec3(0.0) VKRT_LIGHT_KINDS(VKRT_DIRECT_FROM_KIND);
 }
 
-// Next-event estimation from every light kind and the emitters with one
-// shadow ray (the path integrator). Each light offers its sample as in the
+// Next-event estimation from every light kind, the emitters and the
+// environment map with one shadow ray (the path integrator). Each light offers its sample as in the
 // Whitted sums above, but only one is tested for visibility: sample i with
 // probability p_i = w_i / W, its unshadowed weight over their total, and
 // scaled by 1 / p_i. The expectation is the sum of every sample times its
@@ -209,6 +216,11 @@ vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 ns, v
     LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
     VKRT_LIGHT_KINDS(VKRT_OFFER_KIND)
     offerEmitterSample(r, m, hit, ns, wo, origin, rng);
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    // The environment map is one more candidate: one shadow ray for all light.
+    vec4 u4 = sampleNext4D(rng);
+    offerLightSample(r, sampleEnvironmentLight(m, ns, wo, origin, true, u4.xyz), u4.w);
+#endif
     if (r.totalWeight == 0.0)
         return vec3(0.0);
     return r.kept.unshadowed * (r.totalWeight / r.keptWeight) *

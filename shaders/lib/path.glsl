@@ -1,8 +1,8 @@
 // Unbiased path tracing (`integrator = "path"`). At each non-specular vertex:
 // next-event estimation for every point light and one area-sampled point on
 // one emitter (triangle lights and emissive mesh triangles, chosen in
-// proportion to power), with one shadow ray for all of them (chosen by
-// unshadowed contribution), and for the environment (a second shadow ray),
+// proportion to power) and one direction of a sampled environment map, with
+// one shadow ray for all of them (chosen by unshadowed contribution),
 // weighted against BSDF sampling with the power heuristic; then one
 // BSDF-sampled continuation. A continuation that hits an emitter adds its
 // emission with the complementary MIS weight (full weight after a specular
@@ -111,8 +111,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
 #endif
     aovScatter(m, ns);
     if (!scattersIntoDeltasOnly(m)) {
-        p.path.radiance += p.path.throughput * (directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng) +
-                                                directFromEnvironment(m, hit, n, ns, wo, p.path.media, true, rng));
+        p.path.radiance += p.path.throughput * directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng);
     }
     vec4 u4 = sampleNext4D(rng);
     float eta = surfaceEta(p.path.media, hit);
