@@ -203,7 +203,7 @@ std::optional<Camera> cameraFrom(const fs::path& file, const json& doc, const Pl
 {
     const std::string where = formatIndex("cameras", placed.index);
     if (!doc.contains("cameras") || !doc["cameras"].is_array() || placed.index >= doc["cameras"].size())
-        fail(file, formatIndex("nodes", 0) + ".camera: no camera " + std::to_string(placed.index));
+        fail(file, "a node names camera " + std::to_string(placed.index) + ", which the file does not have");
     const json& camera = doc["cameras"][placed.index];
     if (!camera.contains("type") || camera["type"] != "perspective") {
         warnings.push_back(file.string() + ": " + where +
