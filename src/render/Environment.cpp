@@ -70,9 +70,6 @@ std::array<Image, 6> loadCubemapFaces(const Cubemap& cubemap)
     return faces;
 }
 
-} // namespace vkrt
-
-namespace vkrt {
 
 namespace {
 

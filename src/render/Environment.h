@@ -1,5 +1,5 @@
 #pragma once
-// Loading the six faces of a scene's cubemap environment.
+// Loading a scene's environment: the six faces of a cubemap, or a lat-long map.
 #include "io/Image.h"
 #include "scene/Scene.h"
 
@@ -18,9 +18,6 @@ constexpr uint32_t kMaxCubeFaceSide = 4096;
 /// before any face is decoded.
 std::array<Image, 6> loadCubemapFaces(const Cubemap& cubemap);
 
-} // namespace vkrt
-
-namespace vkrt {
 
 /// A lat-long map's sides: at least 2 x 2 texels (its bilinear cells need
 /// two rows), at most 16384 wide (Vulkan's guaranteed 2D image side is

@@ -38,9 +38,6 @@ std::vector<float> environmentCdf(const std::array<Image, 6>& faces)
     return cdf;
 }
 
-} // namespace vkrt
-
-namespace vkrt {
 
 namespace {
 

@@ -1,6 +1,7 @@
 #pragma once
-// The discrete distribution over cubemap texels that the path integrator
-// samples the environment with (shaders/lib/environment.glsl).
+// The distributions the environment maps are importance-sampled with
+// (shaders/lib/environment.glsl): over a cubemap's texels (path integrator)
+// and over a lat-long map's bilinear cells (both integrators).
 #include "io/Image.h"
 
 #include <array>
@@ -14,9 +15,6 @@ namespace vkrt {
 /// uniform distribution (it is never worth sampling, but must stay valid).
 std::vector<float> environmentCdf(const std::array<Image, 6>& faces);
 
-} // namespace vkrt
-
-namespace vkrt {
 
 /// The lat-long map's sampling distribution (shaders/lib/environment.glsl):
 /// a grid over (s, v), s = u - 0.5 / W (mod 1), so that its lines fall on

@@ -31,10 +31,7 @@ struct Rendered {
 
 Rendered render(const Scene& scene, uint32_t seed, uint32_t spp)
 {
-    RenderOptions options = pixelCentreOptions();
-    options.jitter = true;
-    options.variance = true;
-    options.seed = seed;
+    RenderOptions options = statisticalOptions(seed);
     Renderer renderer(gpu(), scene, options);
     renderer.renderFrames(spp);
     return {renderer.mean(), renderer.varianceOfMean()};

@@ -119,10 +119,7 @@ TEST_F(LatLongEnvironment, WhiteFurnaceSphereVanishesInBothIntegrators)
                                  "radius = 1\n" +
                                  environmentTable("scale = [0.5, 1, 2]\n");
         const Scene scene = sceneFromText(text, (dir / "scene.toml").string());
-        RenderOptions options = pixelCentreOptions();
-        options.jitter = true;
-        options.variance = true;
-        options.seed = 5;
+        RenderOptions options = statisticalOptions(5);
         Renderer renderer(gpu(), scene, options);
         renderer.renderFrames(256);
         const double scale[3] = {0.5, 1.0, 2.0};
@@ -165,10 +162,8 @@ TEST_F(LatLongEnvironment, ImportanceSamplingOfASmallSunIsUnbiasedAndLowersTheEr
     for (const char* integrator : {"whitted", "path"}) {
         const Scene scene = sceneFromText(sunnyPlaneScene(integrator), (dir / "scene.toml").string());
         auto render = [&](bool sampled, bool variance, uint32_t spp) {
-            RenderOptions options = pixelCentreOptions();
-            options.jitter = true;
+            RenderOptions options = statisticalOptions(9);
             options.variance = variance;
-            options.seed = 9;
             if (!sampled) options.extraDefines.push_back({"VKRT_TEST_NO_ENVIRONMENT_SAMPLING", "1"});
             Renderer renderer(gpu(), scene, options);
             renderer.renderFrames(spp);

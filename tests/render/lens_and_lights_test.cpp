@@ -151,10 +151,7 @@ TEST_F(LensAndLights, SoftSunGivesTheIrradianceOfADeltaSunInBothIntegrators)
         text.replace(text.find("eye = [0, 2, 3]"), 15, "eye = [0, 2, 0]");
         text.replace(text.find("fov = 50"), 8, "fov = 20\nup = [0, 0, -1]");
         const Scene scene = sceneFromText(text);
-        RenderOptions options = pixelCentreOptions();
-        options.jitter = true;
-        options.variance = true;
-        options.seed = 11;
+        RenderOptions options = statisticalOptions(11);
         Renderer renderer(gpu(), scene, options);
         renderer.renderFrames(256);
         const double z = pooledZ(renderer.mean(), renderer.varianceOfMean(), 0, expected);

@@ -81,6 +81,15 @@ RenderOptions pixelCentreOptions()
     return options;
 }
 
+RenderOptions statisticalOptions(uint32_t seed)
+{
+    RenderOptions options = pixelCentreOptions();
+    options.jitter = true;
+    options.variance = true;
+    options.seed = seed;
+    return options;
+}
+
 Scene sceneFromText(const std::string& text, const std::string& path) { return parseSceneString(text, path); }
 
 ProcessResult runVkrt(const std::vector<std::string>& args, const std::string& stdinFile)

@@ -42,6 +42,10 @@ std::filesystem::path testCacheDir();
 /// cache: deterministic geometry for analytic and exact comparisons.
 RenderOptions pixelCentreOptions();
 
+/// Render options for statistical tests: jittered samples, a per-pixel
+/// variance estimate (independent samples), `seed`, the test cache.
+RenderOptions statisticalOptions(uint32_t seed);
+
 /// Parses scene text (path used for messages and relative files).
 Scene sceneFromText(const std::string& text, const std::string& path = "test.toml");
 
