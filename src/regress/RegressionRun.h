@@ -3,6 +3,7 @@
 // reference, and writes a Markdown report, failure images and JUnit XML.
 #include "gpu/ShaderCompiler.h"
 #include "render/Outcome.h"
+#include "render/RenderSession.h"
 
 #include <filesystem>
 #include <string>
@@ -20,6 +21,7 @@ struct RegressOptions {
     bool update = false;             ///< regenerate the vkrt-made references
     uint32_t seedOffset = 0;         ///< added to the suite's seed (repeat runs)
     bool failOnSlowdown = false;
+    AccelChoice accel = AccelChoice::Auto; ///< --accel: the traversal backend of every case
     std::vector<Define> kernelDefines; ///< test hooks: build every kernel with these
 };
 

@@ -21,6 +21,16 @@ std::optional<SamplerChoice> samplerChoiceNamed(const std::string& name)
 
 std::string samplerName(Sampler sampler) { return sampler == Sampler::Sobol ? "sobol" : "independent"; }
 
+std::optional<AccelChoice> accelChoiceNamed(const std::string& name)
+{
+    if (name == "own") return AccelChoice::Own;
+    if (name == "driver") return AccelChoice::Driver;
+    if (name == "auto") return AccelChoice::Auto;
+    return std::nullopt;
+}
+
+std::string accelName(Accel accel) { return accel == Accel::Driver ? "driver" : "own"; }
+
 Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixels, uint64_t storageBufferRange)
 {
     if (choice == SamplerChoice::Independent) return Sampler::Independent;

@@ -46,6 +46,19 @@ struct VarianceNeeds {
 /// a sixth of that.
 Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixels, uint64_t storageBufferRange);
 
+// ---------------------------------------------------------------- traversal
+
+/// Which traversal answers traceClosest/traceAny (docs/architecture.md,
+/// "Two traversal backends"): vkrt's own BVH walk in the compute kernel, or
+/// the driver's acceleration structures through VK_KHR_ray_query. Auto picks
+/// per device and scene (resolveAccel).
+enum class AccelChoice { Own, Driver, Auto };
+enum class Accel { Own, Driver };
+
+/// "own", "driver" or "auto" (the --accel values); nullopt otherwise.
+std::optional<AccelChoice> accelChoiceNamed(const std::string& name);
+std::string accelName(Accel accel);
+
 // ---------------------------------------------------------------- scene
 
 /// Parses and validates a scene file, then applies and checks `resolution`
@@ -68,6 +81,7 @@ struct SessionConfig {
     SamplerChoice sampler = SamplerChoice::Auto;
     VarianceNeeds variance;
     bool aov = false; ///< average the AOVs too (RenderOptions::aov)
+    AccelChoice accel = AccelChoice::Auto; ///< the traversal backend (resolveAccel decides Auto)
     std::vector<Define> extraDefines; ///< test hooks
     uint64_t maxBandBytes = 0;        ///< RenderOptions::maxBandBytes (a test hook; 0: the device's limit)
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
