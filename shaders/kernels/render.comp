@@ -2,6 +2,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
+#ifdef VKRT_ACCEL_DRIVER
+#extension GL_EXT_ray_query : require
+#endif
 #ifdef VKRT_GROUP_LOOP_COUNT
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #endif

@@ -45,7 +45,9 @@ layout(scalar, binding = BINDING_AOVS) buffer AovBlock { AovPixel aovs[]; };
 VKRT_SCENE_ARRAY(BINDING_MATERIALS, MaterialBlock, Material, materials, UNIFORM_MATERIALS)
 #endif
 #ifdef VKRT_HAS_MESHES
+#ifndef VKRT_ACCEL_DRIVER // the driver backend walks its own structures instead
 layout(scalar, binding = BINDING_MESH_NODES) readonly buffer MeshNodeBlock { BvhNode meshNodes[]; };
+#endif
 layout(scalar, binding = BINDING_MESH_TRIANGLES) readonly buffer MeshTriangleBlock { MeshTriangle meshTriangles[]; };
 #endif
 #ifdef VKRT_HAS_MESH_NORMALS

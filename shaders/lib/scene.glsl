@@ -19,6 +19,9 @@
 #include "lights/triangle.glsl"
 #include "lights/directional.glsl"
 #include "lights/spot.glsl"
+#ifdef VKRT_ACCEL_DRIVER
+#include "ray_query.glsl"
+#endif
 
 #define VKRT_CLOSEST_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     closest##Type(r, tr, best);
@@ -35,7 +38,7 @@
     if (id.shape == HIT_##Type)                                                             \
         describe##Type(r, id, hit);
 
-#ifdef VKRT_HAS_MESHES
+#if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
 layout(scalar, binding = BINDING_TOP_NODES) readonly buffer TopNodeBlock { BvhNode topNodes[]; };
 layout(scalar, binding = BINDING_TOP_REFS) readonly buffer TopRefBlock { uint topRefs[]; };
 
@@ -108,7 +111,13 @@ HitId findClosest(Ray r, float tMax)
 {
     HitId best = noHit(tMax);
     TriangleRay tr = triangleRaySetup(r);
-#ifdef VKRT_HAS_MESHES
+#ifdef VKRT_ACCEL_DRIVER
+    VKRT_SHAPE_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
+    VKRT_LIGHT_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
+    traceDriver(r, tr, false, best.t, best);
+    return best;
+#endif
+#if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
     if (u.topNodeCount > 0u) {
         VKRT_SHAPE_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
         VKRT_LIGHT_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
@@ -170,7 +179,13 @@ bool traceClosest(Ray r, float tMax, out SurfaceHit hit)
 bool traceAny(Ray r, float tMax)
 {
     TriangleRay tr = triangleRaySetup(r);
-#ifdef VKRT_HAS_MESHES
+#ifdef VKRT_ACCEL_DRIVER
+    VKRT_SHAPE_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
+    VKRT_LIGHT_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
+    HitId unused = noHit(tMax);
+    return traceDriver(r, tr, true, tMax, unused);
+#endif
+#if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
     if (u.topNodeCount > 0u) {
         VKRT_SHAPE_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
         VKRT_LIGHT_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)

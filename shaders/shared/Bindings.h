@@ -53,7 +53,10 @@ VKRT_CONSTANT(uint, BINDING_MESH_MATERIALS, BINDING_ENVIRONMENT + 15)
 VKRT_CONSTANT(uint, BINDING_FRAME_RUN, BINDING_ENVIRONMENT + 16)
 // AovPixel[width*height]: the arbitrary output values (render --aov).
 VKRT_CONSTANT(uint, BINDING_AOVS, BINDING_ENVIRONMENT + 17)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 18)
+// The driver traversal backend's top-level acceleration structure
+// (accelerationStructureEXT; lib/ray_query.glsl, render/DriverAccel.h).
+VKRT_CONSTANT(uint, BINDING_TOP_LEVEL, BINDING_ENVIRONMENT + 18)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 19)
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);
 // the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).

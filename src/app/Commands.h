@@ -2,6 +2,7 @@
 // Subcommands of the vkrt executable. Each registers its options on the CLI11
 // app and returns the function that runs it (returning the exit code).
 #include "gpu/ShaderCompiler.h"
+#include "render/RenderSession.h"
 
 #include <functional>
 #include <string>
@@ -26,6 +27,10 @@ CommandRunner addRegressCommand(CLI::App& app);
 /// NAME=VALUE texts of --kernel-define (the kernels' test and measurement
 /// hooks) as defines; InputError names a malformed one.
 std::vector<Define> parseKernelDefines(const std::vector<std::string>& texts);
+
+/// Adds `--accel own|driver|auto` (the traversal backend, render/RenderSession.h:
+/// AccelChoice) to a command, writing the choice to `choice`.
+void addAccelOption(CLI::App& command, AccelChoice& choice);
 
 /// Process exit codes.
 enum ExitCode : int {

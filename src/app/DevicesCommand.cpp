@@ -22,6 +22,14 @@ std::optional<uint32_t> defaultChoice(const std::vector<DeviceInfo>& devices)
     }
 }
 
+/// The --accel backends the device offers and what auto picks on it.
+std::string traversalSummary(const DeviceInfo& d)
+{
+    if (!d.rayQuery()) return "own only (it lacks " + d.rayQueryMissing + " for --accel driver)";
+    if (d.type != vk::PhysicalDeviceType::eCpu) return "own or driver (VK_KHR_ray_query); auto picks driver";
+    return "own or driver (VK_KHR_ray_query); auto picks driver for scenes with meshes, own for the rest";
+}
+
 } // namespace
 
 CommandRunner addDevicesCommand(CLI::App& app)
@@ -35,6 +43,7 @@ CommandRunner addDevicesCommand(CLI::App& app)
             std::printf("%s%u: %s (%s, Vulkan %s, %s)\n", chosen == d.index ? "* " : "  ", d.index, d.name.c_str(),
                         d.typeName().c_str(), d.apiVersionString().c_str(), d.driver.c_str());
             if (!d.suitable()) std::printf("     unsuitable: it %s\n", d.unsuitableReason.c_str());
+            else std::printf("     traversal: %s\n", traversalSummary(d).c_str());
         }
         if (devices.empty()) std::printf("no Vulkan devices (install mesa-vulkan-drivers for lavapipe)\n");
         if (!chosen) return int(kExitFailure);

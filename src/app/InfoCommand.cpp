@@ -25,6 +25,7 @@ struct InfoOptions {
     std::string scenePath;
     std::string device;
     bool uber = false;
+    AccelChoice accel = AccelChoice::Auto;
     std::string json;      ///< --json FILE, or "-" for standard output
     std::string sceneJson; ///< --scene-json FILE, or "-" for standard output
 };
@@ -198,6 +199,25 @@ void printLoopPasses(std::FILE* out, const Scene& scene, const LoopCap& cap)
                      cap.capped() ? "; each subgroup's count is checked against the cap as it renders" : "");
 }
 
+/// The traversal backend, and the driver's structures when they are used.
+void printAccel(std::FILE* out, const RenderSession& session)
+{
+    const DriverAccel* accel = session.renderer().driverAccel();
+    if (!accel) {
+        std::fprintf(out, "traversal:      own (vkrt's BVH in the kernel)\n");
+        return;
+    }
+    std::fprintf(out, "traversal:      driver (VK_KHR_ray_query): structures built in %.3f s, %.1f MiB\n",
+                 accel->buildSeconds(), double(accel->storageBytes()) / (1024.0 * 1024.0));
+}
+
+JsonObject accelJson(const RenderSession& session)
+{
+    const DriverAccel* accel = session.renderer().driverAccel();
+    if (!accel) return {{"backend", "own"}};
+    return {{"backend", "driver"}, {"buildSeconds", accel->buildSeconds()}, {"storageBytes", accel->storageBytes()}};
+}
+
 void printInfo(std::FILE* out, const RenderSession& session, const InfoOptions& options, const InfoTimes& times)
 {
     const Scene& scene = session.scene();
@@ -219,6 +239,7 @@ void printInfo(std::FILE* out, const RenderSession& session, const InfoOptions& 
     std::fprintf(out, "first frame:    %.3f s after set-up began (includes the driver's shader compile)\n",
                  times.firstFrame);
     std::fprintf(out, "loop cap:       %s\n", session.context().loopCap().describe().c_str());
+    printAccel(out, session);
     printLoopPasses(out, scene, session.context().loopCap());
     if (!scene.meshes.empty()) printMeshes(out, meshFacts(scene, session.renderer().meshData()), times.parse);
     if (scene.textures) printTextures(out, *scene.textures);
@@ -282,6 +303,7 @@ JsonObject infoJson(const RenderSession& session, const InfoOptions& options, co
                       {"lights", countsJson(counts.lights)},
                       {"materials", countsJson(counts.materials)}};
     json["kernel"] = kernelJson(session, options);
+    json["accel"] = accelJson(session);
     json["parseSeconds"] = times.parse;
     json["setupSeconds"] = times.setup;
     json["firstFrameSeconds"] = times.firstFrame;
@@ -307,6 +329,7 @@ int runInfo(const InfoOptions& options)
     VulkanContext context({options.device, false});
     SessionConfig config;
     config.uber = options.uber;
+    config.accel = options.accel;
     config.warmUp = false; // the first frame's time is what info measures
     // The variant info has always described: independent samples, no variance.
     config.sampler = SamplerChoice::Independent;
@@ -331,6 +354,7 @@ CommandRunner addInfoCommand(CLI::App& app)
     cmd->add_option("scene", options->scenePath, "Scene file")->required();
     cmd->add_option("--device", options->device, "Vulkan device index or name");
     cmd->add_flag("--uber", options->uber, "Describe the all-features kernel instead");
+    addAccelOption(*cmd, options->accel);
     cmd->add_option("--json", options->json,
                     "Also write these facts as one JSON object to FILE, or to standard output for - (the lines "
                     "above then go to stderr; docs/machine-output.md)");

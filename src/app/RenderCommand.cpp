@@ -53,6 +53,7 @@ struct RenderCommandOptions {
     std::string json; ///< --json FILE, or "-" for standard output (docs/machine-output.md)
     bool sppGiven = false;
     std::string sampler = "auto";
+    AccelChoice accel = AccelChoice::Auto;
     std::string shard;                      ///< "i/n" (docs/farm.md)
     uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
@@ -167,6 +168,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
     config.jitter = !options.pixelCenters;
     config.uber = options.uber;
     config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
+    config.accel = options.accel;
     config.variance = options.varianceNeeds();
     config.aov = !options.aovs.empty();
     config.stop = {shard ? shard->end - shard->begin : options.maxSpp(), options.timeBudget, options.targetError,
@@ -290,6 +292,7 @@ JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& 
     json["device"] = {{"name", facts.device}, {"driver", device.driver}};
     json["integrator"] = integratorName(scene.render.integrator);
     json["sampler"] = samplerName(session.sampler());
+    json["accel"] = accelName(session.accel());
     json["kernel"] = {{"variant", renderer.variant().describe()},
                       {"uber", options.uber},
                       {"cacheKey", renderer.kernel().cacheKey},
@@ -502,6 +505,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "(Owen-scrambled Sobol' points: lower error; any variance estimate comes from " +
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
+    addAccelOption(*cmd, options->accel);
     cmd->add_option("--camera", options->gltf.camera,
                     "A glTF scene's camera to render through: its or its node's name, or its index (default: the "
                     "first)");

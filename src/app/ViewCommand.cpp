@@ -21,6 +21,7 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_option("--environment", o->gltf.environment, "glTF scene: a lat-long .exr/.hdr map lighting it");
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--seed", o->seed, "Random seed");
+    addAccelOption(*cmd, o->accel);
     // Checked with the scene parser's limits (SceneOverrides.h) once the scene is read.
     cmd->add_option("--width", o->width, "Render width (default: the scene's)");
     cmd->add_option("--height", o->height, "Render height (default: the scene's)");

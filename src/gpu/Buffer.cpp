@@ -15,12 +15,20 @@ Buffer::Buffer(const VulkanContext& context, vk::DeviceSize size, vk::BufferUsag
     uint32_t type = use == MemoryUse::Device
                         ? context.findMemoryType(requirements.memoryTypeBits, Mem::eDeviceLocal)
                         : context.findMemoryType(requirements.memoryTypeBits, Mem::eHostVisible, Mem::eHostCached);
-    m_memory = vk::raii::DeviceMemory(device, vk::MemoryAllocateInfo(requirements.size, type));
+    vk::MemoryAllocateInfo allocation(requirements.size, type);
+    vk::MemoryAllocateFlagsInfo addressable(vk::MemoryAllocateFlagBits::eDeviceAddress);
+    if (usage & vk::BufferUsageFlagBits::eShaderDeviceAddress) allocation.setPNext(&addressable);
+    m_memory = vk::raii::DeviceMemory(device, allocation);
     m_buffer = std::move(buffer);
     m_buffer.bindMemory(*m_memory, 0);
     auto flags = context.physicalDevice().getMemoryProperties().memoryTypes[type].propertyFlags;
     m_hostCoherent = bool(flags & Mem::eHostCoherent);
     if (flags & Mem::eHostVisible) m_mapped = m_memory.mapMemory(0, VK_WHOLE_SIZE);
+}
+
+vk::DeviceAddress Buffer::address(const VulkanContext& context) const
+{
+    return context.device().getBufferAddress(vk::BufferDeviceAddressInfo(*m_buffer));
 }
 
 void Buffer::upload(const VulkanContext& context, std::span<const std::byte> bytes)

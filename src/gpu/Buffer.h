@@ -20,6 +20,9 @@ public:
 
     vk::Buffer handle() const { return *m_buffer; }
     vk::DeviceSize size() const { return m_size; }
+    /// The buffer's device address; it needs eShaderDeviceAddress usage
+    /// (acceleration-structure inputs, storage and scratch).
+    vk::DeviceAddress address(const VulkanContext& context) const;
     /// Host pointer when the memory is host-visible (always on lavapipe), else null.
     void* mapped() const { return m_mapped; }
 

@@ -12,6 +12,7 @@ vk::DescriptorType descriptorTypeOf(uint32_t binding)
     VKRT_CHECK(binding < gpu::BINDING_COUNT);
     if (binding == gpu::BINDING_UNIFORMS) return vk::DescriptorType::eUniformBuffer;
     if (binding == gpu::BINDING_ENVIRONMENT) return vk::DescriptorType::eCombinedImageSampler;
+    if (binding == gpu::BINDING_TOP_LEVEL) return vk::DescriptorType::eAccelerationStructureKHR;
     return vk::DescriptorType::eStorageBuffer;
 }
 
@@ -89,6 +90,15 @@ void ComputeKernel::bind(uint32_t binding, vk::ImageView view, vk::Sampler sampl
     vk::DescriptorImageInfo info(sampler, view, vk::ImageLayout::eShaderReadOnlyOptimal);
     for (const auto& set : m_sets) {
         vk::WriteDescriptorSet write(*set, binding, 0, typeOf(binding), info);
+        m_context.device().updateDescriptorSets(write, nullptr);
+    }
+}
+
+void ComputeKernel::bind(uint32_t binding, vk::AccelerationStructureKHR structure)
+{
+    vk::WriteDescriptorSetAccelerationStructureKHR info(structure);
+    for (const auto& set : m_sets) {
+        vk::WriteDescriptorSet write(*set, binding, 0, 1, typeOf(binding), nullptr, nullptr, nullptr, &info);
         m_context.device().updateDescriptorSets(write, nullptr);
     }
 }

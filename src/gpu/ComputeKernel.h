@@ -33,6 +33,8 @@ public:
     void bindInSet(uint32_t set, uint32_t binding, const Buffer& buffer);
     /// Points a combined image-sampler `binding` at an image view.
     void bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler);
+    /// Points an acceleration-structure `binding` at `structure` in every set.
+    void bind(uint32_t binding, vk::AccelerationStructureKHR structure);
     /// Points a storage-image `binding` at an image view in GENERAL layout.
     void bindStorageImage(uint32_t binding, vk::ImageView view);
     /// Records bind + push constants + dispatch of `groups`.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <thread>
 
 namespace vkrt {
@@ -71,6 +72,30 @@ std::string unsuitableReason(const vk::raii::PhysicalDevice& device, const Devic
     return {};
 }
 
+const std::vector<const char*> kRayQueryExtensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                                      VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                                      VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+
+/// What the device lacks for the driver traversal backend (empty: nothing).
+std::string rayQueryMissing(const vk::raii::PhysicalDevice& device)
+{
+    const auto available = device.enumerateDeviceExtensionProperties();
+    for (const char* name : kRayQueryExtensions) {
+        bool found = std::any_of(available.begin(), available.end(),
+                                 [&](const vk::ExtensionProperties& p) { return std::strcmp(p.extensionName, name) == 0; });
+        if (!found) return std::string("the extension ") + name;
+    }
+    auto features = device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features,
+                                        vk::PhysicalDeviceAccelerationStructureFeaturesKHR,
+                                        vk::PhysicalDeviceRayQueryFeaturesKHR>();
+    if (!features.get<vk::PhysicalDeviceVulkan12Features>().bufferDeviceAddress)
+        return "the bufferDeviceAddress feature";
+    if (!features.get<vk::PhysicalDeviceAccelerationStructureFeaturesKHR>().accelerationStructure)
+        return "the accelerationStructure feature";
+    if (!features.get<vk::PhysicalDeviceRayQueryFeaturesKHR>().rayQuery) return "the rayQuery feature";
+    return {};
+}
+
 DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index, vk::SurfaceKHR surface = {})
 {
     auto chain = device.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
@@ -85,6 +110,7 @@ DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index
     info.apiVersion = props.apiVersion;
     info.computeQueueFamily = findComputeQueueFamily(device, surface);
     info.unsuitableReason = unsuitableReason(device, info, surface);
+    if (info.suitable()) info.rayQueryMissing = rayQueryMissing(device);
     return info;
 }
 
@@ -201,11 +227,26 @@ void VulkanContext::createDevice()
 {
     float priority = 1.0f;
     vk::DeviceQueueCreateInfo queueInfo({}, queueFamily(), 1, &priority);
-    vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan12Features> chain;
+    vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan12Features,
+                       vk::PhysicalDeviceAccelerationStructureFeaturesKHR, vk::PhysicalDeviceRayQueryFeaturesKHR>
+        chain;
     chain.get<vk::DeviceCreateInfo>().setQueueCreateInfos(queueInfo);
-    const char* swapchainExtension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
-    if (*m_surface) chain.get<vk::DeviceCreateInfo>().setPEnabledExtensionNames(swapchainExtension);
+    std::vector<const char*> extensions;
+    if (*m_surface) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     chain.get<vk::PhysicalDeviceVulkan12Features>().setScalarBlockLayout(true);
+    // The driver backend's extensions are enabled wherever they exist, so
+    // that one context serves either backend (they cost nothing unused).
+    const bool rayQuery = deviceInfo().rayQuery();
+    if (rayQuery) {
+        extensions.insert(extensions.end(), kRayQueryExtensions.begin(), kRayQueryExtensions.end());
+        chain.get<vk::PhysicalDeviceVulkan12Features>().setBufferDeviceAddress(true);
+        chain.get<vk::PhysicalDeviceAccelerationStructureFeaturesKHR>().setAccelerationStructure(true);
+        chain.get<vk::PhysicalDeviceRayQueryFeaturesKHR>().setRayQuery(true);
+    } else {
+        chain.unlink<vk::PhysicalDeviceAccelerationStructureFeaturesKHR>();
+        chain.unlink<vk::PhysicalDeviceRayQueryFeaturesKHR>();
+    }
+    chain.get<vk::DeviceCreateInfo>().setPEnabledExtensionNames(extensions);
     m_device = vk::raii::Device(m_physicalDevice, chain.get<vk::DeviceCreateInfo>());
     m_queue = vk::raii::Queue(m_device, queueFamily(), 0);
     m_commandPool =

@@ -25,6 +25,12 @@ struct DeviceInfo {
     uint32_t apiVersion = 0;
     std::optional<uint32_t> computeQueueFamily;
     std::string unsuitableReason; ///< empty when vkrt can use the device
+    /// The driver's own traversal (`--accel driver`): VK_KHR_ray_query and
+    /// VK_KHR_acceleration_structure with their features and buffer device
+    /// addresses. Empty when present; otherwise what is missing.
+    std::string rayQueryMissing = "not checked";
+
+    bool rayQuery() const { return rayQueryMissing.empty(); }
 
     bool suitable() const { return unsuitableReason.empty(); }
     std::string typeName() const;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <type_traits>
 
 namespace vkrt {
 
@@ -284,6 +285,49 @@ TopLevel buildTopLevel(const Scene& scene)
     }
     return top;
 }
+
+template <bool Bounded, class Record>
+void addRecordBoxes(const std::vector<Record>& records, int hitCode, const glm::dvec3& eye,
+                    std::vector<RecordBoxes>& out)
+{
+    if constexpr (Bounded && !std::is_same_v<Record, Mesh>) {
+        if (records.empty()) return;
+        RecordBoxes kind;
+        kind.hitCode = hitCode;
+        for (const Record& record : records) {
+            const Aabb world = boundsOf(record);
+            glm::vec3 lower(std::numeric_limits<float>::quiet_NaN()), upper = lower;
+            if (!world.empty()) {
+                roundOutwards(Aabb{world.lower - eye, world.upper - eye}, lower, upper);
+                // 2^-20 of the box's largest coordinate: far more than the
+                // records' own rounding to float.
+                float largest = 0.0f;
+                for (int k = 0; k < 3; ++k) largest = std::max({largest, std::abs(lower[k]), std::abs(upper[k])});
+                const float margin = std::ldexp(largest, -20);
+                lower -= margin;
+                upper += margin;
+            }
+            kind.lower.push_back(lower);
+            kind.upper.push_back(upper);
+        }
+        out.push_back(std::move(kind));
+    }
+}
+
+} // namespace
+
+std::vector<RecordBoxes> recordBoxes(const Scene& scene)
+{
+    std::vector<RecordBoxes> kinds;
+#define VKRT_ADD_RECORD_BOXES(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    addRecordBoxes<bounded != 0>(recordsToUpload(scene, scene.array), gpu::HIT_##Type, scene.camera.eye, kinds);
+    VKRT_SHAPE_KINDS(VKRT_ADD_RECORD_BOXES)
+    VKRT_LIGHT_KINDS(VKRT_ADD_RECORD_BOXES)
+#undef VKRT_ADD_RECORD_BOXES
+    return kinds;
+}
+
+namespace {
 
 /// The top-level nodes with camera-relative boxes, from the leaves up
 /// (children always follow their parent in the array).

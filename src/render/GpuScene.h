@@ -72,6 +72,19 @@ struct GpuSceneStatic {
     double topBuildSeconds = 0.0;
 };
 
+/// The driver backend's box geometry (render/DriverAccel.h): one kind of the
+/// registry with bounded = 1, other than meshes (which are instances of
+/// triangle geometry), with its records' boxes in upload order, the index the
+/// kernel's arrays use. Boxes are camera-relative, rounded outwards and
+/// widened by a few float steps, since the kernel tests float records whose
+/// rounding the double bounds do not see; an empty box is NaN (inactive).
+struct RecordBoxes {
+    int hitCode = 0; ///< gpu::HIT_Type
+    std::vector<glm::vec3> lower, upper;
+};
+/// Every such kind that has records.
+std::vector<RecordBoxes> recordBoxes(const Scene& scene);
+
 /// Fails (InputError naming the mesh and the limit) if a mesh buffer would
 /// exceed `maxBytes` (the device's maxStorageBufferRange).
 GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes = ~0ull);

@@ -34,12 +34,15 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     VKRT_LIGHT_KINDS(VKRT_LIGHT_FEATURE)
 #undef VKRT_SHAPE_FEATURE
 #undef VKRT_LIGHT_FEATURE
-    // Meshes: the geometry buffers and the top-level BVH come with the mesh array.
+    // Meshes: the geometry buffers and the top-level BVH come with the mesh
+    // array; the driver backend has its own structures instead of the BVHs.
     const bool meshes = f.has(ShapeKind::Mesh);
-    list.push_back({meshes, "VKRT_HAS_MESH_NODES", int(gpu::BINDING_MESH_NODES), ""});
+    const bool ownBvh = meshes && !v.driverAccel;
+    list.push_back({ownBvh, "VKRT_HAS_MESH_NODES", int(gpu::BINDING_MESH_NODES), ""});
     list.push_back({meshes, "VKRT_HAS_MESH_TRIANGLES", int(gpu::BINDING_MESH_TRIANGLES), ""});
-    list.push_back({meshes, "VKRT_HAS_TOP_NODES", int(gpu::BINDING_TOP_NODES), ""});
-    list.push_back({meshes, "VKRT_HAS_TOP_REFS", int(gpu::BINDING_TOP_REFS), ""});
+    list.push_back({ownBvh, "VKRT_HAS_TOP_NODES", int(gpu::BINDING_TOP_NODES), ""});
+    list.push_back({ownBvh, "VKRT_HAS_TOP_REFS", int(gpu::BINDING_TOP_REFS), ""});
+    list.push_back({v.driverAccel, "VKRT_ACCEL_DRIVER", int(gpu::BINDING_TOP_LEVEL), "driver-accel"});
     list.push_back({meshes && f.meshNormals, "VKRT_HAS_MESH_NORMALS", int(gpu::BINDING_MESH_NORMALS), "mesh-normals"});
     list.push_back({f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emitters"});
     // Textures: the texel buffer, the texture records and each material's slots;

@@ -34,6 +34,10 @@ struct KernelVariant {
     /// for mesh scenes on a device that caps loops: their traversal has no
     /// useful static bound, so a group that reaches the cap is detected at run time.
     bool groupLoopCount = false;
+    /// The driver traversal backend (VK_KHR_ray_query; render/DriverAccel.h)
+    /// instead of vkrt's own BVH walk: a different kernel, so part of the
+    /// defines and the SPIR-V cache key.
+    bool driverAccel = false;
 
     /// Preprocessor defines selecting this variant, in a stable order.
     std::vector<std::pair<std::string, std::string>> defines() const;

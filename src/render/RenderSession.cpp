@@ -31,6 +31,23 @@ std::optional<AccelChoice> accelChoiceNamed(const std::string& name)
 
 std::string accelName(Accel accel) { return accel == Accel::Driver ? "driver" : "own"; }
 
+Accel resolveAccel(AccelChoice choice, const DeviceInfo& device, const Scene& scene)
+{
+    if (choice == AccelChoice::Own) return Accel::Own;
+    if (choice == AccelChoice::Driver) {
+        if (!device.rayQuery())
+            throw InputError("--accel driver: " + device.name + " (" + device.driver + ") lacks " +
+                             device.rayQueryMissing + "; use --accel own or auto");
+        return Accel::Driver;
+    }
+    if (!device.rayQuery()) return Accel::Own;
+    // docs/performance.md, "Two traversal backends": on a GPU the driver's
+    // traversal is the one that uses its ray-tracing hardware; on lavapipe
+    // the driver's is faster only where meshes make most of the work.
+    if (device.type != vk::PhysicalDeviceType::eCpu) return Accel::Driver;
+    return scene.meshes.empty() ? Accel::Own : Accel::Driver;
+}
+
 Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixels, uint64_t storageBufferRange)
 {
     if (choice == SamplerChoice::Independent) return Sampler::Independent;
@@ -76,6 +93,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
     uint64_t range = context.physicalDevice().getProperties().limits.maxStorageBufferRange;
     options.sobol = resolveSampler(config.sampler, config.variance, pixels, range) == Sampler::Sobol;
+    options.driverAccel = resolveAccel(config.accel, context.deviceInfo(), scene) == Accel::Driver;
     return options;
 }
 
@@ -182,6 +200,7 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
         {"integrator", integratorName(m_scene.render.integrator)},
         {"kernelVariant", renderer.variant().describe() + (m_config.uber ? " (uber)" : "")},
         {"sampler", samplerName(sampler())},
+        {"accel", accelName(accel())},
         {"rejectedSamples", int64_t(renderer.counters().rejectedSamples)},
     };
     // Whether the device may have cut loops short (docs/platform.md).

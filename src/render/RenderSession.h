@@ -5,6 +5,7 @@
 // configure a session instead of each owning a loop, a sampler policy and a
 // metadata list, so a new stop rule or metadata field is one edit here.
 #include "io/ExrFile.h"
+#include "render/Accel.h"
 #include "render/ErrorMetrics.h"
 #include "render/Outcome.h"
 #include "render/RenderLoop.h"
@@ -45,19 +46,6 @@ struct VarianceNeeds {
 /// guarantees (lavapipe: 0.6 M pixels), where independent samples need about
 /// a sixth of that.
 Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixels, uint64_t storageBufferRange);
-
-// ---------------------------------------------------------------- traversal
-
-/// Which traversal answers traceClosest/traceAny (docs/architecture.md,
-/// "Two traversal backends"): vkrt's own BVH walk in the compute kernel, or
-/// the driver's acceleration structures through VK_KHR_ray_query. Auto picks
-/// per device and scene (resolveAccel).
-enum class AccelChoice { Own, Driver, Auto };
-enum class Accel { Own, Driver };
-
-/// "own", "driver" or "auto" (the --accel values); nullopt otherwise.
-std::optional<AccelChoice> accelChoiceNamed(const std::string& name);
-std::string accelName(Accel accel);
 
 // ---------------------------------------------------------------- scene
 
@@ -133,6 +121,8 @@ public:
     const Renderer& renderer() const { return *m_renderer; }
     const VulkanContext& context() const { return m_context; }
     Sampler sampler() const;
+    /// The traversal backend that runs (resolveAccel's choice).
+    Accel accel() const { return m_renderOptions.driverAccel ? Accel::Driver : Accel::Own; }
     uint32_t spp() const { return m_renderer->completedFrames(); }
     double renderSeconds() const { return m_renderSeconds; }
     std::optional<StopReason> stoppedBy() const { return m_stoppedBy; }

@@ -40,6 +40,7 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
     variant.variance = options.variance;
     variant.aov = options.aov;
     variant.sobolSampler = options.sobol;
+    variant.driverAccel = options.driverAccel;
     // The batch sums are laid out for VARIANCE_BATCHES batches; a different
     // sampler batch count would make the estimate describe other batches.
     bool batchOverride = std::any_of(options.extraDefines.begin(), options.extraDefines.end(),
@@ -265,6 +266,10 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     bindEnvironment();
     uploadMeshBuffers();
     uploadSceneBuffers();
+    if (m_variant.driverAccel) {
+        m_driverAccel.emplace(context, m_static, m_scene, m_data);
+        m_kernel.bind(gpu::BINDING_TOP_LEVEL, m_driverAccel->topLevel());
+    }
 }
 
 // Descriptor set b of the kernel holds band b's per-pixel buffers; every
@@ -382,6 +387,10 @@ void Renderer::moveCamera(const Camera& camera)
     m_scene.camera = camera;
     m_data = convertScene(m_scene, frameSettings(), m_static);
     uploadSceneBuffers();
+    if (m_driverAccel) {
+        m_driverAccel->moveCamera(m_scene, m_data);
+        m_kernel.bind(gpu::BINDING_TOP_LEVEL, m_driverAccel->topLevel());
+    }
     reset();
 }
 

@@ -7,6 +7,7 @@
 #include "gpu/EnvironmentTexture.h"
 #include "gpu/ShaderCompiler.h"
 #include "io/Image.h"
+#include "render/DriverAccel.h"
 #include "render/GpuScene.h"
 #include "render/ImageBands.h"
 #include "render/KernelVariant.h"
@@ -26,6 +27,7 @@ struct RenderOptions {
     bool aov = false;          ///< also average the AOVs (albedo, normal, depth, position; a kernel-variant flag)
     bool sobol = false;        ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
     bool storageScene = false; ///< scene arrays in storage buffers even when they fit uniform ones
+    bool driverAccel = false;  ///< the driver's traversal (VK_KHR_ray_query) instead of vkrt's BVH (a kernel-variant flag)
     uint32_t firstFrame = 0;   ///< index of the first frame (sample) rendered: a shard's start
     /// Frames one invocation runs back to back per dispatch (path
     /// regeneration); 0: the device's default (samplesPerInvocationFor).
@@ -106,6 +108,8 @@ public:
     const CompiledKernel& kernel() const { return m_compiled; }
     /// The scene's mesh data as uploaded (empty for a scene without meshes).
     const GpuSceneStatic& meshData() const { return m_static; }
+    /// The driver backend's structures (null with vkrt's own traversal).
+    const DriverAccel* driverAccel() const { return m_driverAccel ? &*m_driverAccel : nullptr; }
     uint32_t width() const { return m_data.uniforms.width; }
     uint32_t height() const { return m_data.uniforms.height; }
 
@@ -126,6 +130,7 @@ private:
     std::optional<BandedBuffer> m_moments;
     std::optional<BandedBuffer> m_aovs;
     ComputeKernel m_kernel;
+    std::optional<DriverAccel> m_driverAccel;
     std::optional<EnvironmentTexture> m_environment;
     std::optional<Buffer> m_environmentCdf;
     /// The map's sizes, which every upload of the uniforms carries.

@@ -170,6 +170,7 @@ SessionConfig sessionConfig(const ViewOptions& options, const Scene& scene)
     config.aov = scene.camera.thinLens();
     config.variance.layer = options.variance;
     config.maxBandBytes = options.maxBandBytes;
+    config.accel = options.accel;
     config.warmUp = false; // the first frames show at once
     return config;
 }

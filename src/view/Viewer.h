@@ -1,6 +1,7 @@
 #pragma once
 // `vkrt view`: a GLFW window showing the progressive render as it converges,
 // with camera controls, and scripted sessions for tests.
+#include "render/Accel.h"
 #include "render/Outcome.h"
 #include "scene/GltfScene.h"
 
@@ -25,6 +26,7 @@ struct ViewOptions {
     bool variance = false;
     bool validation = false;
     uint64_t maxBandBytes = 0; ///< test hook: SessionConfig::maxBandBytes
+    AccelChoice accel = AccelChoice::Auto; ///< --accel
 };
 
 /// Runs the viewer; Passed, or ValidationMessages with them. Bad input (scene,

@@ -36,6 +36,7 @@ vec3 objectToWorldNormal(Mesh mesh, vec3 n)
     return mesh.toObject0.xyz * n.x + mesh.toObject1.xyz * n.y + mesh.toObject2.xyz * n.z;
 }
 
+#ifndef VKRT_ACCEL_DRIVER
 // The closest (anyHit: any) triangle of mesh instance `index` before best.t
 // (tMax). Returns whether one was found.
 bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId best)
@@ -77,13 +78,15 @@ bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId
     }
     return found;
 }
+#endif
 
 #endif
 
 bool hitOneMesh(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)
 {
-#ifdef VKRT_HAS_MESHES
-    // The instance's own ray setup: tr is the world ray's.
+#if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
+    // The instance's own ray setup: tr is the world ray's. (The driver
+    // backend hands mesh triangles to lib/ray_query.glsl, never here.)
     return traverseMesh(r, i, anyHit, tMax, hit);
 #else
     return false;
