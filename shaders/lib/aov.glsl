@@ -30,6 +30,17 @@ void aovSurfaceHit(SurfaceHit hit)
     g_aov.hit = true;
     g_aov.position = hit.position;
     g_aov.depth = dot(hit.position, u.cameraForward);
+#ifdef VKRT_TEST_HIT_PROBE
+    // Test hook (tests/render/accel_backends_test.cpp): the camera ray's
+    // closest hit as the traversal found it, for a hit-for-hit comparison of
+    // the backends at one sample per pixel: albedo = (kind, record,
+    // primitive), exact as floats below 2^24; normal = (t, the length of the
+    // hit point's error bound, |cos| of the incidence: a pinhole camera's
+    // rays start at the camera-relative origin).
+    g_aov.albedo = vec3(float(hit.shape), float(hit.index), float(hit.primitive));
+    g_aov.normal = vec3(hit.t, length(hit.error), abs(dot(normalize(hit.position), hit.normal)));
+    g_aov.settled = true;
+#endif
 }
 
 // What a material reflects at normal incidence, as a denoiser's albedo:

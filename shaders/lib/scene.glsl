@@ -146,6 +146,9 @@ SurfaceHit describeHit(Ray r, HitId id)
 #endif
     hit.shape = id.shape;
     hit.index = id.index;
+#ifdef VKRT_TEST_HIT_PROBE
+    hit.primitive = id.primitive;
+#endif
     hit.material = 0u;
 #ifdef VKRT_HAS_TEXTURES
     hit.uv = vec2(0.0);

@@ -45,6 +45,9 @@ struct SurfaceHit {
     float uvDensity;
     vec4 tangent;
 #endif
+#ifdef VKRT_TEST_HIT_PROBE
+    uint primitive; // HitId::primitive (lib/aov.glsl's hit probe)
+#endif
 };
 
 bool hitsLight(SurfaceHit hit) { return hit.shape >= SHAPE_LIGHT; }

@@ -6,6 +6,7 @@
 #include "render/RenderSession.h"
 #include "scene/SceneOverrides.h"
 #include "support/TestSupport.h"
+#include "util/Error.h"
 #include "view/CameraControl.h"
 
 #include <atomic>
@@ -15,6 +16,44 @@
 
 namespace vkrt::test {
 namespace {
+
+// ---------------------------------------------------------------- backend policy
+
+DeviceInfo deviceWithRayQueries(vk::PhysicalDeviceType type, bool rayQueries)
+{
+    DeviceInfo d;
+    d.name = "test device";
+    d.driver = "test driver";
+    d.type = type;
+    d.rayQueryMissing = rayQueries ? "" : "the extension VK_KHR_ray_query";
+    return d;
+}
+
+TEST(AccelPolicy, KeepsAGivenChoiceAndRefusesTheDriverWithoutRayQueries)
+{
+    const Scene analytic; // no meshes
+    Scene meshes = analytic;
+    meshes.meshes.emplace_back(); // the policy looks only at whether there are meshes
+    const DeviceInfo cpu = deviceWithRayQueries(vk::PhysicalDeviceType::eCpu, true);
+    const DeviceInfo gpu = deviceWithRayQueries(vk::PhysicalDeviceType::eDiscreteGpu, true);
+    const DeviceInfo old = deviceWithRayQueries(vk::PhysicalDeviceType::eCpu, false);
+    EXPECT_EQ(resolveAccel(AccelChoice::Own, gpu, meshes), Accel::Own);
+    EXPECT_EQ(resolveAccel(AccelChoice::Driver, cpu, analytic), Accel::Driver);
+    try {
+        resolveAccel(AccelChoice::Driver, old, analytic);
+        ADD_FAILURE() << "--accel driver without ray queries was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--accel driver: test device (test driver) lacks the extension "
+                                             "VK_KHR_ray_query"),
+                  std::string::npos)
+            << e.what();
+    }
+    // auto: the measured rule (docs/performance.md, "Two traversal backends").
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, old, meshes), Accel::Own);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, gpu, analytic), Accel::Driver);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, meshes), Accel::Driver);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, analytic), Accel::Own);
+}
 
 // ---------------------------------------------------------------- sampler policy
 
