@@ -56,6 +56,10 @@ struct InfoTimes {
     double parse = 0.0;
     double setup = 0.0;      ///< compile or load, pipeline, buffers
     double firstFrame = 0.0; ///< from set-up's start to the first finished frame
+    /// What a camera move costs before the next frame (the viewer's stall):
+    /// the scene re-made camera-relative and uploaded, and with the driver
+    /// backend its camera-relative structures rebuilt.
+    double cameraMove = 0.0;
 };
 
 // ---------------------------------------------------------------- counts
@@ -240,6 +244,8 @@ void printInfo(std::FILE* out, const RenderSession& session, const InfoOptions& 
                  times.firstFrame);
     std::fprintf(out, "loop cap:       %s\n", session.context().loopCap().describe().c_str());
     printAccel(out, session);
+    std::fprintf(out, "camera move:    %.4f s (the viewer's pause per move: re-upload%s)\n", times.cameraMove,
+                 session.renderer().driverAccel() ? ", driver structures rebuilt" : "");
     printLoopPasses(out, scene, session.context().loopCap());
     if (!scene.meshes.empty()) printMeshes(out, meshFacts(scene, session.renderer().meshData()), times.parse);
     if (scene.textures) printTextures(out, *scene.textures);
@@ -307,6 +313,7 @@ JsonObject infoJson(const RenderSession& session, const InfoOptions& options, co
     json["parseSeconds"] = times.parse;
     json["setupSeconds"] = times.setup;
     json["firstFrameSeconds"] = times.firstFrame;
+    json["cameraMoveSeconds"] = times.cameraMove;
     json["loopCap"] = {{"capped", cap.capped()}, {"budget", valueOrNull(cap.budget)}, {"description", cap.describe()}};
     json["loopPassesWorstCase"] = valueOrNull(staticLoopBound(scene));
     json["meshes"] =
@@ -338,6 +345,9 @@ int runInfo(const InfoOptions& options)
     times.setup = secondsSince(start);
     session.renderFrames(1);
     times.firstFrame = secondsSince(start);
+    const auto moveStart = std::chrono::steady_clock::now();
+    if (auto refused = session.moveCamera(session.scene().camera)) throw InternalError("camera move: " + *refused);
+    times.cameraMove = secondsSince(moveStart);
 
     // With the JSON on standard output, the lines for people go to stderr.
     printInfo(options.json == "-" ? stderr : stdout, session, options, times);

@@ -76,7 +76,7 @@ void DriverAccel::moveCamera(const Scene& scene, const GpuSceneData& data)
 {
     const auto start = Clock::now();
     buildCameraRelative(scene, data);
-    m_buildSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    m_rebuildSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 uint64_t DriverAccel::storageBytes() const

@@ -27,9 +27,10 @@ public:
     void moveCamera(const Scene& scene, const GpuSceneData& data);
 
     vk::AccelerationStructureKHR topLevel() const { return *m_topLevel->handle; }
-    /// Seconds the last build took: the mesh structures and the rest at
-    /// construction, the camera-relative ones after moveCamera.
+    /// Seconds the construction took (every structure, meshes included).
     double buildSeconds() const { return m_buildSeconds; }
+    /// Seconds the last moveCamera took (0 before any).
+    double rebuildSeconds() const { return m_rebuildSeconds; }
     /// Bytes of every structure's storage (what the driver asked for).
     uint64_t storageBytes() const;
 
@@ -57,6 +58,7 @@ private:
     std::optional<Buffer> m_instances;
     std::optional<Structure> m_topLevel;
     double m_buildSeconds = 0.0;
+    double m_rebuildSeconds = 0.0;
 
     Structure create(vk::AccelerationStructureTypeKHR type, PendingBuild& build);
     void buildGeometries(const GpuSceneStatic& fixed, const Scene& scene);

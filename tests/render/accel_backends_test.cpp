@@ -195,7 +195,7 @@ TEST_F(AccelBackends, CameraMovesRebuildTheDriversStructures)
         Image before = renderer.mean();
         renderer.moveCamera(moved);
         renderer.renderFrames(2);
-        if (driver) RecordProperty("rebuild seconds", std::to_string(renderer.driverAccel()->buildSeconds()));
+        if (driver) RecordProperty("rebuild seconds", std::to_string(renderer.driverAccel()->rebuildSeconds()));
         return std::make_pair(before, renderer.mean());
     };
     const auto own = render(false), driver = render(true);
