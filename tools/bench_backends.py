@@ -3,8 +3,8 @@
 integrator and paths, only the traversal differs (`--accel own` vs
 `--accel driver`). Runs interleave own and driver, ROUNDS times per scene, and
 read vkrt's --json: samples/s of the timed render (kernel compile and the
-warm-up frame excluded), the first frame's time (start-up: compile, driver
-compile, structure builds) and, from `vkrt info --json`, what a camera move
+warm-up frame excluded), the start-up time (kernel compile, the driver's
+compile, structure builds, the warm-up frame) and, from `vkrt info --json`, what a camera move
 costs. Prints per scene the medians and the driver/own ratio of samples/s,
 taken round by round (the pairing keeps the ratio meaningful while the
 machine's speed drifts).
@@ -67,7 +67,7 @@ def main():
     args = parser.parse_args()
 
     print(f"{'scene':44} {'own ks/s':>9} {'driver ks/s':>11} {'driver/own':>10} "
-          f"{'own 1st s':>9} {'drv 1st s':>9} {'own move ms':>11} {'drv move ms':>11}")
+          f"{'own start s':>11} {'drv start s':>11} {'own move ms':>11} {'drv move ms':>11}")
     for scene in args.scenes:
         rates = {"own": [], "driver": []}
         first = {"own": [], "driver": []}
@@ -82,12 +82,12 @@ def main():
                     sys.exit(f"bench_backends: {scene} ran with {report['accel']}, not {accel}")
                 this_round[accel] = report["samplesPerSecond"]
                 rates[accel].append(report["samplesPerSecond"])
-                first[accel].append(report["firstFrameSeconds"])
+                first[accel].append(report["startupSeconds"])
             ratios.append(this_round["driver"] / this_round["own"])
         moves = {accel: camera_move(args, scene, accel) for accel in ("own", "driver")}
         median = statistics.median
         print(f"{scene:44} {median(rates['own']) / 1e3:9.1f} {median(rates['driver']) / 1e3:11.1f} "
-              f"{median(ratios):10.2f} {median(first['own']):9.2f} {median(first['driver']):9.2f} "
+              f"{median(ratios):10.2f} {median(first['own']):11.2f} {median(first['driver']):11.2f} "
               f"{moves['own'] * 1e3:11.2f} {moves['driver'] * 1e3:11.2f}")
 
 
