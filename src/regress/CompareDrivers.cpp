@@ -227,7 +227,7 @@ private:
             const double secondsA = c.a && c.a->tested() ? c.a->seconds : NAN;
             const double secondsB = c.b && c.b->tested() ? c.b->seconds : NAN;
             csv += c.spec.name + "," + sideStatus(c.a) + "," + sideStatus(c.b) + "," + agreeWord(c) + "," +
-                   fixed(secondsA, 3) + "," + fixed(secondsB, 3) + "," + fixed(c.ratio(), 3) + "\n";
+                   fixed(secondsA, 4) + "," + fixed(secondsB, 4) + "," + fixed(c.ratio(), 3) + "\n";
         }
         return csv;
     }

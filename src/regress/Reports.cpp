@@ -244,7 +244,7 @@ void printResult(const CaseResult& r, size_t done, size_t total)
 {
     const CaseAttempt* a = r.shown();
     const int width = int(std::to_string(total).size());
-    std::printf("[%*zu/%zu] %-34s %-14s", width, done, total, r.spec.name.c_str(), statusName(r.status).c_str());
+    std::printf("[%*zu/%zu] %-34s %-8s", width, done, total, r.spec.name.c_str(), statusName(r.status).c_str());
     if (a && a->tested())
         std::printf(" %.3f%% pass  pooled z %+.2f  %.2f s%s%s", 100.0 * a->test.fractionPassed(), a->test.pooledZ,
                     a->seconds,
