@@ -23,6 +23,7 @@ struct Comparison {
     RegressionCase spec;
     std::optional<CaseAttempt> a, b;
     std::optional<ReferenceTestResult> between; ///< A's image tested against B's, when both rendered
+    double identical = NAN;                     ///< the fraction of values bit-for-bit equal in A and B
     bool agree = false;                         ///< `between` passed the suite's rule
     bool slow = false;                          ///< B/A beyond the suite's max_slowdown
     bool final = false;
@@ -54,6 +55,15 @@ std::string fixed(double value, int decimals)
     char text[64];
     std::snprintf(text, sizeof text, "%.*f", decimals, value);
     return text;
+}
+
+/// Where two drivers compute alike, the same seed gives the same bits: worth
+/// telling apart from "statistically the same" (a change of rounding).
+double identicalFraction(const Image& a, const Image& b)
+{
+    size_t same = 0;
+    for (size_t i = 0; i < a.rgb.size() && i < b.rgb.size(); ++i) same += a.rgb[i] == b.rgb[i];
+    return a.rgb.empty() ? 1.0 : double(same) / double(a.rgb.size());
 }
 
 std::string agreeWord(const Comparison& c) { return c.between ? (c.agree ? "yes" : "no") : "-"; }
@@ -181,6 +191,7 @@ private:
             Rendered renderedA{a.image, a.layers.at("variance"), c.a->seconds, c.a->rejectedSamples, a.metadata};
             Reference referenceB{b.image, b.layers.at("variance")};
             c.between = testRender(renderedA, c.spec.spp, referenceB, c.spec.spp, m_suite);
+            c.identical = identicalFraction(a.image, b.image);
             c.agree = c.between->passedRule(m_suite.minPass);
             if (!c.agree && !m_options.reportDir.empty())
                 writeFailureImages(m_options.reportDir, safeName(c.spec.name) + "-A-vs-B", renderedA, referenceB,
@@ -204,7 +215,8 @@ private:
         std::printf("[%*zu/%zu] %-34s %-8s A %-7s B %-7s", width, done, m_cases.size(), c.spec.name.c_str(),
                     statusName(c.status).c_str(), sideStatus(c.a).c_str(), sideStatus(c.b).c_str());
         if (c.between)
-            std::printf(" A vs B %.3f%% pass  pooled z %+.2f", 100.0 * c.between->fractionPassed(), c.between->pooledZ);
+            std::printf(" A vs B %.3f%% pass  pooled z %+.2f  %.1f%% identical", 100.0 * c.between->fractionPassed(),
+                        c.between->pooledZ, 100.0 * c.identical);
         if (std::isfinite(c.ratio())) std::printf("  %.2f s / %.2f s = %.2f", c.a->seconds, c.b->seconds, c.ratio());
         std::printf("\n");
         if (!message(c).empty()) std::printf("    %s\n", message(c).c_str());
@@ -245,6 +257,7 @@ private:
         return "| " + c.spec.name + " | " + status + (c.slow ? " (slow)" : "") + " | " + side(c.a) + " | " +
                side(c.b) + " | " + (c.between ? fixed(100.0 * c.between->fractionPassed(), 3) + " %" : "-") + " | " +
                (c.between ? fixed(c.between->pooledZ, 2) : "-") + " | " +
+               (c.between ? fixed(100.0 * c.identical, 1) + " %" : "-") + " | " +
                (c.a && c.a->tested() ? fixed(c.a->seconds, 2) : "-") + " | " +
                (c.b && c.b->tested() ? fixed(c.b->seconds, 2) : "-") + " | " + fixed(c.ratio(), 2) + " | " +
                tableCell(message(c)) + " |\n";
@@ -285,8 +298,8 @@ private:
             md << " (" << lines.size() << " of " << m_cases.size() << " cases"
                << (m_interrupted ? ": **interrupted**" : " so far") << ")";
         md << "\n\n| case | status | A vs reference | B vs reference | A vs B values passing | A vs B pooled z | "
-              "seconds A | seconds B | B/A | notes |\n"
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+              "identical values | seconds A | seconds B | B/A | notes |\n"
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
         for (const Comparison& c : m_cases)
             if (c.final) md << markdownRow(c);
         for (const Comparison& c : m_cases)
