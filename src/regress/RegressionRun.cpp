@@ -348,6 +348,7 @@ const RegressionCase& caseNamed(const RegressionSuite& suite, const std::string&
 /// error becomes a Fail that says what; only Ctrl-C or death write nothing.
 Outcome runCaseForParent(const RegressOptions& options)
 {
+    if (options.caseResult.empty()) throw InputError("--run-case " + options.runCase + " needs --case-result FILE");
     const RegressionSuite suite = readRegressionSuite(options.suite);
     const RegressionCase& c = caseNamed(suite, options.runCase);
     const AttemptPlan plan{options.attempt, options.seedOffset, options.reportDir, options.caseImage};

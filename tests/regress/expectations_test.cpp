@@ -17,16 +17,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class ExpectationFiles : public ::testing::Test {
+class RegressExpectations : public ::testing::Test {
 protected:
-    ExpectationFiles()
+    RegressExpectations()
     {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         m_dir = fs::temp_directory_path() / ("vkrt_expectations_" + std::string(info->name()));
         fs::remove_all(m_dir);
         fs::create_directories(m_dir);
     }
-    ~ExpectationFiles() override
+    ~RegressExpectations() override
     {
         std::error_code ignored;
         fs::remove_all(m_dir, ignored);
@@ -55,7 +55,7 @@ protected:
     fs::path m_dir;
 };
 
-TEST_F(ExpectationFiles, BaselineReadsStatusesCommentsAndResultsCsvLines)
+TEST_F(RegressExpectations, BaselineReadsStatusesCommentsAndResultsCsvLines)
 {
     const auto baseline = readBaseline(write("fails.txt", "# known driver bugs\n\n"
                                                           "extreme/tir,Fail\n"
@@ -68,7 +68,7 @@ TEST_F(ExpectationFiles, BaselineReadsStatusesCommentsAndResultsCsvLines)
     EXPECT_EQ(baseline.at("extreme/tir").where, (m_dir / "fails.txt").string() + ":3");
 }
 
-TEST_F(ExpectationFiles, BadBaselineLinesNameFileAndLine)
+TEST_F(RegressExpectations, BadBaselineLinesNameFileAndLine)
 {
     const std::string file = (m_dir / "fails.txt").string();
     EXPECT_NE(baselineError("# header\nextreme/tir\n").find(file + ":2: expected 'case-name,Status'"),
@@ -83,7 +83,7 @@ TEST_F(ExpectationFiles, BadBaselineLinesNameFileAndLine)
     EXPECT_NE(baselineError("a,Fail,1,2\n").find(file + ":1:"), std::string::npos);
 }
 
-TEST_F(ExpectationFiles, MissingFileIsNamedWithItsOption)
+TEST_F(RegressExpectations, MissingFileIsNamedWithItsOption)
 {
     try {
         readExpectations({}, m_dir / "nope.txt", {});
@@ -95,7 +95,7 @@ TEST_F(ExpectationFiles, MissingFileIsNamedWithItsOption)
     }
 }
 
-TEST_F(ExpectationFiles, PatternsMatchAnywhereAndBadOnesNameTheLine)
+TEST_F(RegressExpectations, PatternsMatchAnywhereAndBadOnesNameTheLine)
 {
     const Expectations e = readExpectations({}, write("flakes.txt", "# flaky on lavapipe\nkappa-\n^seed/glass$\n"),
                                             write("skips.txt", "validation/.*texture\n"));
@@ -114,7 +114,7 @@ TEST_F(ExpectationFiles, PatternsMatchAnywhereAndBadOnesNameTheLine)
     }
 }
 
-TEST_F(ExpectationFiles, BaselineLineNamingNoCaseIsReported)
+TEST_F(RegressExpectations, BaselineLineNamingNoCaseIsReported)
 {
     Expectations e;
     e.baseline = readBaseline(write("fails.txt", "extreme/tir,Fail\nextreme/tirr,Fail\n"));
@@ -124,7 +124,7 @@ TEST_F(ExpectationFiles, BaselineLineNamingNoCaseIsReported)
 }
 
 // The rules of docs/regress.md, "Statuses", one by one.
-TEST_F(ExpectationFiles, AttemptsBecomeTheCaseStatus)
+TEST_F(RegressExpectations, AttemptsBecomeTheCaseStatus)
 {
     Expectations e;
     e.baseline = readBaseline(write("fails.txt", "listed-fail,Fail\nlisted-crash,Crash\n"));
