@@ -80,15 +80,16 @@ CommandRunner addRegressCommand(CLI::App& app)
     extras->jobsOption = cmd->add_option("--jobs", extras->jobs,
                                          "Cases at once, each in a child process; 0: in this process (default: "
                                          "the number of cores; 1 with --fail-on-slowdown or --compare-drivers)");
-    extras->caseTimeoutOption =
-        cmd->add_option("--case-timeout", extras->caseTimeout, "Seconds a case's process may run (default: from "
-                                                               "its baseline_seconds, docs/regress.md)")
-            ->check(CLI::PositiveNumber);
+    extras->caseTimeoutOption = cmd->add_option("--case-timeout", extras->caseTimeout,
+                                                "Seconds a case's process may run (default: from "
+                                                "its baseline_seconds, docs/regress.md)")
+                                    ->check(CLI::PositiveNumber);
     cmd->add_option("--baseline", o->baseline, "Expected failures: 'case-name,Status' lines (deqp-runner's fails.txt)");
     cmd->add_option("--flakes", o->flakes, "Known flaky cases: one regular expression per line");
     cmd->add_option("--skips", o->skips, "Cases not to run: one regular expression per line");
-    cmd->add_option("--compare-drivers", o->compareDrivers, "Run every case on two drivers (ICD manifests A.json "
-                                                            "B.json) and compare their images and times")
+    cmd->add_option("--compare-drivers", o->compareDrivers,
+                    "Run every case on two drivers (ICD manifests A.json "
+                    "B.json) and compare their images and times")
         ->expected(2);
     cmd->add_option("--accel", extras->accel, "Traversal backend of every case: own, driver or auto (default auto)");
     cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");

@@ -20,9 +20,9 @@ namespace vkrt {
 
 namespace {
 
-constexpr double kMinimumTimeout = 120.0;        // seconds: no case is cut short below this
-constexpr double kBaselineFactor = 30.0;         // x baseline_seconds: room for a loaded machine and --jobs
-constexpr double kStartUpPerSession = 60.0;      // seconds: start-up and a cold kernel compile per session
+constexpr double kMinimumTimeout = 120.0;         // seconds: no case is cut short below this
+constexpr double kBaselineFactor = 30.0;          // x baseline_seconds: room for a loaded machine and --jobs
+constexpr double kStartUpPerSession = 60.0;       // seconds: start-up and a cold kernel compile per session
 constexpr double kTimeoutWithoutBaseline = 600.0; // seconds: a case that says nothing of its time
 constexpr auto kPollInterval = std::chrono::milliseconds(20);
 constexpr size_t kLogTailBytes = size_t(1) << 20; // a child's output kept in --report-dir: its last MiB
@@ -110,10 +110,11 @@ TemporaryFolder::~TemporaryFolder()
 
 std::vector<std::string> childCommand(const RegressOptions& options, bool forwardSlowdown)
 {
-    std::vector<std::string> argv{currentExecutable().string(), "regress", "--suite",
+    std::vector<std::string> argv{currentExecutable().string(),         "regress", "--suite",
                                   fs::absolute(options.suite).string(), "--accel", accelChoiceName(options.accel)};
     if (!options.device.empty()) argv.insert(argv.end(), {"--device", options.device});
-    for (const Define& d : options.kernelDefines) argv.insert(argv.end(), {"--kernel-define", d.first + "=" + d.second});
+    for (const Define& d : options.kernelDefines)
+        argv.insert(argv.end(), {"--kernel-define", d.first + "=" + d.second});
     if (forwardSlowdown && options.failOnSlowdown) argv.insert(argv.end(), {"--fail-on-slowdown"});
     return argv;
 }
@@ -131,8 +132,7 @@ struct AttemptPool::Running {
     std::unique_ptr<ChildProcess> child;
 };
 
-AttemptPool::AttemptPool(unsigned jobs, std::vector<std::string> childArguments, fs::path logDir,
-                         InProcess inProcess)
+AttemptPool::AttemptPool(unsigned jobs, std::vector<std::string> childArguments, fs::path logDir, InProcess inProcess)
     : m_jobs(jobs),
       m_childArguments(std::move(childArguments)),
       m_logDir(std::move(logDir)),
@@ -236,7 +236,8 @@ CaseAttempt AttemptPool::collect(Running& r, const ExitStatus& status, bool time
 /// tell, kept as NAME[-TAG]-attemptK.log in --report-dir.
 std::string AttemptPool::keepLog(const Running& r, const CaseAttempt& attempt) const
 {
-    const bool testSaysWhy = attempt.status == CaseStatus::Pass || (attempt.status == CaseStatus::Fail && attempt.problem.empty());
+    const bool testSaysWhy =
+        attempt.status == CaseStatus::Pass || (attempt.status == CaseStatus::Fail && attempt.problem.empty());
     if (m_logDir.empty() || testSaysWhy) return "";
     const std::string name = safeName(r.job.caseName) + (r.job.tag.empty() ? "" : "-" + r.job.tag) + "-attempt" +
                              std::to_string(r.job.plan.number) + ".log";

@@ -52,10 +52,10 @@ private:
 /// One attempt to make.
 struct AttemptJob {
     std::string caseName;
-    uint32_t seed = 0;     ///< the render seed, for the report of an attempt that never reported
-    AttemptPlan plan;      ///< number, seed offset, image outputs
-    std::string driver;    ///< the child's --driver (empty: none)
-    std::string tag;       ///< tells apart two attempts of one case in file names ("A", "B"; may be empty)
+    uint32_t seed = 0;  ///< the render seed, for the report of an attempt that never reported
+    AttemptPlan plan;   ///< number, seed offset, image outputs
+    std::string driver; ///< the child's --driver (empty: none)
+    std::string tag;    ///< tells apart two attempts of one case in file names ("A", "B"; may be empty)
     double timeoutSeconds = 600.0;
 };
 

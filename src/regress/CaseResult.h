@@ -17,17 +17,17 @@ struct CaseAttempt {
     int number = 1;                       ///< 1, or 2 for the re-run
     uint32_t seed = 0;                    ///< the render seed (the suite's plus the seed offset)
     CaseStatus status = CaseStatus::Fail; ///< Pass, Fail, Crash or Timeout
-    std::string problem;                  ///< why it did not pass when its test did not say: the error, the signal, the timeout
-    std::string note;                     ///< what a test hook did to it
-    bool slow = false;                    ///< slower than baseline_seconds x max_slowdown
-    ReferenceTestResult test;             ///< tested == 0 when it never got that far; pValues stay in the process
-    double relMse = 0.0;                  ///< against the reference
-    uint64_t rejectedSamples = 0;         ///< non-finite samples the kernel dropped
-    double seconds = 0.0;                 ///< render time, warm-up (the driver's compile) excluded
-    double wallSeconds = 0.0;             ///< the whole attempt as the runner saw it (process start to exit)
-    bool wroteImages = false;             ///< its failure images are in --report-dir
-    std::string device, driver;           ///< where it ran (empty when it never got that far)
-    std::string log;                      ///< the child's output saved in --report-dir (file name), if any
+    std::string problem;          ///< why it did not pass when its test did not say: the error, the signal, the timeout
+    std::string note;             ///< what a test hook did to it
+    bool slow = false;            ///< slower than baseline_seconds x max_slowdown
+    ReferenceTestResult test;     ///< tested == 0 when it never got that far; pValues stay in the process
+    double relMse = 0.0;          ///< against the reference
+    uint64_t rejectedSamples = 0; ///< non-finite samples the kernel dropped
+    double seconds = 0.0;         ///< render time, warm-up (the driver's compile) excluded
+    double wallSeconds = 0.0;     ///< the whole attempt as the runner saw it (process start to exit)
+    bool wroteImages = false;     ///< its failure images are in --report-dir
+    std::string device, driver;   ///< where it ran (empty when it never got that far)
+    std::string log;              ///< the child's output saved in --report-dir (file name), if any
 
     bool tested() const { return test.tested > 0; }
 };

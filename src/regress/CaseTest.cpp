@@ -101,6 +101,8 @@ namespace {
 
 // ---------------------------------------------------------------- rendering
 
+/// Every session of a case: its seed, the variance the test needs, and the
+/// run's --accel and test-hook defines.
 SessionConfig caseConfig(uint32_t seed, const RegressOptions& options, uint32_t firstFrame, uint32_t frames)
 {
     SessionConfig config;
@@ -112,7 +114,6 @@ SessionConfig caseConfig(uint32_t seed, const RegressOptions& options, uint32_t 
     config.stop = {frames, std::nullopt, std::nullopt, &interruptFlag()};
     return config;
 }
-
 
 /// As renderCase, but as `shards` sessions over the contiguous sample ranges
 /// `vkrt render --shard i/n` renders, their tallies added as `vkrt merge`

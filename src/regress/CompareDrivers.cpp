@@ -44,8 +44,8 @@ CaseStatus combinedStatus(const Comparison& c, bool failOnSlowdown)
 {
     for (CaseStatus worst : {CaseStatus::Crash, CaseStatus::Timeout})
         if (c.a->status == worst || c.b->status == worst) return worst;
-    const bool failed = c.a->status != CaseStatus::Pass || c.b->status != CaseStatus::Pass || !c.agree ||
-                        (failOnSlowdown && c.slow);
+    const bool failed =
+        c.a->status != CaseStatus::Pass || c.b->status != CaseStatus::Pass || !c.agree || (failOnSlowdown && c.slow);
     return failed ? CaseStatus::Fail : CaseStatus::Pass;
 }
 
@@ -103,7 +103,9 @@ class DriverComparison {
 public:
     DriverComparison(const RegressionSuite& suite, const std::vector<RegressionCase>& cases,
                      const RegressOptions& options, std::array<fs::path, 2> manifests)
-        : m_suite(suite), m_options(options), m_manifests(std::move(manifests))
+        : m_suite(suite),
+          m_options(options),
+          m_manifests(std::move(manifests))
     {
         for (const RegressionCase& c : cases) m_cases.push_back({c});
     }
@@ -197,7 +199,8 @@ private:
                 writeFailureImages(m_options.reportDir, safeName(c.spec.name) + "-A-vs-B", renderedA, referenceB,
                                    *c.between);
         } catch (const std::exception& e) {
-            c.a->problem += (c.a->problem.empty() ? "" : "; ") + std::string("its image cannot be compared: ") + e.what();
+            c.a->problem +=
+                (c.a->problem.empty() ? "" : "; ") + std::string("its image cannot be compared: ") + e.what();
         }
     }
 
@@ -254,8 +257,8 @@ private:
         };
         std::string status = statusName(c.status);
         if (failsTheRun(c.status)) status = "**" + status + "**";
-        return "| " + c.spec.name + " | " + status + (c.slow ? " (slow)" : "") + " | " + side(c.a) + " | " +
-               side(c.b) + " | " + (c.between ? fixed(100.0 * c.between->fractionPassed(), 3) + " %" : "-") + " | " +
+        return "| " + c.spec.name + " | " + status + (c.slow ? " (slow)" : "") + " | " + side(c.a) + " | " + side(c.b) +
+               " | " + (c.between ? fixed(100.0 * c.between->fractionPassed(), 3) + " %" : "-") + " | " +
                (c.between ? fixed(c.between->pooledZ, 2) : "-") + " | " +
                (c.between ? fixed(100.0 * c.identical, 1) + " %" : "-") + " | " +
                (c.a && c.a->tested() ? fixed(c.a->seconds, 2) : "-") + " | " +
@@ -269,9 +272,9 @@ private:
         const std::string base = safeName(c.spec.name) + "-A-vs-B";
         std::ostringstream md;
         md << "\n## " << c.spec.name << ": A and B differ\n\n"
-           << c.between->tested - c.between->passed << " of " << c.between->tested << " values beyond |z| = "
-           << c.between->threshold << "; pooled z " << c.between->pooledZ << " (limit " << c.between->pooledThreshold
-           << ").\n\n| B | A | difference | significance |\n| --- | --- | --- | --- |\n"
+           << c.between->tested - c.between->passed << " of " << c.between->tested
+           << " values beyond |z| = " << c.between->threshold << "; pooled z " << c.between->pooledZ << " (limit "
+           << c.between->pooledThreshold << ").\n\n| B | A | difference | significance |\n| --- | --- | --- | --- |\n"
            << "| ![](" << base << "-reference.png) | ![](" << base << "-result.png) | ![](" << base
            << "-difference.png) | ![](" << base << "-significance.png) |\n";
         return md.str();
@@ -285,7 +288,8 @@ private:
         md << "# vkrt driver comparison\n\n- suite: `" << m_suite.path.string() << "`\n"
            << "- A: `" << m_manifests[0].string() << "`: " << (m_devices.a.empty() ? "device unknown" : m_devices.a)
            << "\n- B: `" << m_manifests[1].string() << "`: " << (m_devices.b.empty() ? "device unknown" : m_devices.b)
-           << "\n- seed: " << m_suite.seed + m_options.seedOffset << " (both drivers render the same seed; no re-runs)\n"
+           << "\n- seed: " << m_suite.seed + m_options.seedOffset
+           << " (both drivers render the same seed; no re-runs)\n"
            << "- jobs: " << jobs
            << (jobs == 1 ? " (the timed renders ran one at a time; A or B first, alternating from case to case)"
                          : " (**the renders shared the CPU: the times and B/A are distorted**)")
@@ -335,8 +339,9 @@ Outcome compareDrivers(const RegressionSuite& suite, const std::vector<Regressio
     if (!options.reportDir.empty()) createReportDir(options.reportDir);
     const unsigned jobs = jobsFor(options);
     if (jobs > 1)
-        std::fprintf(stderr, "vkrt: warning: --jobs %u: the renders share the CPU, so their times and B/A are "
-                             "distorted (lavapipe uses every core in each process)\n",
+        std::fprintf(stderr,
+                     "vkrt: warning: --jobs %u: the renders share the CPU, so their times and B/A are "
+                     "distorted (lavapipe uses every core in each process)\n",
                      jobs);
 
     InterruptGuard interrupt;

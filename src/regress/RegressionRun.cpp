@@ -187,7 +187,10 @@ class SuiteRun {
 public:
     SuiteRun(const RegressionSuite& suite, const std::vector<RegressionCase>& cases, const Expectations& expectations,
              const RegressOptions& options, RunDescription description)
-        : m_suite(suite), m_expectations(expectations), m_options(options), m_description(std::move(description))
+        : m_suite(suite),
+          m_expectations(expectations),
+          m_options(options),
+          m_description(std::move(description))
     {
         for (const RegressionCase& c : cases) m_results.push_back({c, {}, CaseStatus::Skip});
         for (size_t i = 0; i < cases.size(); ++i) m_index[cases[i].name] = i;
@@ -287,8 +290,8 @@ private:
         const std::vector<StatusLine> lines = finishedLines();
         const fs::path& dir = m_options.reportDir;
         if (!dir.empty()) {
-            writeText(dir / "report.md", markdownReport(m_suite, finished, {m_results.size(), m_interrupted},
-                                                         m_description));
+            writeText(dir / "report.md",
+                      markdownReport(m_suite, finished, {m_results.size(), m_interrupted}, m_description));
             writeText(dir / "results.csv", resultsCsv(lines, false));
             writeText(dir / "failures.csv", resultsCsv(lines, true));
         }
@@ -296,8 +299,8 @@ private:
     }
 };
 
-RunDescription describeRun(const VulkanContext& context, const RegressionSuite& suite,
-                           const Expectations& expectations, const RegressOptions& options)
+RunDescription describeRun(const VulkanContext& context, const RegressionSuite& suite, const Expectations& expectations,
+                           const RegressOptions& options)
 {
     RunDescription run;
     run.device = context.deviceInfo().name + " (" + context.deviceInfo().driver + ")";
@@ -339,7 +342,8 @@ Outcome runSuite(const VulkanContext& context, const RegressionSuite& suite, con
 
 const RegressionCase& caseNamed(const RegressionSuite& suite, const std::string& name)
 {
-    auto it = std::find_if(suite.cases.begin(), suite.cases.end(), [&](const RegressionCase& c) { return c.name == name; });
+    auto it =
+        std::find_if(suite.cases.begin(), suite.cases.end(), [&](const RegressionCase& c) { return c.name == name; });
     if (it == suite.cases.end()) throw InputError("--run-case " + name + ": no such case in " + suite.path.string());
     return *it;
 }
@@ -390,8 +394,7 @@ void refuseContradictions(const RegressOptions& options)
     if (!options.baseline.empty() || !options.flakes.empty())
         throw InputError("--compare-drivers tests two drivers against each other; --baseline and --flakes describe "
                          "one driver's run (--skips is allowed)");
-    if (options.jobs == 0u)
-        throw InputError("--jobs 0: --compare-drivers runs each driver in processes of its own");
+    if (options.jobs == 0u) throw InputError("--jobs 0: --compare-drivers runs each driver in processes of its own");
 }
 
 /// Prints a warning for each baseline line that names no case of the suite.
@@ -464,8 +467,7 @@ Outcome runRegression(const RegressOptions& options)
     const std::vector<RegressionCase> cases = selectedCases(suite, options.filters);
     const Expectations expectations = readExpectations(options.baseline, options.flakes, options.skips);
     warnAboutUnknownBaselineCases(suite, expectations);
-    if (!options.compareDrivers.empty())
-        return compareDrivers(suite, cases, expectations, options);
+    if (!options.compareDrivers.empty()) return compareDrivers(suite, cases, expectations, options);
     if (!options.driver.empty()) selectVulkanDriver(options.driver);
     std::vector<PreparedCase> prepared;
     if (!options.update) prepared = prepareCases(suite, casesToRun(cases, expectations));

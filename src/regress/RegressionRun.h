@@ -25,20 +25,20 @@ struct RegressOptions {
     bool update = false;             ///< regenerate the vkrt-made references
     uint32_t seedOffset = 0;         ///< added to the suite's seed (repeat runs)
     bool failOnSlowdown = false;
-    AccelChoice accel = AccelChoice::Auto; ///< --accel: the traversal backend of every case
-    std::vector<Define> kernelDefines; ///< test hooks: build every kernel with these
-    std::optional<unsigned> jobs;      ///< --jobs: child processes at once, 0: in this process (default: jobsFor)
-    std::optional<double> caseTimeout; ///< --case-timeout: seconds per case process (default: caseTimeoutSeconds)
-    std::filesystem::path baseline;    ///< --baseline: expected failures, `case-name,Status` lines
-    std::filesystem::path flakes;      ///< --flakes: regular expressions of known flaky cases
-    std::filesystem::path skips;       ///< --skips: regular expressions of cases not to run
+    AccelChoice accel = AccelChoice::Auto;   ///< --accel: the traversal backend of every case
+    std::vector<Define> kernelDefines;       ///< test hooks: build every kernel with these
+    std::optional<unsigned> jobs;            ///< --jobs: child processes at once, 0: in this process (default: jobsFor)
+    std::optional<double> caseTimeout;       ///< --case-timeout: seconds per case process (default: caseTimeoutSeconds)
+    std::filesystem::path baseline;          ///< --baseline: expected failures, `case-name,Status` lines
+    std::filesystem::path flakes;            ///< --flakes: regular expressions of known flaky cases
+    std::filesystem::path skips;             ///< --skips: regular expressions of cases not to run
     std::vector<std::string> compareDrivers; ///< --compare-drivers A.json B.json
 
     // The child process's side (hidden options, given by regress/AttemptPool.cpp):
-    std::string runCase;                 ///< --run-case: make one attempt at this case
-    std::filesystem::path caseResult;    ///< --case-result: write the attempt here (JSON)
-    std::filesystem::path caseImage;     ///< --case-image: write the render here (EXR with variance)
-    int attempt = 1;                     ///< --attempt: 1, or 2 for the re-run
+    std::string runCase;              ///< --run-case: make one attempt at this case
+    std::filesystem::path caseResult; ///< --case-result: write the attempt here (JSON)
+    std::filesystem::path caseImage;  ///< --case-image: write the render here (EXR with variance)
+    int attempt = 1;                  ///< --attempt: 1, or 2 for the re-run
 };
 
 /// A re-run's seed offset is the run's plus this: a seed no first attempt of

@@ -111,7 +111,8 @@ std::string markdownRow(const CaseResult& r)
 /// The numbers and images of the first attempt that failed its test.
 std::string failureSection(const CaseResult& r)
 {
-    auto failed = std::find_if(r.attempts.begin(), r.attempts.end(), [](const CaseAttempt& a) { return a.wroteImages; });
+    auto failed =
+        std::find_if(r.attempts.begin(), r.attempts.end(), [](const CaseAttempt& a) { return a.wroteImages; });
     if (failed == r.attempts.end()) return "";
     const ReferenceTestResult& t = failed->test;
     const std::string base = safeName(r.spec.name);
@@ -152,7 +153,8 @@ std::string statusCounts(const std::vector<StatusLine>& lines)
 {
     std::string text;
     for (CaseStatus status : kStatusOrder) {
-        const auto n = std::count_if(lines.begin(), lines.end(), [&](const StatusLine& l) { return l.status == status; });
+        const auto n =
+            std::count_if(lines.begin(), lines.end(), [&](const StatusLine& l) { return l.status == status; });
         if (n) text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + statusName(status);
     }
     return text.empty() ? "no cases" : text;

@@ -37,8 +37,8 @@ struct RunDescription {
 struct StatusLine {
     std::string name;
     CaseStatus status = CaseStatus::Pass;
-    double duration = 0.0;   ///< seconds
-    std::string message;     ///< what happened beyond the status
+    double duration = 0.0; ///< seconds
+    std::string message;   ///< what happened beyond the status
     bool slow = false;
 };
 

@@ -88,7 +88,8 @@ std::map<std::string, std::string> junitOutcomes(const fs::path& path)
 std::map<std::string, double> pooledZ(const std::string& output)
 {
     std::map<std::string, double> z;
-    std::regex line(R"((\S+)\s+(Pass|Fail|Flake|KnownFlake|ExpectedFail|UnexpectedPass)\s+\S+% pass\s+pooled z ([-+0-9.]+))");
+    std::regex line(
+        R"((\S+)\s+(Pass|Fail|Flake|KnownFlake|ExpectedFail|UnexpectedPass)\s+\S+% pass\s+pooled z ([-+0-9.]+))");
     for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it)
         z[(*it)[1]] = std::stod((*it)[3]);
     return z;
@@ -100,7 +101,8 @@ std::map<std::string, std::string> csvStatuses(const fs::path& path)
 {
     std::map<std::string, std::string> statuses;
     std::istringstream in(readFile(path));
-    const std::regex form(R"(([^,]+),(Pass|Fail|Crash|Timeout|Flake|Skip|ExpectedFail|UnexpectedPass|KnownFlake),[0-9]+\.[0-9]{3})");
+    const std::regex form(
+        R"(([^,]+),(Pass|Fail|Crash|Timeout|Flake|Skip|ExpectedFail|UnexpectedPass|KnownFlake),[0-9]+\.[0-9]{3})");
     std::smatch m;
     for (std::string line; std::getline(in, line);) {
         EXPECT_TRUE(std::regex_match(line, m, form)) << path << ": " << line;
@@ -236,7 +238,8 @@ TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
 TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
 {
     std::vector<ManifestCase> cases = {shipped("seed/baseline", 16, "width = 96\nheight = 72"),
-                                       shipped("extreme/kappa-shadow", 32), shipped("seed/area-light", 16, "width = 96\nheight = 72"),
+                                       shipped("extreme/kappa-shadow", 32),
+                                       shipped("seed/area-light", 16, "width = 96\nheight = 72"),
                                        shipped("extreme/ior-huge", 32)};
     fs::path suite = writeManifest(cases, "alpha = 0.01");
     constexpr int kRuns = 10;
@@ -244,16 +247,18 @@ TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
     std::map<std::string, std::vector<double>> zs;
     for (int offset = 1; offset <= kRuns; ++offset) {
         fs::path report = m_dir / ("run" + std::to_string(offset));
-        ProcessResult r =
-            regress({"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--report-dir", report.string()});
+        ProcessResult r = regress(
+            {"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--report-dir", report.string()});
         ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 4) << r.output;
         std::map<std::string, std::string> status = csvStatuses(report / "results.csv");
         ASSERT_EQ(status.size(), cases.size()) << r.output;
         for (const auto& [name, result] : status) {
-            ASSERT_TRUE(result == "Pass" || result == "Fail" || result == "Flake") << name << " " << result << "\n" << r.output;
+            ASSERT_TRUE(result == "Pass" || result == "Fail" || result == "Flake") << name << " " << result << "\n"
+                                                                                   << r.output;
             failures += result != "Pass";
         }
-        EXPECT_EQ(r.exitCode == 4, std::any_of(status.begin(), status.end(), [](auto& o) { return o.second == "Fail"; }));
+        EXPECT_EQ(r.exitCode == 4,
+                  std::any_of(status.begin(), status.end(), [](auto& o) { return o.second == "Fail"; }));
         for (const auto& [name, z] : pooledZ(r.output)) zs[name].push_back(z);
     }
     int allowed = binomialUpperBound(kRuns * int(cases.size()), 0.01, 1e-3);
@@ -441,7 +446,6 @@ TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
     EXPECT_EQ(md.find("extreme/degenerate-lights |"), std::string::npos) << md;
 }
 
-
 // ------------------------------------------------------------ the runner (deqp-runner's shape)
 
 /// Three quick cases at 64 x 48 (white furnaces and a camera inside glass: well under a second each).
@@ -465,8 +469,9 @@ TEST_F(RegressCli, CrashingCaseIsACrashAndTheOthersStillPass)
     ProcessResult r = regress({"--suite", writeManifest(quickCases()).string(), "--jobs", "2", "--report-dir",
                                report.string(), "--junit", junit.string()});
     EXPECT_EQ(r.exitCode, 4) << r.output;
-    const std::map<std::string, std::string> expected{
-        {"extreme/tir", "Pass"}, {"extreme/camera-in-glass", "Crash"}, {"extreme/ior-one", "Pass"}};
+    const std::map<std::string, std::string> expected{{"extreme/tir", "Pass"},
+                                                      {"extreme/camera-in-glass", "Crash"},
+                                                      {"extreme/ior-one", "Pass"}};
     EXPECT_EQ(csvStatuses(report / "results.csv"), expected) << r.output;
     EXPECT_EQ(csvStatuses(report / "failures.csv"),
               (std::map<std::string, std::string>{{"extreme/camera-in-glass", "Crash"}}));
@@ -490,8 +495,9 @@ TEST_F(RegressCli, HangingCaseIsATimeoutWithinTheCaseTimeout)
                                "--report-dir", report.string()});
     const double seconds = secondsSince(start);
     EXPECT_EQ(r.exitCode, 4) << r.output;
-    const std::map<std::string, std::string> expected{
-        {"extreme/tir", "Timeout"}, {"extreme/camera-in-glass", "Pass"}, {"extreme/ior-one", "Pass"}};
+    const std::map<std::string, std::string> expected{{"extreme/tir", "Timeout"},
+                                                      {"extreme/camera-in-glass", "Pass"},
+                                                      {"extreme/ior-one", "Pass"}};
     EXPECT_EQ(csvStatuses(report / "results.csv"), expected) << r.output;
     EXPECT_NE(r.output.find("ran past its 3 s timeout and was killed"), std::string::npos) << r.output;
     // Two attempts of 3 s, and the other cases beside them: far below the default timeout (120 s and more).
@@ -534,11 +540,12 @@ TEST_F(RegressCli, BaselineDecidesWhatIsUnexpected)
     const fs::path fails = m_dir / "fails.txt", skips = m_dir / "skips.txt";
     writeText(fails, "# the driver's known bugs\nextreme/camera-in-glass,Crash\nextreme/tir,Fail\n");
     writeText(skips, "ior-one\n");
-    ProcessResult r = regress({"--suite", suite.string(), "--report-dir", report.string(), "--baseline",
-                               fails.string(), "--skips", skips.string(), "--case-timeout", "30"});
+    ProcessResult r = regress({"--suite", suite.string(), "--report-dir", report.string(), "--baseline", fails.string(),
+                               "--skips", skips.string(), "--case-timeout", "30"});
     EXPECT_EQ(r.exitCode, 4) << r.output;
-    const std::map<std::string, std::string> expected{
-        {"extreme/tir", "UnexpectedPass"}, {"extreme/camera-in-glass", "ExpectedFail"}, {"extreme/ior-one", "Skip"}};
+    const std::map<std::string, std::string> expected{{"extreme/tir", "UnexpectedPass"},
+                                                      {"extreme/camera-in-glass", "ExpectedFail"},
+                                                      {"extreme/ior-one", "Skip"}};
     EXPECT_EQ(csvStatuses(report / "results.csv"), expected) << r.output;
     EXPECT_EQ(csvStatuses(report / "failures.csv"),
               (std::map<std::string, std::string>{{"extreme/tir", "UnexpectedPass"}}));
@@ -561,7 +568,8 @@ TEST_F(RegressCli, BadBaselineLinesNameFileAndLine)
     const fs::path suite = writeManifest(quickCases()), report = m_dir / "report";
     const fs::path fails = m_dir / "fails.txt", skips = m_dir / "skips.txt";
     writeText(fails, "# fine so far\nextreme/tir,Fail\nextreme/ior-one Fail\n");
-    expectInputError(regress({"--suite", suite.string(), "--baseline", fails.string(), "--report-dir", report.string()}),
+    expectInputError(regress(
+                         {"--suite", suite.string(), "--baseline", fails.string(), "--report-dir", report.string()}),
                      {fails.string() + ":3: expected 'case-name,Status'"});
     EXPECT_FALSE(fs::exists(report / "results.csv")) << "nothing runs on bad input";
     writeText(fails, "extreme/tir,Failed\n");
@@ -604,8 +612,9 @@ TEST_F(RegressCli, CompareDriversWithTheSameDriverTwicePasses)
     const fs::path icd = systemLavapipeManifest();
     if (icd.empty()) GTEST_SKIP() << "no lavapipe ICD manifest in /usr/share/vulkan/icd.d";
     const fs::path report = m_dir / "report";
-    ProcessResult r = regress({"--suite", writeManifest({shipped("extreme/tir", 16), shipped("extreme/ior-one", 32)}).string(),
-                               "--compare-drivers", icd.string(), icd.string(), "--report-dir", report.string()});
+    ProcessResult r =
+        regress({"--suite", writeManifest({shipped("extreme/tir", 16), shipped("extreme/ior-one", 32)}).string(),
+                 "--compare-drivers", icd.string(), icd.string(), "--report-dir", report.string()});
     EXPECT_EQ(r.exitCode, 0) << r.output;
     std::istringstream csv(readFile(report / "compare.csv"));
     std::string line;

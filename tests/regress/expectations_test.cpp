@@ -108,8 +108,9 @@ TEST_F(RegressExpectations, PatternsMatchAnywhereAndBadOnesNameTheLine)
         readNamePatterns(write("bad.txt", "fine\n\n(unclosed\n"), "--skips");
         ADD_FAILURE() << "no error";
     } catch (const InputError& error) {
-        EXPECT_NE(std::string(error.what()).find((m_dir / "bad.txt").string() + ":3: not a regular expression: '(unclosed'"),
-                  std::string::npos)
+        EXPECT_NE(
+            std::string(error.what()).find((m_dir / "bad.txt").string() + ":3: not a regular expression: '(unclosed'"),
+            std::string::npos)
             << error.what();
     }
 }
@@ -149,9 +150,10 @@ TEST_F(RegressExpectations, AttemptsBecomeTheCaseStatus)
     EXPECT_TRUE(needsRetry("listed-fail", S::Crash, e));
 
     for (S s : {S::Fail, S::Crash, S::Timeout, S::UnexpectedPass}) EXPECT_TRUE(failsTheRun(s)) << statusName(s);
-    for (S s : {S::Pass, S::Flake, S::KnownFlake, S::ExpectedFail, S::Skip}) EXPECT_FALSE(failsTheRun(s)) << statusName(s);
-    for (S s : {S::Pass, S::Fail, S::Crash, S::Timeout, S::Flake, S::Skip, S::ExpectedFail, S::UnexpectedPass,
-                S::KnownFlake})
+    for (S s : {S::Pass, S::Flake, S::KnownFlake, S::ExpectedFail, S::Skip})
+        EXPECT_FALSE(failsTheRun(s)) << statusName(s);
+    for (S s :
+         {S::Pass, S::Fail, S::Crash, S::Timeout, S::Flake, S::Skip, S::ExpectedFail, S::UnexpectedPass, S::KnownFlake})
         EXPECT_EQ(statusNamed(statusName(s)), s);
 }
 
