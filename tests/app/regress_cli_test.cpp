@@ -404,9 +404,23 @@ TEST_F(RegressCli, UpdateMakesReferencesTheSuiteAccepts)
 
 // ------------------------------------------------------------ Ctrl-C
 
+/// Processes whose command line mentions `text` (the children of a run name its suite).
+int processesMentioning(const std::string& text)
+{
+    int count = 0;
+    std::error_code error; // processes come and go while this reads
+    for (const auto& entry : fs::directory_iterator("/proc", error)) {
+        std::string cmdline = readFile(entry.path() / "cmdline");
+        std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+        count += cmdline.find(text) != std::string::npos;
+    }
+    return count;
+}
+
 // SIGINT once the first case has finished (its JUnit file appears): the run
 // stops within a submission of the second case, exits 130, and the JUnit and
-// report files keep the first case's result.
+// report files keep the first case's result. The second case's child process
+// is gone with it.
 TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
 {
     ManifestCase quick = shipped("extreme/kappa-shadow", 8);
@@ -444,6 +458,7 @@ TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
     EXPECT_NE(md.find("extreme/kappa-shadow"), std::string::npos);
     EXPECT_NE(md.find("1 of 2 cases: **interrupted**"), std::string::npos) << md;
     EXPECT_EQ(md.find("extreme/degenerate-lights |"), std::string::npos) << md;
+    EXPECT_EQ(processesMentioning("--run-case extreme/degenerate-lights"), 0) << "a child outlived Ctrl-C";
 }
 
 // ------------------------------------------------------------ the runner (deqp-runner's shape)
