@@ -2,7 +2,11 @@
 // developer run it: a deliberately biased kernel fails the right cases,
 // repeated seeds fail no more often than the suite's alpha allows, bad input
 // gives clear errors (never exit 4, never a crash), --update makes references
-// the suite then accepts, and Ctrl-C keeps the finished cases on disk.
+// the suite then accepts, and Ctrl-C keeps the finished cases on disk. The
+// runner in the manner of deqp-runner: a crashing or hanging case (test hooks
+// in the environment) is a Crash or Timeout while the others still pass, a
+// case failing once is a Flake, baseline files decide what is unexpected,
+// results.csv says it all, and --compare-drivers compares a driver with itself.
 #include "io/ExrFile.h"
 #include "support/TestSupport.h"
 
@@ -84,11 +88,40 @@ std::map<std::string, std::string> junitOutcomes(const fs::path& path)
 std::map<std::string, double> pooledZ(const std::string& output)
 {
     std::map<std::string, double> z;
-    std::regex line(R"((\S+)\s+(pass|FAIL)\s+\S+% pass\s+pooled z ([-+0-9.]+))");
+    std::regex line(
+        R"((\S+)\s+(Pass|Fail|Flake|KnownFlake|ExpectedFail|UnexpectedPass)\s+\S+% pass\s+pooled z ([-+0-9.]+))");
     for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it)
         z[(*it)[1]] = std::stod((*it)[3]);
     return z;
 }
+
+/// Status per case of a results.csv or failures.csv (deqp-runner's
+/// `test,status,duration` lines, no header); every line must have that form.
+std::map<std::string, std::string> csvStatuses(const fs::path& path)
+{
+    std::map<std::string, std::string> statuses;
+    std::istringstream in(readFile(path));
+    const std::regex form(
+        R"(([^,]+),(Pass|Fail|Crash|Timeout|Flake|Skip|ExpectedFail|UnexpectedPass|KnownFlake),[0-9]+\.[0-9]{3})");
+    std::smatch m;
+    for (std::string line; std::getline(in, line);) {
+        EXPECT_TRUE(std::regex_match(line, m, form)) << path << ": " << line;
+        if (m.size() == 3) statuses[m[1]] = m[2];
+    }
+    return statuses;
+}
+
+/// Sets an environment variable (a test hook) for the lifetime of this object.
+class ScopedEnvironment {
+public:
+    ScopedEnvironment(const char* name, const std::string& value) : m_name(name) { setenv(name, value.c_str(), 1); }
+    ~ScopedEnvironment() { unsetenv(m_name); }
+    ScopedEnvironment(const ScopedEnvironment&) = delete;
+    ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+private:
+    const char* m_name;
+};
 
 /// Smallest m with P(X > m) < tail for X ~ Binomial(n, p).
 int binomialUpperBound(int n, double p, double tail)
@@ -198,35 +231,39 @@ TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
 // renderer fails with probability at most alpha = 0.01 (the pooled test's own
 // alpha is 0.001; the per-value rule almost never fails), so the failures over
 // all runs are at most Binomial(runs x cases, 0.01): allow the count that such
-// a variable exceeds with probability below 1e-3. The seed must really change
-// the noise: the pooled z of a case differs between runs.
+// a variable exceeds with probability below 1e-3. A failing case is re-run
+// with a fresh seed, so a first attempt that failed shows as a Flake (or, if
+// the re-run failed too, a Fail): both count. The seed must really change the
+// noise: the pooled z of a case differs between runs.
 TEST_F(RegressCli, RepeatedSeedsFailNoMoreOftenThanAlphaAllows)
 {
     std::vector<ManifestCase> cases = {shipped("seed/baseline", 16, "width = 96\nheight = 72"),
-                                       shipped("extreme/kappa-shadow", 32), shipped("seed/area-light", 16, "width = 96\nheight = 72"),
+                                       shipped("extreme/kappa-shadow", 32),
+                                       shipped("seed/area-light", 16, "width = 96\nheight = 72"),
                                        shipped("extreme/ior-huge", 32)};
     fs::path suite = writeManifest(cases, "alpha = 0.01");
     constexpr int kRuns = 10;
     int failures = 0;
     std::map<std::string, std::vector<double>> zs;
     for (int offset = 1; offset <= kRuns; ++offset) {
-        fs::path junit = m_dir / ("run" + std::to_string(offset) + ".xml");
-        ProcessResult r =
-            regress({"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--junit", junit.string()});
+        fs::path report = m_dir / ("run" + std::to_string(offset));
+        ProcessResult r = regress(
+            {"--suite", suite.string(), "--seed-offset", std::to_string(offset), "--report-dir", report.string()});
         ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 4) << r.output;
-        std::map<std::string, std::string> outcome = junitOutcomes(junit);
-        ASSERT_EQ(outcome.size(), cases.size()) << r.output;
-        for (const auto& [name, result] : outcome) {
-            ASSERT_NE(result, "error") << r.output;
-            failures += result == "failure";
+        std::map<std::string, std::string> status = csvStatuses(report / "results.csv");
+        ASSERT_EQ(status.size(), cases.size()) << r.output;
+        for (const auto& [name, result] : status) {
+            ASSERT_TRUE(result == "Pass" || result == "Fail" || result == "Flake") << name << " " << result << "\n"
+                                                                                   << r.output;
+            failures += result != "Pass";
         }
         EXPECT_EQ(r.exitCode == 4,
-                  std::any_of(outcome.begin(), outcome.end(), [](auto& o) { return o.second == "failure"; }));
+                  std::any_of(status.begin(), status.end(), [](auto& o) { return o.second == "Fail"; }));
         for (const auto& [name, z] : pooledZ(r.output)) zs[name].push_back(z);
     }
     int allowed = binomialUpperBound(kRuns * int(cases.size()), 0.01, 1e-3);
-    std::printf("[ measured ] %d failing cases in %d runs x %zu cases (allowed %d)\n", failures, kRuns, cases.size(),
-                allowed);
+    std::printf("[ measured ] %d failing first attempts in %d runs x %zu cases (allowed %d)\n", failures, kRuns,
+                cases.size(), allowed);
     EXPECT_LE(failures, allowed);
     for (const auto& [name, values] : zs) {
         ASSERT_EQ(values.size(), size_t(kRuns)) << name;
@@ -367,9 +404,23 @@ TEST_F(RegressCli, UpdateMakesReferencesTheSuiteAccepts)
 
 // ------------------------------------------------------------ Ctrl-C
 
+/// Processes whose command line mentions `text` (the children of a run name its suite).
+int processesMentioning(const std::string& text)
+{
+    int count = 0;
+    std::error_code error; // processes come and go while this reads
+    for (const auto& entry : fs::directory_iterator("/proc", error)) {
+        std::string cmdline = readFile(entry.path() / "cmdline");
+        std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+        count += cmdline.find(text) != std::string::npos;
+    }
+    return count;
+}
+
 // SIGINT once the first case has finished (its JUnit file appears): the run
 // stops within a submission of the second case, exits 130, and the JUnit and
-// report files keep the first case's result.
+// report files keep the first case's result. The second case's child process
+// is gone with it.
 TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
 {
     ManifestCase quick = shipped("extreme/kappa-shadow", 8);
@@ -407,6 +458,203 @@ TEST_F(RegressCli, InterruptKeepsFinishedCasesOnDisk)
     EXPECT_NE(md.find("extreme/kappa-shadow"), std::string::npos);
     EXPECT_NE(md.find("1 of 2 cases: **interrupted**"), std::string::npos) << md;
     EXPECT_EQ(md.find("extreme/degenerate-lights |"), std::string::npos) << md;
+    EXPECT_EQ(processesMentioning("--run-case extreme/degenerate-lights"), 0) << "a child outlived Ctrl-C";
+}
+
+// ------------------------------------------------------------ the runner (deqp-runner's shape)
+
+/// Three quick cases at 64 x 48 (white furnaces and a camera inside glass: well under a second each).
+std::vector<ManifestCase> quickCases()
+{
+    return {shipped("extreme/tir", 32), shipped("extreme/camera-in-glass", 32), shipped("extreme/ior-one", 32)};
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// VKRT_TEST_CRASH_CASE makes the child for one case die of SIGSEGV: that case
+// is a Crash (after its re-run crashed too), every other case still runs and
+// passes, the run fails (exit 4), and the child's output is kept.
+TEST_F(RegressCli, CrashingCaseIsACrashAndTheOthersStillPass)
+{
+    ScopedEnvironment crash("VKRT_TEST_CRASH_CASE", "extreme/camera-in-glass");
+    const fs::path report = m_dir / "report", junit = m_dir / "junit.xml";
+    ProcessResult r = regress({"--suite", writeManifest(quickCases()).string(), "--jobs", "2", "--report-dir",
+                               report.string(), "--junit", junit.string()});
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    const std::map<std::string, std::string> expected{{"extreme/tir", "Pass"},
+                                                      {"extreme/camera-in-glass", "Crash"},
+                                                      {"extreme/ior-one", "Pass"}};
+    EXPECT_EQ(csvStatuses(report / "results.csv"), expected) << r.output;
+    EXPECT_EQ(csvStatuses(report / "failures.csv"),
+              (std::map<std::string, std::string>{{"extreme/camera-in-glass", "Crash"}}));
+    EXPECT_EQ(junitOutcomes(junit)["extreme/camera-in-glass"], "error");
+    EXPECT_NE(r.output.find("seed 1: Crash (killed by SIGSEGV"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("re-run seed 65537: Crash (killed by SIGSEGV"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(report / "extreme_camera-in-glass-attempt1.log"));
+    const std::string md = readFile(report / "report.md");
+    EXPECT_NE(md.find("| extreme/camera-in-glass | **Crash** |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| extreme/tir | Pass |"), std::string::npos) << md;
+}
+
+// VKRT_TEST_HANG_CASE makes one case never finish: with --case-timeout 3 it is
+// killed after 3 s (and its re-run after 3 more) and is a Timeout; the others pass.
+TEST_F(RegressCli, HangingCaseIsATimeoutWithinTheCaseTimeout)
+{
+    ScopedEnvironment hang("VKRT_TEST_HANG_CASE", "extreme/tir");
+    const fs::path report = m_dir / "report";
+    const auto start = std::chrono::steady_clock::now();
+    ProcessResult r = regress({"--suite", writeManifest(quickCases()).string(), "--jobs", "2", "--case-timeout", "3",
+                               "--report-dir", report.string()});
+    const double seconds = secondsSince(start);
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    const std::map<std::string, std::string> expected{{"extreme/tir", "Timeout"},
+                                                      {"extreme/camera-in-glass", "Pass"},
+                                                      {"extreme/ior-one", "Pass"}};
+    EXPECT_EQ(csvStatuses(report / "results.csv"), expected) << r.output;
+    EXPECT_NE(r.output.find("ran past its 3 s timeout and was killed"), std::string::npos) << r.output;
+    // Two attempts of 3 s, and the other cases beside them: far below the default timeout (120 s and more).
+    EXPECT_LT(seconds, 45.0) << r.output;
+    EXPECT_GE(seconds, 6.0) << "the timeout did not wait for the case";
+}
+
+// VKRT_TEST_FLAKY_CASE fails one case's first attempt only: the re-run with a
+// fresh seed passes, so the case is a Flake (both seeds reported) and the run
+// passes; with the case in --flakes it is a KnownFlake. The second run is in
+// this process (--jobs 0): the re-run rule does not depend on child processes.
+TEST_F(RegressCli, FailThenPassIsAFlake)
+{
+    ScopedEnvironment flaky("VKRT_TEST_FLAKY_CASE", "extreme/tir");
+    const fs::path suite = writeManifest(quickCases()), report = m_dir / "report";
+    ProcessResult r = regress({"--suite", suite.string(), "--report-dir", report.string()});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(csvStatuses(report / "results.csv")["extreme/tir"], "Flake") << r.output;
+    EXPECT_EQ(readFile(report / "failures.csv"), "") << "a flake is not a failure of the run";
+    const std::string md = readFile(report / "report.md");
+    EXPECT_NE(md.find("seed 1: Fail [VKRT_TEST_FLAKY_CASE"), std::string::npos) << md;
+    EXPECT_NE(md.find("re-run seed 65537: Pass"), std::string::npos) << md;
+
+    writeText(m_dir / "flakes.txt", "# white furnaces are never flaky, but this one is told to be\nextreme/t.r$\n");
+    r = regress({"--suite", suite.string(), "--report-dir", report.string(), "--flakes",
+                 (m_dir / "flakes.txt").string(), "--jobs", "0"});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(csvStatuses(report / "results.csv")["extreme/tir"], "KnownFlake") << r.output;
+}
+
+// deqp-runner's baseline semantics: a case failing as the baseline says is an
+// ExpectedFail (the run passes), a listed case that passes is an
+// UnexpectedPass (the run fails), a skipped case is not run (its hang hook
+// never fires), and failures.csv holds only what failed the run.
+TEST_F(RegressCli, BaselineDecidesWhatIsUnexpected)
+{
+    ScopedEnvironment crash("VKRT_TEST_CRASH_CASE", "extreme/camera-in-glass");
+    ScopedEnvironment hang("VKRT_TEST_HANG_CASE", "extreme/ior-one");
+    const fs::path suite = writeManifest(quickCases()), report = m_dir / "report";
+    const fs::path fails = m_dir / "fails.txt", skips = m_dir / "skips.txt";
+    writeText(fails, "# the driver's known bugs\nextreme/camera-in-glass,Crash\nextreme/tir,Fail\n");
+    writeText(skips, "ior-one\n");
+    ProcessResult r = regress({"--suite", suite.string(), "--report-dir", report.string(), "--baseline", fails.string(),
+                               "--skips", skips.string(), "--case-timeout", "30"});
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    const std::map<std::string, std::string> expected{{"extreme/tir", "UnexpectedPass"},
+                                                      {"extreme/camera-in-glass", "ExpectedFail"},
+                                                      {"extreme/ior-one", "Skip"}};
+    EXPECT_EQ(csvStatuses(report / "results.csv"), expected) << r.output;
+    EXPECT_EQ(csvStatuses(report / "failures.csv"),
+              (std::map<std::string, std::string>{{"extreme/tir", "UnexpectedPass"}}));
+    EXPECT_EQ(r.output.find("re-run"), std::string::npos) << "an expected crash is not re-run\n" << r.output;
+
+    // The baseline without the case that passes now: nothing is unexpected.
+    writeText(fails, "extreme/camera-in-glass,Crash\n");
+    r = regress({"--suite", suite.string(), "--report-dir", report.string(), "--baseline", fails.string(), "--skips",
+                 skips.string(), "--case-timeout", "30"});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(csvStatuses(report / "results.csv")["extreme/tir"], "Pass");
+    EXPECT_EQ(csvStatuses(report / "results.csv")["extreme/camera-in-glass"], "ExpectedFail");
+    EXPECT_EQ(readFile(report / "failures.csv"), "");
+}
+
+// Bad lines of the baseline files are input errors naming file:line, before
+// anything renders; so are a bad --accel and a misplaced --jobs 0.
+TEST_F(RegressCli, BadBaselineLinesNameFileAndLine)
+{
+    const fs::path suite = writeManifest(quickCases()), report = m_dir / "report";
+    const fs::path fails = m_dir / "fails.txt", skips = m_dir / "skips.txt";
+    writeText(fails, "# fine so far\nextreme/tir,Fail\nextreme/ior-one Fail\n");
+    expectInputError(regress(
+                         {"--suite", suite.string(), "--baseline", fails.string(), "--report-dir", report.string()}),
+                     {fails.string() + ":3: expected 'case-name,Status'"});
+    EXPECT_FALSE(fs::exists(report / "results.csv")) << "nothing runs on bad input";
+    writeText(fails, "extreme/tir,Failed\n");
+    expectInputError(regress({"--suite", suite.string(), "--baseline", fails.string()}),
+                     {fails.string() + ":1: status 'Failed' cannot be expected"});
+    writeText(skips, "\n\n[unclosed\n");
+    expectInputError(regress({"--suite", suite.string(), "--skips", skips.string()}),
+                     {skips.string() + ":3: not a regular expression"});
+    expectInputError(regress({"--suite", suite.string(), "--flakes", (m_dir / "none.txt").string()}),
+                     {"--flakes", "none.txt", "no such file"});
+    expectInputError(regress({"--suite", suite.string(), "--accel", "bvh"}), {"--accel bvh", "own, driver or auto"});
+}
+
+// --accel reaches every case (the report says which) and the children.
+TEST_F(RegressCli, AccelChoiceIsAcceptedAndReported)
+{
+    const fs::path report = m_dir / "report";
+    ProcessResult r = regress({"--suite", writeManifest({shipped("extreme/tir", 16)}).string(), "--accel", "own",
+                               "--report-dir", report.string()});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(readFile(report / "report.md").find("- accel: own"), std::string::npos);
+}
+
+/// The system's lavapipe ICD manifest, or empty if there is none.
+fs::path systemLavapipeManifest()
+{
+    for (const char* dir : {"/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d"}) {
+        std::error_code error;
+        for (const auto& entry : fs::directory_iterator(dir, error))
+            if (entry.path().filename().string().rfind("lvp_icd", 0) == 0) return entry.path();
+    }
+    return {};
+}
+
+// The same driver twice: every case passes on both, the two images agree (the
+// same seed on the same driver gives the same image), and compare.csv has the
+// render-time ratio B/A of each case.
+TEST_F(RegressCli, CompareDriversWithTheSameDriverTwicePasses)
+{
+    const fs::path icd = systemLavapipeManifest();
+    if (icd.empty()) GTEST_SKIP() << "no lavapipe ICD manifest in /usr/share/vulkan/icd.d";
+    const fs::path report = m_dir / "report";
+    ProcessResult r =
+        regress({"--suite", writeManifest({shipped("extreme/tir", 16), shipped("extreme/ior-one", 32)}).string(),
+                 "--compare-drivers", icd.string(), icd.string(), "--report-dir", report.string()});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    std::istringstream csv(readFile(report / "compare.csv"));
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "case,statusA,statusB,agree,secondsA,secondsB,ratio");
+    const std::regex row(R"(extreme/(tir|ior-one),Pass,Pass,yes,([0-9.]+),([0-9.]+),([0-9]+\.[0-9]{3}))");
+    int rows = 0;
+    for (std::smatch m; std::getline(csv, line); ++rows) {
+        ASSERT_TRUE(std::regex_match(line, m, row)) << line;
+        const double a = std::stod(m[2]), b = std::stod(m[3]), ratio = std::stod(m[4]);
+        EXPECT_GT(a, 0.0);
+        // The times are written to 0.1 ms, the ratio to 0.001: allow for that rounding.
+        EXPECT_NEAR(ratio, b / a, 0.0006 + ratio * (0.0001 / a + 0.0001 / b)) << line;
+    }
+    EXPECT_EQ(rows, 2);
+    EXPECT_EQ(csvStatuses(report / "results.csv"),
+              (std::map<std::string, std::string>{{"extreme/tir", "Pass"}, {"extreme/ior-one", "Pass"}}));
+    const std::string md = readFile(report / "report.md");
+    EXPECT_NE(md.find("B/A"), std::string::npos);
+    EXPECT_NE(md.find("- A: `" + icd.string() + "`"), std::string::npos) << md;
+    // Timing is fair by default: one render at a time.
+    EXPECT_NE(md.find("- jobs: 1 (the timed renders ran one at a time"), std::string::npos) << md;
+    expectInputError(regress({"--suite", writeManifest({shipped("extreme/tir", 16)}).string(), "--compare-drivers",
+                              icd.string(), (m_dir / "missing.json").string()}),
+                     {"--compare-drivers", "missing.json", "no such file"});
 }
 
 } // namespace

@@ -1,0 +1,148 @@
+#include "regress/Expectations.h"
+
+#include "util/Error.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace vkrt {
+
+namespace {
+
+std::string trimmed(const std::string& text)
+{
+    const char* space = " \t\r\n";
+    size_t begin = text.find_first_not_of(space);
+    if (begin == std::string::npos) return "";
+    return text.substr(begin, text.find_last_not_of(space) - begin + 1);
+}
+
+/// The file's lines, each with "file:line"; blank lines and `#` comments left out.
+std::vector<std::pair<std::string, std::string>> meaningfulLines(const fs::path& path, const std::string& option)
+{
+    if (!fs::is_regular_file(path)) throw InputError(option + " " + path.string() + ": no such file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(option + " " + path.string() + ": cannot read it");
+    std::vector<std::pair<std::string, std::string>> lines;
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+        line = trimmed(line);
+        if (line.empty() || line[0] == '#') continue;
+        lines.emplace_back(path.string() + ":" + std::to_string(number), line);
+    }
+    if (in.bad()) throw InputError(option + " " + path.string() + ": cannot read it");
+    return lines;
+}
+
+std::vector<std::string> fieldsOf(const std::string& line)
+{
+    std::vector<std::string> fields;
+    std::istringstream in(line);
+    for (std::string field; std::getline(in, field, ',');) fields.push_back(trimmed(field));
+    if (!line.empty() && line.back() == ',') fields.push_back("");
+    return fields;
+}
+
+/// Only the statuses a case can be expected to end with; the others are
+/// outcomes of a comparison with the baseline, and listing one is a mistake
+/// the message explains.
+CaseStatus expectableStatus(const std::string& where, const std::string& text)
+{
+    std::optional<CaseStatus> status = statusNamed(text);
+    if (status && isFailure(*status)) return *status;
+    std::string why = "expected Fail, Crash or Timeout";
+    if (status == CaseStatus::UnexpectedPass) why += " (UnexpectedPass: the case passes now; remove the line)";
+    else if (status == CaseStatus::Flake || status == CaseStatus::KnownFlake) why += " (list flaky cases in --flakes)";
+    else if (status == CaseStatus::Skip) why += " (list skipped cases in --skips)";
+    throw InputError(where + ": status '" + text + "' cannot be expected: " + why);
+}
+
+} // namespace
+
+std::optional<CaseStatus> Expectations::expectedStatus(const std::string& name) const
+{
+    auto it = baseline.find(name);
+    if (it == baseline.end()) return std::nullopt;
+    return it->second.status;
+}
+
+namespace {
+bool anyMatches(const std::vector<NamePattern>& patterns, const std::string& name)
+{
+    return std::any_of(patterns.begin(), patterns.end(),
+                       [&](const NamePattern& p) { return std::regex_search(name, p.regex); });
+}
+} // namespace
+
+bool Expectations::isKnownFlake(const std::string& name) const { return anyMatches(flakes, name); }
+bool Expectations::isSkipped(const std::string& name) const { return anyMatches(skips, name); }
+
+std::map<std::string, ExpectedStatus> readBaseline(const fs::path& path)
+{
+    std::map<std::string, ExpectedStatus> baseline;
+    for (const auto& [where, line] : meaningfulLines(path, "--baseline")) {
+        std::vector<std::string> fields = fieldsOf(line);
+        if (fields.size() < 2 || fields.size() > 3 || fields[0].empty() || fields[1].empty())
+            throw InputError(where + ": expected 'case-name,Status' (e.g. 'extreme/tir,Fail'), got '" + line + "'");
+        ExpectedStatus expected{expectableStatus(where, fields[1]), where};
+        auto [first, inserted] = baseline.emplace(fields[0], expected);
+        if (!inserted)
+            throw InputError(where + ": case " + fields[0] + " is already listed (" + first->second.where + ")");
+    }
+    return baseline;
+}
+
+std::vector<NamePattern> readNamePatterns(const fs::path& path, const std::string& option)
+{
+    std::vector<NamePattern> patterns;
+    for (const auto& [where, line] : meaningfulLines(path, option)) {
+        try {
+            patterns.push_back({std::regex(line, std::regex::ECMAScript), line, where});
+        } catch (const std::regex_error& e) {
+            throw InputError(where + ": not a regular expression: '" + line + "' (" + e.what() + ")");
+        }
+    }
+    return patterns;
+}
+
+Expectations readExpectations(const fs::path& baseline, const fs::path& flakes, const fs::path& skips)
+{
+    Expectations expectations;
+    if (!baseline.empty()) expectations.baseline = readBaseline(baseline);
+    if (!flakes.empty()) expectations.flakes = readNamePatterns(flakes, "--flakes");
+    if (!skips.empty()) expectations.skips = readNamePatterns(skips, "--skips");
+    return expectations;
+}
+
+std::vector<std::string> baselineLinesNamingNoCase(const Expectations& expectations,
+                                                   const std::vector<std::string>& names)
+{
+    std::vector<std::string> warnings;
+    for (const auto& [name, expected] : expectations.baseline)
+        if (std::find(names.begin(), names.end(), name) == names.end())
+            warnings.push_back(expected.where + ": no case named " + name + " in the suite");
+    return warnings;
+}
+
+bool needsRetry(const std::string& name, CaseStatus first, const Expectations& expectations)
+{
+    return isFailure(first) && expectations.expectedStatus(name) != first;
+}
+
+CaseStatus caseStatus(const std::string& name, const std::vector<CaseStatus>& attempts,
+                      const Expectations& expectations)
+{
+    const CaseStatus first = attempts.empty() ? CaseStatus::Skip : attempts.front();
+    const std::optional<CaseStatus> expected = expectations.expectedStatus(name);
+    if (first == CaseStatus::Skip) return first;
+    if (first == CaseStatus::Pass) return expected ? CaseStatus::UnexpectedPass : CaseStatus::Pass;
+    if (expected == first) return CaseStatus::ExpectedFail;
+    if (attempts.size() > 1 && attempts[1] == CaseStatus::Pass)
+        return expectations.isKnownFlake(name) ? CaseStatus::KnownFlake : CaseStatus::Flake;
+    return first;
+}
+
+} // namespace vkrt
