@@ -27,7 +27,8 @@ std::string traversalSummary(const DeviceInfo& d)
 {
     if (!d.rayQuery()) return "own only (it lacks " + d.rayQueryMissing + " for --accel driver)";
     if (d.type != vk::PhysicalDeviceType::eCpu) return "own or driver (VK_KHR_ray_query); auto picks driver";
-    return "own or driver (VK_KHR_ray_query); auto picks driver for scenes with meshes, own for the rest";
+    return "own or driver (VK_KHR_ray_query); auto picks driver for scenes of 1 to " +
+           std::to_string(kDriverAccelMaxCpuTriangles) + " mesh triangles, own for the rest";
 }
 
 } // namespace

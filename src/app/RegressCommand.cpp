@@ -32,9 +32,8 @@ void checkRegressFiles(const RegressOptions& options)
     refuseOverlappingFiles(inputs, written);
 }
 
-/// The options only the command line knows are set: --accel's word, and whether --jobs was given.
+/// The options only the command line knows are set: whether --jobs and --case-timeout were given.
 struct CommandLineExtras {
-    std::string accel = "auto";
     unsigned jobs = 0;
     CLI::Option* jobsOption = nullptr;
     double caseTimeout = 0.0;
@@ -43,9 +42,6 @@ struct CommandLineExtras {
 
 void applyExtras(RegressOptions& o, const CommandLineExtras& extras)
 {
-    std::optional<AccelChoice> accel = accelChoiceNamed(extras.accel);
-    if (!accel) throw InputError("--accel " + extras.accel + ": expected own, driver or auto");
-    o.accel = *accel;
     if (extras.jobsOption->count()) o.jobs = extras.jobs;
     if (extras.caseTimeoutOption->count()) o.caseTimeout = extras.caseTimeout;
 }
@@ -91,7 +87,10 @@ CommandRunner addRegressCommand(CLI::App& app)
                     "Run every case on two drivers (ICD manifests A.json "
                     "B.json) and compare their images and times")
         ->expected(2);
-    cmd->add_option("--accel", extras->accel, "Traversal backend of every case: own, driver or auto (default auto)");
+    cmd->add_flag("--compare-accel", o->compareAccel,
+                  "Run every case with both traversal backends (--accel own and driver) and compare their images "
+                  "and times");
+    addAccelOption(*cmd, o->accel);
     cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");
     addChildOptions(cmd, *o);
     return [o, defines, extras] {

@@ -83,15 +83,6 @@ std::string seconds(double value)
 
 } // namespace
 
-std::string accelChoiceName(AccelChoice choice)
-{
-    switch (choice) {
-    case AccelChoice::Own: return "own";
-    case AccelChoice::Driver: return "driver";
-    case AccelChoice::Auto: break;
-    }
-    return "auto";
-}
 
 TemporaryFolder::TemporaryFolder()
 {
@@ -197,6 +188,12 @@ AttemptPool::Running AttemptPool::start(AttemptJob job)
     argv.insert(argv.end(), {"--run-case", r.job.caseName, "--case-result", r.result.string(), "--attempt",
                              std::to_string(plan.number), "--seed-offset", std::to_string(plan.seedOffset)});
     if (!r.job.driver.empty()) argv.insert(argv.end(), {"--driver", r.job.driver});
+    if (r.job.accel) {
+        // childCommand gave the run's --accel: this attempt's replaces it.
+        auto accel = std::find(argv.begin(), argv.end(), "--accel");
+        VKRT_CHECK(accel != argv.end() && accel + 1 != argv.end());
+        *(accel + 1) = accelChoiceName(*r.job.accel);
+    }
     if (!plan.failureImageDir.empty()) argv.insert(argv.end(), {"--report-dir", plan.failureImageDir.string()});
     if (!plan.imageOut.empty()) argv.insert(argv.end(), {"--case-image", plan.imageOut.string()});
     r.child = std::make_unique<ChildProcess>(argv, r.log);

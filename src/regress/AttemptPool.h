@@ -27,8 +27,6 @@ namespace vkrt {
 /// cold lavapipe compile takes 10-40 s); 600 s for a case without a baseline.
 double caseTimeoutSeconds(const RegressionCase& c, std::optional<double> override);
 
-/// --accel's spelling of a choice ("own", "driver", "auto").
-std::string accelChoiceName(AccelChoice choice);
 
 /// The child's command line up to the per-attempt options: this executable,
 /// "regress" and the options every attempt of the run shares (--suite,
@@ -55,6 +53,7 @@ struct AttemptJob {
     uint32_t seed = 0;  ///< the render seed, for the report of an attempt that never reported
     AttemptPlan plan;   ///< number, seed offset, image outputs
     std::string driver; ///< the child's --driver (empty: none)
+    std::optional<AccelChoice> accel; ///< the child's --accel instead of the run's (--compare-accel)
     std::string tag;    ///< tells apart two attempts of one case in file names ("A", "B"; may be empty)
     double timeoutSeconds = 600.0;
 };

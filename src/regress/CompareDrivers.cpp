@@ -18,7 +18,21 @@ namespace vkrt {
 
 namespace {
 
-/// One case on both drivers.
+/// One side of a comparison: a driver (empty: the system's) and, for
+/// --compare-accel, the traversal backend.
+struct ComparedSide {
+    fs::path manifest;
+    std::optional<AccelChoice> accel;
+
+    std::string describe() const
+    {
+        std::string text = manifest.empty() ? "the system's driver" : "`" + manifest.string() + "`";
+        if (accel) text += ", --accel " + accelChoiceName(*accel);
+        return text;
+    }
+};
+
+/// One case on both sides (two drivers, or two traversal backends).
 struct Comparison {
     RegressionCase spec;
     std::optional<CaseAttempt> a, b;
@@ -102,10 +116,10 @@ struct SideDevices {
 class DriverComparison {
 public:
     DriverComparison(const RegressionSuite& suite, const std::vector<RegressionCase>& cases,
-                     const RegressOptions& options, std::array<fs::path, 2> manifests)
+                     const RegressOptions& options, std::array<ComparedSide, 2> sides)
         : m_suite(suite),
           m_options(options),
-          m_manifests(std::move(manifests))
+          m_sides(std::move(sides))
     {
         for (const RegressionCase& c : cases) m_cases.push_back({c});
     }
@@ -121,7 +135,8 @@ public:
             const int side = (k + int(index)) % 2;
             const RegressionCase& c = m_cases[index].spec;
             AttemptPlan plan{1, m_options.seedOffset, {}, imagePath(index, side)};
-            jobs.push_back({c.name, m_suite.seed + plan.seedOffset, plan, m_manifests[size_t(side)].string(),
+            const ComparedSide& s = m_sides[size_t(side)];
+            jobs.push_back({c.name, m_suite.seed + plan.seedOffset, plan, s.manifest.string(), s.accel,
                             side == 0 ? "A" : "B", caseTimeoutSeconds(c, m_options.caseTimeout)});
         }
         return jobs;
@@ -156,7 +171,7 @@ public:
 private:
     const RegressionSuite& m_suite;
     const RegressOptions& m_options;
-    std::array<fs::path, 2> m_manifests;
+    std::array<ComparedSide, 2> m_sides;
     std::vector<Comparison> m_cases;
     TemporaryFolder m_images;
     SideDevices m_devices;
@@ -285,9 +300,10 @@ private:
         const std::vector<StatusLine> lines = finishedLines();
         const unsigned jobs = jobsFor(m_options);
         std::ostringstream md;
-        md << "# vkrt driver comparison\n\n- suite: `" << m_suite.path.string() << "`\n"
-           << "- A: `" << m_manifests[0].string() << "`: " << (m_devices.a.empty() ? "device unknown" : m_devices.a)
-           << "\n- B: `" << m_manifests[1].string() << "`: " << (m_devices.b.empty() ? "device unknown" : m_devices.b)
+        md << "# vkrt " << (m_options.compareAccel ? "backend" : "driver") << " comparison\n\n- suite: `"
+           << m_suite.path.string() << "`\n"
+           << "- A: " << m_sides[0].describe() << ": " << (m_devices.a.empty() ? "device unknown" : m_devices.a)
+           << "\n- B: " << m_sides[1].describe() << ": " << (m_devices.b.empty() ? "device unknown" : m_devices.b)
            << "\n- seed: " << m_suite.seed + m_options.seedOffset
            << " (both drivers render the same seed; no re-runs)\n"
            << "- jobs: " << jobs
@@ -330,8 +346,14 @@ private:
 Outcome compareDrivers(const RegressionSuite& suite, const std::vector<RegressionCase>& cases,
                        const Expectations& expectations, const RegressOptions& options)
 {
-    const std::array<fs::path, 2> manifests{checkIcdManifest(options.compareDrivers.at(0), "--compare-drivers"),
-                                            checkIcdManifest(options.compareDrivers.at(1), "--compare-drivers")};
+    std::array<ComparedSide, 2> sides;
+    if (options.compareAccel) {
+        const fs::path manifest = options.driver.empty() ? fs::path() : checkIcdManifest(options.driver, "--driver");
+        sides = {ComparedSide{manifest, AccelChoice::Own}, ComparedSide{manifest, AccelChoice::Driver}};
+    } else {
+        sides = {ComparedSide{checkIcdManifest(options.compareDrivers.at(0), "--compare-drivers"), std::nullopt},
+                 ComparedSide{checkIcdManifest(options.compareDrivers.at(1), "--compare-drivers"), std::nullopt}};
+    }
     std::vector<RegressionCase> runnable;
     for (const RegressionCase& c : cases)
         if (!expectations.isSkipped(c.name)) runnable.push_back(c);
@@ -345,7 +367,7 @@ Outcome compareDrivers(const RegressionSuite& suite, const std::vector<Regressio
                      jobs);
 
     InterruptGuard interrupt;
-    DriverComparison comparison(suite, cases, options, manifests);
+    DriverComparison comparison(suite, cases, options, sides);
     AttemptPool pool(jobs, childCommand(options, false), options.reportDir, nullptr);
     for (size_t i = 0; i < cases.size(); ++i) {
         if (expectations.isSkipped(cases[i].name)) comparison.skip(i);

@@ -205,7 +205,7 @@ public:
     {
         const RegressionCase& c = m_results[index].spec;
         AttemptPlan plan{1, m_options.seedOffset, m_options.reportDir, {}};
-        return {c.name, m_suite.seed + plan.seedOffset, plan, m_options.driver, "", timeoutFor(c)};
+        return {c.name, m_suite.seed + plan.seedOffset, plan, m_options.driver, std::nullopt, "", timeoutFor(c)};
     }
 
     /// Records an attempt; returns the re-run to make, if the case needs one.
@@ -387,14 +387,17 @@ void refuseContradictions(const RegressOptions& options)
     if (options.update && expectations)
         throw InputError("--update renders the references of the --filter'ed cases; it takes no --baseline, "
                          "--flakes or --skips");
-    if (options.compareDrivers.empty()) return;
-    if (options.update) throw InputError("--compare-drivers cannot be combined with --update");
-    if (!options.driver.empty())
+    if (!options.compares()) return;
+    const std::string option = options.compareAccel ? "--compare-accel" : "--compare-drivers";
+    if (options.compareAccel && !options.compareDrivers.empty())
+        throw InputError("--compare-accel and --compare-drivers: compare one pair at a time");
+    if (options.update) throw InputError(option + " cannot be combined with --update");
+    if (!options.compareDrivers.empty() && !options.driver.empty())
         throw InputError("--compare-drivers names both drivers; it cannot be combined with --driver");
     if (!options.baseline.empty() || !options.flakes.empty())
-        throw InputError("--compare-drivers tests two drivers against each other; --baseline and --flakes describe "
-                         "one driver's run (--skips is allowed)");
-    if (options.jobs == 0u) throw InputError("--jobs 0: --compare-drivers runs each driver in processes of its own");
+        throw InputError(option + " tests two configurations against each other; --baseline and --flakes describe "
+                                  "one run (--skips is allowed)");
+    if (options.jobs == 0u) throw InputError("--jobs 0: " + option + " runs each side in processes of its own");
 }
 
 /// Prints a warning for each baseline line that names no case of the suite.
@@ -419,7 +422,7 @@ std::vector<RegressionCase> casesToRun(const std::vector<RegressionCase>& cases,
 unsigned jobsFor(const RegressOptions& options)
 {
     if (options.jobs) return *options.jobs;
-    if (options.failOnSlowdown || !options.compareDrivers.empty()) return 1;
+    if (options.failOnSlowdown || options.compares()) return 1;
     return std::max(1u, std::thread::hardware_concurrency());
 }
 
@@ -467,7 +470,7 @@ Outcome runRegression(const RegressOptions& options)
     const std::vector<RegressionCase> cases = selectedCases(suite, options.filters);
     const Expectations expectations = readExpectations(options.baseline, options.flakes, options.skips);
     warnAboutUnknownBaselineCases(suite, expectations);
-    if (!options.compareDrivers.empty()) return compareDrivers(suite, cases, expectations, options);
+    if (options.compares()) return compareDrivers(suite, cases, expectations, options);
     if (!options.driver.empty()) selectVulkanDriver(options.driver);
     std::vector<PreparedCase> prepared;
     if (!options.update) prepared = prepareCases(suite, casesToRun(cases, expectations));

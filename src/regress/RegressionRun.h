@@ -33,6 +33,9 @@ struct RegressOptions {
     std::filesystem::path flakes;            ///< --flakes: regular expressions of known flaky cases
     std::filesystem::path skips;             ///< --skips: regular expressions of cases not to run
     std::vector<std::string> compareDrivers; ///< --compare-drivers A.json B.json
+    bool compareAccel = false;               ///< --compare-accel: own (A) against driver (B) on one driver
+    /// Whether the run compares two configurations (--compare-drivers or --compare-accel).
+    bool compares() const { return !compareDrivers.empty() || compareAccel; }
 
     // The child process's side (hidden options, given by regress/AttemptPool.cpp):
     std::string runCase;              ///< --run-case: make one attempt at this case

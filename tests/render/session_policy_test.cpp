@@ -31,13 +31,11 @@ DeviceInfo deviceWithRayQueries(vk::PhysicalDeviceType type, bool rayQueries)
 
 TEST(AccelPolicy, KeepsAGivenChoiceAndRefusesTheDriverWithoutRayQueries)
 {
-    const Scene analytic; // no meshes
-    Scene meshes = analytic;
-    meshes.meshes.emplace_back(); // the policy looks only at whether there are meshes
+    const uint64_t analytic = 0, fewTriangles = kDriverAccelMaxCpuTriangles, manyTriangles = 69453;
     const DeviceInfo cpu = deviceWithRayQueries(vk::PhysicalDeviceType::eCpu, true);
     const DeviceInfo gpu = deviceWithRayQueries(vk::PhysicalDeviceType::eDiscreteGpu, true);
     const DeviceInfo old = deviceWithRayQueries(vk::PhysicalDeviceType::eCpu, false);
-    EXPECT_EQ(resolveAccel(AccelChoice::Own, gpu, meshes), Accel::Own);
+    EXPECT_EQ(resolveAccel(AccelChoice::Own, gpu, fewTriangles), Accel::Own);
     EXPECT_EQ(resolveAccel(AccelChoice::Driver, cpu, analytic), Accel::Driver);
     try {
         resolveAccel(AccelChoice::Driver, old, analytic);
@@ -49,9 +47,12 @@ TEST(AccelPolicy, KeepsAGivenChoiceAndRefusesTheDriverWithoutRayQueries)
             << e.what();
     }
     // auto: the measured rule (docs/performance.md, "Two traversal backends").
-    EXPECT_EQ(resolveAccel(AccelChoice::Auto, old, meshes), Accel::Own);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, old, fewTriangles), Accel::Own);
     EXPECT_EQ(resolveAccel(AccelChoice::Auto, gpu, analytic), Accel::Driver);
-    EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, meshes), Accel::Driver);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, gpu, manyTriangles), Accel::Driver);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, fewTriangles), Accel::Driver);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, fewTriangles + 1), Accel::Own);
+    EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, manyTriangles), Accel::Own);
     EXPECT_EQ(resolveAccel(AccelChoice::Auto, cpu, analytic), Accel::Own);
 }
 
