@@ -98,6 +98,7 @@ std::set<std::string> keysOf(const Metadata& metadata)
 TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
 {
     SessionConfig c = config();
+    c.accel = AccelChoice::Own;
     c.stop.maxSpp = 8;
     c.stop.timeBudgetSeconds = 100.0;
     c.variance.layer = true;
@@ -108,8 +109,9 @@ TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
     for (const char* key :
          {"vkrtVersion", "spp", "seed", "renderSeconds", "stoppedBy", "device", "driver", "scene", "sceneHash",
           "integrator", "kernelVariant", "sampler", "rejectedSamples", "loopCap", "varianceDegreesOfFreedom",
-          "varianceEstimator", "estimatedRmse", "estimatedRelMse", "timeBudgetSeconds"})
+          "varianceEstimator", "estimatedRmse", "estimatedRelMse", "timeBudgetSeconds", "accel"})
         EXPECT_EQ(m.count(key), 1u) << key;
+    EXPECT_EQ(std::get<std::string>(m.at("accel")), "own") << "the backend asked for";
     EXPECT_EQ(m.count("savedBy"), 0u);
     EXPECT_EQ(std::get<int64_t>(m.at("spp")), 8);
     EXPECT_EQ(std::get<int64_t>(m.at("seed")), 3);
@@ -135,7 +137,7 @@ TEST_F(RenderSessionTest, ViewerSaveMetadataAddsSavedByAndFollowsMovesAndResets)
     std::set<std::string> expected = {"vkrtVersion", "spp",           "seed",    "renderSeconds",
                                       "device",      "driver",        "scene",   "sceneHash",
                                       "integrator",  "kernelVariant", "sampler", "rejectedSamples",
-                                      "loopCap",     "savedBy"};
+                                      "loopCap",     "savedBy",       "accel"};
     EXPECT_EQ(keysOf(saved), expected);
 
     Camera before = session.scene().camera;
