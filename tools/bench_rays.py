@@ -12,10 +12,10 @@ What a path tracer's sample costs is mostly its rays. This isolates them:
   description, and no shadow ray. Mrays/s = width x height x --spp / vkrt's
   own rendering time, median of --runs.
 
-* the device's own traversal (VK_KHR_ray_query, acceleration structures
-  built by the driver) on the same meshes, camera and ray count, through
-  vkrt-rayquery-bench (`cmake --build build --target vkrt-rayquery-bench`;
-  the column is left empty without it). It traces only the meshes.
+* the device's own traversal: the same vkrt render with `--accel driver`
+  (VK_KHR_ray_query over acceleration structures the driver builds; the
+  same rays and hits, docs/architecture.md "Two traversal backends"); the
+  column is left empty on a device without ray queries.
 
 The ratio bounds what any change to the rest of the integrator can gain: a
 sample costs at least its rays.
@@ -60,16 +60,19 @@ def rays_only_scene(text):
     return "\n".join(lines) + "\n"
 
 
-def vkrt_mrays(vkrt, scene, args, work):
+def vkrt_mrays(vkrt, scene, args, work, accel="own"):
     copy = scene.parent / f".bench_rays_{scene.stem}.toml"  # beside it: relative mesh paths keep working
     try:
         copy.write_text(rays_only_scene(scene.read_text()))
         rates = []
         for run in range(args.runs + 1):
-            result = subprocess.run([vkrt, "render", str(copy), "--spp", str(args.spp), "--seed", str(run),
+            result = subprocess.run([vkrt, "render", str(copy), "--accel", accel, "--spp", str(args.spp),
+                                     "--seed", str(run),
                                      "--width", str(args.width), "--height", str(args.height), "-o",
                                      str(Path(work) / "rays.exr")], capture_output=True, text=True)
             if result.returncode != 0:
+                if accel == "driver" and "lacks" in result.stderr:
+                    return None  # a device without ray queries
                 sys.exit(f"bench_rays: error: vkrt on {scene}:\n{result.stderr}")
             match = re.search(r"spp\s+([\d.]+) s", result.stdout + result.stderr)
             if not match:
@@ -79,17 +82,6 @@ def vkrt_mrays(vkrt, scene, args, work):
         return statistics.median(rates)
     finally:
         copy.unlink(missing_ok=True)
-
-
-def rayquery_mrays(binary, scene, args):
-    if not binary or not os.access(binary, os.X_OK):
-        return None
-    result = subprocess.run([binary, str(scene), str(args.spp), str(args.runs), str(args.width), str(args.height)],
-                            capture_output=True, text=True)
-    match = re.search(r"([\d.]+) Mrays/s", result.stdout)
-    if result.returncode != 0 or not match:
-        sys.exit(f"bench_rays: error: {binary} on {scene}:\n{result.stdout}{result.stderr}")
-    return float(match.group(1))
 
 
 def mitsuba_mrays(scene, args, work):
@@ -129,8 +121,6 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenes", nargs="*", type=Path)
     parser.add_argument("--vkrt", default=os.environ.get("VKRT", str(REPO / "build" / "vkrt")))
-    parser.add_argument("--rayquery", default=str(REPO / "build" / "vkrt-rayquery-bench"),
-                        help="vkrt-rayquery-bench binary (default build/vkrt-rayquery-bench; skipped if absent)")
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--spp", type=int, default=16)
     parser.add_argument("--width", type=int, default=320)
@@ -154,8 +144,8 @@ def main():
         for scene in scenes:
             if not scene.is_file():
                 sys.exit(f"bench_rays: error: {scene}: no such scene file")
-            ours = vkrt_mrays(args.vkrt, scene.resolve(), args, work)
-            query = rayquery_mrays(args.rayquery, scene.resolve(), args)
+            ours = vkrt_mrays(args.vkrt, scene.resolve(), args, work, accel="own")
+            query = vkrt_mrays(args.vkrt, scene.resolve(), args, work, accel="driver")
             theirs = mitsuba_mrays(scene.resolve(), args, work)
             query_text = f"{query:.2f} | " if query else "— | "
             query_ratio = f"{query / ours:.3f}" if query else "—"

@@ -158,14 +158,7 @@ public:
     {
         m_interrupted = !completed;
         writeReports();
-        const std::vector<StatusLine> lines = finishedLines();
-        std::printf("%s; %zu unexpected", statusCounts(lines).c_str(), unexpectedCount(lines));
-        if (m_interrupted) {
-            std::printf(" (interrupted after %zu of %zu cases)\n", lines.size(), m_cases.size());
-            return Outcome::of(OutcomeKind::Interrupted);
-        }
-        std::printf("\n");
-        return unexpectedCount(lines) ? Outcome::of(OutcomeKind::Failed) : Outcome::passed();
+        return finishRun(finishedLines(), m_interrupted, m_cases.size());
     }
 
 private:

@@ -225,16 +225,9 @@ public:
     /// Passed, Failed when a case fails the run, Interrupted when it was stopped.
     Outcome end(bool completed)
     {
-        const std::vector<StatusLine> lines = finishedLines();
         m_interrupted = !completed;
         writeReports();
-        std::printf("%s; %zu unexpected", statusCounts(lines).c_str(), unexpectedCount(lines));
-        if (m_interrupted) {
-            std::printf(" (interrupted after %zu of %zu cases)\n", lines.size(), m_results.size());
-            return Outcome::of(OutcomeKind::Interrupted);
-        }
-        std::printf("\n");
-        return unexpectedCount(lines) ? Outcome::of(OutcomeKind::Failed) : Outcome::passed();
+        return finishRun(finishedLines(), m_interrupted, m_results.size());
     }
 
 private:

@@ -165,6 +165,17 @@ size_t unexpectedCount(const std::vector<StatusLine>& lines)
     return size_t(std::count_if(lines.begin(), lines.end(), [](const StatusLine& l) { return failsTheRun(l.status); }));
 }
 
+Outcome finishRun(const std::vector<StatusLine>& lines, bool interrupted, size_t cases)
+{
+    std::printf("%s; %zu unexpected", statusCounts(lines).c_str(), unexpectedCount(lines));
+    if (interrupted) {
+        std::printf(" (interrupted after %zu of %zu cases)\n", lines.size(), cases);
+        return Outcome::of(OutcomeKind::Interrupted);
+    }
+    std::printf("\n");
+    return unexpectedCount(lines) ? Outcome::of(OutcomeKind::Failed) : Outcome::passed();
+}
+
 std::string resultsCsv(const std::vector<StatusLine>& lines, bool unexpectedOnly)
 {
     std::string csv;

@@ -7,6 +7,7 @@
 #include "regress/CaseResult.h"
 #include "regress/Expectations.h"
 #include "regress/Suite.h"
+#include "render/Outcome.h"
 
 #include <filesystem>
 #include <string>
@@ -48,6 +49,10 @@ StatusLine statusLine(const CaseResult& result);
 std::string statusCounts(const std::vector<StatusLine>& lines);
 /// How many lines fail the run (failsTheRun).
 size_t unexpectedCount(const std::vector<StatusLine>& lines);
+/// Prints a run's last line (the counts, and how far an interrupted run got
+/// of its `cases`) and returns its outcome: Interrupted, Failed on an
+/// unexpected result, else Passed.
+Outcome finishRun(const std::vector<StatusLine>& lines, bool interrupted, size_t cases);
 
 /// `test,status,duration` lines, no header (deqp-runner's results.csv);
 /// `unexpectedOnly` keeps the lines that fail the run (failures.csv).

@@ -14,8 +14,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr vk::BufferUsageFlags kBuildInput = vk::BufferUsageFlagBits::eAccelerationStructureBuildInputReadOnlyKHR |
-                                             vk::BufferUsageFlagBits::eShaderDeviceAddress;
+constexpr vk::BufferUsageFlags kBuildInput = DriverAccel::kBuildInputUsage;
 /// Instance custom indices and shader-binding-table offsets have 24 bits.
 constexpr uint32_t kMaxInstanceField = (1u << 24) - 1;
 
@@ -57,8 +56,8 @@ vk::AccelerationStructureInstanceKHR instance(const vk::TransformMatrixKHR& tran
 
 } // namespace
 
-DriverAccel::DriverAccel(const VulkanContext& context, const GpuSceneStatic& fixed, const Scene& scene,
-                         const GpuSceneData& data)
+DriverAccel::DriverAccel(const VulkanContext& context, const GpuSceneStatic& fixed, const Buffer* meshTriangles,
+                         const Scene& scene, const GpuSceneData& data)
     : m_context(context)
 {
     if (!context.deviceInfo().rayQuery())
@@ -67,7 +66,7 @@ DriverAccel::DriverAccel(const VulkanContext& context, const GpuSceneStatic& fix
         throw InputError(scene.path + ": the driver backend (--accel driver) takes at most " +
                          std::to_string(kMaxInstanceField + 1) + " mesh instances");
     const auto start = Clock::now();
-    buildGeometries(fixed, scene);
+    buildGeometries(fixed, meshTriangles, scene);
     buildCameraRelative(scene, data);
     m_buildSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -109,11 +108,11 @@ DriverAccel::Structure DriverAccel::create(vk::AccelerationStructureTypeKHR type
 
 // One structure per geometry, from its run of meshTriangles (three vertices
 // each, not indexed), so the driver's primitive index is the leaf slot.
-void DriverAccel::buildGeometries(const GpuSceneStatic& fixed, const Scene& scene)
+void DriverAccel::buildGeometries(const GpuSceneStatic& fixed, const Buffer* meshTriangles, const Scene& scene)
 {
     if (scene.meshes.empty()) return;
-    m_vertices.emplace(makeBufferFrom(m_context, fixed.meshTriangles, kBuildInput));
-    const vk::DeviceAddress base = m_vertices->address(m_context);
+    VKRT_CHECK(meshTriangles);
+    const vk::DeviceAddress base = meshTriangles->address(m_context);
     std::map<const MeshGeometry*, uint32_t> structureOf;
     std::vector<PendingBuild> builds;
     for (const auto& [geometry, offsets] : fixed.offsets) {

@@ -18,8 +18,15 @@ namespace vkrt {
 
 class DriverAccel {
 public:
-    DriverAccel(const VulkanContext& context, const GpuSceneStatic& fixed, const Scene& scene,
-                const GpuSceneData& data);
+    /// Usage a buffer needs to be read by a build (the mesh triangles' buffer).
+    static constexpr vk::BufferUsageFlags kBuildInputUsage =
+        vk::BufferUsageFlagBits::eAccelerationStructureBuildInputReadOnlyKHR |
+        vk::BufferUsageFlagBits::eShaderDeviceAddress;
+
+    /// `meshTriangles`: the kernel's buffer of GpuSceneStatic::meshTriangles,
+    /// made with kBuildInputUsage (null for a scene without meshes).
+    DriverAccel(const VulkanContext& context, const GpuSceneStatic& fixed, const Buffer* meshTriangles,
+                const Scene& scene, const GpuSceneData& data);
 
     /// Rebuilds the camera-relative structures for the scene's new camera
     /// (`data` converted for it). The caller makes sure no dispatch still reads
@@ -49,7 +56,6 @@ private:
     };
 
     const VulkanContext& m_context;
-    std::optional<Buffer> m_vertices;             ///< every geometry's triangles, as meshTriangles
     std::vector<Structure> m_geometries;          ///< per geometry, as GpuSceneStatic::offsets orders them
     std::vector<uint32_t> m_geometryOfMesh;       ///< mesh record -> m_geometries index
     std::vector<Buffer> m_boxInputs;              ///< per bounded kind: its records' boxes
@@ -61,7 +67,7 @@ private:
     double m_rebuildSeconds = 0.0;
 
     Structure create(vk::AccelerationStructureTypeKHR type, PendingBuild& build);
-    void buildGeometries(const GpuSceneStatic& fixed, const Scene& scene);
+    void buildGeometries(const GpuSceneStatic& fixed, const Buffer* meshTriangles, const Scene& scene);
     void buildCameraRelative(const Scene& scene, const GpuSceneData& data);
     void submit(std::vector<PendingBuild>& bottoms, std::vector<PendingBuild>& tops) const;
 };

@@ -267,7 +267,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
     uploadMeshBuffers();
     uploadSceneBuffers();
     if (m_variant.driverAccel) {
-        m_driverAccel.emplace(context, m_static, m_scene, m_data);
+        m_driverAccel.emplace(context, m_static, m_meshTriangles, m_scene, m_data);
         m_kernel.bind(gpu::BINDING_TOP_LEVEL, m_driverAccel->topLevel());
     }
 }
@@ -285,14 +285,17 @@ void Renderer::bindPerPixelBuffers()
 
 void Renderer::uploadMeshBuffers()
 {
-    auto addBuffer = [&](uint32_t binding, const auto& records) {
+    auto addBuffer = [&](uint32_t binding, const auto& records, vk::BufferUsageFlags extra = {}) {
         if (!m_kernel.uses(binding)) return;
-        m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage));
+        m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage | extra));
         m_kernel.bind(binding, m_meshBuffers.back());
     };
     m_meshBuffers.reserve(9); // bind() keeps references: no reallocation
     addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
-    addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles);
+    // The driver backend builds its triangle structures from this same buffer.
+    addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles,
+              m_variant.driverAccel ? DriverAccel::kBuildInputUsage : vk::BufferUsageFlags{});
+    if (m_variant.driverAccel && m_kernel.uses(gpu::BINDING_MESH_TRIANGLES)) m_meshTriangles = &m_meshBuffers.back();
     addBuffer(gpu::BINDING_MESH_NORMALS, m_static.meshNormals);
     addBuffer(gpu::BINDING_MESH_UVS, m_static.meshUvs);
     addBuffer(gpu::BINDING_MESH_TANGENTS, m_static.meshTangents);

@@ -130,6 +130,7 @@ private:
     std::optional<BandedBuffer> m_moments;
     std::optional<BandedBuffer> m_aovs;
     ComputeKernel m_kernel;
+    const Buffer* m_meshTriangles = nullptr; ///< in m_meshBuffers, for the driver backend's builds
     std::optional<DriverAccel> m_driverAccel;
     std::optional<EnvironmentTexture> m_environment;
     std::optional<Buffer> m_environmentCdf;
