@@ -3,6 +3,7 @@
 
     tools/bench_vs_mitsuba.sh [--runs 3] [--spp 128] [--scenes A.toml B.toml ...] [--quick]
                               [--variant llvm_ad_rgb|scalar_rgb] [--vkrt-sampler auto|sobol|independent]
+                              [--mitsuba-samplers independent,multijitter]
                               [--no-cold] [--markdown FILE] [--json FILE]
 
 Run it through tools/bench_vs_mitsuba.sh, which starts this file with the
@@ -35,9 +36,18 @@ is the Owen-scrambled Sobol' sampler. --vkrt-sampler independent|sobol passes
 --sampler to vkrt explicitly (independent: the throughput levers alone; auto
 passes nothing, so binaries older than --sampler still work).
 
+Mitsuba renders each scene once per sampler of --mitsuba-samplers (default
+independent and multijitter: Mitsuba's default and, measured, its best at
+equal time on these scenes; stratified, ldsampler and orthogonal are also
+accepted), each its own column, in the same interleaved runs. multijitter and
+stratified round the spp up to a full grid (128 -> 132): the efficiency, which
+divides by the time, absorbs that.
+
 Efficiency = 1 / (median MSE x median whole-process seconds of `main`); its
 ratio vkrt/Mitsuba is Mitsuba's MSE x seconds over vkrt's (4 = half the RMSE in
-equal time). Cold start-up (once per scene, 1 spp at 320x240): vkrt with empty
+equal time). The report gives the ratio against every Mitsuba sampler and
+against the best of them for each scene (the highest efficiency); the speed
+table compares with that best sampler's process. Cold start-up (once per scene, 1 spp at 320x240): vkrt with empty
 SPIR-V and Mesa caches, Mitsuba with an empty Dr.Jit cache (HOME and
 XDG_CACHE_HOME pointed at empty folders).
 
@@ -126,6 +136,17 @@ def fail(message: str, status: int = 2):
 def median(values):
     values = [v for v in values if v is not None and math.isfinite(v)]
     return statistics.median(values) if values else None
+
+
+MITSUBA_SAMPLERS = ("independent", "multijitter", "stratified", "ldsampler", "orthogonal")
+
+
+def parse_samplers(text: str):
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    bad = [n for n in names if n not in MITSUBA_SAMPLERS]
+    if bad or not names:
+        raise argparse.ArgumentTypeError(f"'{text}': expected a comma-separated list of {', '.join(MITSUBA_SAMPLERS)}")
+    return list(dict.fromkeys(names))
 
 
 def parse_size(text: str):
@@ -217,7 +238,7 @@ class Scene:
     def __init__(self, name, vkrt_path, xml, reference, size, max_depth, notes):
         self.name = name
         self.vkrt_path = vkrt_path  # the TOML vkrt renders
-        self.xml = xml              # {(w, h): Mitsuba XML}
+        self.xml = xml              # {((w, h), sampler): Mitsuba XML}
         self.reference = reference  # mean.exr or None
         self.size = size            # (w, h) of the main measurement
         self.max_depth = max_depth
@@ -274,8 +295,10 @@ def prepare_scenes(args, work: Path):
             d = to_mitsuba.convert(vkrt_path, files_dir=files, envmap_width=args.envmap_width, spp=1)
             d["sensor"]["film"]["width"] = w
             d["sensor"]["film"]["height"] = h
-            xml[(w, h)] = work / f"{path.stem}-{w}x{h}.xml"
-            to_mitsuba.write_xml(d, xml[(w, h)])
+            for sampler in args.mitsuba_samplers:
+                d["sensor"]["sampler"]["type"] = sampler
+                xml[((w, h), sampler)] = work / f"{path.stem}-{w}x{h}-{sampler}.xml"
+                to_mitsuba.write_xml(d, xml[((w, h), sampler)])
         scenes.append(Scene(name, vkrt_path, xml, reference, size, max_depth, notes))
     return scenes
 
@@ -296,7 +319,7 @@ def derived_reference(args, runner, scene: Scene, work: Path):
         log(f"{scene.name}: rendering a {args.derived_reference_spp}-spp Mitsuba reference (once; cached as {path})")
         start = time.perf_counter()
         tmp = work / "reference.exr"
-        runner.mitsuba_render(scene, scene.size, args.derived_reference_spp, 999, tmp)
+        runner.mitsuba_render(scene, scene.size, args.derived_reference_spp, 999, tmp, sampler=args.mitsuba_samplers[0])
         shutil.move(tmp, path)
         log(f"{scene.name}: reference took {time.perf_counter() - start:.0f} s")
     scene.reference = path
@@ -355,8 +378,8 @@ class Runner:
         m = re.search(r"first frame:\s*([\d.]+) s", text)
         return float(m.group(1)) if m else None
 
-    def mitsuba_render(self, scene: Scene, size, spp, seed, out, env=None):
-        cmd = [self.python, "-c", MITSUBA_CHILD, self.variant, str(scene.xml[size]), str(out), str(spp),
+    def mitsuba_render(self, scene: Scene, size, spp, seed, out, env=None, sampler="independent"):
+        cmd = [self.python, "-c", MITSUBA_CHILD, self.variant, str(scene.xml[(size, sampler)]), str(out), str(spp),
                str(seed), str(self.args.pass_spp)]
         whole, text = self._run(cmd, env or self.mitsuba_env, "Mitsuba render")
         lines = [ln for ln in text.splitlines() if ln.startswith("{")]
@@ -424,6 +447,16 @@ def choose_variant(args) -> list[str]:
     return notes
 
 
+def commit() -> str:
+    """The checkout's commit, and whether shaders/, src/ or tools/ differ from it."""
+    def git(*a):
+        p = subprocess.run(["git", "-C", str(REPO), *a], capture_output=True, text=True)
+        return p.stdout.strip() if p.returncode == 0 else ""
+    head = git("rev-parse", "--short", "HEAD") or "unknown"
+    dirty = git("status", "--porcelain", "--", "shaders", "src", "tools")
+    return head + (" (with uncommitted changes)" if dirty else "")
+
+
 def fmt(x, digits=3):
     if x is None:
         return "—"
@@ -471,6 +504,9 @@ def main(argv) -> int:
     ap.add_argument("--vkrt-sampler", default="auto", choices=["auto", "sobol", "independent"],
                     help="vkrt's --sampler (default %(default)s: no flag, vkrt's own default, which is Sobol' "
                          "for these plain renders; independent: without the Sobol' sampler)")
+    ap.add_argument("--mitsuba-samplers", type=parse_samplers, default=["independent", "multijitter"],
+                    help="Mitsuba samplers to measure, comma-separated (default independent,multijitter; "
+                         f"any of {','.join(MITSUBA_SAMPLERS)})")
     ap.add_argument("--envmap-width", type=int, default=2048,
                     help="width of the equirectangular map Mitsuba gets for a cubemap (default %(default)s; "
                          "tools/to_mitsuba.py's own default, up to 8192, would make Mitsuba load a map of up "
@@ -534,7 +570,15 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
     started = time.time()
     load_start = os.getloadavg()
     lat = args.latency_size
-    results = {s.name: {"vkrt": {}, "mitsuba": {}} for s in scenes}
+    samplers = args.mitsuba_samplers
+    mitsubas = [f"mitsuba:{m}" for m in samplers]
+    results = {s.name: {who: {} for who in ["vkrt"] + mitsubas} for s in scenes}
+
+    def render_as(who):
+        if who == "vkrt":
+            return runner.vkrt_render
+        sampler = who.split(":", 1)[1]
+        return lambda *a, **k: runner.mitsuba_render(*a, **k, sampler=sampler)
 
     def add(scene, renderer, key, value):
         results[scene.name][renderer].setdefault(key, []).append(value)
@@ -543,8 +587,8 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
     log(f"warming up ({len(scenes)} scenes)")
     for s in scenes:
         for size in {s.size, lat}:
-            runner.vkrt_render(s, size, 1, 0, work / "warm.exr")
-            runner.mitsuba_render(s, size, 1, 0, work / "warm.exr")
+            for who in ["vkrt"] + mitsubas:
+                render_as(who)(s, size, 1, 0, work / "warm.exr")
         runner.vkrt_first_frame(s)
 
     # Cold start-up: once per scene, empty caches.
@@ -555,17 +599,18 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
             r = runner.vkrt_render(s, lat, 1, 0, work / "cold.exr", env)
             add(s, "vkrt", "cold_first", r["whole"])
             env = cold_env(runner.mitsuba_env, work / f"cold-mitsuba-{i}")
-            r = runner.mitsuba_render(s, lat, 1, 0, work / "cold.exr", env)
-            add(s, "mitsuba", "cold_first", r["whole"])
+            r = render_as(mitsubas[0])(s, lat, 1, 0, work / "cold.exr", env)
+            for who in mitsubas:  # the sampler does not change what a cold start compiles
+                add(s, who, "cold_first", r["whole"])
 
     for run_index in range(args.runs):
-        order = ["vkrt", "mitsuba"] if run_index % 2 == 0 else ["mitsuba", "vkrt"]
+        order = ["vkrt"] + mitsubas if run_index % 2 == 0 else mitsubas[::-1] + ["vkrt"]
         log(f"run {run_index + 1}/{args.runs} (order: {' then '.join(order)})")
         seed = 1000 + run_index
         for s in scenes:
             for who in order:
-                render = runner.vkrt_render if who == "vkrt" else runner.mitsuba_render
-                out = work / f"{who}-{run_index}.exr"
+                render = render_as(who)
+                out = work / f"{who.replace(':', '-')}-{run_index}.exr"
                 r = render(s, s.size, args.spp, seed, out)
                 add(s, who, "main_whole", r["whole"])
                 add(s, who, "main_cpu", r["cpu"])
@@ -576,14 +621,14 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
                     mse, rel = runner.mse(out, s.reference)
                     add(s, who, "mse", mse)
                     add(s, who, "relmse", rel)
-                r = render(s, s.size, low_spp, seed + 7919, work / f"{who}-low.exr")
+                r = render(s, s.size, low_spp, seed + 7919, work / "low.exr")
                 add(s, who, "low_render", r["render"])
                 add(s, who, "low_whole", r["whole"])
                 add(s, who, "low_cpu", r["cpu"])
-                r = render(s, lat, args.latency_spp, seed, work / f"{who}-lat.exr")
+                r = render(s, lat, args.latency_spp, seed, work / "lat.exr")
                 add(s, who, "latency", r["whole"])
                 add(s, who, "latency_cpu", r["cpu"])
-                r = render(s, lat, 1, seed, work / f"{who}-first.exr")
+                r = render(s, lat, 1, seed, work / "first.exr")
                 add(s, who, "first", r["whole"])
                 if who == "vkrt":
                     add(s, who, "info_first_frame", runner.vkrt_first_frame(s))
@@ -595,7 +640,7 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
     rows = []
     for s in scenes:
         row = {"scene": s.name, "size": s.size, "max_depth": s.max_depth, "reference": str(s.reference or "")}
-        for who in ("vkrt", "mitsuba"):
+        for who in ["vkrt"] + mitsubas:
             m = results[s.name][who]
             pixels = s.size[0] * s.size[1]
             rates = [pixels * (args.spp - low_spp) / (a - b) for a, b in zip(m["main_render"], m["low_render"])
@@ -607,6 +652,12 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
             med["efficiency"] = (1.0 / (med["mse"] * med["main_whole"])) if med.get("mse") else None
             med["cpu_efficiency"] = (1.0 / (med["mse"] * med["main_cpu"])) if med.get("mse") else None
             row[who] = med
+        # The best Mitsuba sampler for this scene: the highest efficiency (the
+        # first sampler where there is no reference to measure error against).
+        effs = {who: row[who]["efficiency"] for who in mitsubas if row[who]["efficiency"]}
+        best = max(effs, key=effs.get) if effs else mitsubas[0]
+        row["mitsuba_best"] = best.split(":", 1)[1]
+        row["mitsuba"] = row[best]
         rows.append(row)
     elapsed = time.time() - started
 
@@ -615,7 +666,7 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
     cpu = next((ln.split(":", 1)[1].strip() for ln in Path("/proc/cpuinfo").read_text().splitlines()
                 if ln.startswith("model name")), platform.processor())
     device = subprocess.run([args.vkrt, "devices"], capture_output=True, text=True).stdout.splitlines()
-    device = next((d.split(":", 1)[1].strip().split(" (CPU")[0] for d in device if d.startswith("*")), "?")
+    device = next((d.split(":", 1)[1].strip() for d in device if d.startswith("*")), "?")
     command = "tools/bench_vs_mitsuba.sh " + " ".join(sys.argv[1:])
     sampler = subprocess.run([args.vkrt, "render", "--help"], capture_output=True, text=True).stdout
     sampler = (("--sampler " + args.vkrt_sampler) if args.vkrt_sampler != "auto" else
@@ -624,8 +675,9 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
     lines = [
         f"- date: {date}; {os.cpu_count()} cores ({cpu}); 1-minute load average {load_start[0]:.1f} at the start, "
         f"{os.getloadavg()[0]:.1f} at the end; timed part {elapsed / 60:.1f} min",
-        f"- vkrt: `{args.vkrt}` on {device}; sampler: {sampler}",
-        f"- Mitsuba {mi.__version__} (Dr.Jit {drjit.__version__}), variant **{args.variant}**"
+        f"- vkrt: `{args.vkrt}` at commit {commit()} on {device}; sampler: {sampler}",
+        f"- Mitsuba {mi.__version__} (Dr.Jit {drjit.__version__}), variant **{args.variant}**, samplers "
+        f"{', '.join(samplers)}"
         + (f", DRJIT_LIBLLVM_PATH={args.libllvm}" if args.libllvm and args.variant.startswith("llvm") else ""),
         f"- command: `{command}`",
         f"- {args.runs} run{'s' if args.runs > 1 else ''}, medians; main render {args.spp} spp (rate from {args.spp} − {low_spp} spp); "
@@ -637,22 +689,31 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
                   "Mitsuba reference; efficiency = 1 / (MSE × whole-process wall s); ratio > 1: vkrt better. "
                   "CPU s: user + system time of the whole process, all threads; the CPU-based ratio is "
                   "less sensitive to other load on the machine)", "",
-              "| scene | MSE vkrt | MSE Mitsuba | whole s vkrt | whole s Mitsuba | **efficiency vkrt / Mitsuba** "
-              "| CPU s vkrt | CPU s Mitsuba | efficiency by CPU s |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "| scene | MSE vkrt | " + " | ".join(f"MSE {m}" for m in samplers)
+              + " | whole s vkrt | " + " | ".join(f"whole s {m}" for m in samplers)
+              + " | " + " | ".join(f"efficiency vs {m}" for m in samplers)
+              + " | best Mitsuba | **efficiency vkrt / best** | CPU s vkrt | CPU s best | efficiency by CPU s |",
+              "|" + " --- |" * (6 + 3 * len(samplers) + 2)]
     for r in rows:
         v, m = r["vkrt"], r["mitsuba"]
         eff = ratio(v["efficiency"], m["efficiency"])
         r["efficiency_ratio"] = eff
+        r["efficiency_ratio_by_sampler"] = {x: ratio(v["efficiency"], r[f"mitsuba:{x}"]["efficiency"])
+                                            for x in samplers}
         r["cpu_efficiency_ratio"] = ratio(v["cpu_efficiency"], m["cpu_efficiency"])
-        lines.append(f"| {r['scene']} | {fmt(v.get('mse'))} | {fmt(m.get('mse'))} "
-                     f"| {v['main_whole']:.2f} | {m['main_whole']:.2f} | **{fmt(eff)}** "
+        lines.append(f"| {r['scene']} | {fmt(v.get('mse'))} | "
+                     + " | ".join(fmt(r[f'mitsuba:{x}'].get('mse')) for x in samplers)
+                     + f" | {v['main_whole']:.2f} | "
+                     + " | ".join(f"{r[f'mitsuba:{x}']['main_whole']:.2f}" for x in samplers)
+                     + " | " + " | ".join(fmt(r["efficiency_ratio_by_sampler"][x]) for x in samplers)
+                     + f" | {r['mitsuba_best']} | **{fmt(eff)}** "
                      f"| {v['main_cpu']:.2f} | {m['main_cpu']:.2f} | {fmt(r['cpu_efficiency_ratio'])} |")
     g = geomean([r["efficiency_ratio"] for r in rows])
-    lines.append(f"| **geometric mean** | | | | | **{fmt(g)}** | | | "
-                 f"{fmt(geomean([r['cpu_efficiency_ratio'] for r in rows]))} |")
+    lines.append("| **geometric mean** | |" + " |" * len(samplers) + " |" + " |" * len(samplers)
+                 + "".join(f" {fmt(geomean([r['efficiency_ratio_by_sampler'][x] for r in rows]))} |" for x in samplers)
+                 + f" | **{fmt(g)}** | | | {fmt(geomean([r['cpu_efficiency_ratio'] for r in rows]))} |")
 
-    lines += ["", f"**Speed** (samples/s: steady state, start-up removed; per CPU s: the same from CPU time; latency: whole process, "
+    lines += ["", f"**Speed** (against each scene's best Mitsuba sampler above; samples/s: steady state, start-up removed; per CPU s: the same from CPU time; latency: whole process, "
                   f"{args.latency_spp} spp at {lat[0]}x{lat[1]}; first frame: whole process, 1 spp at "
                   f"{lat[0]}x{lat[1]}; ratios > 1: vkrt faster)", "",
               "| scene | samples/s vkrt | samples/s Mitsuba | **ratio** | per CPU s ratio "
@@ -672,8 +733,8 @@ def run(args, runner: Runner, scenes, notes, work: Path, low_spp: int) -> int:
                  f"| {fmt(geomean([r['cpu_rate_ratio'] for r in rows]))} | | | "
                  f"**{fmt(geomean([r['latency_speedup'] for r in rows]))}** | | | | |")
     info_ff = median([x for r in rows for x in results[r['scene']]['vkrt'].get('info_first_frame', [])])
-    m_imp = median([x for r in rows for x in results[r['scene']]['mitsuba'].get('import', [])])
-    m_load = median([x for r in rows for x in results[r['scene']]['mitsuba'].get('load', [])])
+    m_imp = median([x for r in rows for who in mitsubas for x in results[r['scene']][who].get('import', [])])
+    m_load = median([x for r in rows for who in mitsubas for x in results[r['scene']][who].get('load', [])])
     v_rep = {r["scene"]: r["vkrt"]["reported_rate"] for r in rows}
     lines += ["",
               f"- vkrt's own first-frame time (`vkrt info`, from set-up start, median over scenes and runs): "

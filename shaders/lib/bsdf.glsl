@@ -163,7 +163,10 @@ vec3 evalDielectric(Material m, vec3 n, vec3 wo, vec3 wi) { return vec3(0.0); } 
 float pdfDielectric(Material m, vec3 n, vec3 wo, vec3 wi, float cosI) { return 0.0; }
 
 // Reflects with probability F, else refracts (Snell's law); each branch
-// carries weight 1 because its probability equals its Fresnel factor.
+// carries weight 1 because its probability equals its Fresnel factor. The
+// path integrator scales radiance by eta^2 across the crossing itself
+// (refractThrough and radianceScale, lib/media.glsl), so that a path in and
+// out of glass carries exactly 1.
 // eta = n_incident / n_transmitted for this crossing (lib/media.glsl).
 BsdfSample sampleDielectric(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
@@ -245,8 +248,8 @@ VKRT_ABSENT_MATERIAL(Conductor)
 // --------------------------------------------------------- rough dielectric
 // Walter et al. 2007 with visible-normal sampling (Mitsuba's roughdielectric,
 // ggx): reflect with probability F(wo.m), else refract about m. Like the
-// smooth dielectric, refraction carries no radiance scaling by eta^2, so
-// roughness -> 0 tends to its image. Light sampling covers the reflection
+// smooth dielectric, refraction's radiance scaling by eta^2 is the
+// integrator's (lib/media.glsl), so roughness -> 0 tends to its image. Light sampling covers the reflection
 // side only: a refracted sample is marked `specular`, so that a light it
 // reaches counts in full (no light sample competes for that direction).
 // eval and pdf need the interface's eta = n_i / n_t, which only the

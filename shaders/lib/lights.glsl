@@ -30,6 +30,7 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, float tMax, MediumStack media)
         if (m.type != MATERIAL_DIELECTRIC)
             return vec3(0.0);
         transmittance *= beerLambert(mediumAbsorption(media), hit.t);
+        media = mediaAtSurface(media, hit);
         // A shadow ray is a straight line, so its angle with the surface is
         // the one light has on the less dense side of this interface (for a
         // slab, the refracted ray inside meets the far side at the matching

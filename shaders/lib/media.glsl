@@ -12,10 +12,18 @@
 struct MediumStack {
     uint count;
     uvec4 materials; // MEDIUM_STACK_DEPTH entries
+    // The products of n_incident (x) and n_transmitted (y) over the
+    // refractions that brought the ray here. Radiance scales by
+    // (n_incident / n_transmitted)^2 at a refraction (the beam's solid angle
+    // changes), so a path's samples carry (x / y)^2: see radianceScale.
+    vec2 refractedIndices;
 };
 
 // The stack the camera starts in (found by the host, innermost last).
-MediumStack cameraMedia() { return MediumStack(min(u.cameraMediumCount, MEDIUM_STACK_DEPTH), u.cameraMedia); }
+MediumStack cameraMedia()
+{
+    return MediumStack(min(u.cameraMediumCount, MEDIUM_STACK_DEPTH), u.cameraMedia, vec2(1.0));
+}
 
 #if defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_MATERIAL_ROUGH_DIELECTRIC)
 float mediumIor(MediumStack s) { return s.count == 0u ? 1.0 : materials[s.materials[s.count - 1u]].ior; }
@@ -53,38 +61,89 @@ MediumStack crossInterface(MediumStack s, uint material, bool entering)
     return s;
 }
 
-// n_incident / n_transmitted for crossing an interface of `material`.
-float interfaceEta(MediumStack s, uint material, bool entering)
-{
-    float inside = mediumIor(s);
-    float beyond = entering ? materials[material].ior : mediumIor(crossInterface(s, material, false));
-    return inside / beyond;
-}
 bool onStack(MediumStack s, uint material)
 {
     return (s.count > 0u && s.materials[0] == material) || (s.count > 1u && s.materials[1] == material) ||
            (s.count > 2u && s.materials[2] == material) || (s.count > 3u && s.materials[3] == material);
 }
 
-// n_incident / n_transmitted at a surface hit. A mesh need not be closed:
+// The stack as it stands at a surface, before its crossing. A ray that meets
+// the front of a mesh is outside that mesh, whatever the stack says: a mesh
+// need not be closed, and a ray that entered it and left through a hole (the
+// Stanford bunny's base) crossed no surface on the way out. Its stale entry
+// goes here, so the front is crossed from the medium around the mesh, as
+// Mitsuba does by the side alone; otherwise the ray would find glass on both
+// sides and pass the front unbent and unreflected.
+MediumStack mediaAtSurface(MediumStack s, SurfaceHit hit)
+{
+#ifdef VKRT_HAS_MESHES
+    if (hit.shape == SHAPE_MESH && hit.front && onStack(s, hit.material))
+        return crossInterface(s, hit.material, false);
+#endif
+    return s;
+}
+
+// (n_incident, n_transmitted) at a surface hit. A mesh need not be closed:
 // a ray can meet the back of a glass mesh without having entered it
 // (through a hole, as in the Stanford bunny). Like Mitsuba, which decides
 // at each interface by its side alone, such a surface is crossed as if the
 // ray had been inside: from the material's index into the current medium.
-float surfaceEta(MediumStack s, SurfaceHit hit)
+vec2 surfaceIndices(MediumStack s, SurfaceHit hit)
 {
 #ifdef VKRT_HAS_MESHES
     if (hit.shape == SHAPE_MESH && !hit.front && !onStack(s, hit.material))
-        return materials[hit.material].ior / mediumIor(s);
+        return vec2(materials[hit.material].ior, mediumIor(s));
 #endif
-    return interfaceEta(s, hit.material, hit.front);
+    float inside = mediumIor(s);
+    float beyond = hit.front ? materials[hit.material].ior : mediumIor(crossInterface(s, hit.material, false));
+    return vec2(inside, beyond);
+}
+
+// n_incident / n_transmitted at a surface hit.
+float surfaceEta(MediumStack s, SurfaceHit hit)
+{
+    vec2 n = surfaceIndices(s, hit);
+    return n.x / n.y;
+}
+
+// The stack beyond a surface the ray refracts through. The index products
+// are rescaled by a power of two each time (exact), so they never overflow,
+// and a path that returns to the medium it started in through interfaces
+// whose sides agree (glass entered, then left) has x == y exactly: its
+// samples are unscaled to the last bit. Where the sides disagree (an open
+// mesh entered by its front and left through a hole), the factor is what
+// Mitsuba's dielectric applies crossing by crossing.
+MediumStack refractThrough(MediumStack s, SurfaceHit hit)
+{
+    vec2 crossed = s.refractedIndices * surfaceIndices(s, hit);
+    int exponent;
+    frexp(crossed.y, exponent);
+    s = crossInterface(s, hit.material, hit.front);
+    s.refractedIndices = ldexp(crossed, ivec2(-exponent));
+    return s;
+}
+
+// The factor a sample's radiance carries for the refractions behind it:
+// (n_incident / n_transmitted)^2 over them, 1 for a path that is back in the
+// medium it started in (the usual case: camera and lights in air).
+float radianceScale(MediumStack s)
+{
+    float ratio = s.refractedIndices.x / s.refractedIndices.y;
+    return ratio * ratio;
 }
 #else
 // Without dielectrics a ray is always in air.
 vec3 mediumAbsorption(MediumStack s) { return vec3(0.0); }
 MediumStack crossInterface(MediumStack s, uint material, bool entering) { return s; }
-float interfaceEta(MediumStack s, uint material, bool entering) { return 1.0; }
+MediumStack mediaAtSurface(MediumStack s, SurfaceHit hit) { return s; }
 float surfaceEta(MediumStack s, SurfaceHit hit) { return 1.0; }
+MediumStack refractThrough(MediumStack s, SurfaceHit hit) { return s; }
+float radianceScale(MediumStack s) { return 1.0; }
 #endif
+
+// What a sample adds for radiance L arriving at the end of a path with this
+// throughput: sampleWeight * L, bit for bit throughput * L when the scale
+// is 1.
+vec3 sampleWeight(vec3 throughput, MediumStack media) { return throughput * radianceScale(media); }
 
 #endif

@@ -82,13 +82,14 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     p.path.throughput *= beerLambert(mediumAbsorption(p.path.media), missed ? FLT_MAX : hit.t);
     if (missed) {
         aovEnd();
-        p.path.radiance += p.path.throughput * (environmentOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf) +
-                                                directionalOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf));
+        p.path.radiance += sampleWeight(p.path.throughput, p.path.media) *
+                           (environmentOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf) +
+                            directionalOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf));
         return false;
     }
 #ifdef VKRT_HAS_EMITTERS
     if (hit.emitter != NO_EMITTER)
-        p.path.radiance += p.path.throughput * emitterOnHit(p.path, p.ray, hit);
+        p.path.radiance += sampleWeight(p.path.throughput, p.path.media) * emitterOnHit(p.path, p.ray, hit);
 #endif
     aovSurfaceHit(hit);
     if (hitsLight(hit)) {
@@ -98,6 +99,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     if (p.depth == u.maxDepth + 1u)
         return false; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
+    p.path.media = mediaAtSurface(p.path.media, hit);
     Material m = materials[hit.material];
 #ifdef VKRT_HAS_TEXTURES
     p.pathLength += hit.t;
@@ -111,7 +113,8 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
 #endif
     aovScatter(m, ns);
     if (!scattersIntoDeltasOnly(m)) {
-        p.path.radiance += p.path.throughput * directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng);
+        p.path.radiance += sampleWeight(p.path.throughput, p.path.media) *
+                           directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng);
     }
     vec4 u4 = sampleNext4D(rng);
     float eta = surfaceEta(p.path.media, hit);
@@ -122,7 +125,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     p.path.specular = s.specular;
     p.path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
     if (s.transmitted)
-        p.path.media = crossInterface(p.path.media, hit.material, hit.front);
+        p.path.media = refractThrough(p.path.media, hit);
     if (!survivesRoulette(p.path, p.depth, u4.w))
         return false;
     p.ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);

@@ -7,7 +7,9 @@
 // refraction), up to max_depth. A light is seen only along purely specular
 // chains from the camera (in mirrors and through glass); after any diffuse or
 // glossy bounce light arrives only through shadow rays, as in the seed, so
-// there are no caustics. Documented in docs/whitted.md.
+// there are no caustics. Also as in the seed, refraction carries no
+// radiance scaling by eta^2 (the path integrator's does: lib/media.glsl).
+// Documented in docs/whitted.md.
 #ifndef VKRT_WHITTED_GLSL
 #define VKRT_WHITTED_GLSL
 
@@ -68,6 +70,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
             break;
         }
 #ifdef VKRT_HAS_MATERIALS
+        path.media = mediaAtSurface(path.media, hit);
         Material m = materials[hit.material];
 #ifdef VKRT_HAS_TEXTURES
         pathLength += hit.t;

@@ -8,6 +8,8 @@
 #include "support/TestSupport.h"
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 
 namespace vkrt::test {
 namespace {
@@ -251,6 +253,77 @@ two_sided = true
             }
         EXPECT_GE(fractionPassingZTest(e, expected), 0.9975) << integrator;
         EXPECT_LT(std::abs(pooledZ(e, expected)), 4.0) << integrator;
+    }
+}
+
+// Glass that is not closed, seen at normal incidence against a light behind
+// it (R = ((n - 1) / (n + 1))^2, T = 1 - R, n = 1.5). The path integrator
+// decides each crossing by the side it meets (a mesh's front is always
+// entered from outside, as in Mitsuba) and scales radiance by
+// (n_incident / n_transmitted)^2 at each refraction:
+// - one open sheet: entered, never left, T / n^2;
+// - two parallel sheets of one mesh facing the camera: the ray enters the
+//   first, leaves through the open side between them without a crossing and
+//   enters the second from outside: T^2 / (n^4 (1 - R^2)) with the
+//   reflections between them. A stale medium-stack entry would see glass on
+//   both sides of the second sheet (no reflection, no bending: T) and no
+//   scaling would give T^2 / (1 - R^2): both far outside the noise.
+TEST_F(PathTest, OpenGlassIsCrossedByItsSidesAndScalesRadiance)
+{
+    const std::filesystem::path dir = freshTempDir("open-glass");
+    const double n = 1.5, r = (n - 1) * (n - 1) / ((n + 1) * (n + 1)), t = 1 - r;
+    auto writeSheets = [&](const std::string& name, std::initializer_list<const char*> depths) {
+        std::string obj;
+        int base = 1;
+        for (const char* z : depths) {
+            for (const char* corner : {"-50 -50", "50 -50", "50 50", "-50 50"})
+                obj += std::string("v ") + corner + " " + z + "\n";
+            // Counter-clockwise seen from +z: the front faces the camera.
+            obj += "f " + std::to_string(base) + " " + std::to_string(base + 1) + " " + std::to_string(base + 2) + "\n";
+            obj += "f " + std::to_string(base) + " " + std::to_string(base + 2) + " " + std::to_string(base + 3) + "\n";
+            base += 4;
+        }
+        std::ofstream(dir / name) << obj;
+    };
+    writeSheets("one.obj", {"0"});
+    writeSheets("two.obj", {"0", "-1"});
+    struct Case {
+        const char* file;
+        double expected;
+    };
+    for (Case c : {Case{"one.obj", t / (n * n)}, Case{"two.obj", t * t / (n * n * n * n * (1 - r * r))}}) {
+        std::string text = R"([render]
+integrator = "path"
+max_depth = 12
+[camera]
+eye = [0, 0, 5]
+target = [0, 0, 0]
+fov = 1
+width = 4
+height = 3
+[materials.glass]
+type = "dielectric"
+ior = 1.5
+[[objects]]
+shape = "mesh"
+material = "glass"
+file = ")";
+        text += c.file;
+        text += R"("
+[[lights]]
+type = "triangle"
+vertices = [[-100, -100, -2], [100, -100, -2], [0, 100, -2]]
+radiance = 1
+)";
+        Scene scene = parseSceneString(text, (dir / "scene.toml").string());
+        Estimate e = estimate(scene, 2048);
+        std::vector<double> expected(e.mean.rgb.size(), c.expected);
+        double mean = 0;
+        for (float v : e.mean.rgb) mean += v / double(e.mean.rgb.size());
+        std::printf("[ measured ] open glass %s: mean %.5f, expected %.5f, pooled z %+.2f\n", c.file, mean,
+                    c.expected, pooledZ(e, expected));
+        EXPECT_LT(std::abs(pooledZ(e, expected)), 4.0) << c.file;
+        EXPECT_NEAR(mean, c.expected, 0.02 * c.expected) << c.file;
     }
 }
 
