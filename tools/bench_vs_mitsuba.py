@@ -382,7 +382,8 @@ class Runner:
         cmd = [self.python, "-c", MITSUBA_CHILD, self.variant, str(scene.xml[(size, sampler)]), str(out), str(spp),
                str(seed), str(self.args.pass_spp)]
         whole, text = self._run(cmd, env or self.mitsuba_env, "Mitsuba render")
-        lines = [ln for ln in text.splitlines() if ln.startswith("{")]
+        # The timing line may follow a warning's colour reset code on the same line.
+        lines = [ln[ln.index('{"import"'):] for ln in text.splitlines() if '{"import"' in ln]
         if not lines:
             fail(f"no timing line from the Mitsuba process:\n{text}", 1)
         t = json.loads(lines[-1])

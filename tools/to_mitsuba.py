@@ -1070,7 +1070,8 @@ _PLUGIN_TAGS = {
     "bitmap": "texture", "sphere": "shape", "cube": "shape", "rectangle": "shape", "ply": "shape", "obj": "shape",
     "area": "emitter", "point": "emitter", "constant": "emitter", "envmap": "emitter", "directional": "emitter",
     "spot": "emitter", "homogeneous": "medium", "perspective": "sensor", "thinlens": "sensor", "hdrfilm": "film",
-    "independent": "sampler", "box": "rfilter", "path": "integrator", "volpath": "integrator",
+    "independent": "sampler", "multijitter": "sampler", "stratified": "sampler", "ldsampler": "sampler",
+    "orthogonal": "sampler", "box": "rfilter", "path": "integrator", "volpath": "integrator",
 }
 
 
