@@ -2,6 +2,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
+#extension GL_EXT_control_flow_attributes : require
 #ifdef VKRT_ACCEL_DRIVER
 #extension GL_EXT_ray_query : require
 #endif

@@ -5,6 +5,7 @@
 #include "render/Environment.h"
 #include "render/EnvironmentSampling.h"
 #include "shared/Bindings.h"
+#include "shared/TextureTypes.h"
 #include "util/Error.h"
 
 #include <algorithm>
@@ -202,7 +203,9 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
     uint64_t lights = sampledLightCount(scene);
     // A ray that escapes looks for every sun (lib/lights/directional.glsl).
     uint64_t escape = scene.directionalLights.size();
-    uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery) + escape;
+    // A textured hit reads its material's slots in a loop (lib/material_textures.glsl).
+    uint64_t textureSlots = featuresOf(scene).textures ? gpu::TEXTURE_SLOT_COUNT : 0;
+    uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery) + escape + textureSlots;
     uint64_t depth = uint64_t(scene.render.maxDepth);
     // Sampling the map (featuresOf: a lat-long map in both integrators, a
     // cubemap in the path integrator): binary searches over at most 2^32
