@@ -809,8 +809,8 @@ TEST_F(ExtremeNestedGlass, CameraInsideGlassSphere)
         double sum = 0;
         size_t dark = 0;
         for (float v : off.mean.rgb) sum += v, dark += v < 0.5f;
-        measured("camera inside glass (%s): centre: %zu/%zu values exactly n^2 (path) or 1 (whitted); off-centre (0.7 r): mean %.4f, %zu "
-                 "values below 0.5 (whispering-gallery paths cut by max_depth)",
+        measured("camera inside glass (%s): centre: %zu/%zu values exactly n^2 (path) or 1 (whitted); "
+                 "off-centre (0.7 r): mean %.4f, %zu values below 0.5 (whispering-gallery paths cut by max_depth)",
                  name, ones, centre.mean.rgb.size(), sum / off.mean.rgb.size(), dark);
     }
 }

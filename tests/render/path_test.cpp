@@ -320,8 +320,8 @@ radiance = 1
         std::vector<double> expected(e.mean.rgb.size(), c.expected);
         double mean = 0;
         for (float v : e.mean.rgb) mean += v / double(e.mean.rgb.size());
-        std::printf("[ measured ] open glass %s: mean %.5f, expected %.5f, pooled z %+.2f\n", c.file, mean,
-                    c.expected, pooledZ(e, expected));
+        std::printf("[ measured ] open glass %s: mean %.5f, expected %.5f, pooled z %+.2f\n", c.file, mean, c.expected,
+                    pooledZ(e, expected));
         EXPECT_LT(std::abs(pooledZ(e, expected)), 4.0) << c.file;
         EXPECT_NEAR(mean, c.expected, 0.02 * c.expected) << c.file;
     }
