@@ -249,9 +249,10 @@ VKRT_ABSENT_MATERIAL(Conductor)
 // Walter et al. 2007 with visible-normal sampling (Mitsuba's roughdielectric,
 // ggx): reflect with probability F(wo.m), else refract about m. Like the
 // smooth dielectric, refraction's radiance scaling by eta^2 is the
-// integrator's (lib/media.glsl), so roughness -> 0 tends to its image. Light sampling covers the reflection
-// side only: a refracted sample is marked `specular`, so that a light it
-// reaches counts in full (no light sample competes for that direction).
+// integrator's (lib/media.glsl), so roughness -> 0 tends to its image. Light
+// sampling covers the reflection side only: a refracted sample is marked
+// `specular`, so that a light it reaches counts in full (no light sample
+// competes for that direction).
 // eval and pdf need the interface's eta = n_i / n_t, which only the
 // integrator knows: it stores it in m.exponent (withInterfaceEta).
 
