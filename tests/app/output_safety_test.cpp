@@ -10,6 +10,7 @@
 #include <chrono>
 #include <csignal>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <thread>
 
@@ -487,6 +488,19 @@ TEST_F(OutputSafety, TheSecondCtrlCExitsAtOnceWithoutTemporaries)
     EXPECT_FALSE(fs::exists(temporary));
 }
 
+/// Waits (up to 2 s) until /proc says the process is stopped ('T').
+void waitUntilStopped(pid_t pid)
+{
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    while (std::chrono::steady_clock::now() < end) {
+        std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+        std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+        const size_t close = text.rfind(')'); // the state follows the command name in parentheses
+        if (close == std::string::npos || close + 2 >= text.size() || text[close + 2] == 'T') return;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+}
+
 TEST_F(OutputSafety, SigtermWhileWritingALargeRenderLeavesNoTemporary)
 {
     // The temporary of an 8 M-pixel EXR exists only while its ~100 MB are written
@@ -520,6 +534,10 @@ TEST_F(OutputSafety, SigtermWhileWritingALargeRenderLeavesNoTemporary)
             }
             if (!created) continue;
             kill(run.pid, SIGSTOP);
+            // SIGSTOP is asynchronous: look for the temporary only once the
+            // process is stopped, or the rename can still follow the look
+            // (seen once in the Debian 13 check).
+            waitUntilStopped(run.pid);
             caught = !temporariesIn(m_dir).empty(); // false: the rename came first
             if (!caught) kill(run.pid, SIGCONT);
         }
