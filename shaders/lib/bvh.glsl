@@ -5,8 +5,6 @@
 #ifndef VKRT_BVH_GLSL
 #define VKRT_BVH_GLSL
 
-const float BVH_FAR = 1.0 / 0.0; // the sort key of a child not entered
-
 struct BvhRay {
     vec3 origin;
     vec3 invDir;
@@ -65,63 +63,6 @@ bool entersBox(vec3 lower, vec3 upper, BvhRay r, float tMax, out float tEntry)
             node = ha ? first : first + 1u;                        \
             descend = true;                                        \
         }                                                          \
-    }
-
-// A 4-wide node (each mesh's tree: src/accel/Bvh.h, widenBvh): its four
-// children nodes[base + first ...] are tested, the entered ones sorted near
-// to far by five compare-exchanges (ties keep the tree's order), the
-// nearest visited next and the others stacked, far first. Unused children
-// hold the point at +infinity, whose entry is never finite.
-#define VKRT_BVH_COMPARE_EXCHANGE(key, id, i, j)  \
-    if (key[j] < key[i]) {                        \
-        float kt = key[i];                        \
-        key[i] = key[j];                          \
-        key[j] = kt;                              \
-        uint it = id[i];                          \
-        id[i] = id[j];                            \
-        id[j] = it;                               \
-    }
-
-#define VKRT_BVH_ENTER_CHILD(nodes, base, first, c, br, limit, key)                           \
-    {                                                                                      \
-        BvhNode child = nodes[base + first + c];                                           \
-        float tc;                                                                          \
-        bool entered = entersBox(child.lower, child.upper, br, limit, tc) && !isinf(tc);   \
-        key[c] = entered ? tc : BVH_FAR;                                                   \
-    }
-
-#define VKRT_BVH_DESCEND_WIDE(nodes, base, first, br, limit, descend)      \
-    {                                                                     \
-        vec4 key;                                                         \
-        uvec4 id = uvec4(first) + uvec4(0u, 1u, 2u, 3u);                  \
-        VKRT_BVH_ENTER_CHILD(nodes, base, first, 0, br, limit, key)       \
-        VKRT_BVH_ENTER_CHILD(nodes, base, first, 1, br, limit, key)       \
-        VKRT_BVH_ENTER_CHILD(nodes, base, first, 2, br, limit, key)       \
-        VKRT_BVH_ENTER_CHILD(nodes, base, first, 3, br, limit, key)       \
-        VKRT_BVH_COMPARE_EXCHANGE(key, id, 0, 1)                          \
-        VKRT_BVH_COMPARE_EXCHANGE(key, id, 2, 3)                          \
-        VKRT_BVH_COMPARE_EXCHANGE(key, id, 0, 2)                          \
-        VKRT_BVH_COMPARE_EXCHANGE(key, id, 1, 3)                          \
-        VKRT_BVH_COMPARE_EXCHANGE(key, id, 1, 2)                          \
-        if (key[0] < BVH_FAR) {                                           \
-            if (key[3] < BVH_FAR) {                                       \
-                stackNode[depth] = id[3];                                 \
-                stackEntry[depth] = key[3];                               \
-                ++depth;                                                  \
-            }                                                             \
-            if (key[2] < BVH_FAR) {                                       \
-                stackNode[depth] = id[2];                                 \
-                stackEntry[depth] = key[2];                               \
-                ++depth;                                                  \
-            }                                                             \
-            if (key[1] < BVH_FAR) {                                       \
-                stackNode[depth] = id[1];                                 \
-                stackEntry[depth] = key[1];                               \
-                ++depth;                                                  \
-            }                                                             \
-            node = id[0];                                                 \
-            descend = true;                                               \
-        }                                                                 \
     }
 
 #define VKRT_BVH_POP_UNLESS(descend, limit)             \

@@ -464,76 +464,8 @@ Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options)
     bvh.order.resize(n);
     for (uint32_t i = 0; i < n; ++i) bvh.order[i] = in.refs[i].index;
     bvh.depth = top.depth;
-    bvh.stackNeed = top.depth - 1;
     bvh.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
-}
-
-namespace {
-
-double boxArea(const gpu::BvhNode& n)
-{
-    const glm::dvec3 e = glm::max(glm::dvec3(n.upper) - glm::dvec3(n.lower), glm::dvec3(0.0));
-    const double area = e.x * e.y + e.y * e.z + e.z * e.x;
-    return std::isfinite(area) ? area : 0.0;
-}
-
-/// The binary children that wide node `node` of `binary` gathers: its own
-/// two, then the inner one with the largest area opened, until `width`.
-std::vector<uint32_t> gatherChildren(const Bvh& binary, uint32_t node, uint32_t width)
-{
-    const gpu::BvhNode& n = binary.nodes[node];
-    std::vector<uint32_t> children{n.first, n.first + 1};
-    while (children.size() < width) {
-        int open = -1;
-        for (size_t k = 0; k < children.size(); ++k) {
-            const gpu::BvhNode& c = binary.nodes[children[k]];
-            if (c.count > 0) continue;
-            if (open < 0 || boxArea(c) > boxArea(binary.nodes[children[size_t(open)]])) open = int(k);
-        }
-        if (open < 0) break;
-        const uint32_t first = binary.nodes[children[size_t(open)]].first;
-        children[size_t(open)] = first; // in place, keeping the children in the binary tree's order
-        children.insert(children.begin() + open + 1, first + 1);
-    }
-    return children;
-}
-
-} // namespace
-
-Bvh widenBvh(const Bvh& binary, uint32_t width)
-{
-    VKRT_CHECK(width >= 2 && binary.width == 2 && !binary.nodes.empty());
-    Bvh wide;
-    wide.width = width;
-    wide.order = binary.order;
-    wide.buildSeconds = binary.buildSeconds;
-    wide.nodes.push_back(binary.nodes[0]);
-    // (wide index, binary index, depth in nodes, stack entries above it), breadth-first.
-    struct Pending {
-        uint32_t wide, binary, depth, stack;
-    };
-    std::vector<Pending> queue{{0, 0, 1, 0}};
-    for (size_t next = 0; next < queue.size(); ++next) {
-        const Pending p = queue[next];
-        wide.depth = std::max(wide.depth, p.depth);
-        wide.stackNeed = std::max(wide.stackNeed, p.stack);
-        if (binary.nodes[p.binary].count > 0) continue;
-        const std::vector<uint32_t> children = gatherChildren(binary, p.binary, width);
-        const uint32_t first = uint32_t(wide.nodes.size());
-        wide.nodes[p.wide].first = first;
-        for (uint32_t k = 0; k < width; ++k) {
-            gpu::BvhNode child{};
-            if (k < children.size()) {
-                child = binary.nodes[children[k]];
-                queue.push_back({first + k, children[k], p.depth + 1, p.stack + uint32_t(children.size()) - 1});
-            } else {
-                roundOutwards(Aabb{}, child.lower, child.upper); // never entered
-            }
-            wide.nodes.push_back(child);
-        }
-    }
-    return wide;
 }
 
 } // namespace vkrt

@@ -42,13 +42,6 @@ struct Bvh {
     std::vector<gpu::BvhNode> nodes;
     std::vector<uint32_t> order; ///< leaf order -> primitive index (a permutation)
     uint32_t depth = 0;          ///< longest root-to-leaf path, in nodes
-    /// Children per inner node: `first` ... `first + width - 1` (2 as built;
-    /// widenBvh makes 4). Unused children are never-entered boxes.
-    uint32_t width = 2;
-    /// The most far children a traversal can hold on its stack at once: the
-    /// largest sum, over a root-to-leaf path, of the children beyond the
-    /// first that each inner node on it has.
-    uint32_t stackNeed = 0;
     double buildSeconds = 0.0;
 };
 
@@ -58,14 +51,6 @@ struct Bvh {
 /// split at the middle of their range. Zero primitives give a single node
 /// (count 0) whose box no ray enters.
 Bvh buildBvh(std::span<const Aabb> boxes, const BvhOptions& options = {});
-
-/// The same tree with `width` children per inner node (Ylitie, Karras &
-/// Laine 2017, section 3.1, without the quantization): each wide node
-/// takes a binary node's children and opens the child with the largest
-/// surface area until it has `width`. Leaves, the primitive order and
-/// every box stay as they are; nodes are renumbered breadth-first. Fewer
-/// levels mean fewer passes of the GPU's traversal loop.
-Bvh widenBvh(const Bvh& binary, uint32_t width);
 
 /// The boxes of float32 triangles (vertex positions, index triples).
 std::vector<Aabb> triangleBoxes(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles);

@@ -1,10 +1,6 @@
 #include "accel/BvhTraversal.h"
 
-#include "util/Error.h"
-
 #include <algorithm>
-#include <array>
-#include <limits>
 #include <vector>
 
 namespace vkrt {
@@ -110,59 +106,21 @@ bool testLeaf(const gpu::BvhNode& n, const Bvh& bvh, const TriangleSet& mesh, co
     return false;
 }
 
-/// VKRT_BVH_DESCEND_WIDE of bvh.glsl: the entered children of a 4-wide
-/// node sorted near to far by the same five compare-exchanges (ties keep
-/// the tree's order), the nearest visited next, the others stacked.
-bool descendWide(const Bvh& bvh, const gpu::BvhNode& n, const TraversalRay& r, const Query& q, uint32_t& node,
-                 std::vector<std::pair<uint32_t, float>>& stack)
-{
-    const float far = std::numeric_limits<float>::infinity();
-    std::array<float, 4> key{};
-    std::array<uint32_t, 4> id{};
-    uint32_t entered = 0;
-    for (uint32_t c = 0; c < 4; ++c) {
-        const gpu::BvhNode& child = bvh.nodes[n.first + c];
-        float t = 0.0f;
-        const bool in = entersBox(child.lower, child.upper, r, q.limit(), t) && t < far;
-        key[c] = in ? t : far;
-        id[c] = n.first + c;
-        entered += in ? 1 : 0;
-    }
-    const auto exchange = [&](int i, int j) {
-        if (key[j] < key[i]) {
-            std::swap(key[i], key[j]);
-            std::swap(id[i], id[j]);
-        }
-    };
-    exchange(0, 1);
-    exchange(2, 3);
-    exchange(0, 2);
-    exchange(1, 3);
-    exchange(1, 2);
-    if (entered == 0) return false;
-    for (uint32_t c = entered; c-- > 1;) stack.emplace_back(id[c], key[c]);
-    node = id[0];
-    return true;
-}
-
 /// traverseMesh of scene.glsl: a stack of far children with their entry
 /// distances, near child first, nodes beyond the closest hit skipped.
 void traverse(const Bvh& bvh, const TriangleSet& mesh, const TraversalRay& r, Query& q)
 {
     std::vector<std::pair<uint32_t, float>> stack;
-    stack.reserve(bvh.stackNeed + 1);
+    stack.reserve(bvh.depth + 1);
     uint32_t node = 0;
     float tEntry = 0.0f;
     bool visiting = entersBox(bvh.nodes[0].lower, bvh.nodes[0].upper, r, q.limit(), tEntry);
     while (visiting) {
-        // A walk enters each node at most once; more means a child that should never be entered was.
-        VKRT_CHECK(++q.stats.nodesVisited <= bvh.nodes.size());
+        ++q.stats.nodesVisited;
         const gpu::BvhNode& n = bvh.nodes[node];
         bool descend = false;
         if (n.count > 0) {
             if (testLeaf(n, bvh, mesh, r, q)) return;
-        } else if (bvh.width == 4) {
-            descend = descendWide(bvh, n, r, q, node, stack);
         } else {
             const gpu::BvhNode& a = bvh.nodes[n.first];
             const gpu::BvhNode& b = bvh.nodes[n.first + 1];

@@ -59,10 +59,10 @@ std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode n
     // After the normal mode: generated tangents are perpendicular to the normals the mesh keeps.
     if (!data.uvs.empty() && data.tangents.empty()) computeTangents(data);
     const std::vector<Aabb> boxes = triangleBoxes(data.positions, data.triangles);
-    geometry->bvh = widenBvh(buildBvh(boxes), 4);
-    if (geometry->bvh.stackNeed > gpu::BVH_STACK_SIZE)
-        throw InputError(geometry->file.string() + ": the mesh's BVH needs " + std::to_string(geometry->bvh.stackNeed) +
-                         " traversal stack entries, more than the " + std::to_string(gpu::BVH_STACK_SIZE) +
+    geometry->bvh = buildBvh(boxes);
+    if (geometry->bvh.depth > gpu::BVH_STACK_SIZE)
+        throw InputError(geometry->file.string() + ": the mesh's BVH is " + std::to_string(geometry->bvh.depth) +
+                         " levels deep, more than the " + std::to_string(gpu::BVH_STACK_SIZE) +
                          " the kernel's traversal stack holds");
     reorderTriangles(data, geometry->bvh.order);
     geometry->bounds = boundsOf(data);

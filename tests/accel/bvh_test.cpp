@@ -37,41 +37,23 @@ bool containsExactly(const gpu::BvhNode& outer, const Aabb& box)
     for (size_t i = 0; i < n; ++i)
         if (sorted.size() != n || sorted[i] != i) return ::testing::AssertionFailure() << "order is no permutation";
     std::vector<int> slotSeen(n, 0), nodeSeen(bvh.nodes.size(), 0);
-    struct Visit {
-        uint32_t node, depth, stack;
-    };
-    std::vector<Visit> stack{{0, 1, 0}};
-    uint32_t depth = 0, stackNeed = 0;
-    const float infinity = std::numeric_limits<float>::infinity();
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{0, 1}}; // node, depth
+    uint32_t depth = 0;
     while (!stack.empty()) {
-        const auto [index, level, held] = stack.back();
+        const auto [index, level] = stack.back();
         stack.pop_back();
         if (index >= bvh.nodes.size() || nodeSeen[index]++)
             return ::testing::AssertionFailure() << "node " << index << " out of range or reached twice";
         const gpu::BvhNode& node = bvh.nodes[index];
-        stackNeed = std::max(stackNeed, held);
         if (node.count == 0) {
-            if (node.first <= index || node.first + bvh.width > bvh.nodes.size())
+            if (node.first <= index || node.first + 1 >= bvh.nodes.size())
                 return ::testing::AssertionFailure() << "node " << index << " has children " << node.first;
-            // An unused child of a wide node: the never-entered box, no children, only after used ones.
-            const auto unused = [&](uint32_t c) {
-                return bvh.width > 2 && bvh.nodes[c].count == 0 && bvh.nodes[c].lower == glm::vec3(infinity) &&
-                       bvh.nodes[c].upper == glm::vec3(infinity);
-            };
-            uint32_t used = 0;
-            for (uint32_t c = node.first; c < node.first + bvh.width; ++c) {
-                if (unused(c)) {
-                    ++nodeSeen[c];
-                    continue;
-                }
-                if (used++ != c - node.first)
-                    return ::testing::AssertionFailure() << "node " << index << " has a used child after an unused one";
+            for (uint32_t c = node.first; c <= node.first + 1; ++c) {
                 if (!contains(node, bvh.nodes[c].lower, bvh.nodes[c].upper) && boxes.size() > 0 &&
-                    bvh.nodes[c].lower.x != infinity)
+                    bvh.nodes[c].lower.x != std::numeric_limits<float>::infinity())
                     return ::testing::AssertionFailure() << "node " << index << " does not contain child " << c;
+                stack.push_back({c, level + 1});
             }
-            if (used < 2) return ::testing::AssertionFailure() << "node " << index << " has " << used << " children";
-            for (uint32_t c = node.first; c < node.first + used; ++c) stack.push_back({c, level + 1, held + used - 1});
             continue;
         }
         depth = std::max(depth, level);
@@ -92,8 +74,6 @@ bool containsExactly(const gpu::BvhNode& outer, const Aabb& box)
         if (!nodeSeen[i]) return ::testing::AssertionFailure() << "node " << i << " unreachable";
     if (n > 0 && depth != bvh.depth)
         return ::testing::AssertionFailure() << "depth " << bvh.depth << ", longest path " << depth;
-    if (n > 0 && stackNeed != bvh.stackNeed)
-        return ::testing::AssertionFailure() << "stack need " << bvh.stackNeed << ", walked " << stackNeed;
     return ::testing::AssertionSuccess();
 }
 
@@ -253,43 +233,6 @@ TEST(BvhBuild, TriangleBoxesAndSurfaceArea)
     EXPECT_EQ(Aabb{}.surfaceArea(), 0.0);
 }
 
-TEST(BvhWiden, KeepsLeavesOrderAndBoxesInFewerLevels)
-{
-    for (uint32_t n : {1u, 2u, 3u, 5u, 16u, 100u, 5000u}) {
-        const std::vector<Aabb> boxes = boxesOf(makeRandomSoup(n, n + 7));
-        const Bvh binary = buildBvh(boxes);
-        const Bvh wide = widenBvh(binary, 4);
-        ASSERT_EQ(wide.width, 4u);
-        EXPECT_TRUE(wellFormed(wide, boxes, 4)) << n << " triangles";
-        EXPECT_EQ(wide.order, binary.order);
-        // The same leaves, each once: only inner nodes are regrouped.
-        const auto leaves = [](const Bvh& bvh) {
-            std::vector<std::pair<uint32_t, uint32_t>> out;
-            for (const gpu::BvhNode& node : bvh.nodes)
-                if (node.count > 0) out.emplace_back(node.first, node.count);
-            std::sort(out.begin(), out.end());
-            return out;
-        };
-        EXPECT_EQ(leaves(wide), leaves(binary)) << n << " triangles";
-        EXPECT_LE(wide.depth, binary.depth);
-        if (n >= 100) {
-            EXPECT_LE(wide.depth, binary.depth / 2 + 2) << n << " triangles";
-        }
-    }
-}
-
-TEST(BvhWiden, LopsidedTreesNeedAKnownStack)
-{
-    std::vector<Aabb> boxes;
-    for (int i = 0; i < 200; ++i) {
-        const double x = std::ldexp(1.0, i);
-        boxes.push_back(Aabb{{x, 0.0, 0.0}, {x * 1.5, 1.0, 1.0}});
-    }
-    const Bvh wide = widenBvh(buildBvh(boxes, BvhOptions{.maxDepth = 40}), 4);
-    EXPECT_TRUE(wellFormed(wide, boxes, 4)); // which walks the stack need too
-    EXPECT_GE(wide.stackNeed, 30u);
-}
-
 // ---------------------------------------------------------------- traversal
 
 glm::vec3 randomDirection(std::mt19937& random)
@@ -301,49 +244,39 @@ glm::vec3 randomDirection(std::mt19937& random)
     }
 }
 
-/// The trees the renderer walks: binary (the top level) and 4-wide (meshes).
-std::vector<Bvh> bothWidths(const std::vector<Aabb>& boxes)
-{
-    Bvh binary = buildBvh(boxes);
-    Bvh wide = widenBvh(binary, 4);
-    return {std::move(binary), std::move(wide)};
-}
-
 TEST(BvhTraversal, ClosestHitEqualsBruteForce)
 {
     const MeshData soup = makeRandomSoup(2000, 11);
-    for (const Bvh& bvh : bothWidths(boxesOf(soup))) {
-        SCOPED_TRACE(std::to_string(bvh.width) + "-wide");
-        const TriangleSet mesh{soup.positions, soup.triangles};
-        std::mt19937 random(42);
-        std::uniform_real_distribution<float> inCube(-0.5f, 1.5f);
-        int hits = 0;
-        for (int i = 0; i < 10000; ++i) {
-            const glm::vec3 origin(inCube(random), inCube(random), inCube(random));
-            // Half the rays aim at a triangle's centroid, so that most rays hit something.
-            const glm::uvec3 aim = soup.triangles[random() % soup.triangles.size()];
-            const glm::vec3 towards = (soup.positions[aim.x] + soup.positions[aim.y] + soup.positions[aim.z]) / 3.0f;
-            const glm::vec3 dir = i % 2 ? glm::normalize(towards - origin) : randomDirection(random);
-            const float tMax = i % 4 == 0 ? 0.3f : 1e30f;
-            const auto expected = bruteForceClosestHit(mesh, origin, dir, tMax);
-            const auto found = closestHit(bvh, mesh, origin, dir, tMax);
-            ASSERT_EQ(found.has_value(), expected.has_value()) << "ray " << i;
-            EXPECT_EQ(anyHit(bvh, mesh, origin, dir, tMax), expected.has_value()) << "ray " << i;
-            if (!expected) continue;
-            ++hits;
-            ASSERT_EQ(std::bit_cast<uint32_t>(found->t), std::bit_cast<uint32_t>(expected->t)) << "ray " << i;
-            if (found->primitive != expected->primitive) {
-                // Only a tie at exactly the same t may pick another triangle.
-                const glm::uvec3 tri = soup.triangles[found->primitive];
-                const auto again = intersectTriangle(soup.positions[tri.x], soup.positions[tri.y],
-                                                     soup.positions[tri.z], makeTraversalRay(origin, dir), tMax);
-                ASSERT_TRUE(again && again->t == expected->t) << "ray " << i;
-            } else {
-                EXPECT_EQ(found->barycentrics, expected->barycentrics);
-            }
+    const Bvh bvh = buildBvh(boxesOf(soup));
+    const TriangleSet mesh{soup.positions, soup.triangles};
+    std::mt19937 random(42);
+    std::uniform_real_distribution<float> inCube(-0.5f, 1.5f);
+    int hits = 0;
+    for (int i = 0; i < 10000; ++i) {
+        const glm::vec3 origin(inCube(random), inCube(random), inCube(random));
+        // Half the rays aim at a triangle's centroid, so that most rays hit something.
+        const glm::uvec3 aim = soup.triangles[random() % soup.triangles.size()];
+        const glm::vec3 towards = (soup.positions[aim.x] + soup.positions[aim.y] + soup.positions[aim.z]) / 3.0f;
+        const glm::vec3 dir = i % 2 ? glm::normalize(towards - origin) : randomDirection(random);
+        const float tMax = i % 4 == 0 ? 0.3f : 1e30f;
+        const auto expected = bruteForceClosestHit(mesh, origin, dir, tMax);
+        const auto found = closestHit(bvh, mesh, origin, dir, tMax);
+        ASSERT_EQ(found.has_value(), expected.has_value()) << "ray " << i;
+        EXPECT_EQ(anyHit(bvh, mesh, origin, dir, tMax), expected.has_value()) << "ray " << i;
+        if (!expected) continue;
+        ++hits;
+        ASSERT_EQ(std::bit_cast<uint32_t>(found->t), std::bit_cast<uint32_t>(expected->t)) << "ray " << i;
+        if (found->primitive != expected->primitive) {
+            // Only a tie at exactly the same t may pick another triangle.
+            const glm::uvec3 tri = soup.triangles[found->primitive];
+            const auto again = intersectTriangle(soup.positions[tri.x], soup.positions[tri.y], soup.positions[tri.z],
+                                                 makeTraversalRay(origin, dir), tMax);
+            ASSERT_TRUE(again && again->t == expected->t) << "ray " << i;
+        } else {
+            EXPECT_EQ(found->barycentrics, expected->barycentrics);
         }
-        EXPECT_GT(hits, 4000); // the comparison saw many hits
     }
+    EXPECT_GT(hits, 4000); // the comparison saw many hits
 }
 
 TEST(BvhTraversal, WatertightAtSharedEdgesAndVertices)
@@ -351,80 +284,47 @@ TEST(BvhTraversal, WatertightAtSharedEdgesAndVertices)
     // n = 64: every vertex coordinate and edge midpoint is exact in float.
     const uint32_t n = 64;
     const MeshData grid = makeGrid(n);
-    for (const Bvh& bvh : bothWidths(boxesOf(grid))) {
-        SCOPED_TRACE(std::to_string(bvh.width) + "-wide");
-        const TriangleSet mesh{grid.positions, grid.triangles};
-        std::mt19937 random(9);
-        std::uniform_real_distribution<float> spread(-3.0f, 3.0f);
-        std::uniform_int_distribution<uint32_t> interior(1, n - 1);
-        const float step = 2.0f / n;
-        int rays = 0, hits = 0, anyHits = 0;
-        for (int i = 0; i < 6000; ++i) {
-            // A vertex, the midpoint of a horizontal, vertical or diagonal edge.
-            const glm::vec2 vertex(-1.0f + step * interior(random), -1.0f + step * interior(random));
-            const glm::vec2 offsets[4] = {{0, 0}, {0.5f, 0}, {0, 0.5f}, {0.5f, 0.5f}};
-            const glm::vec3 target(vertex + step * offsets[i % 4], 0.0f);
-            const glm::vec3 origin(spread(random), spread(random), i % 2 ? 2.0f : -2.0f);
-            const glm::vec3 dir = glm::normalize(target - origin);
-            ++rays;
-            hits += closestHit(bvh, mesh, origin, dir, 1e30f).has_value();
-            anyHits += anyHit(bvh, mesh, origin, dir, 1e30f);
-        }
-        EXPECT_EQ(hits, rays);
-        EXPECT_EQ(anyHits, rays);
+    const Bvh bvh = buildBvh(boxesOf(grid));
+    const TriangleSet mesh{grid.positions, grid.triangles};
+    std::mt19937 random(9);
+    std::uniform_real_distribution<float> spread(-3.0f, 3.0f);
+    std::uniform_int_distribution<uint32_t> interior(1, n - 1);
+    const float step = 2.0f / n;
+    int rays = 0, hits = 0, anyHits = 0;
+    for (int i = 0; i < 6000; ++i) {
+        // A vertex, the midpoint of a horizontal, vertical or diagonal edge.
+        const glm::vec2 vertex(-1.0f + step * interior(random), -1.0f + step * interior(random));
+        const glm::vec2 offsets[4] = {{0, 0}, {0.5f, 0}, {0, 0.5f}, {0.5f, 0.5f}};
+        const glm::vec3 target(vertex + step * offsets[i % 4], 0.0f);
+        const glm::vec3 origin(spread(random), spread(random), i % 2 ? 2.0f : -2.0f);
+        const glm::vec3 dir = glm::normalize(target - origin);
+        ++rays;
+        hits += closestHit(bvh, mesh, origin, dir, 1e30f).has_value();
+        anyHits += anyHit(bvh, mesh, origin, dir, 1e30f);
     }
-}
-
-TEST(BvhTraversal, UnusedWideChildrenAreNeverEntered)
-{
-    // Three small triangles at corners of the unit cube: the 4-wide root
-    // has three leaves and one unused child, the point at +infinity. A ray
-    // through the middle of the cube, positive on every axis, with no
-    // distance limit, misses the three leaves but enters that point's box at
-    // t = +infinity; the walk must not take it for the nearest child (it
-    // has no children of its own).
-    const std::vector<glm::vec3> positions{{0.0f, 0.0f, 0.0f}, {0.1f, 0.0f, 0.0f}, {0.0f, 0.1f, 0.0f},
-                                           {1.0f, 1.0f, 1.0f}, {0.9f, 1.0f, 1.0f}, {1.0f, 0.9f, 1.0f},
-                                           {0.0f, 1.0f, 0.0f}, {0.1f, 1.0f, 0.0f}, {0.0f, 0.9f, 0.0f}};
-    const std::vector<glm::uvec3> triangles{{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
-    const Bvh wide = widenBvh(buildBvh(triangleBoxes(positions, triangles), BvhOptions{.maxLeafSize = 1}), 4);
-    ASSERT_EQ(wide.nodes.size(), 5u);
-    const glm::vec3 origin(-1.0f, 0.5f, 0.5f), direction = glm::normalize(glm::vec3(1.0f, 0.001f, 0.002f));
-    const TraversalRay ray = makeTraversalRay(origin, direction);
-    const float noLimit = 3.402823466e38f; // FLT_MAX, as the kernels pass it
-    float entry = 0.0f;
-    ASSERT_TRUE(entersBox(wide.nodes[0].lower, wide.nodes[0].upper, ray, noLimit, entry));
-    for (uint32_t c = 1; c <= 3; ++c)
-        ASSERT_FALSE(entersBox(wide.nodes[c].lower, wide.nodes[c].upper, ray, noLimit, entry));
-    ASSERT_TRUE(entersBox(wide.nodes[4].lower, wide.nodes[4].upper, ray, noLimit, entry));
-    EXPECT_TRUE(std::isinf(entry));
-    const TriangleSet mesh{positions, triangles};
-    const TraversalStats stats = traversalStats(wide, mesh, origin, direction, noLimit);
-    EXPECT_EQ(stats.nodesVisited, 1u);
-    EXPECT_EQ(stats.trianglesTested, 0u);
+    EXPECT_EQ(hits, rays);
+    EXPECT_EQ(anyHits, rays);
 }
 
 TEST(BvhTraversal, StatsShowTheTreeSavesWork)
 {
     const MeshData soup = makeRandomSoup(10000, 4);
-    for (const Bvh& bvh : bothWidths(boxesOf(soup))) {
-        SCOPED_TRACE(std::to_string(bvh.width) + "-wide");
-        const TriangleSet mesh{soup.positions, soup.triangles};
-        std::mt19937 random(1);
-        uint64_t tested = 0, visited = 0;
-        const int rays = 1000;
-        for (int i = 0; i < rays; ++i) {
-            const TraversalStats s = traversalStats(bvh, mesh, {0.5f, 0.5f, 0.5f}, randomDirection(random), 1e30f);
-            EXPECT_GE(s.nodesVisited, 1u);
-            tested += s.trianglesTested;
-            visited += s.nodesVisited;
-        }
-        EXPECT_LT(double(tested) / rays, 0.02 * 10000); // a few dozen of 10,000 triangles
-        EXPECT_LT(double(visited) / rays, 0.02 * bvh.nodes.size());
-        const TraversalStats miss = traversalStats(bvh, mesh, {5.0f, 5.0f, 5.0f}, {1.0f, 0.0f, 0.0f}, 1e30f);
-        EXPECT_EQ(miss.nodesVisited, 0u);
-        EXPECT_EQ(miss.trianglesTested, 0u);
+    const Bvh bvh = buildBvh(boxesOf(soup));
+    const TriangleSet mesh{soup.positions, soup.triangles};
+    std::mt19937 random(1);
+    uint64_t tested = 0, visited = 0;
+    const int rays = 1000;
+    for (int i = 0; i < rays; ++i) {
+        const TraversalStats s = traversalStats(bvh, mesh, {0.5f, 0.5f, 0.5f}, randomDirection(random), 1e30f);
+        EXPECT_GE(s.nodesVisited, 1u);
+        tested += s.trianglesTested;
+        visited += s.nodesVisited;
     }
+    EXPECT_LT(double(tested) / rays, 0.02 * 10000); // a few dozen of 10,000 triangles
+    EXPECT_LT(double(visited) / rays, 0.02 * bvh.nodes.size());
+    const TraversalStats miss = traversalStats(bvh, mesh, {5.0f, 5.0f, 5.0f}, {1.0f, 0.0f, 0.0f}, 1e30f);
+    EXPECT_EQ(miss.nodesVisited, 0u);
+    EXPECT_EQ(miss.trianglesTested, 0u);
 }
 
 TEST(BvhTraversal, TriangleTestLimitsAndDegenerates)

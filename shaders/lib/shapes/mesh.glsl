@@ -70,7 +70,9 @@ bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId
                 }
             }
         } else {
-            VKRT_BVH_DESCEND_WIDE(meshNodes, mesh.root, n.first, br, limit, descend)
+            BvhNode a = meshNodes[mesh.root + n.first];
+            BvhNode b = meshNodes[mesh.root + n.first + 1u];
+            VKRT_BVH_DESCEND(a, b, n.first, br, limit, descend)
         }
         VKRT_BVH_POP_UNLESS(descend, anyHit ? tMax : best.t)
     }
