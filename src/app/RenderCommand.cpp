@@ -9,6 +9,7 @@
 #include "io/PngFile.h"
 #include "render/ConvergenceReport.h"
 #include "render/Progress.h"
+#include "render/RenderOutput.h"
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
 #include "scene/TomlReader.h"
@@ -113,48 +114,15 @@ std::optional<ShardRange> shardRange(const RenderCommandOptions& options)
 
 // ------------------------------------------------------------------- AOVs
 
-/// The AOVs `--aov` may name, in the order their layers are written.
-constexpr std::array<std::string_view, 4> kAovNames{"albedo", "normal", "depth", "position"};
-
-/// --aov's names, checked: each known, none twice, not with --shard (a
+/// --aov's names, checked (render/RenderOutput.h), and not with --shard (a
 /// merge adds sums; AOVs are means).
 std::vector<std::string> checkedAovs(const RenderCommandOptions& options)
 {
-    std::vector<std::string> names;
-    for (const std::string& name : options.aovs) {
-        if (std::find(kAovNames.begin(), kAovNames.end(), name) == kAovNames.end()) {
-            const std::vector<std::string_view> known(kAovNames.begin(), kAovNames.end());
-            throw InputError("--aov: unknown AOV " + quote(name) + didYouMean(name, known) + " (" +
-                             joinList(known) + ")");
-        }
-        if (std::find(names.begin(), names.end(), name) != names.end())
-            throw InputError("--aov: " + quote(name) + " is named twice");
-        names.push_back(name);
-    }
+    std::vector<std::string> names = checkedAovNames(options.aovs, "--aov");
     if (!names.empty() && !options.shard.empty())
         throw InputError("--aov cannot be combined with --shard: a merge adds the shards' sums, and AOVs are "
                          "means; render the AOVs in one run");
     return names;
-}
-
-/// The EXR layers of the AOVs asked for, in compositors' conventions (Open
-/// Image Denoise reads albedo.R/G/B and N.X/Y/Z; depth is Z, position P.X/Y/Z).
-void addAovLayers(const std::vector<std::string>& names, const AovImages& aovs, std::map<std::string, Image>& layers,
-                  std::vector<ExrChannels>& channels)
-{
-    for (const std::string& name : names) {
-        if (name == "albedo") layers["albedo"] = aovs.albedo;
-        if (name == "normal") channels.push_back({{"N.X", "N.Y", "N.Z"}, aovs.normal.rgb});
-        if (name == "position") channels.push_back({{"P.X", "P.Y", "P.Z"}, aovs.position.rgb});
-        if (name == "depth") channels.push_back({{"Z"}, aovs.depth});
-    }
-}
-
-std::string joinedAovs(const std::vector<std::string>& names)
-{
-    std::string text;
-    for (const std::string& name : names) text += (text.empty() ? "" : ",") + name;
-    return text;
 }
 
 SessionConfig sessionConfig(const RenderCommandOptions& options, const std::optional<ShardRange>& shard)
@@ -247,12 +215,12 @@ void printSummary(const RenderFacts& facts)
 
 // ---------------------------------------------------------------- --json (docs/machine-output.md)
 
-JsonObject errorEstimateJson(const RenderSession& session, const Film& film)
+JsonObject errorEstimateJson(const RenderSession& session, const std::optional<EstimatedError>& estimated)
 {
-    if (!film.estimated) return nullptr;
+    if (!estimated) return nullptr;
     const Renderer& renderer = session.renderer();
-    return {{"rmse", film.estimated->rmse},
-            {"relMse", film.estimated->relMse},
+    return {{"rmse", estimated->rmse},
+            {"relMse", estimated->relMse},
             {"degreesOfFreedom", renderer.varianceDegreesOfFreedom()},
             {"estimator", session.sampler() == Sampler::Sobol ? "batches" : "independent-samples"}};
 }
@@ -280,7 +248,7 @@ JsonObject outputsJson(const RenderCommandOptions& options, const RenderFacts& f
 }
 
 JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& session, const RenderFacts& facts,
-                      const Film& film, const std::map<std::string, Image>& layers,
+                      const std::optional<EstimatedError>& estimated, const std::map<std::string, Image>& layers,
                       const std::optional<ShardRange>& shard, size_t validationMessages)
 {
     const Scene& scene = session.scene();
@@ -313,7 +281,7 @@ JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& 
     json["stoppedBy"] = stopReasonName(session.stoppedBy().value_or(StopReason::SppReached));
     json["timeBudgetSeconds"] = valueOrNull(options.timeBudget);
     json["targetRelMse"] = valueOrNull(options.targetError);
-    json["errorEstimate"] = errorEstimateJson(session, film);
+    json["errorEstimate"] = errorEstimateJson(session, estimated);
     json["shard"] = shardJson(shard, options.spp, facts.spp);
     json["outputs"] = outputsJson(options, facts, layers);
     json["validationMessages"] = validationMessages;
@@ -413,27 +381,21 @@ Outcome runRender(const RenderCommandOptions& options)
                            {"vkrt: interrupted before the first frame finished; nothing written"});
 
     Film film = session.film();
-    Metadata metadata = session.metadata(film);
-    std::map<std::string, Image> layers;
     if (film.variance) {
         warnIfTooFewForAnEstimate(renderer);
         if (report && lastCheckpoint != renderer.completedFrames())
             report->add(renderer.completedFrames(), loop.renderSeconds, film.mean, *film.variance); // the last row
-        if (options.variance) layers["variance"] = std::move(*film.variance);
     }
-    if (shard) addShard(*shard, options.spp, renderer, metadata, layers);
-    std::vector<ExrChannels> aovChannels;
-    if (!aovNames.empty()) {
-        addAovLayers(aovNames, renderer.aovs(), layers, aovChannels);
-        metadata["aovs"] = joinedAovs(aovNames);
-    }
-    writeExr(output, film.mean, metadata, layers, aovChannels);
-    if (!options.png.empty()) writePng(options.png, film.mean, options.exposure);
+    const std::optional<EstimatedError> estimated = film.estimated;
+    RenderOutput out = renderOutput(session, std::move(film), options.variance, aovNames);
+    if (shard) addShard(*shard, options.spp, renderer, out.metadata, out.layers);
+    writeRenderOutput(output, out);
+    if (!options.png.empty()) writePng(options.png, out.mean, options.exposure);
     const RenderFacts facts = renderFacts(session, loop, startupSeconds, output);
     printSummary(facts);
     if (!options.json.empty())
-        writeJson(options.json,
-                  renderJson(options, session, facts, film, layers, shard, context.validationMessages().size()));
+        writeJson(options.json, renderJson(options, session, facts, estimated, out.layers, shard,
+                                           context.validationMessages().size()));
     return withValidation(session.outcome(), context.validationMessages());
 }
 

@@ -152,6 +152,17 @@ LoopResult RenderSession::run(const RunHooks& hooks)
     return loop;
 }
 
+LoopResult RenderSession::runFrames(uint32_t frames, const RunHooks& hooks)
+{
+    StopRules rules;
+    rules.maxSpp = spp() + frames;
+    rules.interrupt = m_config.stop.interrupt;
+    LoopResult loop = runRenderLoop(*m_renderer, rules, hooks.onProgress, {});
+    m_renderSeconds += loop.renderSeconds;
+    m_stoppedBy = loop.reason;
+    return loop;
+}
+
 void RenderSession::renderFrames(uint32_t frames)
 {
     auto start = Clock::now();

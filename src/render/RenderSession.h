@@ -53,8 +53,7 @@ Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixel
 /// with the parser's limits. Throws SceneError / InputError.
 /// A TOML scene, or a glTF file as a scene (scene/GltfScene.h, with `gltf`'s
 /// choices); prints the scene's warnings.
-Scene loadScene(const std::string& path, const ResolutionOverride& resolution = {},
-                const GltfSceneOptions& gltf = {});
+Scene loadScene(const std::string& path, const ResolutionOverride& resolution = {}, const GltfSceneOptions& gltf = {});
 
 // ---------------------------------------------------------------- session
 
@@ -68,10 +67,10 @@ struct SessionConfig {
     bool warmUp = true; ///< render and discard a frame first, so timing excludes the driver's shader compile
     SamplerChoice sampler = SamplerChoice::Auto;
     VarianceNeeds variance;
-    bool aov = false; ///< average the AOVs too (RenderOptions::aov)
+    bool aov = false;                      ///< average the AOVs too (RenderOptions::aov)
     AccelChoice accel = AccelChoice::Auto; ///< the traversal backend (resolveAccel decides Auto)
-    std::vector<Define> extraDefines; ///< test hooks
-    uint64_t maxBandBytes = 0;        ///< RenderOptions::maxBandBytes (a test hook; 0: the device's limit)
+    std::vector<Define> extraDefines;      ///< test hooks
+    uint64_t maxBandBytes = 0;             ///< RenderOptions::maxBandBytes (a test hook; 0: the device's limit)
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
     StopRules stop; ///< of run(); its interrupt is usually &interruptFlag() (InterruptGuard)
 };
@@ -98,6 +97,9 @@ public:
     LoopResult run(const RunHooks& hooks = {});
     /// Renders `frames` more outside the stop rules (the viewer paces frames by its display).
     void renderFrames(uint32_t frames);
+    /// Renders `frames` more in paced submissions, stopping early only on the
+    /// stop rules' interrupt (a batch of the Python module's progressive loop).
+    LoopResult runFrames(uint32_t frames, const RunHooks& hooks = {});
 
     /// Starts the accumulation afresh.
     void reset();

@@ -1,0 +1,545 @@
+// vkrt._vkrt: the C++ side of the Python module (docs/python.md). Every
+// render goes through the same RenderSession and the same EXR writer as the
+// command line (render/RenderSession.h, render/RenderOutput.h); this file
+// only converts arguments and results. The Python package (vkrt/__init__.py)
+// adds the progressive generator and the documentation.
+#include "gpu/VulkanContext.h"
+#include "io/ExrFile.h"
+#include "render/GpuScene.h"
+#include "render/KernelVariant.h"
+#include "render/RenderOutput.h"
+#include "render/RenderSession.h"
+#include "scene/FeatureSet.h"
+#include "scene/SceneOverrides.h"
+#include "scene/SceneParser.h"
+#include "util/Error.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <atomic>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+
+namespace vkrt {
+namespace {
+
+// ---------------------------------------------------------------- errors
+
+/// vkrt.SceneError and vkrt.VkrtError, created at import (PYBIND11_MODULE).
+PyObject* g_sceneError = nullptr;
+PyObject* g_vkrtError = nullptr;
+
+/// Raises vkrt.SceneError(text) with file, line, column and message attributes.
+[[noreturn]] void raiseSceneError(const std::string& file, int line, int column, const std::string& message,
+                                  const std::string& text)
+{
+    py::gil_scoped_acquire acquire;
+    py::object type = py::reinterpret_borrow<py::object>(g_sceneError);
+    py::object exception = type(py::str(text));
+    exception.attr("file") = file;
+    exception.attr("line") = line > 0 ? py::object(py::int_(line)) : py::none();
+    exception.attr("column") = column > 0 ? py::object(py::int_(column)) : py::none();
+    exception.attr("message") = message;
+    PyErr_SetObject(g_sceneError, exception.ptr());
+    throw py::error_already_set();
+}
+
+[[noreturn]] void raiseSceneError(const SceneError& error)
+{
+    raiseSceneError(error.where().file, error.where().line, error.where().column, error.message(), error.what());
+}
+
+// ---------------------------------------------------------------- scenes
+
+/// A parsed, validated scene. Python's Scene wraps one; changes from
+/// Python (the camera) are checked with the parser's own rules.
+struct PyScene {
+    Scene scene;
+    std::string source; ///< the file, or "<string>"
+};
+
+PyScene loadSceneFile(const std::filesystem::path& path)
+{
+    try {
+        py::gil_scoped_release release;
+        return PyScene{loadScene(path.string()), path.string()};
+    } catch (const SceneError& error) {
+        raiseSceneError(error);
+    } catch (const InputError& error) {
+        // A file that cannot be read (or a mesh it names): no line or column to give.
+        raiseSceneError(path.string(), 0, 0, error.what(), error.what());
+    }
+}
+
+PyScene sceneFromToml(const std::string& text, const std::filesystem::path& baseDir)
+{
+    try {
+        // The name resolves the scene's relative paths against base_dir and names the text in messages.
+        const std::string name = (baseDir / "<string>").string();
+        Scene scene = parseSceneString(text, name);
+        for (const std::string& warning : scene.warnings) std::fprintf(stderr, "vkrt: warning: %s\n", warning.c_str());
+        return PyScene{std::move(scene), name};
+    } catch (const SceneError& error) {
+        raiseSceneError(error);
+    }
+}
+
+py::dict sceneInfo(const PyScene& s)
+{
+    const Scene& scene = s.scene;
+    KernelVariant variant(featuresOf(scene));
+    variant.uniformScene = sceneFitsUniformBuffers(scene);
+    py::dict defines;
+    for (const auto& [name, value] : variant.defines()) defines[py::str(name)] = value;
+    py::dict info;
+    info["source"] = s.source;
+    info["integrator"] = integratorName(scene.render.integrator);
+    info["kernel"] = variant.describe();
+    info["defines"] = defines;
+    info["width"] = scene.camera.width;
+    info["height"] = scene.camera.height;
+    py::dict shapes, lights;
+    for (size_t k = 0; k < kShapeKindCount; ++k)
+        if (scene.count(ShapeKind(k)) > 0) shapes[py::str(featureName(ShapeKind(k)))] = scene.count(ShapeKind(k));
+    for (size_t k = 0; k < kLightKindCount; ++k)
+        if (scene.count(LightKind(k)) > 0) lights[py::str(featureName(LightKind(k)))] = scene.count(LightKind(k));
+    info["shapes"] = shapes;
+    info["lights"] = lights;
+    info["triangles"] = meshTriangleCount(scene);
+    info["emissive_triangles"] = emissiveTriangleCount(scene);
+    info["materials"] = scene.materials.size();
+    return info;
+}
+
+using Vec3 = std::array<double, 3>;
+
+glm::dvec3 toVec(const Vec3& v) { return {v[0], v[1], v[2]}; }
+Vec3 fromVec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+/// Moves the camera; the scene is unchanged when the parser would refuse the result.
+void setCamera(PyScene& s, std::optional<Vec3> eye, std::optional<Vec3> target, std::optional<Vec3> up,
+               std::optional<double> fov, std::optional<double> aperture, std::optional<double> focusDistance)
+{
+    Camera camera = s.scene.camera;
+    if (eye) camera.eye = toVec(*eye);
+    if (target) camera.target = toVec(*target);
+    if (up) camera.up = toVec(*up);
+    if (fov) camera.fovY = *fov;
+    if (aperture) {
+        if (!(*aperture >= 0.0) || !std::isfinite(*aperture))
+            throw py::value_error("aperture: must be a finite radius >= 0, got " + std::to_string(*aperture));
+        camera.apertureRadius = *aperture;
+    }
+    if (focusDistance) {
+        if (!(*focusDistance > 0.0) || !std::isfinite(*focusDistance))
+            throw py::value_error("focus_distance: must be finite and > 0, got " + std::to_string(*focusDistance));
+        camera.focusDistance = *focusDistance;
+    }
+    if (const std::optional<std::string> problem = cameraProblem(camera)) throw py::value_error("camera: " + *problem);
+    s.scene.camera = camera;
+}
+
+py::dict cameraOf(const PyScene& s)
+{
+    const Camera& c = s.scene.camera;
+    py::dict d;
+    d["eye"] = fromVec(c.eye);
+    d["target"] = fromVec(c.target);
+    d["up"] = fromVec(c.up);
+    d["fov"] = c.fovY;
+    d["aperture"] = c.apertureRadius;
+    d["focus_distance"] = c.resolvedFocusDistance();
+    d["width"] = c.width;
+    d["height"] = c.height;
+    return d;
+}
+
+// ---------------------------------------------------------------- devices
+
+/// One Vulkan context per device selector, made on first use and kept for
+/// the life of the process (an instance and device take a while to make).
+/// A device renders one session at a time: a second thread waits for it.
+struct Device {
+    std::unique_ptr<VulkanContext> context;
+    std::mutex busy;
+};
+
+std::mutex g_devicesMutex;
+std::map<std::string, std::unique_ptr<Device>>& openDevices()
+{
+    static std::map<std::string, std::unique_ptr<Device>> devices;
+    return devices;
+}
+
+/// The device for `selector` (called without the GIL).
+Device& deviceFor(const std::string& selector)
+{
+    std::lock_guard lock(g_devicesMutex);
+    auto& devices = openDevices();
+    auto it = devices.find(selector);
+    if (it != devices.end()) return *it->second;
+    auto device = std::make_unique<Device>();
+    device->context = std::make_unique<VulkanContext>(ContextOptions{selector, false, std::nullopt});
+    return *devices.emplace(selector, std::move(device)).first->second;
+}
+
+py::list listDevices()
+{
+    std::vector<DeviceInfo> devices;
+    {
+        py::gil_scoped_release release;
+        tuneSoftwareRasterizerThreads();
+        devices = listVulkanDevices();
+    }
+    std::optional<uint32_t> chosen;
+    try {
+        chosen = defaultDeviceIndex(devices);
+    } catch (const GpuError&) {
+    }
+    py::list out;
+    for (const DeviceInfo& d : devices) {
+        py::dict entry;
+        entry["index"] = d.index;
+        entry["name"] = d.name;
+        entry["type"] = d.typeName();
+        entry["api"] = d.apiVersionString();
+        entry["driver"] = d.driver;
+        entry["default"] = chosen == d.index;
+        entry["suitable"] = d.suitable();
+        entry["unsuitable_reason"] = d.unsuitableReason;
+        entry["ray_query"] = d.rayQuery();
+        out.append(entry);
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------- results
+
+/// A float32 array of shape (height, width, channels) that owns `values`
+/// (moved, not copied).
+py::array_t<float> imageArray(std::vector<float>&& values, uint32_t width, uint32_t height, uint32_t channels)
+{
+    auto* owned = new std::vector<float>(std::move(values));
+    py::capsule free(owned, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+    const py::ssize_t w = width, h = height, c = channels, f = sizeof(float);
+    if (channels == 1) return py::array_t<float>({h, w}, {w * f, f}, owned->data(), free);
+    return py::array_t<float>({h, w, c}, {w * c * f, c * f, f}, owned->data(), free);
+}
+
+py::object metadataValue(const MetadataValue& value)
+{
+    return std::visit([](const auto& v) -> py::object { return py::cast(v); }, value);
+}
+
+/// What render() and a session's snapshot return: the EXR's contents, with
+/// NumPy views for Python, and the means to write it as `vkrt render` does.
+struct PyResult {
+    RenderOutput output;
+    py::dict arrays; ///< "image", "variance", "albedo", "normal", "position", "depth"
+    py::dict metadata;
+    uint32_t spp = 0;
+    double renderSeconds = 0.0;
+    std::string stoppedBy;
+    bool interrupted = false;
+
+    void save(const std::filesystem::path& path) const
+    {
+        py::gil_scoped_release release;
+        writeRenderOutput(path, output);
+    }
+};
+
+/// Converts a finished session's output. The arrays copy the pixels once
+/// (the RenderOutput keeps its own for save()).
+std::unique_ptr<PyResult> resultOf(RenderOutput output, const RenderSession& session)
+{
+    auto result = std::make_unique<PyResult>();
+    const uint32_t w = output.mean.width, h = output.mean.height;
+    result->arrays["image"] = imageArray(std::vector<float>(output.mean.rgb), w, h, 3);
+    for (const auto& [name, layer] : output.layers)
+        result->arrays[py::str(name)] = imageArray(std::vector<float>(layer.rgb), w, h, 3);
+    for (const ExrChannels& channels : output.channels) {
+        const std::string name = channels.names[0] == "Z"     ? "depth"
+                                 : channels.names[0] == "N.X" ? "normal"
+                                                              : "position";
+        result->arrays[py::str(name)] =
+            imageArray(std::vector<float>(channels.values), w, h, uint32_t(channels.names.size()));
+    }
+    for (const auto& [key, value] : output.metadata) result->metadata[py::str(key)] = metadataValue(value);
+    result->spp = session.spp();
+    result->renderSeconds = session.renderSeconds();
+    if (session.stoppedBy()) result->stoppedBy = stopReasonName(*session.stoppedBy());
+    result->interrupted = session.outcome().kind == OutcomeKind::Interrupted;
+    result->output = std::move(output);
+    return result;
+}
+
+// ---------------------------------------------------------------- sessions
+
+struct RenderArguments {
+    std::optional<uint32_t> spp, width, height;
+    uint32_t seed = 0;
+    std::string sampler = "auto";
+    std::optional<std::string> integrator;
+    std::string device;
+    std::optional<double> timeBudget, targetError;
+    bool variance = false;
+    std::vector<std::string> aovs;
+    std::string accel = "auto";
+};
+
+Integrator integratorNamed(const std::string& name)
+{
+    if (name == "path") return Integrator::Path;
+    if (name == "whitted") return Integrator::Whitted;
+    throw py::value_error("integrator: expected \"path\" or \"whitted\", got \"" + name + "\"");
+}
+
+/// The scene as the arguments change it (a copy: the Python Scene stays as it was).
+Scene sceneFor(const PyScene& s, const RenderArguments& a)
+{
+    Scene scene = s.scene;
+    applyResolution(scene.camera, ResolutionOverride{a.width, a.height, "width", "height"});
+    if (a.integrator) scene.render.integrator = integratorNamed(*a.integrator);
+    return scene;
+}
+
+/// The command line's sessionConfig (app/RenderCommand.cpp) for the same choices.
+SessionConfig configFor(const RenderArguments& a, const std::atomic<bool>* interrupt)
+{
+    SessionConfig config;
+    config.seed = a.seed;
+    const std::optional<SamplerChoice> sampler = samplerChoiceNamed(a.sampler);
+    if (!sampler)
+        throw py::value_error("sampler: expected \"auto\", \"independent\" or \"sobol\", got \"" + a.sampler + "\"");
+    config.sampler = *sampler;
+    const std::optional<AccelChoice> accel = accelChoiceNamed(a.accel);
+    if (!accel) throw py::value_error("accel: expected \"auto\", \"own\" or \"driver\", got \"" + a.accel + "\"");
+    config.accel = *accel;
+    if (a.spp && *a.spp == 0) throw py::value_error("spp: must be at least 1");
+    if (a.timeBudget && !(*a.timeBudget > 0.0 && std::isfinite(*a.timeBudget)))
+        throw py::value_error("time_budget: must be > 0 seconds and finite");
+    if (a.targetError && !(*a.targetError > 0.0 && std::isfinite(*a.targetError)))
+        throw py::value_error("target_error: must be > 0 and finite");
+    config.variance = {a.variance, a.targetError.has_value()};
+    config.aov = !a.aovs.empty();
+    // --spp caps the render; without it a time or error rule may run long.
+    const uint32_t maxSpp = a.spp ? *a.spp : (a.timeBudget || a.targetError) ? (1u << 30) : 64u;
+    config.stop = {maxSpp, a.timeBudget, a.targetError, interrupt};
+    return config;
+}
+
+/// A render session on one device, kept between calls: the progressive
+/// generator renders batches into it, and run() renders to its stop rules.
+class PySession {
+public:
+    PySession(const PyScene& scene, RenderArguments arguments) : m_arguments(std::move(arguments))
+    {
+        m_aovs = checkedAovNames(m_arguments.aovs, "aovs");
+        Scene copy = sceneFor(scene, m_arguments);
+        SessionConfig config = configFor(m_arguments, &m_interrupt);
+        py::gil_scoped_release release;
+        m_device = &deviceFor(m_arguments.device);
+        std::lock_guard lock(m_device->busy);
+        m_session = std::make_unique<RenderSession>(*m_device->context, std::move(copy), std::move(config));
+    }
+
+    /// Renders to the stop rules; Ctrl-C (checked between submissions) stops it with the image so far.
+    void run()
+    {
+        m_interrupt = false;
+        const RunHooks hooks = signalHooks();
+        {
+            py::gil_scoped_release release;
+            std::lock_guard lock(m_device->busy);
+            m_session->run(hooks);
+        }
+        rethrowPending();
+    }
+
+    /// Renders `frames` more samples per pixel (outside the stop rules but
+    /// Ctrl-C); KeyboardInterrupt leaves the frames done so far in the film.
+    void runFrames(uint32_t frames)
+    {
+        m_interrupt = false;
+        const RunHooks hooks = signalHooks();
+        {
+            py::gil_scoped_release release;
+            std::lock_guard lock(m_device->busy);
+            m_session->runFrames(frames, hooks);
+        }
+        rethrowPending();
+    }
+
+    std::unique_ptr<PyResult> result() const
+    {
+        RenderOutput output;
+        {
+            py::gil_scoped_release release;
+            std::lock_guard lock(m_device->busy);
+            output = renderOutput(*m_session, m_session->film(), m_arguments.variance, m_aovs);
+        }
+        return resultOf(std::move(output), *m_session);
+    }
+
+    uint32_t spp() const { return m_session->spp(); }
+
+private:
+    RenderArguments m_arguments;
+    std::vector<std::string> m_aovs;
+    Device* m_device = nullptr;
+    std::unique_ptr<RenderSession> m_session;
+    std::atomic<bool> m_interrupt{false};
+    std::unique_ptr<py::error_already_set> m_pendingError;
+
+    /// Python's signal handlers run between submissions: Ctrl-C sets the
+    /// interrupt the render loop polls, and its KeyboardInterrupt is raised
+    /// once the loop has stopped.
+    RunHooks signalHooks()
+    {
+        RunHooks hooks;
+        hooks.onProgress = [this](uint32_t) {
+            py::gil_scoped_acquire acquire;
+            if (!m_pendingError && PyErr_CheckSignals() != 0) {
+                m_interrupt = true;
+                m_pendingError = std::make_unique<py::error_already_set>();
+            }
+        };
+        return hooks;
+    }
+
+    void rethrowPending()
+    {
+        if (!m_pendingError) return;
+        std::unique_ptr<py::error_already_set> error = std::move(m_pendingError);
+        error->restore();
+        throw py::error_already_set();
+    }
+};
+
+RenderArguments argumentsOf(std::optional<uint32_t> spp, std::optional<uint32_t> width, std::optional<uint32_t> height,
+                            uint32_t seed, std::string sampler, std::optional<std::string> integrator,
+                            std::string device, std::optional<double> timeBudget, std::optional<double> targetError,
+                            bool variance, std::vector<std::string> aovs, std::string accel)
+{
+    return RenderArguments{spp,
+                           width,
+                           height,
+                           seed,
+                           std::move(sampler),
+                           std::move(integrator),
+                           std::move(device),
+                           timeBudget,
+                           targetError,
+                           variance,
+                           std::move(aovs),
+                           std::move(accel)};
+}
+
+/// Runs `body`, turning vkrt's C++ errors into Python ones.
+template <class Body>
+auto translated(Body&& body) -> decltype(body())
+{
+    try {
+        return body();
+    } catch (const SceneError& error) {
+        raiseSceneError(error);
+    } catch (const InputError& error) {
+        throw py::value_error(error.what());
+    } catch (const GpuError& error) {
+        PyErr_SetString(g_vkrtError, error.what());
+        throw py::error_already_set();
+    }
+}
+
+} // namespace
+} // namespace vkrt
+
+PYBIND11_MODULE(_vkrt, m)
+{
+    using namespace vkrt;
+    m.doc() = "vkrt's C++ side; use the vkrt package (docs/python.md).";
+
+    static py::exception<InputError> vkrtError(m, "VkrtError", PyExc_RuntimeError);
+    g_vkrtError = vkrtError.ptr();
+    static py::exception<SceneError> sceneError(m, "SceneError", PyExc_ValueError);
+    g_sceneError = sceneError.ptr();
+
+    py::class_<PyScene>(m, "Scene")
+        .def_static("load", &loadSceneFile, py::arg("path"))
+        .def_static("from_toml", &sceneFromToml, py::arg("text"), py::arg("base_dir"))
+        .def("info", &sceneInfo)
+        .def("camera", &cameraOf)
+        .def("set_camera", &setCamera, py::arg("eye") = py::none(), py::arg("target") = py::none(),
+             py::arg("up") = py::none(), py::arg("fov") = py::none(), py::arg("aperture") = py::none(),
+             py::arg("focus_distance") = py::none())
+        .def("copy", [](const PyScene& s) { return PyScene(s); })
+        .def_readonly("source", &PyScene::source);
+
+    py::class_<PyResult>(m, "Result")
+        .def_readonly("arrays", &PyResult::arrays)
+        .def_readonly("metadata", &PyResult::metadata)
+        .def_readonly("spp", &PyResult::spp)
+        .def_readonly("render_seconds", &PyResult::renderSeconds)
+        .def_readonly("stopped_by", &PyResult::stoppedBy)
+        .def_readonly("interrupted", &PyResult::interrupted)
+        .def(
+            "save", [](const PyResult& r, const std::filesystem::path& path) { translated([&] { r.save(path); }); },
+            py::arg("path"));
+
+    py::class_<PySession>(m, "Session")
+        .def(py::init([](const PyScene& scene, std::optional<uint32_t> spp, std::optional<uint32_t> width,
+                         std::optional<uint32_t> height, uint32_t seed, std::string sampler,
+                         std::optional<std::string> integrator, std::string device, std::optional<double> timeBudget,
+                         std::optional<double> targetError, bool variance, std::vector<std::string> aovs,
+                         std::string accel) {
+                 return translated([&] {
+                     return std::make_unique<PySession>(scene, argumentsOf(spp, width, height, seed, std::move(sampler),
+                                                                           std::move(integrator), std::move(device),
+                                                                           timeBudget, targetError, variance,
+                                                                           std::move(aovs), std::move(accel)));
+                 });
+             }),
+             py::arg("scene"), py::arg("spp"), py::arg("width"), py::arg("height"), py::arg("seed"), py::arg("sampler"),
+             py::arg("integrator"), py::arg("device"), py::arg("time_budget"), py::arg("target_error"),
+             py::arg("variance"), py::arg("aovs"), py::arg("accel"))
+        .def("run", [](PySession& s) { translated([&] { s.run(); }); })
+        .def(
+            "run_frames", [](PySession& s, uint32_t frames) { translated([&] { s.runFrames(frames); }); },
+            py::arg("frames"))
+        .def("result", [](const PySession& s) { return translated([&] { return s.result(); }); })
+        .def_property_readonly("spp", &PySession::spp);
+
+    m.def("devices", [] { return translated([] { return listDevices(); }); });
+
+    m.def(
+        "read_exr",
+        [](const std::filesystem::path& path) {
+            return translated([&] {
+                ExrContents contents;
+                {
+                    py::gil_scoped_release release;
+                    contents = readExr(path);
+                }
+                const uint32_t w = contents.image.width, h = contents.image.height;
+                py::dict arrays;
+                arrays["image"] = imageArray(std::move(contents.image.rgb), w, h, 3);
+                for (auto& [name, layer] : contents.layers)
+                    arrays[py::str(name)] = imageArray(std::move(layer.rgb), w, h, 3);
+                py::dict metadata;
+                for (const auto& [key, value] : contents.metadata) metadata[py::str(key)] = metadataValue(value);
+                return py::make_tuple(arrays, metadata);
+            });
+        },
+        py::arg("path"));
+}

@@ -1,0 +1,259 @@
+"""The Python module against the command line and its own promises
+(docs/python.md). Run by ctest (python/CMakeLists.txt) with the build's
+package on PYTHONPATH, VKRT_BINARY naming the vkrt executable and
+VKRT_TEST_DEVICE the device (lavapipe)."""
+
+import os
+import signal
+import subprocess
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vkrt
+
+REPO = Path(__file__).resolve().parents[2]
+DEFAULT_SCENE = REPO / "scenes" / "default.toml"
+BINARY = os.environ.get("VKRT_BINARY", str(REPO / "build" / "vkrt"))
+DEVICE = os.environ.get("VKRT_TEST_DEVICE", "")
+
+SMALL = dict(width=48, height=36, device=DEVICE)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return vkrt.Scene.load(DEFAULT_SCENE)
+
+
+def cli_render(tmp_path, *args):
+    out = tmp_path / "cli.exr"
+    device = ["--device", DEVICE] if DEVICE else []
+    subprocess.run([BINARY, "render", str(DEFAULT_SCENE), "-o", str(out), *device, *args], check=True,
+                   capture_output=True)
+    return vkrt.read_exr(out)
+
+
+# ---------------------------------------------------------------- errors
+
+def test_a_scene_error_names_file_line_and_column(tmp_path):
+    # The default scene with its camera's fov (on some line n) out of range.
+    lines = DEFAULT_SCENE.read_text().splitlines()
+    n = next(i for i, line in enumerate(lines) if line.replace(" ", "").startswith("fov=")) + 1
+    lines[n - 1] = "fov = 400"
+    with pytest.raises(vkrt.SceneError) as caught:
+        vkrt.Scene.from_toml("\n".join(lines), base_dir=DEFAULT_SCENE.parent)
+    error = caught.value
+    assert error.line == n
+    assert error.column is not None and error.column >= 1
+    assert error.file.endswith("<string>")
+    assert "fov" in str(error)
+    assert str(error).startswith(f"{error.file}:{n}:")
+    assert error.message and error.message in str(error)
+
+
+def test_a_syntax_error_is_a_scene_error(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[camera\n")
+    with pytest.raises(vkrt.SceneError) as caught:
+        vkrt.Scene.load(bad)
+    assert caught.value.file == str(bad)
+    assert caught.value.line == 1
+
+
+def test_a_missing_file_is_a_scene_error_without_position(tmp_path):
+    missing = tmp_path / "nowhere.toml"
+    with pytest.raises(vkrt.SceneError) as caught:
+        vkrt.Scene.load(missing)
+    assert caught.value.file == str(missing)
+    assert caught.value.line is None and caught.value.column is None
+    assert "nowhere.toml" in str(caught.value)
+
+
+@pytest.mark.parametrize("arguments, words", [
+    (dict(spp=0), "spp"),
+    (dict(sampler="halton"), "sampler"),
+    (dict(integrator="bdpt"), "integrator"),
+    (dict(aovs=["albedo", "albedo"]), "twice"),
+    (dict(aovs=["colour"]), "unknown AOV"),
+    (dict(width=0), "width"),
+    (dict(accel="embree"), "accel"),
+    (dict(time_budget=-1.0), "time_budget"),
+])
+def test_bad_arguments_raise_value_errors_naming_them(scene, arguments, words):
+    with pytest.raises(ValueError, match=words):
+        vkrt.render(scene, **{**SMALL, **arguments})
+
+
+def test_a_device_that_does_not_exist_is_named(scene):
+    with pytest.raises(Exception, match="no-such-device"):
+        vkrt.render(scene, spp=1, width=8, height=8, device="no-such-device")
+
+
+# ---------------------------------------------------------------- results
+
+def test_info_describes_the_scene(scene):
+    info = scene.info()
+    assert info["integrator"] in ("path", "whitted")
+    assert info["width"] > 0 and info["height"] > 0
+    assert sum(info["shapes"].values()) > 0
+    assert any(name.startswith("VKRT_") for name in info["defines"])
+    assert info["triangles"] == 0
+
+
+def test_shapes_and_dtypes(scene):
+    r = vkrt.render(scene, spp=2, variance=True, aovs=["albedo", "depth", "normal", "position"], **SMALL)
+    assert r.image.shape == (36, 48, 3) and r.image.dtype == np.float32
+    assert r.variance.shape == (36, 48, 3)
+    assert r.albedo.shape == (36, 48, 3)
+    assert r.normal.shape == (36, 48, 3)
+    assert r.position.shape == (36, 48, 3)
+    assert r.depth.shape == (36, 48)
+    assert r.spp == 2
+    assert np.isfinite(r.image).all() and r.image.max() > 0
+    assert r.metadata["aovs"] == "albedo,depth,normal,position"
+    plain = vkrt.render(scene, spp=1, **SMALL)
+    assert plain.variance is None and plain.depth is None
+
+
+def test_the_image_equals_vkrt_render_bit_for_bit(scene, tmp_path):
+    arrays, metadata = cli_render(tmp_path, "--spp", "4", "--seed", "7", "--width", "48", "--height", "36")
+    r = vkrt.render(scene, spp=4, seed=7, **SMALL)
+    assert np.array_equal(r.image.view(np.uint32), arrays["image"].view(np.uint32))
+    # The saved EXR holds the same pixels and the same kind of header.
+    saved = tmp_path / "python.exr"
+    r.save(saved)
+    again, saved_metadata = vkrt.read_exr(saved)
+    assert np.array_equal(again["image"].view(np.uint32), arrays["image"].view(np.uint32))
+    assert set(saved_metadata) == set(metadata)
+    for key in ("seed", "spp", "sampler", "integrator"):
+        if key in metadata:
+            assert saved_metadata[key] == metadata[key], key
+
+
+def test_variance_and_aov_layers_equal_vkrt_render(scene, tmp_path):
+    arrays, _ = cli_render(tmp_path, "--spp", "3", "--seed", "2", "--width", "48", "--height", "36", "--variance",
+                           "--aov", "albedo")
+    r = vkrt.render(scene, spp=3, seed=2, variance=True, aovs=["albedo"], **SMALL)
+    assert np.array_equal(r.variance, arrays["variance"])
+    assert np.array_equal(r.albedo, arrays["albedo"])
+
+
+def test_a_different_seed_gives_a_different_image(scene):
+    a = vkrt.render(scene, spp=1, seed=1, **SMALL)
+    b = vkrt.render(scene, spp=1, seed=2, **SMALL)
+    assert not np.array_equal(a.image, b.image)
+
+
+# ---------------------------------------------------------------- progressive
+
+def test_progressive_yields_the_running_mean(scene):
+    frames = list(vkrt.progressive(scene, batches=3, spp_per_batch=2, seed=5, **SMALL))
+    assert [f.spp for f in frames] == [2, 4, 6]
+    for f in frames:
+        whole = vkrt.render(scene, spp=f.spp, seed=5, **SMALL)
+        assert np.array_equal(f.image, whole.image), f.spp
+    # The running mean of k batches is the mean of its batches' own means
+    # (to rounding): batch 2's samples are 2 * mean4 - mean2.
+    second = 2.0 * frames[1].image.astype(np.float64) - frames[0].image
+    assert np.allclose((frames[0].image + second) / 2.0, frames[1].image, rtol=1e-5, atol=1e-6)
+
+
+# ---------------------------------------------------------------- overrides
+
+def test_a_camera_override_equals_the_same_scene_written_out(tmp_path):
+    text = DEFAULT_SCENE.read_text()
+    scene = vkrt.Scene.from_toml(text, base_dir=DEFAULT_SCENE.parent)
+    camera = scene.camera
+    moved_eye = [camera["eye"][0] + 0.25, camera["eye"][1] + 0.1, camera["eye"][2]]
+    before = vkrt.render(scene, spp=2, seed=3, **SMALL)
+    moved = scene.copy()
+    moved.set_camera(eye=moved_eye, fov=camera["fov"] * 0.9)
+    after = vkrt.render(moved, spp=2, seed=3, **SMALL)
+    assert not np.array_equal(before.image, after.image)
+    assert scene.camera["eye"] == camera["eye"]  # the copy changed, not the original
+
+    # The same camera from the file's text: the same image, bit for bit.
+    import re
+    rewritten = re.sub(r"(?m)^eye\s*=.*$", "eye = [%r, %r, %r]" % tuple(moved_eye), text, count=1)
+    rewritten = re.sub(r"(?m)^fov\s*=.*$", "fov = %r" % (camera["fov"] * 0.9), rewritten, count=1)
+    assert rewritten != text
+    written = vkrt.Scene.from_toml(rewritten, base_dir=DEFAULT_SCENE.parent)
+    assert np.array_equal(vkrt.render(written, spp=2, seed=3, **SMALL).image, after.image)
+
+
+def test_a_camera_the_parser_refuses_changes_nothing(scene):
+    copy = scene.copy()
+    before = copy.camera
+    with pytest.raises(ValueError, match="fov"):
+        copy.set_camera(fov=180.0)
+    with pytest.raises(ValueError, match="camera"):
+        copy.set_camera(target=before["eye"])
+    with pytest.raises(ValueError, match="aperture"):
+        copy.set_camera(aperture=-1.0)
+    assert copy.camera == before
+
+
+# ---------------------------------------------------------------- devices, threads, interrupt
+
+def test_devices_lists_the_default_device():
+    devices = vkrt.devices()
+    assert devices, "no Vulkan device"
+    defaults = [d for d in devices if d["default"]]
+    assert len(defaults) == 1 and defaults[0]["suitable"]
+    for d in devices:
+        assert {"index", "name", "type", "driver", "api", "ray_query"} <= set(d)
+
+
+def test_two_threads_render_on_one_device(scene):
+    expected = {seed: vkrt.render(scene, spp=2, seed=seed, **SMALL).image for seed in (11, 12)}
+    results, errors = {}, []
+
+    def work(seed):
+        try:
+            results[seed] = vkrt.render(scene, spp=2, seed=seed, **SMALL).image
+        except Exception as e:  # pragma: no cover - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(seed,)) for seed in (11, 12)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=300)
+    assert not errors
+    for seed in (11, 12):
+        assert np.array_equal(results[seed], expected[seed])
+
+
+def interrupt_after(seconds):
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_progressive_with_the_image_so_far(scene):
+    timer = interrupt_after(1.0)
+    frames = []
+    try:
+        for frame in vkrt.progressive(scene, batches=100000, spp_per_batch=1, seed=1, **SMALL):
+            frames.append(frame)
+    finally:
+        timer.cancel()
+    assert frames, "nothing rendered before the interrupt"
+    last = frames[-1]
+    assert last.interrupted
+    assert 0 < last.spp < 100000
+    assert np.isfinite(last.image).all() and last.image.max() > 0
+    # The device is still usable.
+    assert vkrt.render(scene, spp=1, **SMALL).spp == 1
+
+
+def test_ctrl_c_stops_render_with_keyboard_interrupt(scene):
+    timer = interrupt_after(1.0)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            vkrt.render(scene, spp=1 << 20, **SMALL)
+    finally:
+        timer.cancel()
+    assert vkrt.render(scene, spp=1, **SMALL).spp == 1

@@ -1,0 +1,235 @@
+"""vkrt: a Vulkan compute ray tracer, from Python.
+
+Load a scene, render it on a Vulkan device (lavapipe on any machine), and get
+NumPy arrays back::
+
+    import vkrt
+    scene = vkrt.Scene.load("scenes/default.toml")
+    result = vkrt.render(scene, spp=64, seed=1)
+    result.image            # float32, shape (height, width, 3), linear RGB
+    result.save("out.exr")  # the EXR `vkrt render` writes for the same arguments
+
+    for frame in vkrt.progressive(scene, batches=8, spp_per_batch=4):
+        print(frame.spp, frame.image.mean())
+
+Every render runs the same render session as the command line (one C++ core;
+docs/python.md), so an image equals `vkrt render`'s at the same seed, bit for
+bit. The GIL is released while the device renders; Ctrl-C stops a render
+between submissions.
+"""
+
+import os as _os
+from pathlib import Path as _Path
+
+# An installed wheel carries the kernels' GLSL beside the module; a build tree
+# uses the source tree's (compiled into the module), as the vkrt executable does.
+_PACKAGED_SHADERS = _Path(__file__).resolve().parent / "shaders"
+if (_PACKAGED_SHADERS / "kernels").is_dir():
+    _os.environ.setdefault("VKRT_SHADER_DIR", str(_PACKAGED_SHADERS))
+
+from . import _vkrt  # noqa: E402
+
+__all__ = ["Scene", "Result", "SceneError", "VkrtError", "render", "progressive", "devices", "read_exr", "AOVS"]
+
+SceneError = _vkrt.SceneError
+SceneError.__doc__ = """A scene that vkrt refuses.
+
+Attributes: ``file`` (the scene file, or the name given to text),
+``line`` and ``column`` (1-based; None when the error has no position, such as
+an unreadable file) and ``message`` (the reason, without the position).
+``str(error)`` is the command line's message: ``file:line:column: message``."""
+
+VkrtError = _vkrt.VkrtError
+VkrtError.__doc__ = "A failure of the Vulkan device, the driver or the shader compiler."
+
+AOVS = ("albedo", "normal", "depth", "position")
+"""The arbitrary output values a render can add (``aovs=[...]``)."""
+
+
+class Scene:
+    """A parsed and validated scene (docs/scene-format.md).
+
+    Make one with :meth:`Scene.load` or :meth:`Scene.from_toml`. The camera
+    can be changed between renders (:meth:`set_camera`) without parsing the
+    file again; a render whose kernel variant is unchanged re-uses the
+    compiled kernel (vkrt's SPIR-V cache and the driver's shader cache).
+    """
+
+    def __init__(self, native):
+        self._native = native
+
+    @classmethod
+    def load(cls, path):
+        """Read a scene file: TOML (docs/scene-format.md) or a glTF .gltf/.glb.
+
+        Raises SceneError (with file, line, column and message) for a file vkrt
+        refuses or cannot read.
+        """
+        return cls(_vkrt.Scene.load(_os.fspath(path)))
+
+    @classmethod
+    def from_toml(cls, text, base_dir="."):
+        """Parse a scene from TOML text.
+
+        ``base_dir`` is where the scene's relative paths (meshes, textures,
+        environment maps) are resolved; errors name the text as
+        ``<base_dir>/<string>``.
+        """
+        return cls(_vkrt.Scene.from_toml(text, _os.fspath(base_dir)))
+
+    @property
+    def source(self):
+        """The file the scene came from (or ``<base_dir>/<string>``)."""
+        return self._native.source
+
+    def info(self):
+        """What the scene uses, as a dict: ``integrator``, ``kernel`` (the
+        kernel variant in words) and its ``defines``, ``width`` and ``height``,
+        ``shapes`` and ``lights`` (counts by kind), ``triangles``,
+        ``emissive_triangles`` and ``materials``.
+
+        The variant is the scene's own; render options (sampler, variance,
+        AOVs) add defines, listed in a result's ``metadata``.
+        """
+        return self._native.info()
+
+    @property
+    def camera(self):
+        """The camera as a dict: ``eye``, ``target``, ``up``, ``fov``
+        (vertical, degrees), ``aperture`` (lens radius; 0 for a pinhole),
+        ``focus_distance``, ``width``, ``height``."""
+        return self._native.camera()
+
+    def set_camera(self, eye=None, target=None, up=None, fov=None, aperture=None, focus_distance=None):
+        """Change the camera: any of ``eye``, ``target``, ``up`` (3 numbers
+        each), ``fov`` (vertical, degrees, strictly between 0 and 180),
+        ``aperture`` (lens radius >= 0) and ``focus_distance`` (> 0).
+
+        Checked with the scene parser's rules; raises ValueError (and changes
+        nothing) for a camera the parser would refuse.
+        """
+        self._native.set_camera(eye, target, up, fov, aperture, focus_distance)
+
+    def copy(self):
+        """An independent copy (meshes and textures are shared, read-only)."""
+        return Scene(self._native.copy())
+
+    def __repr__(self):
+        return f"vkrt.Scene({self.source!r})"
+
+
+class Result:
+    """A finished (or interrupted) render.
+
+    ``image`` is the mean radiance, float32 of shape (height, width, 3).
+    ``variance`` (the variance of each pixel's mean, same shape) is there
+    when the render asked for it. AOVs: ``albedo``, ``normal``, ``position``
+    (height, width, 3) and ``depth`` (height, width), each when asked for.
+    Absent arrays are None. ``metadata`` holds what the EXR's header gets.
+    """
+
+    def __init__(self, native, interrupted=None):
+        self._native = native
+        arrays = native.arrays
+        self.image = arrays["image"]
+        self.variance = arrays.get("variance")
+        self.albedo = arrays.get("albedo")
+        self.normal = arrays.get("normal")
+        self.position = arrays.get("position")
+        self.depth = arrays.get("depth")
+        self.metadata = dict(native.metadata)
+        self.spp = native.spp
+        self.render_seconds = native.render_seconds
+        self.stopped_by = native.stopped_by
+        self.interrupted = native.interrupted if interrupted is None else interrupted
+
+    def save(self, path):
+        """Write the EXR `vkrt render` writes for the same render (mean,
+        variance and AOV layers, metadata), atomically."""
+        self._native.save(_os.fspath(path))
+
+    def __repr__(self):
+        h, w = self.image.shape[:2]
+        return f"vkrt.Result({w}x{h}, spp={self.spp}, render_seconds={self.render_seconds:.3f})"
+
+
+def _session(scene, spp, width, height, seed, sampler, integrator, device, time_budget, target_error, variance,
+             aovs, accel):
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: expected a vkrt.Scene, got {type(scene).__name__}")
+    if isinstance(aovs, str):
+        aovs = [aovs]
+    return _vkrt.Session(scene._native, spp, width, height, seed, sampler, integrator, device, time_budget,
+                         target_error, bool(variance), list(aovs), accel)
+
+
+def render(scene, spp=None, width=None, height=None, seed=0, sampler="auto", integrator=None, device="",
+           time_budget=None, target_error=None, variance=False, aovs=(), accel="auto"):
+    """Render ``scene`` and return a :class:`Result`.
+
+    Arguments (each as `vkrt render`'s option of the same name; docs/cli.md):
+
+    - ``spp``: samples per pixel (default 64; with ``time_budget`` or
+      ``target_error`` alone, no cap).
+    - ``width``, ``height``: image size (default: the scene's).
+    - ``seed``: the random seed; the same seed gives the same image, bit
+      for bit, as `vkrt render --seed`.
+    - ``sampler``: "auto", "sobol" or "independent".
+    - ``integrator``: "path" or "whitted" (default: the scene's).
+    - ``device``: a device index or a case-insensitive part of its name
+      (as listed by :func:`devices`); "" picks the default.
+    - ``time_budget``: stop after this many seconds of rendering.
+    - ``target_error``: stop once the estimated relative MSE is below this.
+    - ``variance``: also estimate each pixel's variance (``result.variance``).
+    - ``aovs``: any of "albedo", "normal", "depth", "position".
+    - ``accel``: the traversal backend, "auto", "own" or "driver".
+
+    The GIL is released while rendering; another thread may render on the
+    same device meanwhile, and waits for it. Ctrl-C stops the render between
+    submissions and raises KeyboardInterrupt.
+    """
+    session = _session(scene, spp, width, height, seed, sampler, integrator, device, time_budget, target_error,
+                       variance, aovs, accel)
+    session.run()
+    return Result(session.result())
+
+
+def progressive(scene, batches=8, spp_per_batch=1, width=None, height=None, seed=0, sampler="auto",
+                integrator=None, device="", variance=False, aovs=(), accel="auto"):
+    """Render ``scene`` in ``batches`` batches of ``spp_per_batch`` samples
+    per pixel, yielding a :class:`Result` with the running mean after each.
+
+    The samples are the same as one render of ``batches * spp_per_batch``
+    spp (the last result equals :func:`render`'s at that spp and seed). On
+    Ctrl-C the generator stops cleanly: it yields a last result holding the
+    samples finished so far, with ``interrupted`` set, and ends.
+    """
+    if batches < 1 or spp_per_batch < 1:
+        raise ValueError("batches and spp_per_batch: must be at least 1")
+    session = _session(scene, batches * spp_per_batch, width, height, seed, sampler, integrator, device, None, None,
+                       variance, aovs, accel)
+    for _ in range(batches):
+        try:
+            session.run_frames(spp_per_batch)
+        except KeyboardInterrupt:
+            if session.spp > 0:
+                yield Result(session.result(), interrupted=True)
+            return
+        yield Result(session.result())
+
+
+def devices():
+    """The Vulkan devices, as `vkrt devices` lists them: a list of dicts with
+    ``index``, ``name``, ``type``, ``api``, ``driver``, ``default`` (the one
+    vkrt picks), ``suitable`` and ``unsuitable_reason``, ``ray_query`` (the
+    driver's traversal is available)."""
+    return _vkrt.devices()
+
+
+def read_exr(path):
+    """Read an EXR with R, G, B channels (vkrt's or any tool's): returns
+    ``(arrays, metadata)``, where ``arrays["image"]`` is float32 of shape
+    (height, width, 3) and any further RGB layers (``variance``, ``albedo``)
+    are under their names; ``metadata`` holds vkrt's header attributes.
+    Raises ValueError naming the file when it is missing or damaged."""
+    return _vkrt.read_exr(_os.fspath(path))
