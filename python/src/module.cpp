@@ -19,6 +19,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <map>
@@ -147,6 +148,33 @@ void setCamera(PyScene& s, std::optional<Vec3> eye, std::optional<Vec3> target, 
     }
     if (const std::optional<std::string> problem = cameraProblem(camera)) throw py::value_error("camera: " + *problem);
     s.scene.camera = camera;
+}
+
+/// Replaces material `name` by the one `table` (TOML: the keys of a
+/// `[materials.NAME]` table) describes, read by the scene parser.
+void setMaterial(PyScene& s, const std::string& name, const std::string& table)
+{
+    auto it = std::find_if(s.scene.materials.begin(), s.scene.materials.end(),
+                           [&](const Material& m) { return m.name == name; });
+    if (it == s.scene.materials.end()) {
+        std::string names;
+        for (const Material& m : s.scene.materials) names += (names.empty() ? "" : ", ") + m.name;
+        throw py::key_error("no material \"" + name + "\" in " + s.source + " (it has: " + names + ")");
+    }
+    try {
+        Material material =
+            parseMaterialTable(table, "<material " + name + ">", name, std::filesystem::path(s.source).parent_path());
+        *it = std::move(material);
+    } catch (const SceneError& error) {
+        raiseSceneError(error);
+    }
+}
+
+py::list materialNames(const PyScene& s)
+{
+    py::list names;
+    for (const Material& m : s.scene.materials) names.append(m.name);
+    return names;
 }
 
 py::dict cameraOf(const PyScene& s)
@@ -483,6 +511,8 @@ PYBIND11_MODULE(_vkrt, m)
         .def("set_camera", &setCamera, py::arg("eye") = py::none(), py::arg("target") = py::none(),
              py::arg("up") = py::none(), py::arg("fov") = py::none(), py::arg("aperture") = py::none(),
              py::arg("focus_distance") = py::none())
+        .def("set_material", &setMaterial, py::arg("name"), py::arg("table"))
+        .def("materials", &materialNames)
         .def("copy", [](const PyScene& s) { return PyScene(s); })
         .def_readonly("source", &PyScene::source);
 

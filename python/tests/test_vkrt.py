@@ -257,3 +257,39 @@ def test_ctrl_c_stops_render_with_keyboard_interrupt(scene):
     finally:
         timer.cancel()
     assert vkrt.render(scene, spp=1, **SMALL).spp == 1
+
+
+# ---------------------------------------------------------------- materials
+
+def test_a_material_override_equals_the_same_scene_written_out():
+    text = DEFAULT_SCENE.read_text()
+    scene = vkrt.Scene.from_toml(text, base_dir=DEFAULT_SCENE.parent)
+    assert "floor" in scene.materials
+    before = vkrt.render(scene, spp=2, seed=4, **SMALL)
+    scene.set_material("floor", type="phong", diffuse=[0.9, 0.2, 0.1], specular=0.08, shininess=20)
+    after = vkrt.render(scene, spp=2, seed=4, **SMALL)
+    assert not np.array_equal(before.image, after.image)
+
+    start = text.index("[materials.floor]")
+    end = text.index("\n[", start + 1)
+    rewritten = (text[:start] + '[materials.floor]\ntype = "phong"\ndiffuse = [0.9, 0.2, 0.1]\nspecular = 0.08\n'
+                 "shininess = 20\n" + text[end:])
+    written = vkrt.Scene.from_toml(rewritten, base_dir=DEFAULT_SCENE.parent)
+    assert np.array_equal(vkrt.render(written, spp=2, seed=4, **SMALL).image, after.image)
+
+
+def test_a_material_the_parser_refuses_changes_nothing(scene):
+    copy = scene.copy()
+    reference = vkrt.render(copy, spp=1, seed=9, **SMALL).image
+    with pytest.raises(vkrt.SceneError) as caught:
+        copy.set_material("green_matte", type="lambert", albedo=[2.0, 0.0, 0.0])
+    assert caught.value.file == "<material green_matte>"
+    assert caught.value.line == 2 and caught.value.column is not None
+    assert "albedo" in caught.value.message
+    with pytest.raises(vkrt.SceneError, match="unknown"):
+        copy.set_material("green_matte", type="lambert", colour=[0.5, 0.5, 0.5])
+    with pytest.raises(vkrt.SceneError, match="textures"):
+        copy.set_material("green_matte", type="lambert", albedo={"texture": "validation/textures/floor.png"})
+    with pytest.raises(KeyError, match="no material"):
+        copy.set_material("no_such_material", type="lambert")
+    assert np.array_equal(vkrt.render(copy, spp=1, seed=9, **SMALL).image, reference)

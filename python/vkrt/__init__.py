@@ -18,6 +18,7 @@ bit. The GIL is released while the device renders; Ctrl-C stops a render
 between submissions.
 """
 
+import json as _json
 import os as _os
 from pathlib import Path as _Path
 
@@ -110,12 +111,50 @@ class Scene:
         """
         self._native.set_camera(eye, target, up, fov, aperture, focus_distance)
 
+    @property
+    def materials(self):
+        """The names of the scene's materials, in file order."""
+        return self._native.materials()
+
+    def set_material(self, name, **table):
+        """Replace material ``name`` by the one ``table`` describes: the keys
+        of a ``[materials.NAME]`` table of the scene format, ``type``
+        included (docs/scene-format.md), for example
+        ``scene.set_material("red", type="lambert", albedo=[0.9, 0.1, 0.1])``.
+
+        Read by the scene parser, so the same values are accepted and refused
+        (SceneError, located in the table written out as TOML); textures are
+        not accepted here. Raises KeyError for a name the scene lacks.
+        """
+        if "type" not in table:
+            raise ValueError("set_material: give the material's type (and its parameters), as in the scene file")
+        self._native.set_material(name, "".join(f"{key} = {_toml_value(value)}\n" for key, value in table.items()))
+
     def copy(self):
         """An independent copy (meshes and textures are shared, read-only)."""
         return Scene(self._native.copy())
 
     def __repr__(self):
         return f"vkrt.Scene({self.source!r})"
+
+
+def _toml_value(value):
+    """A Python value as a TOML value (numbers, strings, booleans, sequences, mappings)."""
+    if hasattr(value, "tolist"):  # NumPy arrays and scalars
+        value = value.tolist()
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)  # TOML spells the non-finite ones as Python does: inf, -inf, nan
+    if isinstance(value, str):
+        return _json.dumps(value)  # a TOML basic string: the same escapes
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write a {type(value).__name__} as a scene value")
 
 
 class Result:

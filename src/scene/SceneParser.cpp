@@ -72,8 +72,8 @@ RenderSettings readRender(const TableField& table)
 
 // -------------------------------------------------------------------- camera
 
-constexpr std::array<std::string_view, 8> cameraKeys{"eye",    "target", "up",          "fov",
-                                                    "width", "height", "aperture_radius", "focus_distance"};
+constexpr std::array<std::string_view, 8> cameraKeys{
+    "eye", "target", "up", "fov", "width", "height", "aperture_radius", "focus_distance"};
 
 glm::dvec3 readTarget(const Field& field, const glm::dvec3& eye)
 {
@@ -583,6 +583,23 @@ Scene parseSceneString(std::string_view text, const std::string& path)
     scene.fileHash = fnv1a64(text);
     if (textures->recordCount() > 0) scene.textures = std::move(textures);
     return scene;
+}
+
+Material parseMaterialTable(std::string_view text, const std::string& source, const std::string& name,
+                            const std::filesystem::path& baseDir)
+{
+    Scene scratch;
+    MeshGeometryCache meshes;
+    TextureAtlas textures;
+    ParseContext context{scratch, textures, meshes, {}};
+    const TomlSource toml{source, baseDir};
+    const toml::table root = parseToml(text, toml);
+    const Field table(toml, root, "materials." + name);
+    Material material = readMaterial(name, TableField(table), context);
+    // The scene's textures live in one atlas made with the scene; a new one would need a new upload path.
+    if (material.hasTextures() || textures.recordCount() > 0)
+        table.fail("a material set from outside the scene file cannot use textures (write it in the scene file)");
+    return material;
 }
 
 Scene parseSceneFile(const std::string& path) { return parseSceneString(readFileBytes(path, "scene file"), path); }

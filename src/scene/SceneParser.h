@@ -4,6 +4,7 @@
 // every value it gets.
 #include "scene/Scene.h"
 
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -15,5 +16,12 @@ Scene parseSceneFile(const std::string& path);
 /// Same for text in memory; `path` is used in messages and to resolve relative paths (cubemap faces) against its
 /// directory.
 Scene parseSceneString(std::string_view text, const std::string& path = "<string>");
+
+/// One material table (the keys of `[materials.NAME]`, `type` included) as
+/// the scene parser reads it, for a material changed from outside its file
+/// (the Python module). `source` names the text in errors; textures are
+/// refused. Throws SceneError.
+Material parseMaterialTable(std::string_view text, const std::string& source, const std::string& name,
+                            const std::filesystem::path& baseDir = {});
 
 } // namespace vkrt
