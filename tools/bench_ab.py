@@ -5,7 +5,7 @@ Each round renders every scene with every build, in alternating order (the
 order reverses every other round), with seed 100 + round, and measures:
 vkrt's own samples/s, the whole-process wall time, and the MSE against the
 committed Mitsuba reference (tests/references/validation/<scene>/mean.exr,
-through `vkrt compare`). It prints a Markdown table of medians with
+with `vkrt compare`'s MSE, computed by vkrt's Python module). It prints a Markdown table of medians with
 efficiency = 1 / (MSE x whole-process seconds) and its ratio to the first build.
 
 A build is NAME=BINARY, or NAME=BINARY@SHADER_DIR to run a binary on another
@@ -18,8 +18,8 @@ compared without rebuilding:
 Extra arguments for every render go after `--`, e.g. `-- --sampler independent`.
 """
 import argparse
+import json
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -28,6 +28,12 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
+try:
+    import vkrt  # reads the images (docs/python.md)
+except ImportError:  # a build tree: its package
+    sys.path.insert(0, str(REPO / "build" / "python"))
+    import vkrt
+import numpy as np
 
 
 def parse_build(text):
@@ -42,34 +48,28 @@ def parse_build(text):
     return name, binary, shaders
 
 
-def samples_per_second(output):
-    match = re.search(r"([\d.]+) ([kM]?)samples/s", output)
-    if not match:
-        return None
-    return float(match.group(1)) * {"": 1.0, "k": 1e3, "M": 1e6}[match.group(2)]
-
-
 def render(build, scene, spp, seed, out, extra):
+    """vkrt's samples/s (its --json machine output) and the whole process's wall time."""
     name, binary, shaders = build
     env = dict(os.environ)
     if shaders:
         env["VKRT_SHADER_DIR"] = shaders
+    facts = out + ".json"
     start = time.monotonic()
-    result = subprocess.run([binary, "render", str(scene), "--spp", str(spp), "--seed", str(seed), "-o", out] + extra,
-                            capture_output=True, text=True, env=env)
+    result = subprocess.run([binary, "render", str(scene), "--spp", str(spp), "--seed", str(seed), "-o", out,
+                             "--json", facts] + extra, capture_output=True, text=True, env=env)
     wall = time.monotonic() - start
-    rate = samples_per_second(result.stdout + result.stderr)
-    if result.returncode != 0 or rate is None:
+    if result.returncode != 0:
         sys.exit(f"bench_ab: error: build '{name}' failed on {scene}:\n{result.stdout}{result.stderr}")
-    return rate, wall
+    return json.loads(Path(facts).read_text())["samplesPerSecond"], wall
 
 
-def mse_against_reference(compare_binary, image, reference):
-    text = subprocess.run([compare_binary, "compare", image, str(reference)], capture_output=True, text=True).stdout
-    match = re.search(r"RMSE\s+([\d.e+-]+)", text)
-    if not match:
-        sys.exit(f"bench_ab: error: vkrt compare gave no RMSE for {image}:\n{text}")
-    return float(match.group(1)) ** 2
+def mse_against_reference(image, reference):
+    """The MSE of `vkrt compare`: the mean over the values finite in both images of the squared difference."""
+    a = vkrt.read_exr(image)[0]["image"].astype(np.float64)
+    b = vkrt.read_exr(reference)[0]["image"].astype(np.float64)
+    finite = np.isfinite(a) & np.isfinite(b)
+    return float(np.mean((a[finite] - b[finite]) ** 2))
 
 
 def main(argv):
@@ -103,7 +103,7 @@ def main(argv):
                     out = str(Path(tmp) / f"{build[0]}.exr")
                     rate, wall = render(build, REPO / "scenes/validation" / f"{scene}.toml", args.spp,
                                         100 + round_index, out, extra)
-                    mse = mse_against_reference(builds[0][1], out,
+                    mse = mse_against_reference(out,
                                                 REPO / "tests/references/validation" / scene / "mean.exr")
                     results.setdefault((scene, build[0]), []).append((rate, wall, mse))
 

@@ -4,7 +4,7 @@ uses them against a Lambert-only version of the same scene (every conductor,
 rough_dielectric, plastic and pbr material replaced by a lambert of albedo
 0.5; everything else equal), interleaved renders, medians and ratios.
 
-    tools/bench_materials.py [--runs 5] [--spp 256] [--vkrt build/vkrt] [SCENE ...]
+    tools/bench_materials.py [--runs 5] [--spp 256] [--device llvmpipe] [SCENE ...]
 
 Default scenes: scenes/validation/{conductor,plastic,rough-glass,textured}.toml.
 A scene with textures gets a third version: the same materials with every
@@ -13,18 +13,26 @@ textures alone). The versions of a scene are rendered alternately RUNS times
 each (the same seed), so drift on a shared machine hits them alike; kernels
 are compiled before timing. Prints one row per scene: median Msamples/s of
 each and the ratios Lambert / materials (the slowdown the materials cost)
-and constants / textured."""
+and constants / textured.
+
+Renders through the Python module (docs/python.md): the build's package
+(build/python) or an installed one; samples/s is the render's pixels x spp
+over its render seconds (the command line's figure; the kernel compile and
+start-up are not in it)."""
 from __future__ import annotations
 
 import argparse
 import re
 import statistics
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+try:
+    import vkrt
+except ImportError:  # a build tree: its package
+    sys.path.insert(0, str(ROOT / "build" / "python"))
+    import vkrt
 NEW_KINDS = ("conductor", "rough_dielectric", "plastic", "pbr")
 
 
@@ -61,13 +69,11 @@ def untextured(text: str) -> str:
     return TEXTURE_VALUE.sub(lambda m: m.group(1) + "0.5", text)
 
 
-def samples_per_second(vkrt: str, scene: Path, spp: int, out: Path) -> float:
-    result = subprocess.run([vkrt, "render", str(scene), "--spp", str(spp), "--seed", "1", "-o", str(out)],
-                            capture_output=True, text=True, check=True)
-    match = re.search(r"([\d.]+) (k|M)samples/s", result.stdout + result.stderr)
-    if not match:
-        sys.exit(f"bench_materials: no samples/s in vkrt's output: {result.stdout}{result.stderr}")
-    return float(match.group(1)) * (1e-3 if match.group(2) == "k" else 1.0)
+def samples_per_second(scene: "vkrt.Scene", spp: int, device: str) -> float:
+    """Millions of samples per second of one render (seed 1)."""
+    result = vkrt.render(scene, spp=spp, seed=1, device=device)
+    height, width = result.image.shape[:2]
+    return width * height * result.spp / result.render_seconds * 1e-6
 
 
 def main() -> None:
@@ -75,41 +81,32 @@ def main() -> None:
     parser.add_argument("scenes", nargs="*", type=Path)
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--spp", type=int, default=256)
-    parser.add_argument("--vkrt", default=str(ROOT / "build" / "vkrt"))
+    parser.add_argument("--device", default="", help="a device index or part of its name (vkrt.devices())")
     args = parser.parse_args()
     names = ("conductor", "plastic", "rough-glass", "textured")
     scenes = args.scenes or [ROOT / "scenes" / "validation" / f"{n}.toml" for n in names]
     print(f"{'scene':14s} {'materials Ms/s':>15s} {'lambert Ms/s':>13s} {'ratio':>6s} "
           f"{'constants Ms/s':>15s} {'ratio':>6s}")
-    with tempfile.TemporaryDirectory() as tmp:
-        for scene in scenes:
-            text = scene.read_text()
-            # Beside the scene: its relative paths keep working.
-            versions = {"lambert": (scene.parent / f".{scene.stem}-lambert.toml", untextured(lambert_only(text)))}
-            if untextured(text) != text:
-                versions["constants"] = (scene.parent / f".{scene.stem}-constants.toml", untextured(text))
-            for path, body in versions.values():
-                path.write_text(body)
-            try:
-                out = Path(tmp) / "out.exr"
-                files = [scene] + [path for path, _ in versions.values()]
-                for f in files:  # compile every kernel before timing
-                    samples_per_second(args.vkrt, f, 1, out)
-                rates = {f: [] for f in files}
-                for _ in range(args.runs):
-                    for f in files:
-                        rates[f].append(samples_per_second(args.vkrt, f, args.spp, out))
-            finally:
-                for path, _ in versions.values():
-                    path.unlink()
-            median = {f: statistics.median(r) for f, r in rates.items()}
-            a = median[scene]
-            b = median[versions["lambert"][0]]
-            row = f"{scene.stem:14s} {a:15.3f} {b:13.3f} {b / a:6.2f}"
-            if "constants" in versions:
-                c = median[versions["constants"][0]]
-                row += f" {c:15.3f} {c / a:6.2f}"
-            print(row)
+    for path in scenes:
+        text = path.read_text()
+        # Parsed with the scene's folder as base, so its relative paths keep working.
+        versions = {"materials": vkrt.Scene.load(path),
+                    "lambert": vkrt.Scene.from_toml(untextured(lambert_only(text)), base_dir=path.parent)}
+        if untextured(text) != text:
+            versions["constants"] = vkrt.Scene.from_toml(untextured(text), base_dir=path.parent)
+        for scene in versions.values():  # compile every kernel before timing
+            samples_per_second(scene, 1, args.device)
+        rates = {name: [] for name in versions}
+        for _ in range(args.runs):
+            for name, scene in versions.items():
+                rates[name].append(samples_per_second(scene, args.spp, args.device))
+        median = {name: statistics.median(r) for name, r in rates.items()}
+        a, b = median["materials"], median["lambert"]
+        row = f"{path.stem:14s} {a:15.3f} {b:13.3f} {b / a:6.2f}"
+        if "constants" in median:
+            c = median["constants"]
+            row += f" {c:15.3f} {c / a:6.2f}"
+        print(row)
 
 
 if __name__ == "__main__":

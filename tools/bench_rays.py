@@ -22,14 +22,13 @@ sample costs at least its rays.
 
     tools/bench_rays.py [--runs 3] [--spp 16] [--width 320 --height 240] [SCENE.toml ...]
 
-Needs .venv-mitsuba and a vkrt binary ($VKRT, default build/vkrt). Default
-scenes: the validation scenes with meshes.
+Needs .venv-mitsuba and vkrt's Python module (docs/python.md: the build's
+package, build/python, is found without installing). Default scenes: the
+validation scenes with meshes.
 """
 import argparse
-import os
 import re
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -37,6 +36,11 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "tools"))
+try:
+    import vkrt
+except ImportError:  # a build tree: its package
+    sys.path.insert(0, str(REPO / "build" / "python"))
+    import vkrt
 
 
 def rays_only_scene(text):
@@ -60,28 +64,21 @@ def rays_only_scene(text):
     return "\n".join(lines) + "\n"
 
 
-def vkrt_mrays(vkrt, scene, args, work, accel="own"):
-    copy = scene.parent / f".bench_rays_{scene.stem}.toml"  # beside it: relative mesh paths keep working
-    try:
-        copy.write_text(rays_only_scene(scene.read_text()))
-        rates = []
-        for run in range(args.runs + 1):
-            result = subprocess.run([vkrt, "render", str(copy), "--accel", accel, "--spp", str(args.spp),
-                                     "--seed", str(run),
-                                     "--width", str(args.width), "--height", str(args.height), "-o",
-                                     str(Path(work) / "rays.exr")], capture_output=True, text=True)
-            if result.returncode != 0:
-                if accel == "driver" and "lacks" in result.stderr:
-                    return None  # a device without ray queries
-                sys.exit(f"bench_rays: error: vkrt on {scene}:\n{result.stderr}")
-            match = re.search(r"spp\s+([\d.]+) s", result.stdout + result.stderr)
-            if not match:
-                sys.exit(f"bench_rays: error: no rendering time in vkrt's output:\n{result.stdout}")
-            if run > 0:  # the first run fills the caches
-                rates.append(args.width * args.height * args.spp / float(match.group(1)) / 1e6)
-        return statistics.median(rates)
-    finally:
-        copy.unlink(missing_ok=True)
+def vkrt_mrays(scene, args, accel="own"):
+    # Parsed with the scene's folder as base: relative mesh paths keep working.
+    rays_only = vkrt.Scene.from_toml(rays_only_scene(scene.read_text()), base_dir=scene.parent)
+    rates = []
+    for run in range(args.runs + 1):
+        try:
+            result = vkrt.render(rays_only, spp=args.spp, seed=run, width=args.width, height=args.height,
+                                 accel=accel, device=args.device)
+        except ValueError as error:
+            if accel == "driver" and "lacks" in str(error):
+                return None  # a device without ray queries
+            sys.exit(f"bench_rays: error: vkrt on {scene}: {error}")
+        if run > 0:  # the first run fills the caches
+            rates.append(args.width * args.height * args.spp / result.render_seconds / 1e6)
+    return statistics.median(rates)
 
 
 def mitsuba_mrays(scene, args, work):
@@ -120,7 +117,7 @@ def mitsuba_mrays(scene, args, work):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenes", nargs="*", type=Path)
-    parser.add_argument("--vkrt", default=os.environ.get("VKRT", str(REPO / "build" / "vkrt")))
+    parser.add_argument("--device", default="", help="a device index or part of its name (vkrt.devices())")
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--spp", type=int, default=16)
     parser.add_argument("--width", type=int, default=320)
@@ -144,8 +141,8 @@ def main():
         for scene in scenes:
             if not scene.is_file():
                 sys.exit(f"bench_rays: error: {scene}: no such scene file")
-            ours = vkrt_mrays(args.vkrt, scene.resolve(), args, work, accel="own")
-            query = vkrt_mrays(args.vkrt, scene.resolve(), args, work, accel="driver")
+            ours = vkrt_mrays(scene.resolve(), args, accel="own")
+            query = vkrt_mrays(scene.resolve(), args, accel="driver")
             theirs = mitsuba_mrays(scene.resolve(), args, work)
             query_text = f"{query:.2f} | " if query else "— | "
             query_ratio = f"{query / ours:.3f}" if query else "—"

@@ -34,6 +34,9 @@ packages=(
   xvfb xauth
   # the render farm's test runs a real single-node Slurm cluster (tools/slurm/local-cluster.sh)
   slurm-wlm munge
+  # the Python module (python/, docs/python.md): its binding library and headers, NumPy, its tests,
+  # and the virtual environment tools/setup.sh makes (python3-venv; pip for `pip install .`)
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-venv python3-pip
 )
 
 codename=$( (. /etc/os-release && echo "${VERSION_CODENAME:-}") 2>/dev/null || true)

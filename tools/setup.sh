@@ -19,14 +19,29 @@ build_dir=${VKRT_BUILD_DIR:-build}
 jobs=$(nproc)
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVKRT_WERROR=ON
 
+# The Python module's virtual environment .venv: the interpreter the build
+# made the module for, Debian's NumPy (--system-site-packages), and the
+# build's package (build/python) on its path through a .pth file, so that a
+# rebuild needs no reinstall (docs/python.md; `pip install .` makes a wheel instead).
+python_env() {
+  local python site
+  python=$(sed -n 's/^_\{0,1\}Python_EXECUTABLE:[A-Z]*=//p' "$build_dir/CMakeCache.txt" | head -n 1)
+  [[ -x .venv/bin/python ]] || "${python:-python3}" -m venv --system-site-packages .venv
+  site=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+  printf '%s\n' "$(cd "$build_dir" && pwd)/python" >"$site/vkrt-build.pth"
+  echo "Python: .venv/bin/python -c 'import vkrt' (docs/python.md)"
+}
+
 if [[ $mode == render ]]; then
-  # Rendering needs the vkrt executable alone, not the test executables and tools.
-  cmake --build "$build_dir" --parallel "$jobs" --target vkrt
+  # Rendering needs the vkrt executable and the Python module, not the test executables and tools.
+  cmake --build "$build_dir" --parallel "$jobs" --target vkrt _vkrt
   "$build_dir/vkrt" render scenes/default.toml -o default.exr --png default.png
   echo "wrote $root/default.exr and $root/default.png"
+  python_env
 else
   cmake --build "$build_dir" --parallel "$jobs"
   # Tests use lavapipe even where a GPU exists, so results match the references.
   export VKRT_TEST_DEVICE=${VKRT_TEST_DEVICE:-llvmpipe}
+  python_env
   ctest --test-dir "$build_dir" --output-on-failure --parallel "$jobs" --timeout 600
 fi
