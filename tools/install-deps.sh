@@ -37,6 +37,8 @@ packages=(
   # the Python module (python/, docs/python.md): its binding library and headers, NumPy, its tests,
   # and the virtual environment tools/setup.sh makes (python3-venv; pip for `pip install .`)
   pybind11-dev python3-dev python3-numpy python3-pytest python3-venv python3-pip
+  # examples/convergence.py plots with matplotlib (and the suite runs it)
+  python3-matplotlib
 )
 
 codename=$( (. /etc/os-release && echo "${VERSION_CODENAME:-}") 2>/dev/null || true)

@@ -279,6 +279,7 @@ struct PyResult {
     double renderSeconds = 0.0;
     std::string stoppedBy;
     bool interrupted = false;
+    py::object errorEstimate = py::none(); ///< {"rmse", "rel_mse"} from the kernel's variance, or None
 
     void save(const std::filesystem::path& path) const
     {
@@ -289,9 +290,16 @@ struct PyResult {
 
 /// Converts a finished session's output. The arrays copy the pixels once
 /// (the RenderOutput keeps its own for save()).
-std::unique_ptr<PyResult> resultOf(RenderOutput output, const RenderSession& session)
+std::unique_ptr<PyResult> resultOf(RenderOutput output, const std::optional<EstimatedError>& estimated,
+                                   const RenderSession& session)
 {
     auto result = std::make_unique<PyResult>();
+    if (estimated) {
+        py::dict error;
+        error["rmse"] = estimated->rmse;
+        error["rel_mse"] = estimated->relMse;
+        result->errorEstimate = error;
+    }
     const uint32_t w = output.mean.width, h = output.mean.height;
     result->arrays["image"] = imageArray(std::vector<float>(output.mean.rgb), w, h, 3);
     for (const auto& [name, layer] : output.layers)
@@ -412,12 +420,15 @@ public:
     std::unique_ptr<PyResult> result() const
     {
         RenderOutput output;
+        std::optional<EstimatedError> estimated;
         {
             py::gil_scoped_release release;
             std::lock_guard lock(m_device->busy);
-            output = renderOutput(*m_session, m_session->film(), m_arguments.variance, m_aovs);
+            Film film = m_session->film();
+            estimated = film.estimated;
+            output = renderOutput(*m_session, std::move(film), m_arguments.variance, m_aovs);
         }
-        return resultOf(std::move(output), *m_session);
+        return resultOf(std::move(output), estimated, *m_session);
     }
 
     uint32_t spp() const { return m_session->spp(); }
@@ -523,6 +534,7 @@ PYBIND11_MODULE(_vkrt, m)
         .def_readonly("render_seconds", &PyResult::renderSeconds)
         .def_readonly("stopped_by", &PyResult::stoppedBy)
         .def_readonly("interrupted", &PyResult::interrupted)
+        .def_readonly("error_estimate", &PyResult::errorEstimate)
         .def(
             "save", [](const PyResult& r, const std::filesystem::path& path) { translated([&] { r.save(path); }); },
             py::arg("path"));

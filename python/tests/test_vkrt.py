@@ -293,3 +293,33 @@ def test_a_material_the_parser_refuses_changes_nothing(scene):
     with pytest.raises(KeyError, match="no material"):
         copy.set_material("no_such_material", type="lambert")
     assert np.array_equal(vkrt.render(copy, spp=1, seed=9, **SMALL).image, reference)
+
+
+# ---------------------------------------------------------------- stop rules and the example
+
+def test_stop_rules_and_the_error_estimate(scene):
+    by_error = vkrt.render(scene, target_error=0.05, spp=4096, **SMALL)
+    assert by_error.stopped_by == "target-error"
+    assert by_error.error_estimate["rel_mse"] <= 0.05
+    assert by_error.spp < 4096
+    by_time = vkrt.render(scene, time_budget=0.5, **SMALL)
+    assert by_time.stopped_by == "time-budget"
+    assert by_time.render_seconds >= 0.5 and by_time.spp > 0
+    assert vkrt.render(scene, spp=2, **SMALL).error_estimate is None
+
+
+def test_the_convergence_example_follows_one_over_root_n(tmp_path):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("convergence", REPO / "examples" / "convergence.py")
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    rows, last = example.convergence(vkrt.Scene.load(DEFAULT_SCENE), batches=4, spp_per_batch=8, width=48,
+                                     height=36, device=DEVICE)
+    assert [spp for spp, _, _ in rows] == [8, 16, 24, 32]
+    rmse = [e for _, _, e in rows]
+    # An estimate of n samples has RMSE ~ 1 / sqrt(n): 32 spp against 8, half the error (give or take the
+    # estimate's own noise over 48 x 36 x 3 values).
+    assert 0.4 < rmse[-1] / rmse[0] < 0.6
+    out = tmp_path / "convergence.png"
+    example.plot(rows, "default", out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -165,6 +165,12 @@ class Result:
     when the render asked for it. AOVs: ``albedo``, ``normal``, ``position``
     (height, width, 3) and ``depth`` (height, width), each when asked for.
     Absent arrays are None. ``metadata`` holds what the EXR's header gets.
+    ``error_estimate`` is the image's estimated error, ``{"rmse": ...,
+    "rel_mse": ...}``, when the render estimated variance (``variance=True``
+    or ``target_error``), else None. ``spp``, ``render_seconds`` (rendering
+    only: no start-up or kernel compile), ``stopped_by`` ("spp",
+    "time-budget", "target-error", "interrupted") and ``interrupted``
+    describe the run.
     """
 
     def __init__(self, native, interrupted=None):
@@ -181,6 +187,7 @@ class Result:
         self.render_seconds = native.render_seconds
         self.stopped_by = native.stopped_by
         self.interrupted = native.interrupted if interrupted is None else interrupted
+        self.error_estimate = native.error_estimate
 
     def save(self, path):
         """Write the EXR `vkrt render` writes for the same render (mean,

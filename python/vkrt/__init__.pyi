@@ -55,6 +55,7 @@ class Result:
     render_seconds: float
     stopped_by: str
     interrupted: bool
+    error_estimate: Optional[dict[str, float]]
     def save(self, path: _Path) -> None: ...
 
 def render(
