@@ -5,7 +5,7 @@ Each round renders every scene with every build, in alternating order (the
 order reverses every other round), with seed 100 + round, and measures:
 vkrt's own samples/s, the whole-process wall time, and the MSE against the
 committed Mitsuba reference (tests/references/validation/<scene>/mean.exr,
-with `vkrt compare`'s MSE, computed by vkrt's Python module). It prints a Markdown table of medians with
+`vkrt compare`'s MSE, through vkrt's Python module). It prints a Markdown table of medians with
 efficiency = 1 / (MSE x whole-process seconds) and its ratio to the first build.
 
 A build is NAME=BINARY, or NAME=BINARY@SHADER_DIR to run a binary on another
@@ -29,11 +29,10 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 try:
-    import vkrt  # reads the images (docs/python.md)
+    import vkrt  # reads and compares the images (docs/python.md)
 except ImportError:  # a build tree: its package
     sys.path.insert(0, str(REPO / "build" / "python"))
     import vkrt
-import numpy as np
 
 
 def parse_build(text):
@@ -65,11 +64,8 @@ def render(build, scene, spp, seed, out, extra):
 
 
 def mse_against_reference(image, reference):
-    """The MSE of `vkrt compare`: the mean over the values finite in both images of the squared difference."""
-    a = vkrt.read_exr(image)[0]["image"].astype(np.float64)
-    b = vkrt.read_exr(reference)[0]["image"].astype(np.float64)
-    finite = np.isfinite(a) & np.isfinite(b)
-    return float(np.mean((a[finite] - b[finite]) ** 2))
+    """The MSE `vkrt compare` reports."""
+    return vkrt.measure_error(vkrt.read_exr(image)[0]["image"], vkrt.read_exr(reference)[0]["image"])["mse"]
 
 
 def main(argv):

@@ -332,10 +332,6 @@ def derived_reference(args, runner, scene: Scene, work: Path):
 # Running the renderers
 # ----------------------------------------------------------------------------
 
-SUMMARY = re.compile(r"(\d+) spp\s+([\d.]+) s\s+([\d.]+) ([kMG]?)samples/s")
-UNITS = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
-
-
 class Runner:
     def __init__(self, args, work: Path):
         self.args = args
@@ -360,23 +356,20 @@ class Runner:
         return seconds, p.stdout + p.stderr
 
     def vkrt_render(self, scene: Scene, size, spp, seed, out, env=None):
+        facts = Path(str(out) + ".json")
         cmd = [self.vkrt, "render", str(scene.vkrt_path), "-o", str(out), "--spp", str(spp),
-               "--width", str(size[0]), "--height", str(size[1]), "--seed", str(seed)]
+               "--width", str(size[0]), "--height", str(size[1]), "--seed", str(seed), "--json", str(facts)]
         if self.args.vkrt_sampler != "auto":
             cmd += ["--sampler", self.args.vkrt_sampler]
-        whole, text = self._run(cmd, env, "vkrt render")
-        m = SUMMARY.search(text)
-        if not m:
-            fail(f"no summary line in vkrt's output:\n{text}", 1)
-        su = re.search(r"start-up ([\d.]+) s", text)
-        return {"whole": whole, "cpu": self.last_cpu, "render": float(m.group(2)),
-                "reported_rate": float(m.group(3)) * UNITS[m.group(4)],
-                "startup": float(su.group(1)) if su else None}
+        whole, _ = self._run(cmd, env, "vkrt render")
+        j = json.loads(facts.read_text())  # vkrt's machine output (docs/machine-output.md)
+        return {"whole": whole, "cpu": self.last_cpu, "render": j["renderSeconds"],
+                "reported_rate": j["samplesPerSecond"], "startup": j["startupSeconds"]}
 
     def vkrt_first_frame(self, scene: Scene):
-        whole, text = self._run([self.vkrt, "info", str(scene.vkrt_path)], None, "vkrt info")
-        m = re.search(r"first frame:\s*([\d.]+) s", text)
-        return float(m.group(1)) if m else None
+        facts = self.work / "info.json"
+        self._run([self.vkrt, "info", str(scene.vkrt_path), "--json", str(facts)], None, "vkrt info")
+        return json.loads(facts.read_text()).get("firstFrameSeconds")
 
     def mitsuba_render(self, scene: Scene, size, spp, seed, out, env=None, sampler="independent"):
         cmd = [self.python, "-c", MITSUBA_CHILD, self.variant, str(scene.xml[(size, sampler)]), str(out), str(spp),
@@ -390,14 +383,20 @@ class Runner:
         return {"whole": whole, "cpu": self.last_cpu, "render": t["render"], "import": t["import"], "load": t["load"]}
 
     def mse(self, image, reference):
-        p = subprocess.run([self.vkrt, "compare", str(image), str(reference)], capture_output=True, text=True)
-        if p.returncode not in (0, 4):
-            fail(f"vkrt compare failed (exit {p.returncode}):\n{p.stdout}{p.stderr}", 1)
-        rmse = re.search(r"^RMSE\s+(\S+)", p.stdout, re.M)
-        rel = re.search(r"^relMSE\s+(\S+)", p.stdout, re.M)
-        if not rmse:
-            fail(f"cannot read vkrt compare's output:\n{p.stdout}", 1)
-        return float(rmse.group(1)) ** 2, float(rel.group(1)) if rel else None
+        """MSE and relMSE as `vkrt compare` measures them, through vkrt's Python module."""
+        vkrt = import_vkrt()
+        e = vkrt.measure_error(vkrt.read_exr(image)[0]["image"], vkrt.read_exr(reference)[0]["image"])
+        return e["mse"], e["rel_mse"]
+
+
+def import_vkrt():
+    """vkrt's Python module (docs/python.md): installed, or the build tree's package."""
+    try:
+        import vkrt
+    except ImportError:
+        sys.path.insert(0, str(REPO / "build" / "python"))
+        import vkrt
+    return vkrt
 
 
 def cold_env(base: dict, root: Path) -> dict:

@@ -5,6 +5,7 @@
 // adds the progressive generator and the documentation.
 #include "gpu/VulkanContext.h"
 #include "io/ExrFile.h"
+#include "render/ErrorMetrics.h"
 #include "render/GpuScene.h"
 #include "render/KernelVariant.h"
 #include "render/RenderOutput.h"
@@ -563,6 +564,35 @@ PYBIND11_MODULE(_vkrt, m)
         .def_property_readonly("spp", &PySession::spp);
 
     m.def("devices", [] { return translated([] { return listDevices(); }); });
+
+    m.def(
+        "measure_error",
+        [](py::array_t<float, py::array::c_style | py::array::forcecast> image,
+           py::array_t<float, py::array::c_style | py::array::forcecast> reference) {
+            const auto imageOf = [](const py::array_t<float, py::array::c_style | py::array::forcecast>& a,
+                                    const char* what) {
+                if (a.ndim() != 3 || a.shape(2) != 3)
+                    throw py::value_error(std::string(what) + ": expected an array of shape (height, width, 3)");
+                Image out(uint32_t(a.shape(1)), uint32_t(a.shape(0)));
+                std::copy(a.data(), a.data() + a.size(), out.rgb.begin());
+                return out;
+            };
+            const Image a = imageOf(image, "image"), b = imageOf(reference, "reference");
+            if (a.width != b.width || a.height != b.height)
+                throw py::value_error("image and reference: different shapes");
+            const MeasuredError e = measureError(a, b);
+            py::dict out;
+            out["rmse"] = e.rmse;
+            out["mse"] = e.rmse * e.rmse;
+            out["rel_mse"] = e.relMse;
+            out["mape"] = e.mape;
+            out["max_abs"] = e.maxAbs;
+            out["compared"] = e.compared;
+            out["non_finite_image"] = e.nonFiniteA;
+            out["non_finite_reference"] = e.nonFiniteB;
+            return out;
+        },
+        py::arg("image"), py::arg("reference"));
 
     m.def(
         "read_exr",

@@ -30,7 +30,7 @@ if (_PACKAGED_SHADERS / "kernels").is_dir():
 
 from . import _vkrt  # noqa: E402
 
-__all__ = ["Scene", "Result", "SceneError", "VkrtError", "render", "progressive", "devices", "read_exr", "AOVS"]
+__all__ = ["Scene", "Result", "SceneError", "VkrtError", "render", "progressive", "devices", "read_exr", "measure_error", "AOVS"]
 
 SceneError = _vkrt.SceneError
 SceneError.__doc__ = """A scene that vkrt refuses.
@@ -279,3 +279,12 @@ def read_exr(path):
     are under their names; ``metadata`` holds vkrt's header attributes.
     Raises ValueError naming the file when it is missing or damaged."""
     return _vkrt.read_exr(_os.fspath(path))
+
+
+def measure_error(image, reference):
+    """The error of ``image`` against ``reference`` (arrays of shape (height,
+    width, 3)) as `vkrt compare` measures it, over the values finite in both:
+    a dict with ``rmse``, ``mse``, ``rel_mse`` (squared difference over
+    reference squared plus a small epsilon), ``mape``, ``max_abs``,
+    ``compared`` and the counts of non-finite values in each."""
+    return _vkrt.measure_error(image, reference)
