@@ -204,25 +204,26 @@ struct Device {
 };
 
 std::mutex g_devicesMutex;
-std::map<std::string, std::unique_ptr<Device>>& openDevices()
+std::map<std::string, std::shared_ptr<Device>>& openDevices()
 {
-    static std::map<std::string, std::unique_ptr<Device>> devices;
+    static std::map<std::string, std::shared_ptr<Device>> devices;
     return devices;
 }
 
-/// The device for `selector` (called without the GIL).
-Device& deviceFor(const std::string& selector)
+/// The device for `selector` (called without the GIL). Sessions hold it, so
+/// it outlives the map's entry (cleared at exit) while one is alive.
+std::shared_ptr<Device> deviceFor(const std::string& selector)
 {
     std::lock_guard lock(g_devicesMutex);
     auto& devices = openDevices();
     auto it = devices.find(selector);
-    if (it != devices.end()) return *it->second;
-    auto device = std::make_unique<Device>();
+    if (it != devices.end()) return it->second;
+    auto device = std::make_shared<Device>();
     device->context = std::make_unique<VulkanContext>(ContextOptions{selector, false, std::nullopt});
-    return *devices.emplace(selector, std::move(device)).first->second;
+    return devices.emplace(selector, std::move(device)).first->second;
 }
 
-py::list listDevices()
+py::list listVulkanDevicesForPython()
 {
     std::vector<DeviceInfo> devices;
     {
@@ -386,7 +387,7 @@ public:
         Scene copy = sceneFor(scene, m_arguments);
         SessionConfig config = configFor(m_arguments, &m_interrupt);
         py::gil_scoped_release release;
-        m_device = &deviceFor(m_arguments.device);
+        m_device = deviceFor(m_arguments.device);
         std::lock_guard lock(m_device->busy);
         m_session = std::make_unique<RenderSession>(*m_device->context, std::move(copy), std::move(config));
     }
@@ -434,10 +435,21 @@ public:
 
     uint32_t spp() const { return m_session->spp(); }
 
+    /// The session's GPU objects go while no other session uses the device
+    /// (another thread may be rendering on its queue).
+    ~PySession()
+    {
+        py::gil_scoped_release release;
+        std::lock_guard lock(m_device->busy);
+        m_session.reset(); // before the device it was made on
+    }
+    PySession(const PySession&) = delete;
+    PySession& operator=(const PySession&) = delete;
+
 private:
     RenderArguments m_arguments;
     std::vector<std::string> m_aovs;
-    Device* m_device = nullptr;
+    std::shared_ptr<Device> m_device;
     std::unique_ptr<RenderSession> m_session;
     std::atomic<bool> m_interrupt{false};
     std::unique_ptr<py::error_already_set> m_pendingError;
@@ -563,7 +575,15 @@ PYBIND11_MODULE(_vkrt, m)
         .def("result", [](const PySession& s) { return translated([&] { return s.result(); }); })
         .def_property_readonly("spp", &PySession::spp);
 
-    m.def("devices", [] { return translated([] { return listDevices(); }); });
+    m.def("devices", [] { return translated([] { return listVulkanDevicesForPython(); }); });
+
+    // The devices' Vulkan contexts go before the interpreter does, not in
+    // static destruction, after the driver's own threads may have stopped.
+    py::module_::import("atexit").attr("register")(py::cpp_function([] {
+        py::gil_scoped_release release;
+        std::lock_guard lock(g_devicesMutex);
+        openDevices().clear();
+    }));
 
     m.def(
         "measure_error",

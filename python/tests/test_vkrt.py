@@ -323,3 +323,20 @@ def test_the_convergence_example_follows_one_over_root_n(tmp_path):
     out = tmp_path / "convergence.png"
     example.plot(rows, "default", out)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_session_alive_at_exit_ends_cleanly():
+    # A progressive render left half done in a global: its session outlives
+    # the module's exit handler and goes during the interpreter's shutdown.
+    script = (
+        "import vkrt\n"
+        f"scene = vkrt.Scene.load({str(DEFAULT_SCENE)!r})\n"
+        f"frames = vkrt.progressive(scene, batches=4, width=32, height=24, device={DEVICE!r})\n"
+        "first = next(frames)\n"
+        "print(first.spp)\n"
+    )
+    import sys
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "1"
