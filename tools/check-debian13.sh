@@ -258,6 +258,17 @@ run_step() { # NAME COMMAND...
 }
 
 run_step setup-render tools/setup.sh render || true
+# The Python module from the environment the set-up made (docs/python.md): it
+# imports, and its image equals `vkrt render`'s at the same seed, bit for bit.
+run_step python-module .venv/bin/python -c "
+import subprocess, numpy, vkrt
+r = vkrt.render(vkrt.Scene.load('scenes/default.toml'), spp=4, seed=3)
+print(r.image.shape)
+subprocess.run(['build/vkrt', 'render', 'scenes/default.toml', '--spp', '4', '--seed', '3', '-o', 'python-check.exr'],
+               check=True)
+assert numpy.array_equal(r.image, vkrt.read_exr('python-check.exr')[0]['image']), 'the images differ'
+print('equal to vkrt render')
+" || true
 run_step setup-test tools/setup.sh test || true
 
 version_of() { in_chroot dpkg-query -W -f='${Version}' "$1" 2>/dev/null || echo "not installed"; }
