@@ -255,15 +255,21 @@ py::list listVulkanDevicesForPython()
 
 // ---------------------------------------------------------------- results
 
-/// A float32 array of shape (height, width, channels) that owns `values`
-/// (moved, not copied).
+/// A float32 array of shape (height, width, channels), or (height, width)
+/// for one channel, over `data`, which `owner` keeps alive: no copy.
+py::array_t<float> imageArray(const float* data, uint32_t width, uint32_t height, uint32_t channels, py::capsule owner)
+{
+    const py::ssize_t w = width, h = height, c = channels, f = sizeof(float);
+    if (channels == 1) return py::array_t<float>({h, w}, {w * f, f}, data, owner);
+    return py::array_t<float>({h, w, c}, {w * c * f, c * f, f}, data, owner);
+}
+
+/// The same over `values`, moved into the array's keeping.
 py::array_t<float> imageArray(std::vector<float>&& values, uint32_t width, uint32_t height, uint32_t channels)
 {
     auto* owned = new std::vector<float>(std::move(values));
     py::capsule free(owned, [](void* p) { delete static_cast<std::vector<float>*>(p); });
-    const py::ssize_t w = width, h = height, c = channels, f = sizeof(float);
-    if (channels == 1) return py::array_t<float>({h, w}, {w * f, f}, owned->data(), free);
-    return py::array_t<float>({h, w, c}, {w * c * f, c * f, f}, owned->data(), free);
+    return imageArray(owned->data(), width, height, channels, free);
 }
 
 py::object metadataValue(const MetadataValue& value)
@@ -274,7 +280,7 @@ py::object metadataValue(const MetadataValue& value)
 /// What render() and a session's snapshot return: the EXR's contents, with
 /// NumPy views for Python, and the means to write it as `vkrt render` does.
 struct PyResult {
-    RenderOutput output;
+    std::shared_ptr<const RenderOutput> output;
     py::dict arrays; ///< "image", "variance", "albedo", "normal", "position", "depth"
     py::dict metadata;
     uint32_t spp = 0;
@@ -286,13 +292,13 @@ struct PyResult {
     void save(const std::filesystem::path& path) const
     {
         py::gil_scoped_release release;
-        writeRenderOutput(path, output);
+        writeRenderOutput(path, *output);
     }
 };
 
-/// Converts a finished session's output. The arrays copy the pixels once
-/// (the RenderOutput keeps its own for save()).
-std::unique_ptr<PyResult> resultOf(RenderOutput output, const std::optional<EstimatedError>& estimated,
+/// Converts a finished session's output. The arrays are read-only views of
+/// the pixels save() writes (no copy): each holds a reference to them.
+std::unique_ptr<PyResult> resultOf(RenderOutput rendered, const std::optional<EstimatedError>& estimated,
                                    const RenderSession& session)
 {
     auto result = std::make_unique<PyResult>();
@@ -302,23 +308,30 @@ std::unique_ptr<PyResult> resultOf(RenderOutput output, const std::optional<Esti
         error["rel_mse"] = estimated->relMse;
         result->errorEstimate = error;
     }
-    const uint32_t w = output.mean.width, h = output.mean.height;
-    result->arrays["image"] = imageArray(std::vector<float>(output.mean.rgb), w, h, 3);
-    for (const auto& [name, layer] : output.layers)
-        result->arrays[py::str(name)] = imageArray(std::vector<float>(layer.rgb), w, h, 3);
+    auto shared = std::make_shared<const RenderOutput>(std::move(rendered));
+    result->output = shared;
+    const RenderOutput& output = *shared;
+    const auto view = [&](const std::vector<float>& values, uint32_t channels) {
+        auto* keep = new std::shared_ptr<const RenderOutput>(shared);
+        py::capsule owner(keep, [](void* p) { delete static_cast<std::shared_ptr<const RenderOutput>*>(p); });
+        py::array_t<float> array = imageArray(values.data(), output.mean.width, output.mean.height, channels, owner);
+        // Read-only: save() writes these very pixels, so a change would leak into the file.
+        py::detail::array_proxy(array.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+        return array;
+    };
+    result->arrays["image"] = view(output.mean.rgb, 3);
+    for (const auto& [name, layer] : output.layers) result->arrays[py::str(name)] = view(layer.rgb, 3);
     for (const ExrChannels& channels : output.channels) {
         const std::string name = channels.names[0] == "Z"     ? "depth"
                                  : channels.names[0] == "N.X" ? "normal"
                                                               : "position";
-        result->arrays[py::str(name)] =
-            imageArray(std::vector<float>(channels.values), w, h, uint32_t(channels.names.size()));
+        result->arrays[py::str(name)] = view(channels.values, uint32_t(channels.names.size()));
     }
     for (const auto& [key, value] : output.metadata) result->metadata[py::str(key)] = metadataValue(value);
     result->spp = session.spp();
     result->renderSeconds = session.renderSeconds();
     if (session.stoppedBy()) result->stoppedBy = stopReasonName(*session.stoppedBy());
     result->interrupted = session.outcome().kind == OutcomeKind::Interrupted;
-    result->output = std::move(output);
     return result;
 }
 
@@ -434,6 +447,9 @@ public:
     }
 
     uint32_t spp() const { return m_session->spp(); }
+
+    /// Asks a running loop to stop after its current submission (from a signal handler).
+    void interrupt() { m_interrupt = true; }
 
     /// The session's GPU objects go while no other session uses the device
     /// (another thread may be rendering on its queue).
@@ -573,6 +589,7 @@ PYBIND11_MODULE(_vkrt, m)
             "run_frames", [](PySession& s, uint32_t frames) { translated([&] { s.runFrames(frames); }); },
             py::arg("frames"))
         .def("result", [](const PySession& s) { return translated([&] { return s.result(); }); })
+        .def("interrupt", &PySession::interrupt)
         .def_property_readonly("spp", &PySession::spp);
 
     m.def("devices", [] { return translated([] { return listVulkanDevicesForPython(); }); });

@@ -115,6 +115,11 @@ def test_shapes_and_dtypes(scene):
     assert r.metadata["aovs"] == "albedo,depth,normal,position"
     plain = vkrt.render(scene, spp=1, **SMALL)
     assert plain.variance is None and plain.depth is None
+    # Views of the pixels save() writes (no copy), so read-only.
+    assert not r.image.flags.owndata and not r.image.flags.writeable
+    with pytest.raises(ValueError, match="read-only"):
+        r.image[0, 0, 0] = 1.0
+    assert np.array_equal(r.image.copy(), r.image)
 
 
 def test_the_image_equals_vkrt_render_bit_for_bit(scene, tmp_path):
@@ -233,13 +238,16 @@ def interrupt_after(seconds):
 
 
 def test_ctrl_c_stops_progressive_with_the_image_so_far(scene):
-    timer = interrupt_after(1.0)
+    # The signal comes once rendering runs (a Ctrl-C while the session is
+    # made, before any frame, raises KeyboardInterrupt like any other call).
+    timer = None
     frames = []
     try:
         for frame in vkrt.progressive(scene, batches=100000, spp_per_batch=1, seed=1, **SMALL):
             frames.append(frame)
+            timer = timer or interrupt_after(1.0)
     finally:
-        timer.cancel()
+        timer and timer.cancel()
     assert frames, "nothing rendered before the interrupt"
     last = frames[-1]
     assert last.interrupted
@@ -247,6 +255,22 @@ def test_ctrl_c_stops_progressive_with_the_image_so_far(scene):
     assert np.isfinite(last.image).all() and last.image.max() > 0
     # The device is still usable.
     assert vkrt.render(scene, spp=1, **SMALL).spp == 1
+
+
+def test_ctrl_c_in_the_loop_body_also_stops_progressive_cleanly(scene):
+    import time
+    timer = None
+    frames = []
+    try:
+        for frame in vkrt.progressive(scene, batches=1000, spp_per_batch=1, seed=1, **SMALL):
+            frames.append(frame)
+            timer = timer or interrupt_after(0.5)
+            time.sleep(0.2)  # most of the time is spent here, outside the render
+    finally:
+        timer and timer.cancel()
+    assert frames[-1].interrupted and 0 < frames[-1].spp < 1000
+    assert [f.spp for f in frames[:-1]] == list(range(1, len(frames)))
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
 
 
 def test_ctrl_c_stops_render_with_keyboard_interrupt(scene):

@@ -20,6 +20,8 @@ between submissions.
 
 import json as _json
 import os as _os
+import signal as _signal
+import threading as _threading
 from pathlib import Path as _Path
 
 # An installed wheel carries the kernels' GLSL beside the module; a build tree
@@ -240,28 +242,62 @@ def render(scene, spp=None, width=None, height=None, seed=0, sampler="auto", int
     return Result(session.result())
 
 
+class _FirstCtrlCStops:
+    """While active (in the main thread), the first SIGINT asks the session to
+    stop after its current submission instead of raising, and a second one
+    raises KeyboardInterrupt as usual: the command line's Ctrl-C."""
+
+    def __init__(self, session):
+        self._session = session
+        self._previous = None
+        self.requested = False
+
+    def _handle(self, signum, frame):
+        self.requested = True
+        self._session.interrupt()
+        _signal.signal(_signal.SIGINT, self._previous)  # the second Ctrl-C: the usual KeyboardInterrupt
+
+    def __enter__(self):
+        if _threading.current_thread() is _threading.main_thread():
+            self._previous = _signal.signal(_signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc):
+        if self._previous is not None and _signal.getsignal(_signal.SIGINT) == self._handle:
+            _signal.signal(_signal.SIGINT, self._previous)
+        return False
+
+
 def progressive(scene, batches=8, spp_per_batch=1, width=None, height=None, seed=0, sampler="auto",
                 integrator=None, device="", variance=False, aovs=(), accel="auto"):
     """Render ``scene`` in ``batches`` batches of ``spp_per_batch`` samples
     per pixel, yielding a :class:`Result` with the running mean after each.
 
     The samples are the same as one render of ``batches * spp_per_batch``
-    spp (the last result equals :func:`render`'s at that spp and seed). On
-    Ctrl-C the generator stops cleanly: it yields a last result holding the
-    samples finished so far, with ``interrupted`` set, and ends.
+    spp (the last result equals :func:`render`'s at that spp and seed).
+
+    Ctrl-C (in the main thread) stops cleanly, whether it comes while a batch
+    renders or while the loop's body runs: the render stops after its
+    current submission, the generator yields a last result holding the
+    samples finished so far with ``interrupted`` set, and ends. A second
+    Ctrl-C raises KeyboardInterrupt.
     """
     if batches < 1 or spp_per_batch < 1:
         raise ValueError("batches and spp_per_batch: must be at least 1")
     session = _session(scene, batches * spp_per_batch, width, height, seed, sampler, integrator, device, None, None,
                        variance, aovs, accel)
-    for _ in range(batches):
-        try:
-            session.run_frames(spp_per_batch)
-        except KeyboardInterrupt:
-            if session.spp > 0:
-                yield Result(session.result(), interrupted=True)
-            return
-        yield Result(session.result())
+    with _FirstCtrlCStops(session) as ctrl_c:
+        for _ in range(batches):
+            try:
+                if not ctrl_c.requested:
+                    session.run_frames(spp_per_batch)
+            except KeyboardInterrupt:  # outside the main thread: Python's own handler raised it
+                ctrl_c.requested = True
+            if ctrl_c.requested:
+                if session.spp > 0:
+                    yield Result(session.result(), interrupted=True)
+                return
+            yield Result(session.result())
 
 
 def devices():
