@@ -64,10 +64,10 @@ PyObject* g_vkrtError = nullptr;
 // ---------------------------------------------------------------- scenes
 
 /// A parsed, validated scene. Python's Scene wraps one; changes from
-/// Python (the camera) are checked with the parser's own rules.
+/// Python (camera, materials) are checked with the parser's own rules.
 struct PyScene {
     Scene scene;
-    std::string source; ///< the file, or "<string>"
+    std::string source; ///< the file, or "<base_dir>/<string>" for text
 };
 
 PyScene loadSceneFile(const std::filesystem::path& path)
@@ -137,16 +137,8 @@ void setCamera(PyScene& s, std::optional<Vec3> eye, std::optional<Vec3> target, 
     if (target) camera.target = toVec(*target);
     if (up) camera.up = toVec(*up);
     if (fov) camera.fovY = *fov;
-    if (aperture) {
-        if (!(*aperture >= 0.0) || !std::isfinite(*aperture))
-            throw py::value_error("aperture: must be a finite radius >= 0, got " + std::to_string(*aperture));
-        camera.apertureRadius = *aperture;
-    }
-    if (focusDistance) {
-        if (!(*focusDistance > 0.0) || !std::isfinite(*focusDistance))
-            throw py::value_error("focus_distance: must be finite and > 0, got " + std::to_string(*focusDistance));
-        camera.focusDistance = *focusDistance;
-    }
+    if (aperture) camera.apertureRadius = *aperture;
+    if (focusDistance) camera.focusDistance = *focusDistance;
     if (const std::optional<std::string> problem = cameraProblem(camera)) throw py::value_error("camera: " + *problem);
     s.scene.camera = camera;
 }
@@ -321,12 +313,9 @@ std::unique_ptr<PyResult> resultOf(RenderOutput rendered, const std::optional<Es
     };
     result->arrays["image"] = view(output.mean.rgb, 3);
     for (const auto& [name, layer] : output.layers) result->arrays[py::str(name)] = view(layer.rgb, 3);
-    for (const ExrChannels& channels : output.channels) {
-        const std::string name = channels.names[0] == "Z"     ? "depth"
-                                 : channels.names[0] == "N.X" ? "normal"
-                                                              : "position";
-        result->arrays[py::str(name)] = view(channels.values, uint32_t(channels.names.size()));
-    }
+    for (size_t k = 0; k < output.channels.size(); ++k)
+        result->arrays[py::str(output.channelAovs[k])] =
+            view(output.channels[k].values, uint32_t(output.channels[k].names.size()));
     for (const auto& [key, value] : output.metadata) result->metadata[py::str(key)] = metadataValue(value);
     result->spp = session.spp();
     result->renderSeconds = session.renderSeconds();
@@ -384,9 +373,7 @@ SessionConfig configFor(const RenderArguments& a, const std::atomic<bool>* inter
         throw py::value_error("target_error: must be > 0 and finite");
     config.variance = {a.variance, a.targetError.has_value()};
     config.aov = !a.aovs.empty();
-    // --spp caps the render; without it a time or error rule may run long.
-    const uint32_t maxSpp = a.spp ? *a.spp : (a.timeBudget || a.targetError) ? (1u << 30) : 64u;
-    config.stop = {maxSpp, a.timeBudget, a.targetError, interrupt};
+    config.stop = {sppCap(a.spp, a.timeBudget || a.targetError), a.timeBudget, a.targetError, interrupt};
     return config;
 }
 
@@ -408,28 +395,14 @@ public:
     /// Renders to the stop rules; Ctrl-C (checked between submissions) stops it with the image so far.
     void run()
     {
-        m_interrupt = false;
-        const RunHooks hooks = signalHooks();
-        {
-            py::gil_scoped_release release;
-            std::lock_guard lock(m_device->busy);
-            m_session->run(hooks);
-        }
-        rethrowPending();
+        withSignals([this](const RunHooks& hooks) { m_session->run(hooks); });
     }
 
     /// Renders `frames` more samples per pixel (outside the stop rules but
     /// Ctrl-C); KeyboardInterrupt leaves the frames done so far in the film.
     void runFrames(uint32_t frames)
     {
-        m_interrupt = false;
-        const RunHooks hooks = signalHooks();
-        {
-            py::gil_scoped_release release;
-            std::lock_guard lock(m_device->busy);
-            m_session->runFrames(frames, hooks);
-        }
-        rethrowPending();
+        withSignals([this, frames](const RunHooks& hooks) { m_session->runFrames(frames, hooks); });
     }
 
     std::unique_ptr<PyResult> result() const
@@ -470,11 +443,13 @@ private:
     std::atomic<bool> m_interrupt{false};
     std::unique_ptr<py::error_already_set> m_pendingError;
 
-    /// Python's signal handlers run between submissions: Ctrl-C sets the
-    /// interrupt the render loop polls, and its KeyboardInterrupt is raised
-    /// once the loop has stopped.
-    RunHooks signalHooks()
+    /// Runs `loop` on the device without the GIL. Python's signal handlers
+    /// run between submissions: Ctrl-C sets the interrupt the render loop
+    /// polls, and its KeyboardInterrupt is raised once the loop has stopped.
+    template <class Loop>
+    void withSignals(const Loop& loop)
     {
+        m_interrupt = false;
         RunHooks hooks;
         hooks.onProgress = [this](uint32_t) {
             py::gil_scoped_acquire acquire;
@@ -483,36 +458,17 @@ private:
                 m_pendingError = std::make_unique<py::error_already_set>();
             }
         };
-        return hooks;
-    }
-
-    void rethrowPending()
-    {
+        {
+            py::gil_scoped_release release;
+            std::lock_guard lock(m_device->busy);
+            loop(hooks);
+        }
         if (!m_pendingError) return;
         std::unique_ptr<py::error_already_set> error = std::move(m_pendingError);
         error->restore();
         throw py::error_already_set();
     }
 };
-
-RenderArguments argumentsOf(std::optional<uint32_t> spp, std::optional<uint32_t> width, std::optional<uint32_t> height,
-                            uint32_t seed, std::string sampler, std::optional<std::string> integrator,
-                            std::string device, std::optional<double> timeBudget, std::optional<double> targetError,
-                            bool variance, std::vector<std::string> aovs, std::string accel)
-{
-    return RenderArguments{spp,
-                           width,
-                           height,
-                           seed,
-                           std::move(sampler),
-                           std::move(integrator),
-                           std::move(device),
-                           timeBudget,
-                           targetError,
-                           variance,
-                           std::move(aovs),
-                           std::move(accel)};
-}
 
 /// Runs `body`, turning vkrt's C++ errors into Python ones.
 template <class Body>
@@ -538,7 +494,7 @@ PYBIND11_MODULE(_vkrt, m)
     using namespace vkrt;
     m.doc() = "vkrt's C++ side; use the vkrt package (docs/python.md).";
 
-    static py::exception<InputError> vkrtError(m, "VkrtError", PyExc_RuntimeError);
+    static py::exception<GpuError> vkrtError(m, "VkrtError", PyExc_RuntimeError);
     g_vkrtError = vkrtError.ptr();
     static py::exception<SceneError> sceneError(m, "SceneError", PyExc_ValueError);
     g_sceneError = sceneError.ptr();
@@ -575,10 +531,11 @@ PYBIND11_MODULE(_vkrt, m)
                          std::optional<double> targetError, bool variance, std::vector<std::string> aovs,
                          std::string accel) {
                  return translated([&] {
-                     return std::make_unique<PySession>(scene, argumentsOf(spp, width, height, seed, std::move(sampler),
-                                                                           std::move(integrator), std::move(device),
-                                                                           timeBudget, targetError, variance,
-                                                                           std::move(aovs), std::move(accel)));
+                     return std::make_unique<PySession>(scene,
+                                                        RenderArguments{spp, width, height, seed, std::move(sampler),
+                                                                        std::move(integrator), std::move(device),
+                                                                        timeBudget, targetError, variance,
+                                                                        std::move(aovs), std::move(accel)});
                  });
              }),
              py::arg("scene"), py::arg("spp"), py::arg("width"), py::arg("height"), py::arg("seed"), py::arg("sampler"),

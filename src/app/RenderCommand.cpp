@@ -36,7 +36,7 @@ namespace {
 struct RenderCommandOptions {
     std::string scenePath;
     std::string output;
-    uint32_t spp = 64;
+    uint32_t spp = kDefaultSpp;
     std::optional<uint32_t> width;
     std::optional<uint32_t> height;
     uint32_t seed = 0;
@@ -64,7 +64,10 @@ struct RenderCommandOptions {
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
-    uint32_t maxSpp() const { return sppGiven || !(timeBudget || targetError) ? spp : (1u << 30); }
+    uint32_t maxSpp() const
+    {
+        return sppCap(sppGiven ? std::optional<uint32_t>(spp) : std::nullopt, timeBudget || targetError);
+    }
 };
 
 bool environmentFlag(const char* name)

@@ -13,6 +13,17 @@
 
 namespace vkrt {
 
+/// Samples per pixel when a render names none and has no time or error rule.
+constexpr uint32_t kDefaultSpp = 64;
+
+/// The spp cap of a render (`--spp`, Python's `spp=`): the one given; else
+/// none to speak of (2^30) when a time budget or target error will stop it,
+/// else kDefaultSpp.
+constexpr uint32_t sppCap(std::optional<uint32_t> spp, bool timeOrErrorRule)
+{
+    return spp ? *spp : timeOrErrorRule ? (1u << 30) : kDefaultSpp;
+}
+
 /// When a render stops: whichever rule fires first.
 struct StopRules {
     uint32_t maxSpp = 64;

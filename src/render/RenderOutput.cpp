@@ -51,10 +51,14 @@ RenderOutput renderOutput(const RenderSession& session, Film film, bool variance
     if (aovs.empty()) return out;
     const AovImages images = session.renderer().aovs();
     for (const std::string& name : aovs) {
-        if (name == "albedo") out.layers["albedo"] = images.albedo;
+        if (name == "albedo") {
+            out.layers["albedo"] = images.albedo;
+            continue;
+        }
         if (name == "normal") out.channels.push_back({{"N.X", "N.Y", "N.Z"}, images.normal.rgb});
         if (name == "position") out.channels.push_back({{"P.X", "P.Y", "P.Z"}, images.position.rgb});
         if (name == "depth") out.channels.push_back({{"Z"}, images.depth});
+        out.channelAovs.push_back(name);
     }
     out.metadata["aovs"] = joined(aovs);
     return out;

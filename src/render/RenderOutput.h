@@ -22,8 +22,9 @@ std::vector<std::string> checkedAovNames(const std::vector<std::string>& names, 
 struct RenderOutput {
     Image mean;
     Metadata metadata;
-    std::map<std::string, Image> layers; ///< "variance" when asked for, "albedo"
-    std::vector<ExrChannels> channels;   ///< N.X/Y/Z, P.X/Y/Z, Z
+    std::map<std::string, Image> layers;  ///< "variance" when asked for, "albedo"
+    std::vector<ExrChannels> channels;    ///< N.X/Y/Z, P.X/Y/Z, Z
+    std::vector<std::string> channelAovs; ///< the AOV of each of `channels`: "normal", "position", "depth"
 };
 
 /// The session's film as an EXR's contents: the variance layer when
