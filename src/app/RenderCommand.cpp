@@ -60,7 +60,7 @@ struct RenderCommandOptions {
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
     uint64_t maxBandBytes = 0;              ///< test hook: bands of at most this many bytes per buffer
     std::vector<std::string> aovs;          ///< --aov albedo,normal,depth,position
-    GltfSceneOptions gltf;                  ///< --camera, --environment (a glTF scene)
+    GltfSceneOptions gltf;                  ///< --camera, --scene, --environment (a glTF scene)
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
     /// --spp caps the render; without it a time or error rule may run long.
@@ -474,6 +474,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--camera", options->gltf.camera,
                     "A glTF scene's camera to render through: its or its node's name, or its index (default: the "
                     "first)");
+    cmd->add_option("--scene", options->gltf.scene,
+                    "Which of a glTF file's scenes to render: its name or index (default: the file's `scene`)");
     cmd->add_option("--environment", options->gltf.environment,
                     "A lat-long .exr or .hdr map lighting a glTF scene (default: white for a file without lights, "
                     "else black)");

@@ -18,6 +18,7 @@ CommandRunner addViewCommand(CLI::App& app)
     CLI::App* cmd = app.add_subcommand("view", "Watch a scene converge in a window (keys: press H)");
     cmd->add_option("scene", o->scenePath, "Scene file (TOML, or a glTF .gltf/.glb file as a scene)")->required();
     cmd->add_option("--camera", o->gltf.camera, "glTF scene: the camera to look through (name or index)");
+    cmd->add_option("--scene", o->gltf.scene, "glTF file: which of its scenes to show (name or index)");
     cmd->add_option("--environment", o->gltf.environment, "glTF scene: a lat-long .exr/.hdr map lighting it");
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--seed", o->seed, "Random seed");

@@ -2,9 +2,6 @@
 
 #include "util/Error.h"
 
-#include <assimp/GltfMaterial.h>
-#include <assimp/material.h>
-#include <assimp/scene.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -90,15 +87,6 @@ std::vector<std::string> extensionNames(const json& object)
     return names;
 }
 
-std::vector<std::string> stringList(const json& doc, const char* key)
-{
-    std::vector<std::string> strings;
-    if (const json* list = arrayMember(doc, key))
-        for (const json& each : *list)
-            if (each.is_string()) strings.push_back(each.get<std::string>());
-    return strings;
-}
-
 /// Bytes above 0x7f as '?'. They can only stand inside JSON strings;
 /// assimp's rapidjson takes them without checking their encoding and
 /// nlohmann's parser refuses bad UTF-8, so both see one structure only when
@@ -159,92 +147,6 @@ json parseJson(const fs::path& file)
 }
 
 // ---------------------------------------------------------------------------
-// Which file material is which aiMaterial. Assimp 5.2.5's glTF2 reader
-// creates objects lazily, in the order the default scene reaches them
-// (Asset::Load: scenes[scene] -> nodes, children before a node's own mesh
-// -> meshes -> primitives' materials; then every skin's joints; then every
-// animation channel's target node), and its aiMaterial i is the i-th material
-// so reached, not the file's i-th. This walk repeats that order.
-
-class MaterialOrder {
-public:
-    explicit MaterialOrder(const json& doc) : m_doc(doc) {}
-
-    std::vector<uint32_t> walk()
-    {
-        const uint32_t sceneIndex = uintMember(m_doc, "scene").value_or(0);
-        if (const json* scene = element(arrayMember(m_doc, "scenes"), sceneIndex))
-            visitNodeList(arrayMember(*scene, "nodes"));
-        if (const json* skins = arrayMember(m_doc, "skins"))
-            for (const json& skin : *skins) visitNodeList(arrayMember(skin, "joints"));
-        if (const json* animations = arrayMember(m_doc, "animations"))
-            for (const json& animation : *animations) visitChannels(animation);
-        return m_materials;
-    }
-
-private:
-    void visitNodeList(const json* list)
-    {
-        if (!list) return;
-        for (const json& node : *list)
-            if (node.is_number_unsigned() && node.get<uint64_t>() <= std::numeric_limits<uint32_t>::max())
-                visitNode(uint32_t(node.get<uint64_t>()));
-    }
-
-    void visitChannels(const json& animation)
-    {
-        if (const json* channels = arrayMember(animation, "channels"))
-            for (const json& channel : *channels)
-                if (const json* target = member(channel, "target"); target && target->is_object())
-                    if (const auto node = uintMember(*target, "node")) visitNode(*node);
-    }
-
-    /// Depth first, a node's children before its mesh, without recursion (a
-    /// file may nest nodes deeply; assimp refuses cycles before we get here).
-    void visitNode(uint32_t root)
-    {
-        struct Pending {
-            uint32_t node;
-            size_t nextChild;
-        };
-        std::vector<Pending> stack;
-        if (enter(root)) stack.push_back({root, 0});
-        while (!stack.empty()) {
-            Pending& top = stack.back();
-            const json* node = element(arrayMember(m_doc, "nodes"), top.node);
-            const json* children = node ? arrayMember(*node, "children") : nullptr;
-            if (children && top.nextChild < children->size()) {
-                const json& child = (*children)[top.nextChild++];
-                if (child.is_number_unsigned() && child.get<uint64_t>() <= std::numeric_limits<uint32_t>::max() &&
-                    enter(uint32_t(child.get<uint64_t>())))
-                    stack.push_back({uint32_t(child.get<uint64_t>()), 0});
-                continue;
-            }
-            if (node)
-                if (const auto mesh = uintMember(*node, "mesh")) visitMesh(*mesh);
-            stack.pop_back();
-        }
-    }
-
-    bool enter(uint32_t node) { return m_nodes.insert(node).second; }
-
-    void visitMesh(uint32_t index)
-    {
-        if (!m_meshes.insert(index).second) return;
-        const json* mesh = element(arrayMember(m_doc, "meshes"), index);
-        const json* primitives = mesh ? arrayMember(*mesh, "primitives") : nullptr;
-        if (!primitives) return;
-        for (const json& primitive : *primitives)
-            if (const auto material = uintMember(primitive, "material"))
-                if (m_seen.insert(*material).second) m_materials.push_back(*material);
-    }
-
-    const json& m_doc;
-    std::set<uint32_t> m_nodes, m_meshes, m_seen;
-    std::vector<uint32_t> m_materials;
-};
-
-// ---------------------------------------------------------------------------
 // What vkrt will not honour, from the JSON (assimp keeps no list of the
 // extensions it read, and drops those it does not know).
 
@@ -266,19 +168,6 @@ const json* textureInfo(const json& material, const TextureSlot& slot)
     return info && info->is_object() ? info : nullptr;
 }
 
-/// Every extension a material or its texture references names.
-std::set<std::string> materialExtensions(const json& material)
-{
-    std::set<std::string> names;
-    for (const std::string& name : extensionNames(material)) names.insert(name);
-    if (const json* pbr = member(material, "pbrMetallicRoughness"))
-        for (const std::string& name : extensionNames(*pbr)) names.insert(name);
-    for (const TextureSlot& slot : kTextureSlots)
-        if (const json* info = textureInfo(material, slot))
-            for (const std::string& name : extensionNames(*info)) names.insert(name);
-    return names;
-}
-
 void listTextureProblems(const json& material, std::vector<std::string>& out)
 {
     for (const TextureSlot& slot : kTextureSlots) {
@@ -286,227 +175,24 @@ void listTextureProblems(const json& material, std::vector<std::string>& out)
         if (!info || !slot.honoured) continue;
         for (const std::string& name : extensionNames(*info))
             if (name != "KHR_texture_transform") out.push_back(name + " on " + slot.name + ": not applied");
-        const json* extensions = member(*info, "extensions");
-        const json* transform = extensions ? member(*extensions, "KHR_texture_transform") : nullptr;
-        if (const json* texCoord = transform ? member(*transform, "texCoord") : nullptr;
-            texCoord && texCoord->is_number_integer() && texCoord->get<int64_t>() != 0)
-            out.push_back(std::string("KHR_texture_transform on ") + slot.name + " reads TEXCOORD_" +
-                          std::to_string(texCoord->get<int64_t>()) + ": vkrt reads only TEXCOORD_0");
-        if (const json* texCoord = member(*info, "texCoord");
-            texCoord && texCoord->is_number_integer() && texCoord->get<int64_t>() != 0)
-            out.push_back(std::string(slot.name) + " reads TEXCOORD_" + std::to_string(texCoord->get<int64_t>()) +
-                          ": vkrt reads only TEXCOORD_0");
     }
 }
 
-/// Material extensions vkrt honours (readHonouredExtensions).
-bool honouredMaterialExtension(const std::string& name)
-{
-    return name == "KHR_materials_emissive_strength" || name == "KHR_materials_transmission" ||
-           name == "KHR_materials_ior";
-}
-
-/// The unsupported list of one file material (before the file's own extensions).
+/// The unsupported list of one file material. Extensions themselves are
+/// named once per file (GltfReader's extensionsUsed warning), not here.
 std::vector<std::string> materialProblems(const json& material)
 {
     std::vector<std::string> out;
-    for (const std::string& name : extensionNames(material))
-        if (!honouredMaterialExtension(name)) out.push_back(name + ": material extension not supported");
     if (const json* extensions = member(material, "extensions"))
         if (const json* transmission = member(*extensions, "KHR_materials_transmission"))
             if (member(*transmission, "transmissionTexture"))
                 out.push_back("KHR_materials_transmission's transmissionTexture: not applied (its factor is)");
-    if (const json* pbr = member(material, "pbrMetallicRoughness"))
-        for (const std::string& name : extensionNames(*pbr))
-            out.push_back(name + " on pbrMetallicRoughness: not supported");
     listTextureProblems(material, out);
     if (const json* mode = member(material, "alphaMode"); mode && mode->is_string() && *mode != "OPAQUE")
         out.push_back("alphaMode " + mode->get<std::string>() + ": rendered opaque");
     return out;
 }
 
-/// Extensions the file uses or requires that no material names (lights,
-/// mesh compression, ...): every material lists them, so none is silent.
-std::vector<std::string> fileProblems(const json& doc)
-{
-    std::set<std::string> inMaterials;
-    if (const json* materials = arrayMember(doc, "materials"))
-        for (const json& material : *materials) inMaterials.merge(materialExtensions(material));
-    std::set<std::string> fileLevel;
-    for (const char* key : {"extensionsRequired", "extensionsUsed"})
-        for (const std::string& name : stringList(doc, key))
-            if (!inMaterials.count(name)) fileLevel.insert(name);
-    std::vector<std::string> out;
-    for (const std::string& name : fileLevel) out.push_back(name + ": file extension not supported");
-    return out;
-}
-
-// ---------------------------------------------------------------------------
-// aiMaterial -> FileMaterial: the values, as assimp 5.2.5's glTF2 importer
-// stores them (ImportMaterial: BASE_COLOR, METALLIC_FACTOR, ROUGHNESS_FACTOR,
-// textures under aiTextureType_BASE_COLOR, METALNESS (the metallicRoughness
-// image, also under DIFFUSE_ROUGHNESS and UNKNOWN), NORMALS, EMISSIVE).
-
-struct MaterialReader {
-    const aiScene& scene;
-    const fs::path& file;
-    std::string materialName; ///< for messages
-    const ReferencePolicy& references;
-
-    [[noreturn]] void malformed(const std::string& what) const { fail(file, "material " + materialName + ": " + what); }
-
-    float factor(const aiMaterial& m, const char* key, unsigned type, unsigned index, float fallback,
-                 const char* gltfName) const
-    {
-        float value = fallback;
-        if (m.Get(key, type, index, value) != AI_SUCCESS) return fallback;
-        if (!std::isfinite(value) || value < 0.0f || value > 1.0f)
-            malformed(std::string(gltfName) + " " + std::to_string(value) + " is outside [0, 1]");
-        return value;
-    }
-
-    glm::vec4 colour(const aiMaterial& m, const char* key, unsigned type, unsigned index, glm::vec4 fallback,
-                     const char* gltfName, bool unbounded) const
-    {
-        aiColor4D c;
-        if (m.Get(key, type, index, c) != AI_SUCCESS) return fallback;
-        const glm::vec4 value(c.r, c.g, c.b, c.a);
-        for (int i = 0; i < 4; ++i)
-            if (!std::isfinite(value[i]) || value[i] < 0.0f || (!unbounded && value[i] > 1.0f))
-                malformed(std::string(gltfName) + " has a component " + std::to_string(value[i]) +
-                          (unbounded ? " that is negative or not finite" : " outside [0, 1]"));
-        return value;
-    }
-
-    std::optional<FileTexture> texture(const aiMaterial& m, aiTextureType type) const
-    {
-        aiString path;
-        if (m.GetTextureCount(type) == 0 || m.Get(AI_MATKEY_TEXTURE(type, 0), path) != AI_SUCCESS) return std::nullopt;
-        FileTexture texture;
-        const std::string uri(path.C_Str(), path.length);
-        if (!uri.empty() && uri[0] == '*') {
-            embed(texture, uri);
-        } else {
-            if (uri.empty()) malformed("an image has neither a file nor base64 data");
-            texture.file = file.parent_path() / percentDecoded(uri);
-            references.check(texture.file, uri, "material " + materialName + "'s image");
-            texture.name = texture.file.string();
-        }
-        texture.wrapU = wrap(m, AI_MATKEY_MAPPINGMODE_U(type, 0));
-        texture.wrapV = wrap(m, AI_MATKEY_MAPPINGMODE_V(type, 0));
-        return texture;
-    }
-
-    /// "*N": assimp's reference to its embedded texture N (a .glb's bufferView or a data: URI).
-    void embed(FileTexture& texture, const std::string& reference) const
-    {
-        unsigned index = 0;
-        const auto [end, error] = std::from_chars(reference.data() + 1, reference.data() + reference.size(), index);
-        if (error != std::errc() || end != reference.data() + reference.size() || index >= scene.mNumTextures ||
-            !scene.mTextures[index])
-            malformed("names embedded image '" + reference + "', which the file does not have");
-        const aiTexture& image = *scene.mTextures[index];
-        // glTF images are always compressed (PNG, JPEG): assimp then gives the bytes, mHeight 0, mWidth bytes.
-        if (image.mHeight != 0 || !image.pcData) malformed("embedded image " + std::to_string(index) + " has no data");
-        const auto* bytes = reinterpret_cast<const uint8_t*>(image.pcData);
-        texture.embedded.assign(bytes, bytes + image.mWidth);
-        texture.name = file.string() + " (embedded image " + std::to_string(index) + ")";
-    }
-
-    static TextureWrap wrap(const aiMaterial& m, const char* key, unsigned type, unsigned index)
-    {
-        int mode = aiTextureMapMode_Wrap;
-        m.Get(key, type, index, mode);
-        if (mode == aiTextureMapMode_Clamp) return TextureWrap::Clamp;
-        if (mode == aiTextureMapMode_Mirror) return TextureWrap::Mirror;
-        return TextureWrap::Repeat; // glTF's default sampler
-    }
-
-    AlphaMode alphaMode(const aiMaterial& m) const
-    {
-        aiString mode;
-        if (m.Get(AI_MATKEY_GLTF_ALPHAMODE, mode) != AI_SUCCESS) return AlphaMode::Opaque;
-        const std::string text = mode.C_Str();
-        if (text == "MASK") return AlphaMode::Mask;
-        if (text == "BLEND") return AlphaMode::Blend;
-        return AlphaMode::Opaque;
-    }
-
-    float positive(const aiMaterial& m, const char* key, unsigned type, unsigned index, float fallback,
-                   const char* gltfName) const
-    {
-        float value = fallback;
-        if (m.Get(key, type, index, value) != AI_SUCCESS) return fallback;
-        if (!std::isfinite(value) || value < 0.0f)
-            malformed(std::string(gltfName) + " " + std::to_string(value) + " is negative or not finite");
-        return value;
-    }
-
-    FileMaterial convert(const aiMaterial& m) const
-    {
-        FileMaterial out;
-        aiString name;
-        if (m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) out.name = name.C_Str();
-        out.baseColorFactor =
-            colour(m, AI_MATKEY_BASE_COLOR, out.baseColorFactor, "baseColorFactor", /*unbounded=*/false);
-        out.baseColorTexture = texture(m, aiTextureType_BASE_COLOR);
-        if (!out.baseColorTexture) out.baseColorTexture = texture(m, aiTextureType_DIFFUSE);
-        out.metallicFactor = factor(m, AI_MATKEY_METALLIC_FACTOR, out.metallicFactor, "metallicFactor");
-        out.roughnessFactor = factor(m, AI_MATKEY_ROUGHNESS_FACTOR, out.roughnessFactor, "roughnessFactor");
-        out.metallicRoughnessTexture = texture(m, aiTextureType_METALNESS);
-        if (!out.metallicRoughnessTexture) out.metallicRoughnessTexture = texture(m, aiTextureType_UNKNOWN);
-        out.normalTexture = texture(m, aiTextureType_NORMALS);
-        out.normalScale = 1.0f;
-        if (m.Get(AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0), out.normalScale) == AI_SUCCESS &&
-            !std::isfinite(out.normalScale))
-            malformed("normalTexture scale is not finite");
-        out.emissiveFactor = glm::vec3(colour(m, AI_MATKEY_COLOR_EMISSIVE, glm::vec4(0.0f), "emissiveFactor",
-                                              /*unbounded=*/true));
-        out.emissiveTexture = texture(m, aiTextureType_EMISSIVE);
-        out.alphaMode = alphaMode(m);
-        out.alphaCutoff = positive(m, AI_MATKEY_GLTF_ALPHACUTOFF, out.alphaCutoff, "alphaCutoff");
-        m.Get(AI_MATKEY_TWOSIDED, out.doubleSided);
-        return out;
-    }
-};
-
-/// "0 'Cube'", "2", "'Cube'" (index unknown) or "(glTF's default)": how messages name a material.
-std::string describeMaterial(bool isDefault, int fileIndex, const std::string& name)
-{
-    if (isDefault) return "(glTF's default)";
-    const std::string quoted = name.empty() ? "" : "'" + name + "'";
-    if (fileIndex < 0) return quoted.empty() ? "(unnamed)" : quoted;
-    return std::to_string(fileIndex) + (quoted.empty() ? "" : " " + quoted);
-}
-
-bool isGltf2(const json& doc)
-{
-    const json* asset = member(doc, "asset");
-    const json* version = asset ? member(*asset, "version") : nullptr;
-    return version && version->is_string() && version->get<std::string>().rfind("2", 0) == 0;
-}
-
-/// Whether `order` (the walk's file indices) fits assimp's materials: as many, and the same names.
-bool orderMatches(const aiScene& scene, const std::vector<uint32_t>& order, const json* materials)
-{
-    if (scene.mNumMaterials == 0 || order.size() != scene.mNumMaterials - 1) return false;
-    for (size_t i = 0; i < order.size(); ++i) {
-        const json* material = element(materials, order[i]);
-        if (!material || !scene.mMaterials[i]) return false;
-        aiString name;
-        scene.mMaterials[i]->Get(AI_MATKEY_NAME, name);
-        const json* fileName = member(*material, "name");
-        const std::string expected = fileName && fileName->is_string() ? fileName->get<std::string>() : "";
-        if (expected != masked(name.C_Str())) return false;
-    }
-    return true;
-}
-
-void appendUnique(std::vector<std::string>& list, const std::vector<std::string>& more)
-{
-    for (const std::string& each : more)
-        if (std::find(list.begin(), list.end(), each) == list.end()) list.push_back(each);
-}
 
 } // namespace
 
@@ -755,44 +441,47 @@ std::vector<uint64_t> importsPerNode(const json& doc, const json& nodes, const s
     return times;
 }
 
-/// Refuses a file whose import would read more than kMaxGltfNodes nodes or
-/// make more than kMaxGltfTriangles triangles, naming the mesh that gives most.
+/// Refuses a file whose scene would read more than kMaxGltfNodes nodes,
+/// place meshes more than kMaxGltfInstances times, or whose placed meshes
+/// hold more than kMaxGltfTriangles triangles (each mesh counted once: its
+/// instances share it), naming the mesh that gives most.
 void checkInstancing(const fs::path& file, const json& doc, const std::vector<uint32_t>& parent)
 {
     const json* nodes = arrayMember(doc, "nodes");
     if (!nodes) return;
     if (nodes->size() > kMaxGltfNodes)
         fail(file, "the file has " + withThousands(nodes->size()) + " nodes; vkrt reads at most " +
-                       withThousands(kMaxGltfNodes) + " (the glTF reader slows with the square of their number)");
+                       withThousands(kMaxGltfNodes));
     const std::vector<uint64_t> times = importsPerNode(doc, *nodes, parent);
     const std::vector<uint64_t> triangles = meshTriangles(doc);
-    std::vector<uint64_t> instances(triangles.size(), 0);
+    std::vector<bool> placed(triangles.size(), false);
     uint64_t importedNodes = 0, meshInstances = 0;
     for (uint32_t node = 0; node < nodes->size(); ++node) {
         importedNodes = saturatingAdd(importedNodes, times[node]);
         const auto mesh = uintMember((*nodes)[node], "mesh");
-        if (!mesh || *mesh >= instances.size()) continue;
-        instances[*mesh] = saturatingAdd(instances[*mesh], times[node]);
+        if (!mesh || *mesh >= placed.size() || times[node] == 0) continue;
+        placed[*mesh] = true;
         meshInstances = saturatingAdd(meshInstances, times[node]);
     }
     if (importedNodes > kMaxGltfNodes)
-        fail(file, "the scene imports " + withThousands(importedNodes) +
-                       " nodes (a node listed more than once among its roots is imported each time, with its "
+        fail(file, "the scene reaches " + withThousands(importedNodes) +
+                       " nodes (a node listed more than once among its roots is reached each time, with its "
                        "children); vkrt reads at most " +
                        withThousands(kMaxGltfNodes));
+    if (meshInstances > kMaxGltfInstances)
+        fail(file, "the node hierarchy places meshes " + withThousands(meshInstances) + " times; vkrt reads at most " +
+                       withThousands(kMaxGltfInstances) + " instances");
     uint64_t total = 0;
     size_t largest = 0;
     for (size_t m = 0; m < triangles.size(); ++m) {
-        const uint64_t made = saturatingMultiply(instances[m], triangles[m]);
-        total = saturatingAdd(total, made);
-        if (made > saturatingMultiply(instances[largest], triangles[largest])) largest = m;
+        if (!placed[m]) continue;
+        total = saturatingAdd(total, triangles[m]);
+        if (triangles[m] > triangles[largest] || !placed[largest]) largest = m;
     }
     if (total > kMaxGltfTriangles)
-        fail(file, "the node hierarchy instances meshes " + withThousands(meshInstances) + " times, " +
-                       withThousands(total) + " triangles in all (mesh " + std::to_string(largest) + ", " +
-                       withThousands(triangles[largest]) + " triangles, " + withThousands(instances[largest]) +
-                       " times); vkrt reads at most " + withThousands(kMaxGltfTriangles) +
-                       " triangles after instancing");
+        fail(file, "the meshes the scene places hold " + withThousands(total) + " triangles (mesh " +
+                       std::to_string(largest) + ": " + withThousands(triangles[largest]) + "); vkrt reads at most " +
+                       withThousands(kMaxGltfTriangles));
 }
 
 /// The bytes of accessor data one reference asks assimp for: count x
@@ -881,13 +570,19 @@ void checkFileReferences(const fs::path& file, const json& doc, const ReferenceP
 
 } // namespace
 
-void checkGltfBeforeImport(const fs::path& file, const ReferencePolicy& references)
+json checkedGltfDocument(const fs::path& file, const ReferencePolicy& references)
 {
-    const json doc = parseJson(file);
+    json doc = parseJson(file);
     checkBufferBounds(file, doc);
     checkInstancing(file, doc, checkNodeHierarchy(file, doc));
     checkAccessorUse(file, doc);
     checkFileReferences(file, doc, references);
+    return doc;
+}
+
+void checkGltfBeforeImport(const fs::path& file, const ReferencePolicy& references)
+{
+    checkedGltfDocument(file, references);
 }
 
 namespace {
@@ -959,44 +654,206 @@ void readHonouredExtensions(const fs::path& file, const json& material, FileMate
 
 } // namespace
 
-std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const fs::path& file,
-                                            const ReferencePolicy& references)
-{
-    const json doc = parseJson(file);
-    if (!isGltf2(doc) || scene.mNumMaterials == 0) return {};
-    const json* fileMaterials = arrayMember(doc, "materials");
-    const std::vector<uint32_t> order = MaterialOrder(doc).walk();
-    const bool matched = orderMatches(scene, order, fileMaterials);
-    const std::vector<std::string> fileLevel = fileProblems(doc);
-    // Unmatched (an assimp whose order differs from 5.2.5's): every material
-    // lists what any file material uses, so that nothing is silent.
-    std::vector<std::string> anyMaterial;
-    if (!matched && fileMaterials)
-        for (const json& material : *fileMaterials) appendUnique(anyMaterial, materialProblems(material));
+namespace {
 
-    std::vector<FileMaterial> materials;
-    for (unsigned i = 0; i < scene.mNumMaterials; ++i) {
-        const bool isDefault = i + 1 == scene.mNumMaterials;
-        const int fileIndex = matched && !isDefault ? int(order[i]) : -1;
-        std::string name;
-        if (scene.mMaterials[i]) {
-            aiString aiName;
-            scene.mMaterials[i]->Get(AI_MATKEY_NAME, aiName);
-            name = aiName.C_Str();
+// ---------------------------------------------------------------------------
+// A material's JSON -> FileMaterial, glTF 2.0's defaults for what it omits.
+
+/// glTF sampler wrap modes (WebGL enums).
+TextureWrap wrapMode(uint32_t mode)
+{
+    if (mode == 33071) return TextureWrap::Clamp;
+    if (mode == 33648) return TextureWrap::Mirror;
+    return TextureWrap::Repeat; // 10497, glTF's default
+}
+
+struct MaterialReader {
+    const json& doc;
+    const fs::path& file;
+    const ReferencePolicy& references;
+    const GltfViewBytes& viewBytes;
+    std::string materialName; ///< for messages
+
+    [[noreturn]] void malformed(const std::string& what) const { fail(file, "material " + materialName + ": " + what); }
+
+    float unitFactor(const json* owner, const char* key, float fallback) const
+    {
+        const json* value = owner ? member(*owner, key) : nullptr;
+        if (!value) return fallback;
+        if (!value->is_number() || !(value->get<double>() >= 0.0 && value->get<double>() <= 1.0))
+            malformed(std::string(key) + " must be a number in [0, 1]");
+        return float(value->get<double>());
+    }
+
+    glm::vec4 colour(const json* owner, const char* key, glm::vec4 fallback, size_t size, bool unbounded) const
+    {
+        const json* value = owner ? member(*owner, key) : nullptr;
+        if (!value) return fallback;
+        if (!value->is_array() || value->size() != size)
+            malformed(std::string(key) + " must be an array of " + std::to_string(size) + " numbers");
+        glm::vec4 out = fallback;
+        for (size_t i = 0; i < size; ++i) {
+            const json& c = (*value)[i];
+            if (!c.is_number() || !std::isfinite(c.get<double>()) || c.get<double>() < 0.0 ||
+                (!unbounded && c.get<double>() > 1.0) || c.get<double>() > std::numeric_limits<float>::max())
+                malformed(std::string(key) + " has a component that is " +
+                          (unbounded ? "negative or not finite" : "outside [0, 1]"));
+            out[int(i)] = float(c.get<double>());
         }
-        const MaterialReader reader{scene, file, describeMaterial(isDefault, fileIndex, name), references};
-        FileMaterial material = scene.mMaterials[i] ? reader.convert(*scene.mMaterials[i]) : FileMaterial{};
-        material.fileIndex = fileIndex;
-        if (fileIndex >= 0) {
-            const json& source = *element(fileMaterials, uint32_t(fileIndex));
+        return out;
+    }
+
+    /// The image of a texture: a file beside the glTF, or bytes inside it.
+    void readImage(uint32_t index, FileTexture& texture) const
+    {
+        const json* image = element(arrayMember(doc, "images"), index);
+        if (!image || !image->is_object()) malformed("names image " + std::to_string(index) + ", which the file does not have");
+        const json* uri = member(*image, "uri");
+        if (uri && uri->is_string() && uri->get<std::string>().rfind("data:", 0) != 0) {
+            const std::string text = uri->get<std::string>();
+            texture.file = file.parent_path() / gltfUriPath(text);
+            references.check(texture.file, text, "material " + materialName + "'s image");
+            texture.name = texture.file.string();
+            return;
+        }
+        const std::string what = file.string() + " (embedded image " + std::to_string(index) + ")";
+        if (uri && uri->is_string()) {
+            const std::string text = uri->get<std::string>();
+            const size_t comma = text.find(',');
+            if (comma == std::string::npos || comma < 7 || text.compare(comma - 7, 7, ";base64") != 0)
+                malformed("image " + std::to_string(index) + "'s data: URI is not base64");
+            texture.embedded = decodeBase64(std::string_view(text).substr(comma + 1));
+            if (texture.embedded.empty()) malformed("image " + std::to_string(index) + "'s base64 data is malformed");
+        } else if (const auto view = uintMember(*image, "bufferView")) {
+            texture.embedded = viewBytes(*view, "images[" + std::to_string(index) + "]");
+        } else {
+            malformed("image " + std::to_string(index) + " has neither a uri nor a bufferView");
+        }
+        texture.name = what;
+    }
+
+    std::optional<FileTexture> texture(const json* info, const char* slot) const
+    {
+        if (!info) return std::nullopt;
+        const auto index = uintMember(*info, "index");
+        const json* entry = index ? element(arrayMember(doc, "textures"), *index) : nullptr;
+        if (!entry || !entry->is_object()) malformed(std::string(slot) + " names a texture the file does not have");
+        const auto source = uintMember(*entry, "source");
+        if (!source) malformed(std::string(slot) + "'s texture has no source image vkrt can read (only PNG and JPEG)");
+        FileTexture texture;
+        readImage(*source, texture);
+        if (const auto sampler = uintMember(*entry, "sampler")) {
+            const json* s = element(arrayMember(doc, "samplers"), *sampler);
+            if (!s) malformed(std::string(slot) + "'s texture names a sampler the file does not have");
+            texture.wrapU = wrapMode(uintMember(*s, "wrapS").value_or(10497));
+            texture.wrapV = wrapMode(uintMember(*s, "wrapT").value_or(10497));
+        }
+        texture.texCoord = uintMember(*info, "texCoord").value_or(0);
+        const json* extensions = member(*info, "extensions");
+        const json* transform = extensions ? member(*extensions, "KHR_texture_transform") : nullptr;
+        if (transform)
+            if (const auto texCoord = uintMember(*transform, "texCoord")) texture.texCoord = *texCoord;
+        if (texture.texCoord > 1)
+            malformed(std::string(slot) + " reads TEXCOORD_" + std::to_string(texture.texCoord) +
+                      "; vkrt reads TEXCOORD_0 and TEXCOORD_1");
+        return texture;
+    }
+
+    FileMaterial convert(const json& m) const
+    {
+        FileMaterial out;
+        if (!m.is_object()) malformed("expected an object");
+        if (const json* name = member(m, "name"); name && name->is_string()) out.name = name->get<std::string>();
+        const json* pbr = member(m, "pbrMetallicRoughness");
+        out.baseColorFactor = colour(pbr, "baseColorFactor", out.baseColorFactor, 4, false);
+        out.baseColorTexture = texture(pbr ? member(*pbr, "baseColorTexture") : nullptr, "baseColorTexture");
+        out.metallicFactor = unitFactor(pbr, "metallicFactor", out.metallicFactor);
+        out.roughnessFactor = unitFactor(pbr, "roughnessFactor", out.roughnessFactor);
+        out.metallicRoughnessTexture =
+            texture(pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr, "metallicRoughnessTexture");
+        const json* normal = member(m, "normalTexture");
+        out.normalTexture = texture(normal, "normalTexture");
+        if (const json* scale = normal ? member(*normal, "scale") : nullptr) {
+            if (!scale->is_number() || !std::isfinite(scale->get<double>()))
+                malformed("normalTexture.scale must be a finite number");
+            out.normalScale = float(scale->get<double>());
+        }
+        out.emissiveFactor = glm::vec3(colour(&m, "emissiveFactor", glm::vec4(0.0f), 3, true));
+        out.emissiveTexture = texture(member(m, "emissiveTexture"), "emissiveTexture");
+        const std::string mode = member(m, "alphaMode") && m["alphaMode"].is_string() ? m["alphaMode"].get<std::string>()
+                                                                                     : "OPAQUE";
+        if (mode == "MASK") out.alphaMode = AlphaMode::Mask;
+        else if (mode == "BLEND") out.alphaMode = AlphaMode::Blend;
+        else if (mode != "OPAQUE") malformed("alphaMode must be OPAQUE, MASK or BLEND, not '" + mode + "'");
+        if (const json* cutoff = member(m, "alphaCutoff")) {
+            if (!cutoff->is_number() || !(cutoff->get<double>() >= 0.0) || !std::isfinite(cutoff->get<double>()))
+                malformed("alphaCutoff must be a finite number >= 0");
+            out.alphaCutoff = float(cutoff->get<double>());
+        }
+        if (const json* two = member(m, "doubleSided"); two && two->is_boolean()) out.doubleSided = two->get<bool>();
+        return out;
+    }
+};
+
+std::string describeMaterial(size_t index, const json& material)
+{
+    const json* name = member(material, "name");
+    return std::to_string(index) + (name && name->is_string() ? " '" + name->get<std::string>() + "'" : "");
+}
+
+} // namespace
+
+std::vector<uint8_t> decodeBase64(std::string_view text)
+{
+    auto value = [](char c) -> int {
+        if (c >= 'A' && c <= 'Z') return c - 'A';
+        if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+        if (c >= '0' && c <= '9') return c - '0' + 52;
+        if (c == '+' || c == '-') return 62;
+        if (c == '/' || c == '_') return 63;
+        return -1;
+    };
+    std::vector<uint8_t> out;
+    out.reserve(text.size() / 4 * 3);
+    uint32_t bits = 0;
+    int count = 0;
+    for (char c : text) {
+        if (c == '=') break;
+        const int v = value(c);
+        if (v < 0) return {};
+        bits = (bits << 6) | uint32_t(v);
+        if (++count == 4) {
+            out.insert(out.end(), {uint8_t(bits >> 16), uint8_t(bits >> 8), uint8_t(bits)});
+            bits = 0;
+            count = 0;
+        }
+    }
+    if (count == 1) return {};
+    if (count == 2) out.push_back(uint8_t(bits >> 4));
+    if (count == 3) out.insert(out.end(), {uint8_t(bits >> 10), uint8_t(bits >> 2)});
+    return out;
+}
+
+fs::path gltfUriPath(const std::string& uri) { return fs::path(percentDecoded(uri)); }
+
+std::vector<FileMaterial> readGltfMaterials(const json& doc, const fs::path& file, const ReferencePolicy& references,
+                                            const GltfViewBytes& viewBytes)
+{
+    std::vector<FileMaterial> materials;
+    if (const json* list = arrayMember(doc, "materials")) {
+        for (size_t i = 0; i < list->size(); ++i) {
+            const json& source = (*list)[i];
+            const MaterialReader reader{doc, file, references, viewBytes, describeMaterial(i, source)};
+            FileMaterial material = reader.convert(source);
+            material.fileIndex = int(i);
             material.unsupported = materialProblems(source);
             readHonouredExtensions(file, source, material);
+            materials.push_back(std::move(material));
         }
-        if (!isDefault) appendUnique(material.unsupported, anyMaterial);
-        appendUnique(material.unsupported, fileLevel);
-        materials.push_back(std::move(material));
     }
+    materials.emplace_back(); // glTF's default material, for primitives without one
     return materials;
 }
+
 
 } // namespace vkrt

@@ -24,13 +24,15 @@
 
 #include <glm/glm.hpp>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
-
-struct aiScene;
 
 namespace vkrt {
 
@@ -39,6 +41,7 @@ struct FileTexture {
     std::filesystem::path file;    ///< resolved against the glTF's folder; empty when embedded
     std::vector<uint8_t> embedded; ///< bytes of an embedded image (.glb, data: URIs), else empty
     std::string name;              ///< for messages: the URI, or "embedded image N of FILE"
+    uint32_t texCoord = 0;         ///< the TEXCOORD_n set it reads (KHR_texture_transform's override applied)
     TextureWrap wrapU = TextureWrap::Repeat;
     TextureWrap wrapV = TextureWrap::Repeat;
     /// KHR_texture_transform (MaterialTexture's convention): offset, rotation (radians), scale.
@@ -73,15 +76,23 @@ struct FileMaterial {
     std::vector<std::string> unsupported; ///< what vkrt will not honour, one readable phrase each
 };
 
-/// The materials of a glTF 2.0 file that assimp imported as `scene`, one per
-/// aiScene material (the same indices: assimp appends glTF's default material
-/// last, for primitives without one). Throws InputError naming `file` for a
-/// malformed material (non-finite or out-of-range factor, an embedded image
-/// that is not there). A glTF 1.0 file, whose materials are not
-/// metallic-roughness, gives an empty list. An image file that `references`
+/// The bytes of a bufferView (for images stored in the file), or an InputError.
+using GltfViewBytes = std::function<std::vector<uint8_t>(uint32_t view, const std::string& where)>;
+
+/// The materials of a glTF 2.0 document by file index, then glTF's default
+/// material (for primitives without one) last. Throws InputError naming
+/// `file` for a malformed material (non-finite or out-of-range factor, a
+/// texture or image that is not there). An image file that `references`
 /// refuses (outside the glTF's folder) is an InputError too.
-std::vector<FileMaterial> readGltfMaterials(const aiScene& scene, const std::filesystem::path& file,
-                                            const ReferencePolicy& references);
+std::vector<FileMaterial> readGltfMaterials(const nlohmann::json& doc, const std::filesystem::path& file,
+                                            const ReferencePolicy& references, const GltfViewBytes& viewBytes);
+
+/// The bytes of base64 text (RFC 4648, standard or URL alphabet, padding
+/// optional); empty when the text is not base64.
+std::vector<uint8_t> decodeBase64(std::string_view text);
+
+/// A URI's file path (RFC 3986 percent-decoding: "my%20wood.png" is "my wood.png").
+std::filesystem::path gltfUriPath(const std::string& uri);
 
 /// The glTF JSON of a .gltf file or of a .glb's first chunk; throws InputError naming `file`.
 std::string readGltfJson(const std::filesystem::path& file);
@@ -93,6 +104,10 @@ constexpr size_t kMaxGltfJsonNesting = 1024;
 /// recurses once per level and crashes on a chain of 30,000 nodes.
 constexpr uint32_t kMaxGltfNodeDepth = 1024;
 
+/// The most mesh instances a glTF scene may place (nodes and
+/// EXT_mesh_gpu_instancing copies): each is a 144-byte GPU record and a leaf
+/// of the top-level BVH.
+constexpr uint64_t kMaxGltfInstances = uint64_t(1) << 18;
 /// The most nodes a glTF file may have, and the most its scene may import
 /// (a node listed twice among the scene's roots is imported twice, with its
 /// subtree): assimp 5.2.5's glTF reader takes time growing with the square
@@ -133,5 +148,7 @@ constexpr uint64_t kMaxGltfAccessorBytes = uint64_t(1) << 30;
 /// (which assimp's parser and ours would read differently). Fields of the
 /// wrong type are left to assimp, which reports them.
 void checkGltfBeforeImport(const std::filesystem::path& file, const ReferencePolicy& references);
+/// The same checks, returning the parsed document (the one parse of its JSON).
+nlohmann::json checkedGltfDocument(const std::filesystem::path& file, const ReferencePolicy& references);
 
 } // namespace vkrt

@@ -30,6 +30,8 @@ struct MeshData {
     /// mesh has none); w = +1 or -1 so that w * cross(normal, xyz) is the
     /// bitangent, along increasing v. From the file (glTF TANGENT) or computeTangents.
     std::vector<glm::vec4> tangents;
+    /// Per vertex, or empty: linear RGBA (glTF COLOR_0; white where a primitive has none).
+    std::vector<glm::vec4> colors;
     std::vector<glm::uvec3> triangles;
     /// Per triangle, its index into `materials`; empty when `materials` is.
     std::vector<uint32_t> triangleMaterials;

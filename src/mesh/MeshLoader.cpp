@@ -1,6 +1,7 @@
 #include "mesh/MeshLoader.h"
 
 #include "mesh/FileMaterials.h"
+#include "mesh/GltfReader.h"
 #include "mesh/PlyReader.h"
 #include "mesh/ReferencePolicy.h"
 
@@ -378,34 +379,6 @@ void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const Mes
     }
 }
 
-/// The glTF materials, one per aiScene material; empty for OBJ (and glTF 1.0).
-std::vector<FileMaterial> sceneMaterials(const aiScene& scene, const MeshCheck& check)
-{
-    if (!check.isGltf()) return {};
-    std::vector<FileMaterial> materials = readGltfMaterials(scene, check.file, check.references);
-    if (materials.size() != scene.mNumMaterials) return {};
-    return materials;
-}
-
-/// Keeps the materials the triangles use, in order (assimp's default
-/// material only when a primitive has none), and renumbers the triangles'.
-void keepUsedMaterials(MeshData& out, std::vector<FileMaterial> all, const MeshCheck& check)
-{
-    std::vector<uint32_t> renumbered(all.size(), UINT32_MAX);
-    for (uint32_t& material : out.triangleMaterials) {
-        if (material >= all.size())
-            fail(check.file,
-                 "a mesh uses material " + std::to_string(material) + " of only " + std::to_string(all.size()));
-        renumbered[material] = 0;
-    }
-    for (size_t i = 0; i < all.size(); ++i) {
-        if (renumbered[i] == UINT32_MAX) continue;
-        renumbered[i] = uint32_t(out.materials.size());
-        out.materials.push_back(std::move(all[i]));
-    }
-    for (uint32_t& material : out.triangleMaterials) material = renumbered[material];
-}
-
 MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
 {
     const std::vector<const aiMesh*> meshes = triangleMeshes(scene);
@@ -419,7 +392,6 @@ MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
     // Tangents belong to uvs and are oriented by normals (glTF has them only with both).
     attributes.tangents =
         attributes.normals && attributes.uvs && every([](const aiMesh* m) { return m->HasTangentsAndBitangents(); });
-    std::vector<FileMaterial> materials = sceneMaterials(scene, check);
     MeshData out;
     for (size_t i = 0; i < meshes.size(); ++i) {
         if (out.positions.size() + meshes[i]->mNumVertices > std::numeric_limits<uint32_t>::max()) {
@@ -427,10 +399,9 @@ MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
         }
         const auto base = static_cast<uint32_t>(out.positions.size());
         appendVertices(out, *meshes[i], i, check, attributes);
-        appendTriangles(out, *meshes[i], base, check, !materials.empty());
+        appendTriangles(out, *meshes[i], base, check, /*materials=*/false);
     }
     if (out.triangles.empty()) fail(check.file, "no triangles in " + check.file.string());
-    if (!materials.empty()) keepUsedMaterials(out, std::move(materials), check);
     return out;
 }
 
@@ -496,8 +467,12 @@ MeshData loadMeshFile(const fs::path& file, const MeshLoadOptions& options)
     checkIsMeshFile(file);
     const std::string extension = lowerExtension(file);
     if (extension == ".ply") return readPlyFile(file); // not assimp: see PlyReader.h
+    if (extension == ".gltf" || extension == ".glb") {
+        GltfReadOptions gltf;
+        gltf.references = options;
+        return flattenGltfModel(readGltfModel(file, gltf)); // not assimp: see GltfReader.h
+    }
     const ReferencePolicy policy(file, options);
-    if (extension == ".gltf" || extension == ".glb") checkGltfBeforeImport(file, policy); // before assimp trusts it
     Assimp::Importer importer;
     const aiScene* scene = importScene(importer, file, extension, policy);
     MeshData mesh = convertScene(*scene, MeshCheck{file, extension, policy});

@@ -10,7 +10,7 @@ namespace {
 
 /// A file material's texture in the scene's atlas; a load failure becomes a
 /// SceneError at the mesh's `material` key that names the mesh file.
-uint32_t addFileTexture(const FileTexture& texture, bool linear, const MeshGeometry& geometry,
+uint32_t addFileTexture(const FileTexture& texture, bool linear, const std::filesystem::path& file,
                         const SourceLocation& where, TextureAtlas& atlas)
 {
     try {
@@ -20,7 +20,7 @@ uint32_t addFileTexture(const FileTexture& texture, bool linear, const MeshGeome
             return atlas.addEncoded(texture.embedded, texture.name, linear, texture.wrapU, texture.wrapV);
         return atlas.add(TextureRequest{texture.file, linear, texture.wrapU, texture.wrapV});
     } catch (const InputError& error) {
-        throw SceneError(where, "a texture of the mesh file " + geometry.file.string() + ": " + error.what());
+        throw SceneError(where, "a texture of the mesh file " + file.string() + ": " + error.what());
     }
 }
 
@@ -45,12 +45,12 @@ std::string displayName(const FileMaterial& f, size_t index)
 /// glTF 2.0 metallic-roughness as vkrt's pbr kind: the factors are the
 /// constants each texel multiplies (glTF's own rule), G and B of the
 /// metallic-roughness texture are roughness and metallic.
-Material toPbr(const FileMaterial& f, size_t index, const MeshGeometry& geometry, const SourceLocation& where,
+Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path& file, const SourceLocation& where,
                TextureAtlas& atlas)
 {
     Material m;
     m.type = MaterialType::Pbr;
-    m.name = geometry.file.filename().string() + "#" + displayName(f, index);
+    m.name = file.filename().string() + "#" + displayName(f, index);
     m.where = where;
     m.diffuse = Color(f.baseColorFactor.r, f.baseColorFactor.g, f.baseColorFactor.b);
     m.metallic = f.metallicFactor;
@@ -59,14 +59,14 @@ Material toPbr(const FileMaterial& f, size_t index, const MeshGeometry& geometry
     auto set = [&](TextureSlot which, MaterialTexture texture) { m.textures[size_t(which)] = texture; };
     if (f.baseColorTexture)
         set(TextureSlot::Color,
-            slot(addFileTexture(*f.baseColorTexture, false, geometry, where, atlas), *f.baseColorTexture));
+            slot(addFileTexture(*f.baseColorTexture, false, file, where, atlas), *f.baseColorTexture));
     if (f.metallicRoughnessTexture) {
-        const uint32_t record = addFileTexture(*f.metallicRoughnessTexture, true, geometry, where, atlas);
+        const uint32_t record = addFileTexture(*f.metallicRoughnessTexture, true, file, where, atlas);
         set(TextureSlot::Roughness, slot(record, *f.metallicRoughnessTexture, 1));
         set(TextureSlot::Metallic, slot(record, *f.metallicRoughnessTexture, 2));
     }
     if (f.normalTexture) {
-        set(TextureSlot::Normal, slot(addFileTexture(*f.normalTexture, true, geometry, where, atlas), *f.normalTexture));
+        set(TextureSlot::Normal, slot(addFileTexture(*f.normalTexture, true, file, where, atlas), *f.normalTexture));
         m.normalStrength = f.normalScale;
     }
     return m;
@@ -118,23 +118,30 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
 
 } // namespace
 
-std::vector<uint32_t> importFileMaterials(const MeshGeometry& geometry, const SourceLocation& where,
+std::vector<uint32_t> importFileMaterials(const std::vector<FileMaterial>& fileMaterials,
+                                          const std::filesystem::path& file, const SourceLocation& where,
                                           TextureAtlas& atlas, std::vector<Material>& materials,
                                           std::vector<std::string>& warnings)
 {
-    const std::vector<FileMaterial>& fileMaterials = geometry.data.materials;
-    if (fileMaterials.empty())
-        throw SceneError(where, "material = \"file\" needs a mesh file with materials of its own (glTF 2.0); " +
-                                    geometry.file.string() + " has none: name a [materials.NAME] table instead");
     std::vector<uint32_t> indices;
     for (size_t i = 0; i < fileMaterials.size(); ++i) {
-        Material m = toPbr(fileMaterials[i], i, geometry, where, atlas);
+        Material m = toPbr(fileMaterials[i], i, file, where, atlas);
         if (transmits(fileMaterials[i])) m = toGlass(fileMaterials[i], std::move(m));
         warnAbout(fileMaterials[i], m, where, warnings);
         indices.push_back(uint32_t(materials.size()));
         materials.push_back(std::move(m));
     }
     return indices;
+}
+
+std::vector<uint32_t> importFileMaterials(const MeshGeometry& geometry, const SourceLocation& where,
+                                          TextureAtlas& atlas, std::vector<Material>& materials,
+                                          std::vector<std::string>& warnings)
+{
+    if (geometry.data.materials.empty())
+        throw SceneError(where, "material = \"file\" needs a mesh file with materials of its own (glTF 2.0); " +
+                                    geometry.file.string() + " has none: name a [materials.NAME] table instead");
+    return importFileMaterials(geometry.data.materials, geometry.file, where, atlas, materials, warnings);
 }
 
 } // namespace vkrt

@@ -5,7 +5,10 @@
 // (extensions, alpha modes, emissive textures, ...) becomes a warning that
 // names it, located at the mesh's `material` key.
 #include "scene/Scene.h"
+#include "mesh/FileMaterials.h"
 #include "texture/TextureAtlas.h"
+
+#include <filesystem>
 
 #include <string>
 #include <vector>
@@ -16,6 +19,13 @@ namespace vkrt {
 /// and returns their indices, in the order of the file's materials (the
 /// geometry's triangleMaterials index this list). Throws SceneError at
 /// `where` when the file has no materials or a texture cannot be loaded.
+/// The same for a list of a file's materials (a glTF scene's, GltfReader.h);
+/// `file` names them in material names and messages.
+std::vector<uint32_t> importFileMaterials(const std::vector<FileMaterial>& fileMaterials,
+                                          const std::filesystem::path& file, const SourceLocation& where,
+                                          TextureAtlas& atlas, std::vector<Material>& materials,
+                                          std::vector<std::string>& warnings);
+
 std::vector<uint32_t> importFileMaterials(const MeshGeometry& geometry, const SourceLocation& where,
                                           TextureAtlas& atlas, std::vector<Material>& materials,
                                           std::vector<std::string>& warnings);

@@ -2,7 +2,8 @@
 // A glTF 2.0 file as a scene (`vkrt render model.glb`) or imported into a
 // TOML scene (`[import] gltf = "model.glb"`): its meshes with their own
 // materials (one mesh instance of the whole file: assimp flattens the node
-// hierarchy with its TRS and matrix transforms), its cameras and its
+// hierarchy: each glTF mesh one geometry, each node placing it an instance),
+// its cameras and its
 // KHR_lights_punctual lights, placed by the nodes that carry them.
 //
 // Conventions (glTF 2.0): a camera looks down its node's -Z with +Y up;
@@ -29,6 +30,8 @@ struct GltfSceneOptions {
     /// `--environment FILE`: a lat-long map lighting the scene; unset: a
     /// white constant environment for a file without lights, black otherwise.
     std::optional<std::string> environment;
+    /// `--scene NAME|INDEX`: one of the file's `scenes`; unset: its `scene`, else the first.
+    std::optional<std::string> scene;
 };
 
 /// Whether `path` names a glTF file (.gltf or .glb, any case).

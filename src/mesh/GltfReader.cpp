@@ -1,0 +1,940 @@
+// glTF 2.0 files read once (mesh/GltfReader.h): buffers, accessors,
+// primitives, the node tree and the materials, from the JSON document that
+// checkGltfDocument has checked. Every read of the buffers is bounds-checked
+// here again against the bytes actually loaded, so nothing below trusts the
+// JSON's byte counts.
+#include "mesh/GltfReader.h"
+
+#include "mesh/FileMaterials.h"
+#include "scene/TomlReader.h"
+#include "util/Error.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <set>
+
+namespace vkrt {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+[[noreturn]] void fail(const fs::path& file, const std::string& what) { throw InputError(file.string() + ": " + what); }
+
+const json* member(const json& object, const char* key)
+{
+    if (!object.is_object()) return nullptr;
+    const auto found = object.find(key);
+    return found == object.end() ? nullptr : &*found;
+}
+
+const json* arrayMember(const json& object, const char* key)
+{
+    const json* value = member(object, key);
+    return value && value->is_array() ? value : nullptr;
+}
+
+std::optional<uint32_t> uintMember(const json& object, const char* key)
+{
+    const json* value = member(object, key);
+    if (!value || !value->is_number_unsigned() || value->get<uint64_t>() > UINT32_MAX) return std::nullopt;
+    return uint32_t(value->get<uint64_t>());
+}
+
+std::string stringMember(const json& object, const char* key)
+{
+    const json* value = member(object, key);
+    return value && value->is_string() ? value->get<std::string>() : "";
+}
+
+std::string indexed(const char* array, uint64_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
+
+// ------------------------------------------------------------------ buffers
+
+constexpr uint32_t kGlbMagic = 0x46546C67;     // "glTF"
+constexpr uint32_t kGlbJsonChunk = 0x4E4F534A; // "JSON"
+constexpr uint32_t kGlbBinChunk = 0x004E4942;  // "BIN\0"
+
+uint32_t word(const std::string& bytes, size_t offset)
+{
+    uint32_t value = 0;
+    if (offset + 4 <= bytes.size()) std::memcpy(&value, bytes.data() + offset, 4);
+    return value;
+}
+
+/// A .glb's BIN chunk (the one after the JSON chunk), or nullopt for a .gltf
+/// or a .glb without one.
+std::optional<std::string> glbBinaryChunk(const fs::path& file)
+{
+    const std::string bytes = readFileBytes(file.string(), "glTF file", size_t(1) << 31);
+    if (word(bytes, 0) != kGlbMagic) return std::nullopt;
+    const uint64_t jsonLength = word(bytes, 12);
+    if (word(bytes, 16) != kGlbJsonChunk) fail(file, "the binary glTF's first chunk is not JSON");
+    const uint64_t next = 20 + jsonLength;
+    if (next + 8 > bytes.size()) return std::nullopt;
+    const uint64_t length = word(bytes, size_t(next));
+    if (word(bytes, size_t(next) + 4) != kGlbBinChunk) return std::nullopt;
+    if (next + 8 + length > bytes.size())
+        fail(file, "the binary glTF's BIN chunk says " + std::to_string(length) + " bytes, but the file ends after " +
+                       std::to_string(bytes.size() - next - 8));
+    return bytes.substr(size_t(next) + 8, size_t(length));
+}
+
+/// The bytes of a `data:` URI (base64; RFC 2397), or nullopt when it is not one vkrt can decode.
+std::optional<std::string> dataUriBytes(const std::string& uri)
+{
+    const size_t comma = uri.find(',');
+    if (comma == std::string::npos || comma < 7 || uri.compare(comma - 7, 7, ";base64") != 0) return std::nullopt;
+    const std::vector<uint8_t> bytes = decodeBase64(std::string_view(uri).substr(comma + 1));
+    if (bytes.empty() && comma + 1 < uri.size()) return std::nullopt;
+    return std::string(bytes.begin(), bytes.end());
+}
+
+/// The document and its buffers' bytes.
+struct Document {
+    fs::path file;
+    json doc;
+    ReferencePolicy references;
+    std::vector<std::string> buffers;
+
+    const json* array(const char* key) const { return arrayMember(doc, key); }
+
+    const json& element(const char* key, uint64_t index, const std::string& where) const
+    {
+        const json* list = array(key);
+        if (!list || index >= list->size() || !(*list)[index].is_object())
+            fail(file, where + " names " + indexed(key, index) + ", which the file does not have");
+        return (*list)[index];
+    }
+
+    /// `length` bytes at `offset` of bufferView `view`, checked against the loaded buffer.
+    const char* viewBytes(uint64_t view, uint64_t offset, uint64_t length, const std::string& where) const
+    {
+        const json& v = element("bufferViews", view, where);
+        const auto buffer = uintMember(v, "buffer");
+        if (!buffer || *buffer >= buffers.size()) fail(file, indexed("bufferViews", view) + ": no such buffer");
+        const uint64_t viewOffset = uintMember(v, "byteOffset").value_or(0);
+        const uint64_t viewLength = uintMember(v, "byteLength").value_or(0);
+        const std::string& bytes = buffers[*buffer];
+        if (offset > viewLength || length > viewLength - offset || viewOffset > bytes.size() ||
+            viewOffset + viewLength > bytes.size())
+            fail(file, where + " reads bytes " + std::to_string(offset) + " to " + std::to_string(offset + length) +
+                           " of " + indexed("bufferViews", view) + " (" + std::to_string(viewLength) +
+                           " bytes), beyond its buffer's data");
+        return bytes.data() + viewOffset + offset;
+    }
+};
+
+std::string loadBuffer(const Document& d, size_t index, const std::optional<std::string>& glbChunk)
+{
+    const json& buffer = (*d.array("buffers"))[index];
+    const std::string where = indexed("buffers", index);
+    const auto length = member(buffer, "byteLength") ? uintMember(buffer, "byteLength") : std::nullopt;
+    if (!length) fail(d.file, where + ": byteLength must be an integer from 1 to 2^32 - 1");
+    std::string bytes;
+    const std::string uri = stringMember(buffer, "uri");
+    if (!member(buffer, "uri")) {
+        if (index != 0 || !glbChunk) fail(d.file, where + " has no uri and is not a binary glTF's BIN chunk");
+        bytes = *glbChunk;
+    } else if (uri.rfind("data:", 0) == 0) {
+        const auto decoded = dataUriBytes(uri);
+        if (!decoded) fail(d.file, where + ": its data: URI is not base64 data vkrt can decode");
+        bytes = *decoded;
+    } else {
+        const fs::path path = d.file.parent_path() / gltfUriPath(uri);
+        d.references.check(path, uri, "buffer " + std::to_string(index));
+        try {
+            bytes = readFileBytes(path.string(), "glTF buffer", size_t(1) << 31);
+        } catch (const InputError& error) {
+            fail(d.file, where + " ('" + uri + "') cannot be read: " + error.what());
+        }
+    }
+    if (bytes.size() < *length)
+        fail(d.file, where + " holds " + std::to_string(bytes.size()) + " bytes, but its byteLength is " +
+                         std::to_string(*length));
+    bytes.resize(*length);
+    return bytes;
+}
+
+Document openDocument(const fs::path& file, const MeshLoadOptions& options)
+{
+    Document d{file, checkedGltfDocument(file, ReferencePolicy(file, options)), ReferencePolicy(file, options), {}};
+    const std::string version = member(d.doc, "asset") ? stringMember(d.doc["asset"], "version") : "";
+    if (version.rfind("2.", 0) != 0)
+        fail(file, "asset.version is " + (version.empty() ? std::string("missing") : "'" + version + "'") +
+                       ": vkrt reads glTF 2.0");
+    if (const json* buffers = d.array("buffers")) {
+        const std::optional<std::string> chunk = glbBinaryChunk(file);
+        for (size_t i = 0; i < buffers->size(); ++i) d.buffers.push_back(loadBuffer(d, i, chunk));
+    }
+    return d;
+}
+
+// ---------------------------------------------------------------- accessors
+
+struct ElementType {
+    uint32_t components = 0;
+    uint32_t componentType = 0;
+    bool normalized = false;
+};
+
+uint32_t componentBytes(uint32_t componentType)
+{
+    switch (componentType) {
+    case 5120:
+    case 5121: return 1;
+    case 5122:
+    case 5123: return 2;
+    case 5125:
+    case 5126: return 4;
+    default: return 0;
+    }
+}
+
+/// One component as a double: floats as they are, integers as integers or,
+/// normalized, as glTF's normalization says (signed: max(c / max, -1)).
+double componentValue(const char* at, const ElementType& type)
+{
+    switch (type.componentType) {
+    case 5120: {
+        int8_t v;
+        std::memcpy(&v, at, 1);
+        return type.normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case 5121: {
+        uint8_t v;
+        std::memcpy(&v, at, 1);
+        return type.normalized ? v / 255.0 : v;
+    }
+    case 5122: {
+        int16_t v;
+        std::memcpy(&v, at, 2);
+        return type.normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case 5123: {
+        uint16_t v;
+        std::memcpy(&v, at, 2);
+        return type.normalized ? v / 65535.0 : v;
+    }
+    case 5125: {
+        uint32_t v;
+        std::memcpy(&v, at, 4);
+        return type.normalized ? v / 4294967295.0 : v;
+    }
+    default: {
+        float v;
+        std::memcpy(&v, at, 4);
+        return v;
+    }
+    }
+}
+
+/// Reads elements of an accessor (or a sparse part) from a view: count x components doubles.
+void readElements(const Document& d, uint64_t view, uint64_t offset, uint64_t count, const ElementType& type,
+                  uint64_t stride, const std::string& where, double* out)
+{
+    const uint64_t size = uint64_t(componentBytes(type.componentType)) * type.components;
+    if (count == 0) return;
+    const char* bytes = d.viewBytes(view, offset, (count - 1) * stride + size, where);
+    for (uint64_t i = 0; i < count; ++i)
+        for (uint32_t c = 0; c < type.components; ++c)
+            out[i * type.components + c] = componentValue(bytes + i * stride + c * componentBytes(type.componentType), type);
+}
+
+struct Accessor {
+    uint64_t count = 0;
+    uint32_t components = 0;
+    std::vector<double> values; ///< count x components
+    double at(uint64_t i, uint32_t c) const { return values[i * components + c]; }
+};
+
+uint32_t componentsOf(const std::string& type)
+{
+    if (type == "SCALAR") return 1;
+    if (type == "VEC2") return 2;
+    if (type == "VEC3") return 3;
+    if (type == "VEC4") return 4;
+    return 0;
+}
+
+/// Accessor `index`, of one of the `allowed` element sizes, sparse substitution applied.
+Accessor readAccessor(const Document& d, uint64_t index, std::initializer_list<uint32_t> allowed,
+                      const std::string& where)
+{
+    const std::string name = indexed("accessors", index);
+    const json& a = d.element("accessors", index, where);
+    ElementType type;
+    type.components = componentsOf(stringMember(a, "type"));
+    type.componentType = uintMember(a, "componentType").value_or(0);
+    type.normalized = member(a, "normalized") && a["normalized"].is_boolean() && a["normalized"].get<bool>();
+    if (std::find(allowed.begin(), allowed.end(), type.components) == allowed.end())
+        fail(d.file, where + " uses " + name + " of type '" + stringMember(a, "type") + "', which it cannot be");
+    const uint32_t size = componentBytes(type.componentType);
+    if (size == 0) fail(d.file, name + ": unknown componentType");
+    const auto count = uintMember(a, "count");
+    if (!count || *count == 0) fail(d.file, name + ": count must be at least 1");
+    Accessor out;
+    out.count = *count;
+    out.components = type.components;
+    out.values.assign(size_t(*count) * type.components, 0.0); // no bufferView: zeros (then the sparse values)
+    if (const auto view = uintMember(a, "bufferView")) {
+        const json& v = d.element("bufferViews", *view, name);
+        const uint64_t stride = uintMember(v, "byteStride").value_or(0);
+        const uint64_t element = uint64_t(size) * type.components;
+        readElements(d, *view, uintMember(a, "byteOffset").value_or(0), *count, type, stride ? stride : element, name,
+                     out.values.data());
+    }
+    const json* sparse = member(a, "sparse");
+    if (!sparse) return out;
+    const std::string sparseName = name + ".sparse";
+    const auto sparseCount = uintMember(*sparse, "count");
+    const json* indices = member(*sparse, "indices");
+    const json* values = member(*sparse, "values");
+    if (!sparseCount || *sparseCount == 0 || *sparseCount > *count || !indices || !values)
+        fail(d.file, sparseName + ": needs a count from 1 to the accessor's count, indices and values");
+    ElementType indexType{1, uintMember(*indices, "componentType").value_or(0), false};
+    if (indexType.componentType != 5121 && indexType.componentType != 5123 && indexType.componentType != 5125)
+        fail(d.file, sparseName + ".indices: componentType must be an unsigned byte, short or int");
+    const auto indexView = uintMember(*indices, "bufferView");
+    const auto valueView = uintMember(*values, "bufferView");
+    if (!indexView || !valueView) fail(d.file, sparseName + ": indices and values need a bufferView");
+    std::vector<double> where_(*sparseCount), substitutes(size_t(*sparseCount) * type.components);
+    readElements(d, *indexView, uintMember(*indices, "byteOffset").value_or(0), *sparseCount, indexType,
+                 componentBytes(indexType.componentType), sparseName + ".indices", where_.data());
+    readElements(d, *valueView, uintMember(*values, "byteOffset").value_or(0), *sparseCount, type,
+                 uint64_t(size) * type.components, sparseName + ".values", substitutes.data());
+    for (uint64_t i = 0; i < *sparseCount; ++i) {
+        const double target = where_[i];
+        if (!(target < double(*count)))
+            fail(d.file, sparseName + ".indices[" + std::to_string(i) + "] is " + std::to_string(uint64_t(target)) +
+                             ", beyond the accessor's " + std::to_string(*count) + " elements");
+        std::copy_n(substitutes.begin() + long(i * type.components), type.components,
+                    out.values.begin() + long(uint64_t(target) * type.components));
+    }
+    return out;
+}
+
+// --------------------------------------------------------------- primitives
+
+enum : uint32_t { kPoints = 0, kLines = 1, kLineLoop = 2, kLineStrip = 3, kTriangles = 4, kStrip = 5, kFan = 6 };
+
+/// The triangles of a primitive's vertex sequence (glTF 2.0, 3.7.2.1).
+std::vector<glm::uvec3> assembleTriangles(const std::vector<uint32_t>& v, uint32_t mode)
+{
+    std::vector<glm::uvec3> triangles;
+    if (mode == kTriangles)
+        for (size_t i = 0; i + 2 < v.size(); i += 3) triangles.push_back({v[i], v[i + 1], v[i + 2]});
+    if (mode == kStrip)
+        for (size_t i = 0; i + 2 < v.size(); ++i)
+            triangles.push_back({v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]});
+    if (mode == kFan)
+        for (size_t i = 1; i + 1 < v.size(); ++i) triangles.push_back({v[i], v[i + 1], v[0]});
+    return triangles;
+}
+
+/// The texture coordinate sets a material's textures read.
+std::set<uint32_t> texCoordSets(const FileMaterial& m)
+{
+    std::set<uint32_t> sets;
+    for (const std::optional<FileTexture>* t :
+         {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture})
+        if (*t) sets.insert((*t)->texCoord);
+    return sets;
+}
+
+struct MeshBuilder {
+    const Document& d;
+    const std::vector<FileMaterial>& materials;
+    std::vector<std::string>& warnings;
+    MeshData out;
+    bool anyNormals = false, anyUvs = false, anyColors = false, allTangents = true;
+    std::vector<char> hasNormal, hasUv; // per vertex: whether its primitive had them
+
+    void warnOnce(const std::string& text)
+    {
+        if (std::find(warnings.begin(), warnings.end(), text) == warnings.end()) warnings.push_back(text);
+    }
+
+    static bool finite(const Accessor& a, uint64_t i)
+    {
+        for (uint32_t c = 0; c < a.components; ++c)
+            if (!std::isfinite(a.at(i, c))) return false;
+        return true;
+    }
+
+    void checkCount(const Accessor& a, uint64_t count, const std::string& where, const char* name) const
+    {
+        if (a.count != count)
+            fail(d.file, where + ": " + name + " has " + std::to_string(a.count) + " elements, POSITION " +
+                             std::to_string(count));
+    }
+
+    /// The uv set the primitive's material reads: one set for all its
+    /// textures (MeshData has one); a material mixing sets gets set 0 and a warning.
+    uint32_t uvSetFor(const FileMaterial& material, const std::string& where)
+    {
+        const std::set<uint32_t> sets = texCoordSets(material);
+        if (sets.size() > 1)
+            warnOnce(where + ": its material's textures read different TEXCOORD sets; vkrt reads all of them "
+                             "through TEXCOORD_" + std::to_string(*sets.begin()));
+        return sets.empty() ? 0 : *sets.begin();
+    }
+
+    void addPrimitive(const json& primitive, const std::string& where)
+    {
+        const uint32_t mode = uintMember(primitive, "mode").value_or(kTriangles);
+        if (mode > kFan) fail(d.file, where + ".mode: " + std::to_string(mode) + " is not a glTF primitive mode");
+        if (mode < kTriangles) {
+            warnOnce("points and lines (primitive modes 0-3) are not rendered");
+            return;
+        }
+        const json* attributes = member(primitive, "attributes");
+        const auto position = attributes ? uintMember(*attributes, "POSITION") : std::nullopt;
+        if (!position) fail(d.file, where + ": a triangle primitive needs a POSITION attribute");
+        const Accessor positions = readAccessor(d, *position, {3}, where + ".attributes.POSITION");
+        const uint64_t count = positions.count;
+        const uint32_t materialIndex = uintMember(primitive, "material").value_or(uint32_t(materials.size() - 1));
+        if (materialIndex >= materials.size() - 1 && member(primitive, "material"))
+            fail(d.file, where + ".material names a material the file does not have");
+        const FileMaterial& material = materials[materialIndex];
+        auto optional = [&](const char* name, std::initializer_list<uint32_t> sizes) -> std::optional<Accessor> {
+            const auto index = uintMember(*attributes, name);
+            if (!index) return std::nullopt;
+            Accessor a = readAccessor(d, *index, sizes, where + ".attributes." + name);
+            checkCount(a, count, where, name);
+            return a;
+        };
+        const std::optional<Accessor> normals = optional("NORMAL", {3});
+        const std::optional<Accessor> tangents = normals ? optional("TANGENT", {4}) : std::nullopt;
+        const uint32_t uvSet = uvSetFor(material, where);
+        const std::string uvName = "TEXCOORD_" + std::to_string(uvSet);
+        const std::optional<Accessor> uvs = optional(uvName.c_str(), {2});
+        const std::optional<Accessor> colors = optional("COLOR_0", {3, 4});
+        if (!uvs && !texCoordSets(material).empty())
+            fail(d.file, where + ": its material (" + (material.name.empty() ? "unnamed" : "'" + material.name + "'") +
+                             ") samples textures through " + uvName + ", which the primitive does not have");
+        std::vector<uint32_t> sequence(count);
+        if (const auto indices = uintMember(primitive, "indices")) {
+            const Accessor a = readAccessor(d, *indices, {1}, where + ".indices");
+            sequence.resize(a.count);
+            for (uint64_t i = 0; i < a.count; ++i) {
+                if (!(a.values[i] < double(count)))
+                    fail(d.file, where + ".indices[" + std::to_string(i) + "] is " +
+                                     std::to_string(uint64_t(a.values[i])) + ", beyond the " + std::to_string(count) +
+                                     " vertices");
+                sequence[i] = uint32_t(a.values[i]);
+            }
+        } else {
+            for (uint32_t i = 0; i < count; ++i) sequence[i] = i;
+        }
+        if (out.positions.size() + count > UINT32_MAX) fail(d.file, "a mesh has more than 2^32 vertices");
+        const auto base = uint32_t(out.positions.size());
+        for (uint64_t i = 0; i < count; ++i) {
+            if (!finite(positions, i))
+                fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite position");
+            out.positions.emplace_back(positions.at(i, 0), positions.at(i, 1), positions.at(i, 2));
+            glm::vec3 n(0.0f);
+            if (normals) {
+                if (!finite(*normals, i))
+                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite normal");
+                const glm::dvec3 v(normals->at(i, 0), normals->at(i, 1), normals->at(i, 2));
+                const double length = glm::length(v);
+                if (length > 0.0) n = glm::vec3(v / length);
+            }
+            out.normals.push_back(n);
+            glm::vec4 t(0.0f);
+            if (tangents) {
+                if (!finite(*tangents, i))
+                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite tangent");
+                const glm::dvec3 v(tangents->at(i, 0), tangents->at(i, 1), tangents->at(i, 2));
+                const double length = glm::length(v);
+                // glTF's bitangent runs along increasing file v; MeshData's v is 1 - file v (MeshData.h).
+                const float w = tangents->at(i, 3) < 0.0 ? 1.0f : -1.0f;
+                t = length > 0.0 ? glm::vec4(glm::vec3(v / length), w) : glm::vec4(0.0f);
+            }
+            out.tangents.push_back(t);
+            glm::vec2 uv(0.0f);
+            if (uvs) {
+                if (!finite(*uvs, i))
+                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite texture coordinate");
+                uv = glm::vec2(float(uvs->at(i, 0)), float(1.0 - uvs->at(i, 1)));
+            }
+            out.uvs.push_back(uv);
+            glm::vec4 color(1.0f);
+            if (colors) {
+                if (!finite(*colors, i))
+                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite colour");
+                for (uint32_t c = 0; c < colors->components; ++c) color[int(c)] = float(colors->at(i, c));
+            }
+            out.colors.push_back(color);
+        }
+        anyNormals |= normals.has_value();
+        anyUvs |= uvs.has_value();
+        anyColors |= colors.has_value();
+        allTangents &= tangents.has_value();
+        for (const glm::uvec3& t : assembleTriangles(sequence, mode)) {
+            out.triangles.push_back(t + base);
+            out.triangleMaterials.push_back(materialIndex);
+        }
+    }
+
+    /// Drops the attributes no primitive had; tangents unless every primitive had them (computed instead).
+    MeshData finish()
+    {
+        if (!anyNormals) out.normals.clear();
+        if (!anyUvs) out.uvs.clear();
+        if (!anyColors) out.colors.clear();
+        if (!allTangents || out.uvs.empty() || out.normals.empty()) out.tangents.clear();
+        return std::move(out);
+    }
+};
+
+MeshData readMesh(const Document& d, uint32_t index, const std::vector<FileMaterial>& materials,
+                  std::vector<std::string>& warnings)
+{
+    const json& mesh = (*d.array("meshes"))[index];
+    const std::string where = indexed("meshes", index);
+    const json* primitives = arrayMember(mesh, "primitives");
+    if (!primitives || primitives->empty()) fail(d.file, where + ": a mesh needs at least one primitive");
+    MeshBuilder builder{d, materials, warnings, {}};
+    for (size_t p = 0; p < primitives->size(); ++p)
+        builder.addPrimitive((*primitives)[p], where + ".primitives[" + std::to_string(p) + "]");
+    if (member(mesh, "weights") || std::any_of(primitives->begin(), primitives->end(),
+                                               [](const json& p) { return member(p, "targets") != nullptr; }))
+        builder.warnOnce("morph targets are not applied (meshes render in their base shape)");
+    return builder.finish();
+}
+
+// -------------------------------------------------------------------- nodes
+
+double finiteNumber(const fs::path& file, const json& value, const std::string& where)
+{
+    if (!value.is_number() || !std::isfinite(value.get<double>())) fail(file, where + ": expected finite numbers");
+    return value.get<double>();
+}
+
+glm::dvec3 numbers3(const fs::path& file, const json& node, const char* key, glm::dvec3 fallback,
+                    const std::string& where)
+{
+    const json* value = member(node, key);
+    if (!value) return fallback;
+    if (!value->is_array() || value->size() != 3) fail(file, where + "." + key + ": expected 3 numbers");
+    glm::dvec3 out;
+    for (int i = 0; i < 3; ++i) out[i] = finiteNumber(file, (*value)[size_t(i)], where + "." + key);
+    return out;
+}
+
+glm::dmat4 trs(const glm::dvec3& t, const glm::dquat& r, const glm::dvec3& s)
+{
+    return glm::translate(glm::dmat4(1.0), t) * glm::mat4_cast(r) * glm::scale(glm::dmat4(1.0), s);
+}
+
+/// A rotation quaternion (x, y, z, w) made unit; a zero one is an error.
+glm::dquat unitQuaternion(const fs::path& file, const glm::dvec4& q, const std::string& where)
+{
+    const double length = glm::length(q);
+    if (!(length > 0.0) || !std::isfinite(length)) fail(file, where + ": a rotation quaternion must not be zero");
+    return glm::dquat(q.w / length, q.x / length, q.y / length, q.z / length);
+}
+
+/// A node's transform relative to its parent: `matrix` (column-major) or T R S, exactly.
+glm::dmat4 localTransform(const fs::path& file, const json& node, const std::string& where)
+{
+    if (const json* m = member(node, "matrix")) {
+        if (!m->is_array() || m->size() != 16) fail(file, where + ".matrix: expected 16 numbers");
+        glm::dmat4 matrix;
+        for (int i = 0; i < 16; ++i) matrix[i / 4][i % 4] = finiteNumber(file, (*m)[size_t(i)], where + ".matrix");
+        return matrix;
+    }
+    glm::dvec4 q(0.0, 0.0, 0.0, 1.0);
+    if (const json* r = member(node, "rotation")) {
+        if (!r->is_array() || r->size() != 4) fail(file, where + ".rotation: expected a quaternion of 4 numbers");
+        for (int i = 0; i < 4; ++i) q[i] = finiteNumber(file, (*r)[size_t(i)], where + ".rotation");
+    }
+    return trs(numbers3(file, node, "translation", glm::dvec3(0.0), where), unitQuaternion(file, q, where + ".rotation"),
+               numbers3(file, node, "scale", glm::dvec3(1.0), where));
+}
+
+/// EXT_mesh_gpu_instancing's per-instance transforms (TRS), or one identity.
+std::vector<glm::dmat4> instanceTransforms(const Document& d, const json& node, const std::string& where)
+{
+    const json* extensions = member(node, "extensions");
+    const json* instancing = extensions ? member(*extensions, "EXT_mesh_gpu_instancing") : nullptr;
+    const json* attributes = instancing ? member(*instancing, "attributes") : nullptr;
+    if (!attributes) return {glm::dmat4(1.0)};
+    const std::string name = where + ".extensions.EXT_mesh_gpu_instancing.attributes";
+    std::optional<Accessor> t, r, s;
+    uint64_t count = 0;
+    auto read = [&](const char* key, uint32_t size, std::optional<Accessor>& into) {
+        if (const auto index = uintMember(*attributes, key)) {
+            into = readAccessor(d, *index, {size}, name + "." + key);
+            if (count != 0 && into->count != count)
+                fail(d.file, name + ": TRANSLATION, ROTATION and SCALE must have the same count");
+            count = into->count;
+        }
+    };
+    read("TRANSLATION", 3, t);
+    read("ROTATION", 4, r);
+    read("SCALE", 3, s);
+    if (count == 0) return {glm::dmat4(1.0)};
+    if (count > kMaxGltfInstances)
+        fail(d.file, name + ": " + std::to_string(count) + " instances; vkrt reads at most " +
+                         std::to_string(kMaxGltfInstances));
+    std::vector<glm::dmat4> out;
+    out.reserve(count);
+    for (uint64_t i = 0; i < count; ++i) {
+        const glm::dvec3 translation = t ? glm::dvec3(t->at(i, 0), t->at(i, 1), t->at(i, 2)) : glm::dvec3(0.0);
+        const glm::dvec4 q = r ? glm::dvec4(r->at(i, 0), r->at(i, 1), r->at(i, 2), r->at(i, 3)) : glm::dvec4(0, 0, 0, 1);
+        const glm::dvec3 scale = s ? glm::dvec3(s->at(i, 0), s->at(i, 1), s->at(i, 2)) : glm::dvec3(1.0);
+        if (!std::isfinite(glm::dot(translation, translation) + glm::dot(scale, scale)))
+            fail(d.file, name + ": instance " + std::to_string(i) + " has a non-finite transform");
+        out.push_back(trs(translation, unitQuaternion(d.file, q, name + ".ROTATION[" + std::to_string(i) + "]"), scale));
+    }
+    return out;
+}
+
+/// The chosen scene's index; nullopt when the file has no scenes.
+std::optional<uint32_t> chosenScene(const Document& d, const std::optional<std::string>& choice)
+{
+    const json* scenes = d.array("scenes");
+    const size_t count = scenes ? scenes->size() : 0;
+    if (!choice) {
+        if (count == 0) return std::nullopt;
+        const uint32_t index = uintMember(d.doc, "scene").value_or(0);
+        if (index >= count) fail(d.file, "scene: " + std::to_string(index) + " names a scene the file does not have");
+        return index;
+    }
+    const std::string& text = *choice;
+    const bool isIndex = !text.empty() && text.size() < 10 && text.find_first_not_of("0123456789") == std::string::npos;
+    std::string known;
+    for (size_t i = 0; i < count; ++i) {
+        const std::string name = stringMember((*scenes)[i], "name");
+        if ((isIndex && std::stoul(text) == i) || (!name.empty() && name == text)) return uint32_t(i);
+        known += (known.empty() ? "" : ", ") + std::to_string(i) + (name.empty() ? "" : " ('" + name + "')");
+    }
+    throw InputError("--scene " + text + ": " + d.file.string() + " has no such scene (" +
+                     (count == 0 ? std::string("it has none") : "its scenes: " + known) + ")");
+}
+
+/// The root nodes: the chosen scene's, or without scenes every node that is no child.
+std::vector<uint32_t> rootNodes(const Document& d, std::optional<uint32_t> scene)
+{
+    const json* nodes = d.array("nodes");
+    const size_t nodeCount = nodes ? nodes->size() : 0;
+    std::vector<uint32_t> roots;
+    if (scene) {
+        if (const json* list = arrayMember((*d.array("scenes"))[*scene], "nodes"))
+            for (const json& n : *list) {
+                if (!n.is_number_unsigned() || n.get<uint64_t>() >= nodeCount)
+                    fail(d.file, indexed("scenes", *scene) + ".nodes names a node the file does not have");
+                roots.push_back(uint32_t(n.get<uint64_t>()));
+            }
+        return roots;
+    }
+    std::vector<bool> child(nodeCount, false);
+    for (size_t i = 0; i < nodeCount; ++i)
+        if (const json* children = arrayMember((*nodes)[i], "children"))
+            for (const json& c : *children)
+                if (c.is_number_unsigned() && c.get<uint64_t>() < nodeCount) child[c.get<uint64_t>()] = true;
+    for (uint32_t i = 0; i < nodeCount; ++i)
+        if (!child[i]) roots.push_back(i);
+    return roots;
+}
+
+void walkNodes(const Document& d, GltfModel& model, std::optional<uint32_t> scene)
+{
+    const json* nodes = d.array("nodes");
+    if (!nodes) return;
+    struct Visit {
+        uint32_t node;
+        glm::dmat4 parent;
+    };
+    std::vector<Visit> stack;
+    const std::vector<uint32_t> roots = rootNodes(d, scene);
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
+    const size_t meshCount = d.array("meshes") ? d.array("meshes")->size() : 0;
+    bool singular = false;
+    // checkGltfDocument refused cycles, second parents and deep hierarchies, and bounded the nodes the walk meets.
+    while (!stack.empty()) {
+        const Visit visit = stack.back();
+        stack.pop_back();
+        const std::string where = indexed("nodes", visit.node);
+        const json& node = (*nodes)[visit.node];
+        if (!node.is_object()) fail(d.file, where + ": expected an object");
+        const glm::dmat4 world = visit.parent * localTransform(d.file, node, where);
+        const std::string name = stringMember(node, "name");
+        if (const auto mesh = uintMember(node, "mesh")) {
+            if (*mesh >= meshCount) fail(d.file, where + ".mesh names a mesh the file does not have");
+            for (const glm::dmat4& instance : instanceTransforms(d, node, where)) {
+                const glm::dmat4 placed = world * instance;
+                const double det = glm::determinant(glm::dmat3(placed));
+                if (!(std::abs(det) > 0.0) || !std::isfinite(det)) {
+                    singular = true; // a zero scale hides a node (glTF viewers use it so): nothing to draw
+                    continue;
+                }
+                model.instances.push_back({*mesh, placed, name});
+            }
+            if (model.instances.size() > kMaxGltfInstances)
+                fail(d.file, "the scene places meshes more than " + std::to_string(kMaxGltfInstances) +
+                                 " times; vkrt reads at most that many instances");
+        }
+        if (const auto camera = uintMember(node, "camera")) model.cameras.push_back({*camera, visit.node, name, world});
+        if (const json* extensions = member(node, "extensions"))
+            if (const json* light = member(*extensions, "KHR_lights_punctual"))
+                if (const auto index = uintMember(*light, "light"))
+                    model.lights.push_back({*index, visit.node, name, world});
+        if (const json* children = arrayMember(node, "children"))
+            for (size_t c = children->size(); c-- > 0;)
+                if (const json& child = (*children)[c]; child.is_number_unsigned() && child.get<uint64_t>() < nodes->size())
+                    stack.push_back({uint32_t(child.get<uint64_t>()), world});
+    }
+    if (singular)
+        model.warnings.push_back("nodes with a zero scale (a singular transform) are not drawn");
+}
+
+// --------------------------------------------------- cameras and lights
+
+double number(const fs::path& file, const json& object, const char* key, double fallback, const std::string& where)
+{
+    const json* value = member(object, key);
+    if (!value) return fallback;
+    if (!value->is_number() || !std::isfinite(value->get<double>()))
+        fail(file, where + "." + key + ": expected a finite number");
+    return value->get<double>();
+}
+
+GltfCamera readCamera(const fs::path& file, const json& camera, const std::string& where)
+{
+    GltfCamera c;
+    c.name = stringMember(camera, "name");
+    const std::string type = stringMember(camera, "type");
+    if (type == "orthographic") {
+        const json* o = member(camera, "orthographic");
+        if (!o || !o->is_object()) fail(file, where + ": an orthographic camera needs its `orthographic` object");
+        c.orthographic = true;
+        c.xmag = number(file, *o, "xmag", 0.0, where + ".orthographic");
+        c.ymag = number(file, *o, "ymag", 0.0, where + ".orthographic");
+        if (c.xmag == 0.0 || c.ymag == 0.0)
+            fail(file, where + ".orthographic: xmag and ymag must be given and not zero");
+        return c;
+    }
+    if (type != "perspective")
+        fail(file, where + ".type: must be \"perspective\" or \"orthographic\", got '" + type + "'");
+    const json* p = member(camera, "perspective");
+    if (!p || !p->is_object()) fail(file, where + ": a perspective camera needs its `perspective` object");
+    c.yfov = number(file, *p, "yfov", 0.0, where + ".perspective");
+    if (!(c.yfov > 0.0 && c.yfov < 3.141592653589793))
+        fail(file, where + ".perspective.yfov: must be strictly between 0 and pi radians");
+    if (member(*p, "aspectRatio")) {
+        c.aspectRatio = number(file, *p, "aspectRatio", 1.0, where + ".perspective");
+        if (!(*c.aspectRatio > 0.0)) fail(file, where + ".perspective.aspectRatio: must be > 0");
+    }
+    return c;
+}
+
+GltfLight readLight(const fs::path& file, const json& light, const std::string& where)
+{
+    if (!light.is_object()) fail(file, where + ": expected an object with a `type`");
+    GltfLight l;
+    l.name = stringMember(light, "name");
+    l.type = stringMember(light, "type");
+    if (l.type != "point" && l.type != "spot" && l.type != "directional")
+        fail(file, where + ".type: unknown light type '" + l.type + "' (point, spot, directional)");
+    l.color = numbers3(file, light, "color", glm::dvec3(1.0), where);
+    l.intensity = number(file, light, "intensity", 1.0, where);
+    if (!(l.intensity >= 0.0) || glm::any(glm::lessThan(l.color, glm::dvec3(0.0))))
+        fail(file, where + ": color and intensity must be >= 0");
+    if (std::max({l.color.r, l.color.g, l.color.b}) * l.intensity > std::numeric_limits<float>::max())
+        fail(file, where + ": color x intensity is beyond 32-bit float range");
+    l.hasRange = member(light, "range") != nullptr;
+    if (l.type == "spot") {
+        const json* spot = member(light, "spot");
+        const json empty = json::object();
+        const json& s = spot ? *spot : empty;
+        l.innerConeAngle = number(file, s, "innerConeAngle", 0.0, where + ".spot");
+        l.outerConeAngle = number(file, s, "outerConeAngle", l.outerConeAngle, where + ".spot");
+        if (!(l.outerConeAngle > 0.0 && l.outerConeAngle <= 3.141592653589793 / 2.0) ||
+            !(l.innerConeAngle >= 0.0 && l.innerConeAngle <= l.outerConeAngle))
+            fail(file, where + ".spot: needs 0 <= innerConeAngle <= outerConeAngle <= pi/2 and outerConeAngle > 0");
+    }
+    return l;
+}
+
+void readCamerasAndLights(const Document& d, GltfModel& model)
+{
+    if (const json* cameras = d.array("cameras"))
+        for (size_t i = 0; i < cameras->size(); ++i)
+            model.cameraDefinitions.push_back(readCamera(d.file, (*cameras)[i], indexed("cameras", i)));
+    const json* extensions = member(d.doc, "extensions");
+    const json* punctual = extensions ? member(*extensions, "KHR_lights_punctual") : nullptr;
+    if (const json* lights = punctual ? arrayMember(*punctual, "lights") : nullptr)
+        for (size_t i = 0; i < lights->size(); ++i)
+            model.lightDefinitions.push_back(
+                readLight(d.file, (*lights)[i], "extensions.KHR_lights_punctual." + indexed("lights", i)));
+    for (const GltfPlaced& c : model.cameras)
+        if (c.index >= model.cameraDefinitions.size())
+            fail(d.file, indexed("nodes", c.node) + ".camera names a camera the file does not have");
+    for (const GltfPlaced& l : model.lights)
+        if (l.index >= model.lightDefinitions.size())
+            fail(d.file, indexed("nodes", l.node) + " names a KHR_lights_punctual light the file does not have");
+}
+
+// --------------------------------------------------------------- extensions
+
+void checkExtensions(const Document& d, GltfModel& model)
+{
+    const std::vector<std::string>& implemented = implementedGltfExtensions();
+    auto known = [&](const std::string& name) {
+        return std::find(implemented.begin(), implemented.end(), name) != implemented.end();
+    };
+    if (const json* required = d.array("extensionsRequired"))
+        for (const json& name : *required)
+            if (name.is_string() && !known(name.get<std::string>()))
+                fail(d.file, "extensionsRequired names " + name.get<std::string>() +
+                                 ", which vkrt does not implement (the file cannot be rendered without it)");
+    if (const json* used = d.array("extensionsUsed"))
+        for (const json& name : *used)
+            if (name.is_string() && !known(name.get<std::string>()))
+                model.warnings.push_back("extension " + name.get<std::string>() +
+                                         " is not supported: what it adds is ignored");
+}
+
+} // namespace
+
+const std::vector<std::string>& implementedGltfExtensions()
+{
+    static const std::vector<std::string> names{
+        "KHR_lights_punctual",        "KHR_texture_transform", "KHR_materials_emissive_strength",
+        "KHR_materials_ior",          "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+    };
+    return names;
+}
+
+GltfModel readGltfModel(const fs::path& file, const GltfReadOptions& options)
+{
+    const Document d = openDocument(file, options.references);
+    GltfModel model;
+    model.file = file;
+    checkExtensions(d, model);
+    const auto viewBytes = [&](uint32_t view, const std::string& where) {
+        const json& v = d.element("bufferViews", view, where);
+        const uint64_t length = uintMember(v, "byteLength").value_or(0);
+        const char* bytes = d.viewBytes(view, 0, length, where);
+        return std::vector<uint8_t>(bytes, bytes + length);
+    };
+    model.materials = readGltfMaterials(d.doc, file, d.references, viewBytes);
+    const std::optional<uint32_t> scene = chosenScene(d, options.scene);
+    model.sceneIndex = scene.value_or(0);
+    if (scene) model.sceneName = stringMember((*d.array("scenes"))[*scene], "name");
+    walkNodes(d, model, scene);
+    readCamerasAndLights(d, model);
+    // Only meshes the scene places are read: a file's other scenes may hold meshes it never shows.
+    const size_t meshCount = d.array("meshes") ? d.array("meshes")->size() : 0;
+    model.meshes.resize(meshCount);
+    model.meshNames.resize(meshCount);
+    std::vector<bool> placed(meshCount, false);
+    for (const GltfInstance& instance : model.instances) placed[instance.mesh] = true;
+    for (uint32_t m = 0; m < meshCount; ++m) {
+        model.meshNames[m] = stringMember((*d.array("meshes"))[m], "name");
+        if (placed[m]) model.meshes[m] = readMesh(d, m, model.materials, model.warnings);
+    }
+    std::erase_if(model.instances, [&](const GltfInstance& i) { return model.meshes[i.mesh].triangles.empty(); });
+    return model;
+}
+
+// --------------------------------------------------------------- flattening
+
+namespace {
+
+/// Appends one instance of `mesh` transformed by `world`, its materials renumbered through `materialMap`.
+void appendInstance(MeshData& out, const MeshData& mesh, const glm::dmat4& world, const std::vector<uint32_t>& materialMap)
+{
+    const auto base = uint32_t(out.positions.size());
+    const glm::dmat3 linear(world);
+    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(linear));
+    const bool mirrored = glm::determinant(linear) < 0.0;
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        out.positions.push_back(glm::vec3(world * glm::dvec4(glm::dvec3(mesh.positions[v]), 1.0)));
+        if (!mesh.normals.empty()) {
+            const glm::dvec3 n = normalMatrix * glm::dvec3(mesh.normals[v]);
+            const double length = glm::length(n);
+            out.normals.push_back(length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f));
+        }
+        if (!mesh.tangents.empty()) {
+            const glm::dvec3 t = linear * glm::dvec3(mesh.tangents[v]);
+            const double length = glm::length(t);
+            const float w = mesh.tangents[v].w * (mirrored ? -1.0f : 1.0f);
+            out.tangents.push_back(length > 0.0 && std::isfinite(length) ? glm::vec4(glm::vec3(t / length), w)
+                                                                         : glm::vec4(0.0f));
+        }
+        if (!mesh.uvs.empty()) out.uvs.push_back(mesh.uvs[v]);
+        if (!mesh.colors.empty()) out.colors.push_back(mesh.colors[v]);
+    }
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const glm::uvec3 tri = mesh.triangles[t] + base;
+        // A mirroring transform turns the winding round; glTF keeps the front side (3.7.4).
+        out.triangles.push_back(mirrored ? glm::uvec3(tri.x, tri.z, tri.y) : tri);
+        out.triangleMaterials.push_back(materialMap[mesh.triangleMaterials[t]]);
+    }
+}
+
+} // namespace
+
+MeshData flattenGltfModel(GltfModel model)
+{
+    uint64_t triangles = 0, vertices = 0;
+    for (const GltfInstance& i : model.instances) {
+        triangles += model.meshes[i.mesh].triangles.size();
+        vertices += model.meshes[i.mesh].positions.size();
+    }
+    if (triangles == 0) fail(model.file, "no triangles in " + model.file.string() + " (its scene places no triangle mesh)");
+    if (triangles > kMaxGltfTriangles)
+        fail(model.file, "the node hierarchy instances meshes " + std::to_string(model.instances.size()) + " times, " +
+                             std::to_string(triangles) + " triangles in all; vkrt reads at most " +
+                             std::to_string(kMaxGltfTriangles) +
+                             " triangles after instancing into one mesh (a glTF scene keeps instances instead)");
+    if (vertices > UINT32_MAX) fail(model.file, "more than 2^32 vertices after instancing");
+    // Attributes are all or nothing in MeshData: a mesh without one gets neutral values.
+    auto any = [&](auto member) {
+        return std::any_of(model.instances.begin(), model.instances.end(),
+                           [&](const GltfInstance& i) { return !(model.meshes[i.mesh].*member).empty(); });
+    };
+    auto all = [&](auto member) {
+        return std::all_of(model.instances.begin(), model.instances.end(),
+                           [&](const GltfInstance& i) { return !(model.meshes[i.mesh].*member).empty(); });
+    };
+    const bool normals = any(&MeshData::normals), uvs = any(&MeshData::uvs), colors = any(&MeshData::colors);
+    const bool tangents = all(&MeshData::tangents);
+    for (MeshData& mesh : model.meshes) {
+        if (normals && mesh.normals.empty()) mesh.normals.assign(mesh.positions.size(), glm::vec3(0.0f));
+        if (uvs && mesh.uvs.empty()) mesh.uvs.assign(mesh.positions.size(), glm::vec2(0.0f));
+        if (colors && mesh.colors.empty()) mesh.colors.assign(mesh.positions.size(), glm::vec4(1.0f));
+        if (!tangents) mesh.tangents.clear();
+    }
+    // The materials the placed triangles use, in order of first use.
+    std::vector<uint32_t> materialMap(model.materials.size(), UINT32_MAX);
+    MeshData out;
+    for (const GltfInstance& i : model.instances)
+        for (uint32_t m : model.meshes[i.mesh].triangleMaterials)
+            if (materialMap[m] == UINT32_MAX) {
+                materialMap[m] = uint32_t(out.materials.size());
+                out.materials.push_back(model.materials[m]);
+            }
+    // What the file as a whole does not honour reaches the scene's warnings through the first material.
+    for (const std::string& warning : model.warnings) out.materials.front().unsupported.push_back(warning);
+    out.positions.reserve(vertices);
+    out.triangles.reserve(triangles);
+    for (const GltfInstance& i : model.instances) appendInstance(out, model.meshes[i.mesh], i.world, materialMap);
+    return out;
+}
+
+} // namespace vkrt
