@@ -952,6 +952,9 @@ def _lens(cam: dict) -> dict:
     or an export without the key). vkrt's focus_distance is Mitsuba's `thinlens`
     one: the distance from the eye to the plane in focus along the viewing
     direction; the aperture is a disc of aperture_radius perpendicular to it."""
+    if float(cam.get("orthographic_height", 0.0)) > 0:
+        raise ConversionError("camera: an orthographic camera (a glTF file's) is not converted; "
+                              "Mitsuba's `orthographic` sensor scales its view by the to_world transform instead")
     aperture = float(cam.get("aperture_radius", 0.0))
     if aperture <= 0:
         return {}

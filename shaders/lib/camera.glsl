@@ -12,8 +12,19 @@ vec3 pinholeDirection(uvec2 pixel, vec2 subpixel)
     return ndc.x * u.cameraRight + ndc.y * u.cameraUp + u.cameraForward;
 }
 
+// An orthographic camera (glTF's; kernels with VKRT_ORTHOGRAPHIC, chosen by
+// RENDER_FLAG_ORTHOGRAPHIC so the uber kernel has both): parallel rays along
+// cameraForward from the plane through the eye, cameraRight and cameraUp
+// scaled to the view's half width and height in scene units.
 Ray cameraRay(uvec2 pixel, vec2 subpixel)
 {
+#ifdef VKRT_ORTHOGRAPHIC
+    if ((u.flags & RENDER_FLAG_ORTHOGRAPHIC) != 0u) {
+        vec2 film = (vec2(pixel) + subpixel) / vec2(u.width, u.height);
+        vec2 ndc = vec2(2.0 * film.x - 1.0, 1.0 - 2.0 * film.y);
+        return Ray(ndc.x * u.cameraRight + ndc.y * u.cameraUp, u.cameraForward);
+    }
+#endif
     return Ray(vec3(0.0), normalize(pinholeDirection(pixel, subpixel)));
 }
 

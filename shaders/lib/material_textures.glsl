@@ -8,13 +8,30 @@
 // bounce the cone keeps the camera's spread, as pbrt-v4 approximates ray
 // differentials after the first hit: no blur beyond what a camera ray of the
 // same length would have).
+//
+// The cone of one pixel is right for one sample per pixel; jittered samples
+// already average over the pixel, and filtering each one over the whole
+// pixel again blurs the converged image by about a pixel (textured test
+// charts came out visibly softer than Cycles'). As pbrt-v4 scales camera ray
+// differentials by 1/sqrt(spp), the cone of the pixel's n-th sample (n from
+// 1) is 1/sqrt(n) of the pixel's: the first samples keep their mip-mapped
+// low noise, and the average converges to the texture's own detail (the
+// filters' added variance, ~ w^2/n, averages to O(log N / N)).
 #ifndef VKRT_MATERIAL_TEXTURES_GLSL
 #define VKRT_MATERIAL_TEXTURES_GLSL
 
 #include "lib/texture.glsl"
 
-// The angle one pixel subtends at the image centre.
-float pixelSpreadAngle() { return 2.0 * length(u.cameraUp) / float(u.height); }
+// 1/sqrt(n) for the pixel's n-th jittered sample, 1 without jitter (kernels/render.comp sets it per sample).
+float g_textureConeScale = 1.0;
+
+void setTextureConeScale(uint frameIndex)
+{
+    g_textureConeScale = (u.flags & RENDER_FLAG_JITTER) != 0u ? inversesqrt(float(frameIndex) + 1.0) : 1.0;
+}
+
+// The angle one pixel subtends at the image centre, narrowed for later samples (above).
+float pixelSpreadAngle() { return g_textureConeScale * 2.0 * length(u.cameraUp) / float(u.height); }
 
 vec4 lookupSlot(TextureSlot slot, SurfaceHit hit, float coneWidth, float cosTheta)
 {
@@ -65,6 +82,10 @@ vec3 normalMapped(SurfaceHit hit, vec3 texel, float strength)
 Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float pathLength)
 {
     float coneWidth = pixelSpreadAngle() * pathLength;
+#ifdef VKRT_ORTHOGRAPHIC
+    if ((u.flags & RENDER_FLAG_ORTHOGRAPHIC) != 0u)
+        coneWidth = pixelSpreadAngle(); // parallel rays: one pixel's width at any distance
+#endif
     float cosTheta = dot(dir, hit.normal);
 #ifdef VKRT_HAS_NORMAL_MAPS
     const uint slots = TEXTURE_SLOT_COUNT;

@@ -221,6 +221,8 @@ VKRT_CONSTANT(uint, TOP_REF_MAX_INDEX, 16777215)
 
 // SceneUniforms::flags
 VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
+// The camera projects orthographically (kernels with VKRT_ORTHOGRAPHIC, lib/camera.glsl).
+VKRT_CONSTANT(uint, RENDER_FLAG_ORTHOGRAPHIC, 2)
 
 /// Per-render constants. Camera ray for pixel coordinate (x, y) in [0,w]x[0,h]:
 /// normalize(ndc.x * cameraRight + ndc.y * cameraUp + cameraForward).

@@ -1,6 +1,7 @@
 #pragma once
-// Mesh files -> MeshData, through Open Asset Import Library (assimp): OBJ,
-// PLY (ASCII and binary, either byte order) and glTF 2.0 (.gltf + .bin, .glb).
+// Mesh files -> MeshData: OBJ through Open Asset Import Library (assimp),
+// PLY (ASCII and binary, either byte order) through PlyReader, glTF 2.0
+// (.gltf + .bin, .glb) through GltfReader (its instances flattened into one mesh).
 // Every failure is an InputError whose message names the file and, where the
 // format allows, the line (OBJ) or element and byte offset (PLY): unreadable
 // or unsupported files, syntax errors, indices out of range, NaN or infinite

@@ -450,7 +450,8 @@ void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
     glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
     glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
     glm::dvec3 up = glm::cross(right, forward);
-    double halfHeight = std::tan(glm::radians(camera.fovY) / 2.0);
+    // Perspective: scaled to the plane one unit ahead; orthographic: the view's half extents.
+    double halfHeight = camera.orthographic() ? camera.orthographicHeight / 2.0 : std::tan(glm::radians(camera.fovY) / 2.0);
     double halfWidth = halfHeight * double(camera.width) / double(camera.height);
     u.cameraRight = toFloat(right * halfWidth);
     u.cameraUp = toFloat(up * halfHeight);
@@ -637,7 +638,8 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
 
     gpu::SceneUniforms& u = data.uniforms;
     convertCamera(scene.camera, u);
-    u.flags = settings.jitter ? gpu::RENDER_FLAG_JITTER : 0u;
+    u.flags = (settings.jitter ? gpu::RENDER_FLAG_JITTER : 0u) |
+              (scene.camera.orthographic() ? gpu::RENDER_FLAG_ORTHOGRAPHIC : 0u);
     u.backgroundColor = toFloat(scene.background.color);
     if (scene.background.environment) {
         const glm::dmat3& rotation = scene.background.environment->rotation;

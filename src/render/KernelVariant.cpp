@@ -60,6 +60,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     // The rough plastics' coating tables come with the plastic kind.
     list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});
+    list.push_back({f.orthographic, "VKRT_ORTHOGRAPHIC", -1, "orthographic"});
     list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});
     list.push_back({f.latLong, "VKRT_HAS_LATLONG", int(gpu::BINDING_ENVIRONMENT), "lat-long"});
     list.push_back({f.environmentSampling, "VKRT_ENVIRONMENT_SAMPLING", int(gpu::BINDING_ENVIRONMENT_CDF),

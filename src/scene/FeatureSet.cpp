@@ -40,6 +40,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.normalMaps = true;
     all.fileMaterials = true;
     all.thinLens = true;
+    all.orthographic = true;
     all.integrator = integrator;
     return all;
 }
@@ -87,6 +88,7 @@ FeatureSet featuresOf(const Scene& scene)
     set.environmentSampling = (set.cubemap && scene.render.integrator == Integrator::Path) || set.latLong;
     set.integrator = scene.render.integrator;
     set.thinLens = scene.camera.thinLens();
+    set.orthographic = scene.camera.orthographic();
     for (const TriangleLight& light : scene.triangleLights) set.emitters = set.emitters || emits(light);
     for (const Mesh& mesh : scene.meshes) {
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();

@@ -23,6 +23,7 @@ struct FeatureSet {
     bool normalMaps = false;          ///< ... a normal map
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
+    bool orthographic = false;        ///< the camera projects orthographically (parallel rays)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).

@@ -86,8 +86,17 @@ Camera cameraFrom(const GltfModel& model, const GltfPlaced& placed, const Aabb& 
     const double size = bounds.empty() ? 1.0 : glm::length(bounds.upper - bounds.lower);
     c.target = c.eye + *forward * std::max(ahead, 1e-3 * std::max(size, 1e-30));
     c.up = *up;
-    c.fovY = glm::degrees(definition.yfov);
-    const double aspect = definition.aspectRatio.value_or(4.0 / 3.0);
+    double aspect = 4.0 / 3.0;
+    if (definition.orthographic) {
+        // The node's scale scales the view like everything else it carries.
+        const double scaleX = glm::length(axisOf(placed.world, {1, 0, 0}));
+        const double scaleY = glm::length(axisOf(placed.world, {0, 1, 0}));
+        c.orthographicHeight = 2.0 * std::abs(definition.ymag) * scaleY;
+        aspect = (std::abs(definition.xmag) * scaleX) / (std::abs(definition.ymag) * scaleY);
+    } else {
+        c.fovY = glm::degrees(definition.yfov);
+        aspect = definition.aspectRatio.value_or(aspect);
+    }
     c.width = 640;
     c.height = uint32_t(std::clamp(std::lround(640.0 / aspect), 1l, long(SceneLimits::maxImageSide)));
     if (auto problem = cameraProblem(c)) fail(model.file, where + ": " + *problem);
@@ -208,13 +217,6 @@ void importGltf(const fs::path& file, const GltfSceneOptions& options, bool take
         return;
     }
     const std::optional<GltfPlaced> chosen = chosenCamera(model, options.camera);
-    if (chosen && model.cameraDefinitions[chosen->index].orthographic) {
-        scene.warnings.push_back(file.string() + ": cameras[" + std::to_string(chosen->index) +
-                                 "]: only perspective cameras are rendered; this one is replaced by a camera framing "
-                                 "the scene");
-        scene.camera = framingCamera(bounds);
-        return;
-    }
     scene.camera = chosen ? cameraFrom(model, *chosen, bounds) : framingCamera(bounds);
 }
 

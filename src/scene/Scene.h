@@ -53,8 +53,14 @@ struct Camera {
     /// direction (unset: the distance to `target`, which moves with it).
     double apertureRadius = 0.0;
     std::optional<double> focusDistance;
+    /// Orthographic projection (a glTF orthographic camera): the full height
+    /// of the view in scene units, the width following the image's aspect;
+    /// 0: perspective (fovY). Parallel rays along the view direction from the
+    /// plane through `eye`.
+    double orthographicHeight = 0.0;
 
     bool thinLens() const { return apertureRadius > 0.0; }
+    bool orthographic() const { return orthographicHeight > 0.0; }
     double resolvedFocusDistance() const;
 };
 

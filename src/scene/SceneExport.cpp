@@ -388,7 +388,8 @@ Json camera(const Camera& c)
             {"width", c.width},
             {"height", c.height},
             {"aperture_radius", c.apertureRadius},
-            {"focus_distance", c.resolvedFocusDistance()}};
+            {"focus_distance", c.resolvedFocusDistance()},
+            {"orthographic_height", c.orthographicHeight}};
 }
 
 Json renderSettings(const RenderSettings& r)

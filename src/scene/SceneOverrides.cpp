@@ -44,6 +44,10 @@ std::optional<std::string> lensProblem(const Camera& camera)
     // The default, the distance to the target, can overflow for far-apart finite points.
     if (camera.thinLens() && !std::isfinite(camera.resolvedFocusDistance()))
         return std::string("focus_distance: the distance from eye to target overflows; set focus_distance");
+    if (!(camera.orthographicHeight >= 0 && std::isfinite(camera.orthographicHeight)))
+        return "orthographic height: must be finite and at least 0, got " + formatNumber(camera.orthographicHeight);
+    if (camera.orthographic() && camera.thinLens())
+        return std::string("aperture_radius: an orthographic camera has no lens");
     return std::nullopt;
 }
 

@@ -1,0 +1,328 @@
+// The glTF reader (mesh/GltfReader.h) on files each test writes: exact node
+// transforms of any size, meshes placed by several nodes and by
+// EXT_mesh_gpu_instancing as instances of one mesh, primitives that differ
+// in their attributes, strips and fans, sparse and interleaved accessors,
+// normalized vertex colours, negative scales, scenes, and the extension rules.
+#include "mesh/GltfReader.h"
+#include "mesh/MeshLoader.h"
+#include "scene/GltfScene.h"
+#include "support/GltfTestFiles.h"
+#include "support/TestSupport.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+
+namespace vkrt::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+fs::path testDir()
+{
+    static const fs::path dir = freshTempDir("gltf-reader");
+    return dir;
+}
+
+/// A glTF 2.0 document built in memory, its one buffer inline as a data: URI.
+class GltfBuilder {
+public:
+    GltfBuilder()
+    {
+        m_doc = {{"asset", {{"version", "2.0"}}}, {"bufferViews", json::array()}, {"accessors", json::array()},
+                 {"meshes", json::array()}, {"nodes", json::array()}};
+    }
+
+    /// An accessor over tightly packed values of one component type.
+    template <typename T>
+    uint32_t accessor(const std::vector<T>& values, const char* type, uint32_t componentType, bool normalized = false)
+    {
+        const uint32_t components = std::string(type) == "SCALAR" ? 1 : uint32_t(type[3] - '0');
+        align();
+        const size_t offset = m_bin.size();
+        for (T v : values) put(m_bin, v);
+        m_doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
+        json a = {{"bufferView", m_doc["bufferViews"].size() - 1},
+                  {"componentType", componentType},
+                  {"count", values.size() / components},
+                  {"type", type}};
+        if (normalized) a["normalized"] = true;
+        m_doc["accessors"].push_back(a);
+        return uint32_t(m_doc["accessors"].size() - 1);
+    }
+    uint32_t floats(const std::vector<float>& v, const char* type) { return accessor(v, type, 5126); }
+    uint32_t indices(const std::vector<uint32_t>& v) { return accessor(v, "SCALAR", 5125); }
+
+    /// A mesh of one primitive with the given attributes; returns its index.
+    uint32_t mesh(json attributes, std::optional<uint32_t> indexAccessor = {}, uint32_t mode = 4,
+                  std::optional<uint32_t> material = {})
+    {
+        json primitive = {{"attributes", attributes}, {"mode", mode}};
+        if (indexAccessor) primitive["indices"] = *indexAccessor;
+        if (material) primitive["material"] = *material;
+        m_doc["meshes"].push_back({{"primitives", json::array({primitive})}});
+        return uint32_t(m_doc["meshes"].size() - 1);
+    }
+
+    uint32_t node(json node)
+    {
+        m_doc["nodes"].push_back(node);
+        return uint32_t(m_doc["nodes"].size() - 1);
+    }
+
+    json& doc() { return m_doc; }
+
+    fs::path write(const std::string& name)
+    {
+        json doc = m_doc;
+        doc["buffers"] = json::array({{{"byteLength", m_bin.size()}, {"uri", dataUri("application/octet-stream", m_bin)}}});
+        const fs::path path = testDir() / name;
+        std::ofstream(path) << doc.dump();
+        return path;
+    }
+
+private:
+    void align()
+    {
+        while (m_bin.size() % 4) m_bin.push_back('\0');
+    }
+    json m_doc;
+    std::string m_bin;
+};
+
+/// One triangle in the z = 0 plane: (0,0,0) (1,0,0) (0,1,0), with an optional uv set.
+uint32_t triangleMesh(GltfBuilder& b, bool uvs = false, std::optional<uint32_t> material = {})
+{
+    json attributes = {{"POSITION", b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3")}};
+    if (uvs) attributes["TEXCOORD_0"] = b.floats({0, 0, 1, 0, 0, 1}, "VEC2");
+    return b.mesh(attributes, std::nullopt, 4, material);
+}
+
+std::string errorOf(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(GltfReader, SmallNodeTranslationsArePlacedExactly)
+{
+    // assimp's identity test (tolerance 1e-2) dropped translations like these.
+    GltfBuilder b;
+    const uint32_t mesh = triangleMesh(b);
+    b.node({{"mesh", mesh}, {"translation", {0.001, -0.004, 0.0}}});
+    b.node({{"mesh", mesh}, {"translation", {1e-7, 0.0, 0.0}}});
+    const GltfModel model = readGltfModel(b.write("small.gltf"));
+    ASSERT_EQ(model.instances.size(), 2u);
+    EXPECT_EQ(model.instances[0].world[3], glm::dvec4(0.001, -0.004, 0.0, 1.0));
+    EXPECT_EQ(model.instances[1].world[3], glm::dvec4(1e-7, 0.0, 0.0, 1.0));
+    const MeshData flat = loadMeshFile(b.write("small2.gltf"));
+    ASSERT_EQ(flat.triangles.size(), 2u);
+    EXPECT_FLOAT_EQ(flat.positions[flat.triangles[0].x].x, 0.001f);
+    EXPECT_FLOAT_EQ(flat.positions[flat.triangles[0].x].y, -0.004f);
+    EXPECT_FLOAT_EQ(flat.positions[flat.triangles[1].y].x, 1.0f + 1e-7f);
+}
+
+TEST(GltfReader, AMeshPlacedTwiceAndByGpuInstancingIsOneMeshWithInstances)
+{
+    GltfBuilder b;
+    const uint32_t mesh = triangleMesh(b);
+    b.node({{"mesh", mesh}, {"translation", {5.0, 0.0, 0.0}}});
+    const uint32_t translations = b.floats({0, 0, 0, 0, 2, 0, 0, 4, 0}, "VEC3");
+    const uint32_t scales = b.floats({1, 1, 1, 2, 2, 2, 3, 3, 3}, "VEC3");
+    b.node({{"mesh", mesh},
+            {"translation", {0.0, 0.0, 1.0}},
+            {"extensions",
+             {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", translations}, {"SCALE", scales}}}}}}}});
+    b.doc()["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+    b.doc()["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+    const GltfModel model = readGltfModel(b.write("instanced.gltf"));
+    ASSERT_EQ(model.meshes.size(), 1u);
+    EXPECT_EQ(model.meshes[0].triangles.size(), 1u);
+    ASSERT_EQ(model.instances.size(), 4u);
+    // The node's transform, then each copy's own (EXT_mesh_gpu_instancing: instance x node).
+    EXPECT_EQ(model.instances[2].world[3], glm::dvec4(0.0, 2.0, 1.0, 1.0));
+    EXPECT_EQ(model.instances[3].world[0][0], 3.0);
+    EXPECT_TRUE(model.warnings.empty());
+    // The scene keeps them as instances sharing one geometry.
+    const Scene scene = parseGltfScene(b.write("instanced-scene.gltf").string());
+    ASSERT_EQ(scene.meshes.size(), 4u);
+    for (const Mesh& m : scene.meshes) EXPECT_EQ(m.geometry, scene.meshes[0].geometry);
+}
+
+TEST(GltfReader, PrimitivesWithAndWithoutTextureCoordinatesShareAFile)
+{
+    // The Khronos validator's rule: only a primitive whose material samples a
+    // texture needs uvs; the others are fine without them.
+    GltfBuilder b;
+    b.doc()["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}, {{"name", "plain"}}};
+    b.doc()["textures"] = {{{"source", 0}}};
+    b.doc()["images"] = {{{"uri", "texture.png"}}};
+    const uint32_t textured = triangleMesh(b, true, 0);
+    const uint32_t plain = triangleMesh(b, false, 1);
+    b.node({{"mesh", textured}});
+    b.node({{"mesh", plain}, {"translation", {2.0, 0.0, 0.0}}});
+    const GltfModel model = readGltfModel(b.write("mixed.gltf"));
+    ASSERT_EQ(model.instances.size(), 2u);
+    EXPECT_EQ(model.meshes[0].uvs.size(), 3u);
+    EXPECT_TRUE(model.meshes[1].uvs.empty());
+    // Flattened, the plain triangle gets (0, 0) uvs.
+    const MeshData flat = flattenGltfModel(model);
+    EXPECT_EQ(flat.uvs.size(), flat.positions.size());
+
+    // A textured primitive without uvs is the error, and it is named.
+    GltfBuilder bad;
+    bad.doc()["materials"] = b.doc()["materials"];
+    bad.doc()["textures"] = b.doc()["textures"];
+    bad.doc()["images"] = b.doc()["images"];
+    bad.node({{"mesh", triangleMesh(bad, false, 0)}});
+    const std::string error = errorOf([&] { readGltfModel(bad.write("bad-uvs.gltf")); });
+    EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
+    EXPECT_NE(error.find("TEXCOORD_0"), std::string::npos) << error;
+}
+
+TEST(GltfReader, StripsAndFansBecomeTrianglesWithTheirWinding)
+{
+    GltfBuilder b;
+    const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0}, "VEC3");
+    const uint32_t strip = b.mesh({{"POSITION", positions}}, std::nullopt, 5);
+    const uint32_t fan = b.mesh({{"POSITION", positions}}, std::nullopt, 6);
+    const uint32_t lines = b.mesh({{"POSITION", positions}}, std::nullopt, 1);
+    b.node({{"mesh", strip}});
+    b.node({{"mesh", fan}});
+    b.node({{"mesh", lines}});
+    const GltfModel model = readGltfModel(b.write("modes.gltf"));
+    // glTF 3.7.2.1: strip triangle i = {i, i + 1 + i % 2, i + 2 - i % 2}; fan = {i, i + 1, 0}.
+    ASSERT_EQ(model.meshes[0].triangles.size(), 3u);
+    EXPECT_EQ(model.meshes[0].triangles[1], glm::uvec3(1, 3, 2));
+    ASSERT_EQ(model.meshes[1].triangles.size(), 3u);
+    EXPECT_EQ(model.meshes[1].triangles[0], glm::uvec3(1, 2, 0));
+    // Every strip triangle faces +z like the first (counter-clockwise seen from +z).
+    for (const glm::uvec3& t : model.meshes[0].triangles) {
+        const auto& p = model.meshes[0].positions;
+        EXPECT_GT(glm::cross(p[t.y] - p[t.x], p[t.z] - p[t.x]).z, 0.0f);
+    }
+    EXPECT_TRUE(model.meshes[2].triangles.empty());
+    EXPECT_EQ(model.instances.size(), 2u); // the lines are not placed
+    ASSERT_EQ(model.warnings.size(), 1u);
+    EXPECT_NE(model.warnings[0].find("lines"), std::string::npos);
+}
+
+TEST(GltfReader, SparseInterleavedAndNormalizedAccessors)
+{
+    GltfBuilder b;
+    // Positions with no bufferView (zeros), made a triangle by a sparse substitution of elements 1 and 2.
+    const uint32_t sparseIndices = b.accessor(std::vector<uint16_t>{1, 2}, "SCALAR", 5123);
+    const uint32_t sparseValues = b.floats({1, 0, 0, 0, 1, 0}, "VEC3");
+    json& accessors = b.doc()["accessors"];
+    accessors.push_back({{"componentType", 5126},
+                         {"count", 3},
+                         {"type", "VEC3"},
+                         {"sparse",
+                          {{"count", 2},
+                           {"indices", {{"bufferView", accessors[sparseIndices]["bufferView"]}, {"componentType", 5123}}},
+                           {"values", {{"bufferView", accessors[sparseValues]["bufferView"]}}}}}}});
+    const uint32_t positions = uint32_t(accessors.size() - 1);
+    // Colours as normalized unsigned bytes: 255 is 1, 51 is 0.2.
+    const uint32_t colors = b.accessor(std::vector<uint8_t>{255, 51, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255}, "VEC4",
+                                       5121, /*normalized=*/true);
+    b.node({{"mesh", b.mesh({{"POSITION", positions}, {"COLOR_0", colors}})}});
+    const GltfModel model = readGltfModel(b.write("sparse.gltf"));
+    const MeshData& mesh = model.meshes[0];
+    ASSERT_EQ(mesh.positions.size(), 3u);
+    EXPECT_EQ(mesh.positions[0], glm::vec3(0.0f));
+    EXPECT_EQ(mesh.positions[1], glm::vec3(1, 0, 0));
+    EXPECT_EQ(mesh.positions[2], glm::vec3(0, 1, 0));
+    ASSERT_EQ(mesh.colors.size(), 3u);
+    EXPECT_FLOAT_EQ(mesh.colors[0].r, 1.0f);
+    EXPECT_FLOAT_EQ(mesh.colors[0].g, 0.2f);
+    EXPECT_FLOAT_EQ(mesh.colors[1].b, 1.0f);
+
+    // Interleaved: position and normal in one view with byteStride 24.
+    GltfBuilder i;
+    const uint32_t both = i.floats({0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 1}, "VEC3");
+    json& view = i.doc()["bufferViews"][i.doc()["accessors"][both]["bufferView"].get<size_t>()];
+    view["byteStride"] = 24;
+    i.doc()["accessors"][both]["count"] = 3;
+    json normal = i.doc()["accessors"][both];
+    normal["byteOffset"] = 12;
+    i.doc()["accessors"].push_back(normal);
+    i.node({{"mesh", i.mesh({{"POSITION", both}, {"NORMAL", 1}})}});
+    const MeshData interleaved = readGltfModel(i.write("interleaved.gltf")).meshes[0];
+    EXPECT_EQ(interleaved.positions[2], glm::vec3(0, 1, 0));
+    EXPECT_EQ(interleaved.normals[1], glm::vec3(0, 0, 1));
+}
+
+TEST(GltfReader, ANegativeScaleKeepsTheFrontSide)
+{
+    // glTF 3.7.4: a mirroring transform reverses the winding, so the same
+    // side stays the front. Flattened, the triangle's winding normal follows
+    // the transformed vertex normal.
+    GltfBuilder b;
+    const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    const uint32_t normals = b.floats({0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
+    b.node({{"mesh", b.mesh({{"POSITION", positions}, {"NORMAL", normals}})}, {"scale", {-1.0, 1.0, 1.0}}});
+    const MeshData flat = loadMeshFile(b.write("mirror.gltf"));
+    const glm::uvec3 t = flat.triangles[0];
+    const glm::vec3 winding = glm::cross(flat.positions[t.y] - flat.positions[t.x], flat.positions[t.z] - flat.positions[t.x]);
+    EXPECT_GT(glm::dot(winding, flat.normals[t.x]), 0.0f);
+    EXPECT_EQ(flat.normals[t.x], glm::vec3(0, 0, 1));
+}
+
+TEST(GltfReader, ScenesAreChosenByNameOrIndex)
+{
+    GltfBuilder b;
+    const uint32_t mesh = triangleMesh(b);
+    b.node({{"mesh", mesh}});
+    b.node({{"mesh", mesh}, {"translation", {3, 0, 0}}});
+    b.doc()["scenes"] = {{{"name", "left"}, {"nodes", {0}}}, {{"name", "both"}, {"nodes", {0, 1}}}};
+    b.doc()["scene"] = 1;
+    const fs::path file = b.write("scenes.gltf");
+    EXPECT_EQ(readGltfModel(file).instances.size(), 2u);
+    GltfReadOptions options;
+    options.scene = "left";
+    EXPECT_EQ(readGltfModel(file, options).instances.size(), 1u);
+    options.scene = "0";
+    EXPECT_EQ(readGltfModel(file, options).sceneName, "left");
+    options.scene = "right";
+    const std::string error = errorOf([&] { readGltfModel(file, options); });
+    EXPECT_NE(error.find("--scene right"), std::string::npos) << error;
+    EXPECT_NE(error.find("1 ('both')"), std::string::npos) << error;
+}
+
+TEST(GltfReader, RequiredExtensionsMustBeImplementedUsedOnesAreNamedOnce)
+{
+    GltfBuilder b;
+    b.node({{"mesh", triangleMesh(b)}});
+    b.doc()["extensionsUsed"] = {"KHR_materials_variants", "KHR_lights_punctual"};
+    const GltfModel model = readGltfModel(b.write("used.gltf"));
+    ASSERT_EQ(model.warnings.size(), 1u);
+    EXPECT_NE(model.warnings[0].find("KHR_materials_variants"), std::string::npos);
+    b.doc()["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    const std::string error = errorOf([&] { readGltfModel(b.write("required.gltf")); });
+    EXPECT_NE(error.find("extensionsRequired names KHR_draco_mesh_compression"), std::string::npos) << error;
+}
+
+TEST(GltfReader, BadAccessorsAndIndicesAreNamed)
+{
+    GltfBuilder b;
+    const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    b.node({{"mesh", b.mesh({{"POSITION", positions}}, b.indices({0, 1, 7}))}});
+    std::string error = errorOf([&] { readGltfModel(b.write("index.gltf")); });
+    EXPECT_NE(error.find("meshes[0].primitives[0].indices[2] is 7"), std::string::npos) << error;
+    b.doc()["accessors"][positions]["count"] = 4; // past its bufferView
+    error = errorOf([&] { readGltfModel(b.write("count.gltf")); });
+    EXPECT_NE(error.find("accessor 0"), std::string::npos) << error;
+}
+
+} // namespace
+} // namespace vkrt::test
