@@ -32,8 +32,10 @@ Options (defaults in brackets):
 What both renderers are given
 -----------------------------
 * The camera. The tool walks the glTF's default scene as vkrt does (depth
-  first, children in order) and takes the first camera node met; without one
-  (or with an orthographic one) it computes vkrt's framing camera
+  first, children in order) and takes the first camera node met (perspective,
+  or orthographic: a view 2 ymag x the node's Y scale tall, as vkrt renders it
+  since it renders orthographic cameras); without one it computes vkrt's
+  framing camera
   (src/scene/GltfScene.cpp, framingCamera): vertical fov 40 degrees, looking at
   the centre of the world bounding box of all mesh instances (each glTF mesh's
   box of its triangle primitives' POSITION min/max, its 8 corners moved by the
@@ -116,12 +118,15 @@ def ensure_venv() -> None:
         return
     python = VENV / "bin" / "python"
     if not python.exists():
+        if any(a in ("-h", "--help") for a in sys.argv[1:]):
+            print(__doc__)
+            sys.exit(0)
         print(f"compare_cycles: error: {VENV} does not exist: run tools/setup-cycles-venv.sh first", file=sys.stderr)
         sys.exit(2)
     os.execv(str(python), [str(python), str(Path(__file__).resolve())] + sys.argv[1:])
 
 
-if __name__ == "__main__" and not any(a in ("-h", "--help") for a in sys.argv[1:]):
+if __name__ == "__main__":
     ensure_venv()
 
 import numpy as np  # noqa: E402
@@ -417,20 +422,24 @@ def choose_camera(gltf: dict, folder: Path | None = None):
     if cameras:
         index, node, world = cameras[0]
         definition = gltf["cameras"][index]
-        if definition.get("type") == "perspective":
-            eye = world[:3, 3]
-            forward = _normalize(world[:3, :3] @ np.array([0.0, 0.0, -1.0]))
-            up = _normalize(world[:3, :3] @ np.array([0.0, 1.0, 0.0]))
-            if forward is not None and up is not None:
-                lower, upper = world_bounds(gltf, instances, folder)
-                centre = 0.5 * (lower + upper) if np.all(lower <= upper) else eye + forward
-                ahead = max(float(np.dot(centre - eye, forward)), 1e-3)
-                fov = math.degrees(definition["perspective"]["yfov"])
-                return ({"eye": eye.tolist(), "target": (eye + ahead * forward).tolist(), "up": up.tolist(),
-                         "fov_y": fov}, f"the file's camera {index} (node {node})")
+        eye = world[:3, 3]
+        forward = _normalize(world[:3, :3] @ np.array([0.0, 0.0, -1.0]))
+        up = _normalize(world[:3, :3] @ np.array([0.0, 1.0, 0.0]))
+        if forward is not None and up is not None:
+            lower, upper = world_bounds(gltf, instances, folder)
+            centre = 0.5 * (lower + upper) if np.all(lower <= upper) else eye + forward
+            ahead = max(float(np.dot(centre - eye, forward)), 1e-3)
+            camera = {"eye": eye.tolist(), "target": (eye + ahead * forward).tolist(), "up": up.tolist()}
+            if definition.get("type") == "orthographic":
+                # vkrt (GltfScene.cpp, cameraFrom): a view 2 ymag tall, times the node's Y scale;
+                # the width follows the image's aspect.
+                scale_y = float(np.linalg.norm(world[:3, :3] @ np.array([0.0, 1.0, 0.0])))
+                camera["ortho_height"] = 2.0 * abs(float(definition["orthographic"]["ymag"])) * scale_y
+                return camera, f"the file's orthographic camera {index} (node {node})"
+            camera["fov_y"] = math.degrees(definition["perspective"]["yfov"])
+            return camera, f"the file's camera {index} (node {node})"
     lower, upper = world_bounds(gltf, instances, folder)
-    why = "its only camera is orthographic" if cameras else "it has no camera"
-    return framing_camera(lower, upper), f"vkrt's framing camera ({why})"
+    return framing_camera(lower, upper), "vkrt's framing camera (the file has no camera)"
 
 
 def punctual_lights(gltf: dict, folder: Path | None = None) -> list:
@@ -502,9 +511,14 @@ def add_camera(gltf: dict, camera: dict, aspect: float) -> int:
     """Adds `camera` as a new root node of the default scene (in place);
     returns the new camera's index (for vkrt's --camera)."""
     cameras = gltf.setdefault("cameras", [])
-    cameras.append({"type": "perspective", "name": "compare_cycles",
-                    "perspective": {"yfov": math.radians(camera["fov_y"]), "aspectRatio": aspect,
-                                    "znear": 1e-3}})
+    if "ortho_height" in camera:
+        half = camera["ortho_height"] / 2.0
+        cameras.append({"type": "orthographic", "name": "compare_cycles",
+                        "orthographic": {"xmag": half * aspect, "ymag": half, "znear": 0.0, "zfar": 1e30}})
+    else:
+        cameras.append({"type": "perspective", "name": "compare_cycles",
+                        "perspective": {"yfov": math.radians(camera["fov_y"]), "aspectRatio": aspect,
+                                        "znear": 1e-3}})
     nodes = gltf.setdefault("nodes", [])
     nodes.append({"name": "compare_cycles_camera", "camera": len(cameras) - 1,
                   "matrix": camera_node_matrix(camera)})
@@ -603,7 +617,12 @@ def find_vkrt(explicit: str | None) -> Path:
     sys.exit(2)
 
 
-def run_vkrt(vkrt: Path, copy: Path, camera_index: int, args, out_exr: Path, environment: Path | None) -> dict:
+class Unsupported(Exception):
+    """vkrt refuses the file (an extensionsRequired it does not implement)."""
+
+
+def run_vkrt(vkrt: Path, copy: Path, source: Path, camera_index: int, args, out_exr: Path,
+             environment: Path | None) -> dict:
     json_path = out_exr.with_suffix(".json")
     command = [str(vkrt), "render", str(copy), "--camera", str(camera_index), "--spp", str(args.vkrt_spp),
                "--width", str(args.width), "--height", str(args.height), "--seed", str(args.seed),
@@ -618,10 +637,15 @@ def run_vkrt(vkrt: Path, copy: Path, camera_index: int, args, out_exr: Path, env
             break
         time.sleep(30)  # the binary vanished mid-run: a rebuild
     if done.returncode != 0:
-        raise RuntimeError(f"vkrt exited {done.returncode}: {done.stderr.strip()[-2000:]}")
+        message = done.stderr.strip().replace(str(copy), source.name).replace(copy.name, source.name)
+        if done.returncode == 2 and "vkrt does not implement" in message:
+            raise Unsupported(message.splitlines()[-1][:300])
+        raise RuntimeError(f"vkrt exited {done.returncode}: {message[-2000:]}")
     facts = json.loads(json_path.read_text()) if json_path.exists() else {}
     warnings = [line.split("warning:", 1)[1].strip() for line in done.stderr.splitlines() if "warning:" in line]
-    warnings = [w.replace(str(copy), "MODEL") for w in warnings]
+    # Name the model's own file, not the temporary copy, and drop the file prefix.
+    warnings = [w.replace(str(copy), copy.name).replace(copy.name, source.name) for w in warnings]
+    warnings = [w[len(source.name) + 2:] if w.startswith(source.name + ": ") else w for w in warnings]
     return {"seconds": seconds, "warnings": warnings, "facts": facts}
 
 
@@ -687,12 +711,13 @@ def compare_model(name: str, source: Path, args, vkrt: Path, work: Path) -> dict
     copy = write_temporary_copy(source, gltf)
     vkrt_exr, cycles_exr = work / f"{name}.vkrt.exr", work / f"{name}.cycles.exr"
     try:
-        row["vkrt"] = run_vkrt(vkrt, copy, camera_index, args, vkrt_exr, environment)
+        row["vkrt"] = run_vkrt(vkrt, copy, source, camera_index, args, vkrt_exr, environment)
         row["cycles"] = run_cycles(copy, camera, lights, white_world, args, cycles_exr)
     finally:
         copy.unlink(missing_ok=True)
-    if row["vkrt"]["warnings"]:
-        row["notes"].append("vkrt warned: " + "; ".join(dict.fromkeys(row["vkrt"]["warnings"])))
+    warned = list(dict.fromkeys(row["vkrt"]["warnings"]))
+    if warned:
+        row["notes"].append(f"vkrt warned ({len(warned)}): " + "; ".join(warned))
     vkrt_rgb, cycles_rgb = read_exr(vkrt_exr), read_exr(cycles_exr)
     row.update(compare_images(vkrt_rgb, cycles_rgb, args.tolerance))
     if exclusions:
@@ -710,6 +735,10 @@ def compare_model(name: str, source: Path, args, vkrt: Path, work: Path) -> dict
     return row
 
 
+def _short(note: str, limit: int = 160) -> str:
+    return note if len(note) <= limit else note[:limit - 1] + "…"
+
+
 def markdown_table(rows: list, table_path: Path, args) -> str:
     lines = [
         f"vkrt against Cycles: {args.width}x{args.height}, vkrt {args.vkrt_spp} spp, Cycles {args.cycles_spp} spp, "
@@ -721,16 +750,18 @@ def markdown_table(rows: list, table_path: Path, args) -> str:
     ]
     for r in rows:
         if "error" in r:
-            lines.append(f"| {r['model']} | | | error | {r['error'].splitlines()[0][:200]} | |")
+            text = r["error"].replace("vkrt: error: ", "").replace(r["file"], Path(r["file"]).name)
+            lines.append(f"| {r['model']} | | | {r['verdict']} | {text.splitlines()[0][:200]} | |")
             continue
-        link = os.path.relpath(r["png"], table_path.resolve().parent)
-        notes = "; ".join(r["notes"]).replace("|", "\\|")
+        link = os.path.relpath(Path(r["png"]).resolve(), table_path.resolve().parent)
+        notes = "; ".join(_short(n) for n in r["notes"]).replace("|", "\\|")
         lines.append(f"| {r['model']} | {r['mean_rel_diff']:+.1%} | {r['share_over']:.1%} | {r['verdict']} | "
                      f"{notes} | [png]({link}) |")
     judged = [r for r in rows if r.get("verdict") in ("pass", "fail")]
     lines += ["", f"{sum(r['verdict'] == 'pass' for r in judged)} of {len(judged)} judged models pass; "
               f"{sum(r.get('verdict') == 'excluded' for r in rows)} excluded; "
-              f"{sum('error' in r for r in rows)} errors."]
+              f"{sum(r.get('verdict') == 'unsupported' for r in rows)} refused by vkrt; "
+              f"{sum(r.get('verdict') == 'error' for r in rows)} errors."]
     return "\n".join(lines) + "\n"
 
 
@@ -770,7 +801,27 @@ def parse_args(argv):
     return args
 
 
+def summary_of(rows: list, args, vkrt: Path) -> dict:
+    return {"settings": {"width": args.width, "height": args.height, "vkrt_spp": args.vkrt_spp,
+                            "cycles_spp": args.cycles_spp, "seed": args.seed, "cycles_bounces": CYCLES_BOUNCES,
+                            "vkrt_max_depth": VKRT_MAX_DEPTH, "tolerance": args.tolerance,
+                            "floor_fraction": FLOOR_FRACTION, "max_mean_diff": args.max_mean_diff,
+                            "max_share": args.max_share, "vkrt": str(vkrt)},
+               "models": rows}
+
+
+def write_outputs(rows: list, args, vkrt: Path) -> None:
+    """Writes --json (when a file) and --table for the rows so far."""
+    if args.json_out and args.json_out != "-":
+        Path(args.json_out).write_text(json.dumps(summary_of(rows, args, vkrt), indent=1, default=float) + "\n")
+    if args.table:
+        args.table.write_text(markdown_table(rows, args.table, args))
+
+
 def main(argv=None) -> int:
+    # SIGTERM runs the finally blocks too, so that no temporary copy is left beside a model.
+    import signal
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     args = parse_args(sys.argv[1:] if argv is None else argv)
     vkrt = find_vkrt(args.vkrt)
     models = [(f.stem, f.resolve()) for f in args.files]
@@ -793,25 +844,18 @@ def main(argv=None) -> int:
                 print(f"{name:32s} mean {row['mean_rel_diff']:+7.2%}  over {args.tolerance:.0%}: "
                       f"{row['share_over']:6.2%}  {row['verdict']:8s}  (vkrt {row['vkrt']['seconds']:.1f} s, "
                       f"Cycles {row['cycles']['seconds']:.1f} s)  {'; '.join(row['notes'])}", flush=True)
+            except Unsupported as error:
+                row = {"model": name, "file": str(path), "verdict": "unsupported", "error": str(error)}
+                print(f"{name:32s} unsupported by vkrt: {error}", flush=True)
             except Exception as error:  # one model's failure must not stop the others
                 row = {"model": name, "file": str(path), "verdict": "error", "error": str(error)}
                 print(f"{name:32s} error: {error}", flush=True)
             rows.append(row)
-    summary = {"settings": {"width": args.width, "height": args.height, "vkrt_spp": args.vkrt_spp,
-                            "cycles_spp": args.cycles_spp, "seed": args.seed, "cycles_bounces": CYCLES_BOUNCES,
-                            "vkrt_max_depth": VKRT_MAX_DEPTH, "tolerance": args.tolerance,
-                            "floor_fraction": FLOOR_FRACTION, "max_mean_diff": args.max_mean_diff,
-                            "max_share": args.max_share, "vkrt": str(vkrt)},
-               "models": rows}
-    if args.json_out:
-        text = json.dumps(summary, indent=1, default=float)
-        if args.json_out == "-":
-            print(text)
-        else:
-            Path(args.json_out).write_text(text + "\n")
-    if args.table:
-        args.table.write_text(markdown_table(rows, args.table, args))
-    failed = any(r.get("verdict") in ("fail", "error") for r in rows)
+            write_outputs(rows, args, vkrt)  # after each model, so an interrupted run leaves its rows
+    write_outputs(rows, args, vkrt)
+    if args.json_out == "-":
+        print(json.dumps(summary_of(rows, args, vkrt), indent=1, default=float))
+    failed = any(r.get("verdict") in ("fail", "error") for r in rows)  # "unsupported" is reported, not failed
     return 1 if failed else 0
 
 

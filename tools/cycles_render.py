@@ -5,10 +5,10 @@ compare_cycles.py in a child process, one per model:
     .venv-cycles/bin/python tools/cycles_render.py SPEC.json
 
 SPEC.json (written by compare_cycles.py): gltf, output (.exr), width, height,
-spp, seed, bounces, threads (0: all), camera {eye, target, up, fov_y (vertical,
-degrees)} and lights [{type, position, direction, power, inner, outer}] in
-glTF's Y-up world, white_world (a constant white environment of radiance 1,
-else black).
+spp, seed, bounces, threads (0: all), camera {eye, target, up, and fov_y
+(vertical, degrees) or ortho_height (orthographic: the view's height)} and
+lights [{type, position, direction, power, inner, outer}] in glTF's Y-up
+world, white_world (a constant white environment of radiance 1, else black).
 
 The scene: Blender's glTF importer (default options) loads the file; the
 lights it made are deleted and the spec's lights made instead (delta lights:
@@ -50,9 +50,13 @@ def make_camera(scene, camera: dict, size: float) -> None:
     r, u, b, e = to_blender(right), to_blender(up), to_blender(-forward), to_blender(eye)
     matrix = Matrix(((r.x, u.x, b.x, e.x), (r.y, u.y, b.y, e.y), (r.z, u.z, b.z, e.z), (0, 0, 0, 1)))
     data = bpy.data.cameras.new("compare_cycles")
-    data.type = "PERSP"
     data.sensor_fit = "VERTICAL"
-    data.angle_y = math.radians(camera["fov_y"])
+    if "ortho_height" in camera:  # the view's height in scene units; the width follows the image
+        data.type = "ORTHO"
+        data.ortho_scale = camera["ortho_height"]
+    else:
+        data.type = "PERSP"
+        data.angle_y = math.radians(camera["fov_y"])
     data.shift_x = data.shift_y = 0.0
     data.clip_start = max(1e-6, 1e-6 * size)
     data.clip_end = 1e6 * max(size, 1.0)

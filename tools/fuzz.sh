@@ -102,6 +102,47 @@ gltf_instanced() { # ROOT_LISTINGS
                 {"bufferView": 1, "componentType": 5123, "count": 12288, "type": "SCALAR"}]}' "$roots" "$bin"
 }
 for n in 16 2049; do gltf_instanced $n >"$work/instanced-$n.gltf"; seed 2 "$work/instanced-$n.gltf"; done
+# What the glTF reader maps beyond the Cube (src/mesh/GltfReader.h): a sparse
+# accessor without a bufferView, an interleaved view, a strip and a fan, a
+# primitive without normals beside one with them, COLOR_0 as normalized bytes,
+# TEXCOORD_1, EXT_mesh_gpu_instancing, a mirrored node, two scenes and an
+# orthographic camera.
+python3 - "$work/features.gltf" <<'PY'
+import base64, json, struct, sys
+b = bytearray()
+def view(data, stride=None):
+    while len(b) % 4: b.append(0)
+    v = {"buffer": 0, "byteOffset": len(b), "byteLength": len(data)}
+    if stride: v["byteStride"] = stride
+    b.extend(data); views.append(v); return len(views) - 1
+views, accessors = [], []
+def acc(**a): accessors.append(a); return len(accessors) - 1
+inter = view(struct.pack("<18f", 0,0,0, 0,0,1, 1,0,0, 0,0,1, 0,1,0, 0,0,1), 24)
+pos = acc(bufferView=inter, componentType=5126, count=3, type="VEC3", min=[0,0,0], max=[1,1,0])
+nrm = acc(bufferView=inter, byteOffset=12, componentType=5126, count=3, type="VEC3")
+uv = acc(bufferView=view(struct.pack("<6f", 0,0, 1,0, 0,1)), componentType=5126, count=3, type="VEC2")
+col = acc(bufferView=view(bytes([255,0,0,255, 0,255,0,128, 0,0,255,0])), componentType=5121, normalized=True, count=3, type="VEC4")
+si = view(struct.pack("<2H", 1, 2)); sv = view(struct.pack("<6f", 1,0,0, 0,1,0))
+sparse = acc(componentType=5126, count=4, type="VEC3", sparse={"count": 2, "indices": {"bufferView": si, "componentType": 5123}, "values": {"bufferView": sv}})
+trs = view(struct.pack("<9f", 0,0,0, 2,0,0, 0,2,0))
+tr = acc(bufferView=trs, componentType=5126, count=3, type="VEC3")
+doc = {"asset": {"version": "2.0"}, "scene": 1,
+  "extensionsUsed": ["EXT_mesh_gpu_instancing", "KHR_materials_variants"],
+  "scenes": [{"name": "one", "nodes": [0]}, {"name": "all", "nodes": [0, 1, 2, 3, 4]}],
+  "nodes": [{"mesh": 0}, {"mesh": 1, "scale": [-1, 1, 1]}, {"mesh": 2, "translation": [0.001, 0, 0]},
+            {"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": tr}}}},
+            {"camera": 0, "translation": [0, 0, 5]}],
+  "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1.5, "znear": 0.1, "zfar": 10}}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0.5, 1]}}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "COLOR_0": col, "TEXCOORD_1": uv}, "material": 0},
+                             {"attributes": {"POSITION": pos}, "mode": 5}]},
+             {"primitives": [{"attributes": {"POSITION": sparse}, "mode": 6}]},
+             {"primitives": [{"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "mode": 4}]}],
+  "accessors": accessors, "bufferViews": views,
+  "buffers": [{"byteLength": len(b), "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(b)).decode()}]}
+open(sys.argv[1], "w").write(json.dumps(doc))
+PY
+seed 2 "$work/features.gltf"
 find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
 # Nesting at the parser's bound (kMaxTomlNesting, 128 levels) and one past it,
 # as a header, a dotted key and inline tables, so mutations explore both sides.

@@ -73,6 +73,9 @@ layout(scalar, binding = BINDING_MESH_TANGENTS) readonly buffer MeshTangentBlock
 #ifdef VKRT_HAS_MESH_MATERIALS
 layout(scalar, binding = BINDING_MESH_MATERIALS) readonly buffer MeshMaterialBlock { uint meshMaterials[]; };
 #endif
+#ifdef VKRT_HAS_MESH_COLORS
+layout(scalar, binding = BINDING_MESH_COLORS) readonly buffer MeshColorBlock { MeshColors meshColors[]; };
+#endif
 // Shading normals differ from geometric ones with meshes' vertex normals or normal maps.
 #if defined(VKRT_HAS_MESH_NORMALS) || defined(VKRT_HAS_NORMAL_MAPS)
 #define VKRT_HAS_SHADING_NORMALS

@@ -100,7 +100,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
         return false; // a light or the sky could still end this path, a surface cannot
 #ifdef VKRT_HAS_MATERIALS
     p.path.media = mediaAtSurface(p.path.media, hit);
-    Material m = materials[hit.material];
+    Material m = withVertexColor(materials[hit.material], hit);
 #ifdef VKRT_HAS_TEXTURES
     p.pathLength += hit.t;
     m = texturedMaterial(m, hit, p.ray.dir, p.pathLength);

@@ -155,6 +155,9 @@ SurfaceHit describeHit(Ray r, HitId id)
     hit.uvDensity = 0.0;
     hit.tangent = vec4(1.0, 0.0, 0.0, 1.0);
 #endif
+#ifdef VKRT_HAS_MESH_COLORS
+    hit.color = vec4(1.0);
+#endif
     VKRT_SHAPE_KINDS(VKRT_DESCRIBE_KIND)
     VKRT_LIGHT_KINDS(VKRT_DESCRIBE_KIND)
     // Meshes set their own shading normal; normal maps may change it later.

@@ -45,10 +45,23 @@ struct SurfaceHit {
     float uvDensity;
     vec4 tangent;
 #endif
+#ifdef VKRT_HAS_MESH_COLORS
+    vec4 color; // the interpolated vertex colour (glTF COLOR_0) multiplying the base colour; white elsewhere
+#endif
 #ifdef VKRT_TEST_HIT_PROBE
     uint primitive; // HitId::primitive (lib/aov.glsl's hit probe)
 #endif
 };
+
+// The material a hit sees before its textures: its vertex colour multiplies
+// the base (diffuse) colour, as glTF's COLOR_0 does.
+Material withVertexColor(Material m, SurfaceHit hit)
+{
+#ifdef VKRT_HAS_MESH_COLORS
+    m.diffuse *= hit.color.rgb;
+#endif
+    return m;
+}
 
 bool hitsLight(SurfaceHit hit) { return hit.shape >= SHAPE_LIGHT; }
 

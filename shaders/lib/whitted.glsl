@@ -71,7 +71,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         }
 #ifdef VKRT_HAS_MATERIALS
         path.media = mediaAtSurface(path.media, hit);
-        Material m = materials[hit.material];
+        Material m = withVertexColor(materials[hit.material], hit);
 #ifdef VKRT_HAS_TEXTURES
         pathLength += hit.t;
         m = texturedMaterial(m, hit, ray.dir, pathLength);

@@ -90,6 +90,7 @@ VKRT_CONSTANT(uint, MESH_FLAG_TWO_SIDED, 4) // they emit on both sides
 VKRT_CONSTANT(uint, MESH_FLAG_UVS, 8)        // meshUvs holds its triangles' texture coordinates
 VKRT_CONSTANT(uint, MESH_FLAG_TANGENTS, 16)  // meshTangents holds its triangles' tangents
 VKRT_CONSTANT(uint, MESH_FLAG_MATERIALS, 32) // meshMaterials holds each triangle's material (file materials)
+VKRT_CONSTANT(uint, MESH_FLAG_COLORS, 64)    // meshColors holds its triangles' vertex colours (glTF COLOR_0)
 
 /// One instance of a mesh (src/scene/Scene.h: Mesh). The matrices are the
 /// object -> camera-relative world transform and its inverse, as three rows
@@ -124,6 +125,14 @@ struct MeshUvs {
     vec2 uv0;
     vec2 uv1;
     vec2 uv2;
+};
+
+/// Linear RGBA vertex colours at a mesh triangle's three vertices (glTF
+/// COLOR_0, multiplying the base colour of its file material). Same index as MeshUvs.
+struct MeshColors {
+    vec4 c0;
+    vec4 c1;
+    vec4 c2;
 };
 
 /// Tangents at a mesh triangle's three vertices (object space): xyz along

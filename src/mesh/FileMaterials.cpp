@@ -48,7 +48,7 @@ std::string percentDecoded(const std::string& uri)
 
 // ---------------------------------------------------------------------------
 // JSON access that never throws on a wrong type: the file is whatever bytes
-// it is, and assimp has accepted it, which says little about its other fields.
+// it is, and nothing about one field says anything about another.
 
 const json* member(const json& object, const char* key)
 {
@@ -63,7 +63,7 @@ const json* arrayMember(const json& object, const char* key)
     return value && value->is_array() ? value : nullptr;
 }
 
-/// rapidjson's IsUint, which assimp's FindUInt uses: a non-negative integer below 2^32.
+/// A non-negative integer below 2^32 (glTF's indices and counts).
 std::optional<uint32_t> uintMember(const json& object, const char* key)
 {
     const json* value = member(object, key);
@@ -87,10 +87,9 @@ std::vector<std::string> extensionNames(const json& object)
     return names;
 }
 
-/// Bytes above 0x7f as '?'. They can only stand inside JSON strings;
-/// assimp's rapidjson takes them without checking their encoding and
-/// nlohmann's parser refuses bad UTF-8, so both see one structure only when
-/// they are masked (names are compared masked too).
+/// Bytes above 0x7f as '?'. They can only stand inside JSON strings, and
+/// nlohmann's parser refuses bad UTF-8: masked, such a file still parses
+/// (parseJson tries the bytes as they are first).
 std::string masked(std::string text)
 {
     for (char& c : text)
@@ -121,12 +120,11 @@ std::optional<size_t> findExcessiveNesting(std::string_view text, size_t limit)
     return std::nullopt;
 }
 
-/// The file's JSON as assimp reads it. Duplicate keys are refused: rapidjson
-/// takes the first, nlohmann the last, and bounds checked on one value
-/// would not protect reads of the other.
-json parseJson(const fs::path& file)
+/// The file's JSON. Duplicate keys are refused: parsers differ in which one
+/// they keep (the first or the last), and a file that means two things to
+/// two readers is no file to trust.
+json parseJsonText(const fs::path& file, const std::string& text, bool mustParse)
 {
-    const std::string text = masked(readGltfJson(file));
     if (const auto offset = findExcessiveNesting(text, kMaxGltfJsonNesting))
         fail(file, "the glTF JSON nests arrays and objects more than " + std::to_string(kMaxGltfJsonNesting) +
                        " levels deep (at byte " + std::to_string(*offset) + " of the JSON)");
@@ -141,14 +139,24 @@ json parseJson(const fs::path& file)
         return true;
     };
     json doc = json::parse(text, noteKeys, /*allow_exceptions=*/false);
+    if (!mustParse && doc.is_discarded()) return doc;
     if (doc.is_discarded() || !doc.is_object()) fail(file, "the glTF JSON cannot be parsed");
     if (!duplicate.empty()) fail(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
     return doc;
 }
 
+json parseJson(const fs::path& file)
+{
+    const std::string raw = readGltfJson(file);
+    // glTF's JSON is UTF-8; a file with other bytes in its strings is read
+    // with them masked rather than refused (names and messages show '?').
+    json doc = parseJsonText(file, raw, /*mustParse=*/false);
+    if (!doc.is_discarded()) return doc;
+    return parseJsonText(file, masked(raw), /*mustParse=*/true);
+}
+
 // ---------------------------------------------------------------------------
-// What vkrt will not honour, from the JSON (assimp keeps no list of the
-// extensions it read, and drops those it does not know).
+// What vkrt will not honour of a material, from its JSON.
 
 struct TextureSlot {
     const char* name; ///< as glTF names it
@@ -288,7 +296,7 @@ void checkBufferBounds(const fs::path& file, const json& doc)
     }
 }
 
-/// A child index as assimp reads it, or nullopt (assimp reports those itself).
+/// A child index, or nullopt for one that names no node (the reader reports those).
 std::optional<uint32_t> nodeIndex(const json& value, size_t nodeCount)
 {
     if (!value.is_number_unsigned() || value.get<uint64_t>() >= nodeCount) return std::nullopt;
@@ -322,9 +330,9 @@ std::vector<uint32_t> nodeParents(const fs::path& file, const json& nodes)
 }
 
 /// Refuses cycles and hierarchies deeper than kMaxGltfNodeDepth, walking up
-/// the parent links without recursion: assimp 5.2.5 recurses once per level
-/// (reading, importing, pre-transforming and freeing nodes) and overflows its
-/// stack on a chain of 30,000 nodes. Each node's depth is computed once.
+/// the parent links without recursion (a recursive reader, assimp 5.2.5's,
+/// overflowed its stack on a chain of 30,000 nodes). Each node's depth is
+/// computed once.
 std::vector<uint32_t> checkNodeHierarchy(const fs::path& file, const json& doc)
 {
     const json* nodes = arrayMember(doc, "nodes");
@@ -416,9 +424,9 @@ std::vector<uint64_t> meshTriangles(const json& doc)
     return triangles;
 }
 
-/// How many times the import reaches each node: once per listing of it or
-/// of an ancestor among the roots of the scene assimp imports (`scene`, or
-/// 0). Parents come before children in a walk down from the forest's roots.
+/// How many times the reader reaches each node: once per listing of it or
+/// of an ancestor among the roots of the default scene (`scene`, or 0;
+/// another scene chosen with --scene is bounded by the reader's own walk). Parents come before children in a walk down from the forest's roots.
 std::vector<uint64_t> importsPerNode(const json& doc, const json& nodes, const std::vector<uint32_t>& parent)
 {
     std::vector<uint64_t> times(nodes.size(), 0);
@@ -454,12 +462,13 @@ void checkInstancing(const fs::path& file, const json& doc, const std::vector<ui
                        withThousands(kMaxGltfNodes));
     const std::vector<uint64_t> times = importsPerNode(doc, *nodes, parent);
     const std::vector<uint64_t> triangles = meshTriangles(doc);
+    // Every mesh a node names counts, in whichever scene: --scene may choose any.
     std::vector<bool> placed(triangles.size(), false);
     uint64_t importedNodes = 0, meshInstances = 0;
     for (uint32_t node = 0; node < nodes->size(); ++node) {
         importedNodes = saturatingAdd(importedNodes, times[node]);
         const auto mesh = uintMember((*nodes)[node], "mesh");
-        if (!mesh || *mesh >= placed.size() || times[node] == 0) continue;
+        if (!mesh || *mesh >= placed.size()) continue;
         placed[*mesh] = true;
         meshInstances = saturatingAdd(meshInstances, times[node]);
     }
@@ -484,8 +493,8 @@ void checkInstancing(const fs::path& file, const json& doc, const std::vector<ui
                        withThousands(kMaxGltfTriangles));
 }
 
-/// The bytes of accessor data one reference asks assimp for: count x
-/// element size, twice without a bufferView (zeros made, then copied).
+/// The bytes of accessor data one reference asks the reader for: count x
+/// element size, twice without a bufferView (zeros made, then substituted).
 uint64_t referencedBytes(const json* accessors, std::optional<uint32_t> index)
 {
     const json* accessor = index ? element(accessors, *index) : nullptr;

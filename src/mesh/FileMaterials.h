@@ -108,21 +108,20 @@ constexpr uint32_t kMaxGltfNodeDepth = 1024;
 /// EXT_mesh_gpu_instancing copies): each is a 144-byte GPU record and a leaf
 /// of the top-level BVH.
 constexpr uint64_t kMaxGltfInstances = uint64_t(1) << 18;
-/// The most nodes a glTF file may have, and the most its scene may import
-/// (a node listed twice among the scene's roots is imported twice, with its
-/// subtree): assimp 5.2.5's glTF reader takes time growing with the square
-/// of the nodes array (12 s for 100,000 nodes, reachable or not, on one
-/// core; 6 s for 65,536) and about 0.5 KB a node it imports.
+/// The most nodes a glTF file may have, and the most its scene may reach (a
+/// node listed twice among the scene's roots is reached twice, with its
+/// subtree): each costs a walk step and, placing a mesh, an instance.
 constexpr uint64_t kMaxGltfNodes = 65536;
-/// The most triangles a glTF file may give after instancing (each node
-/// naming a mesh gets its own copy: PreTransformVertices flattens the
-/// hierarchy into one list). Measured through `vkrt info` on lavapipe: an
-/// indexed mesh with normals peaks at 1.55 GB for 8.4 M triangles (about
-/// 190 bytes a triangle to parse, 64 bytes on the GPU before BVH nodes), a
-/// triangle soup with normals and uvs at about 460 bytes a triangle. 8 Mi
-/// triangles are 288 MiB of triangle storage: within every discrete GPU's
-/// maxStorageBufferRange (4 GiB), over lavapipe's 128 MiB (3.7 M triangles,
-/// refused when the scene is uploaded, naming the mesh).
+/// The most triangles the meshes a glTF scene places may hold, each mesh
+/// counted once (its instances share it), and the most a mesh object may
+/// hold after its instances are flattened into one mesh (GltfReader.h).
+/// Measured through `vkrt info` on lavapipe: an indexed mesh with normals
+/// peaks at 1.55 GB for 8.4 M triangles (about 190 bytes a triangle to parse,
+/// 64 bytes on the GPU before BVH nodes), a triangle soup with normals and
+/// uvs at about 460 bytes a triangle. 8 Mi triangles are 288 MiB of triangle
+/// storage: within every discrete GPU's maxStorageBufferRange (4 GiB), over
+/// lavapipe's 128 MiB (3.7 M triangles, refused when the scene is uploaded,
+/// naming the mesh).
 constexpr uint64_t kMaxGltfTriangles = uint64_t(8) << 20;
 /// The most bytes of accessor data the file's meshes, morph targets, skins
 /// and animations may name, each reference counted (assimp copies an
@@ -132,15 +131,16 @@ constexpr uint64_t kMaxGltfTriangles = uint64_t(8) << 20;
 /// about 290 MB; the same as a soup of unshared vertices, 1.15 GB.
 constexpr uint64_t kMaxGltfAccessorBytes = uint64_t(1) << 30;
 
-/// Checks, before assimp reads the file, what assimp would trust:
+/// Checks, before the reader (GltfReader.h) maps the file, what it would trust:
 /// - every accessor lies inside its bufferView and every bufferView inside
 ///   its buffer's byteLength (assimp 5.2.5 copies accessor data without that
 ///   check: a heap overflow the fuzzer found);
 /// - the JSON nests at most kMaxGltfJsonNesting levels, and the node
 ///   hierarchy is a set of trees (no cycle, at most one parent per node) at
 ///   most kMaxGltfNodeDepth levels deep;
-/// - the file has, and its scene imports, at most kMaxGltfNodes nodes; the
-///   meshes give at most kMaxGltfTriangles triangles after instancing, and
+/// - the file has, and its scene reaches, at most kMaxGltfNodes nodes, placing
+///   meshes at most kMaxGltfInstances times; the placed meshes hold at most
+///   kMaxGltfTriangles triangles, and
 ///   the accessors it uses at most kMaxGltfAccessorBytes bytes;
 /// - every buffer and image file URI is one `references` allows.
 /// Throws InputError naming `file` and the accessor, view, node, buffer or

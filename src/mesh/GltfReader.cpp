@@ -56,6 +56,14 @@ std::string stringMember(const json& object, const char* key)
     return value && value->is_string() ? value->get<std::string>() : "";
 }
 
+/// 3456789012 as "3,456,789,012".
+std::string withThousands(uint64_t value)
+{
+    std::string digits = std::to_string(value);
+    for (size_t at = digits.size(); at > 3; at -= 3) digits.insert(at - 3, ",");
+    return digits;
+}
+
 std::string indexed(const char* array, uint64_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
 
 // ------------------------------------------------------------------ buffers
@@ -155,7 +163,7 @@ std::string loadBuffer(const Document& d, size_t index, const std::optional<std:
         try {
             bytes = readFileBytes(path.string(), "glTF buffer", size_t(1) << 31);
         } catch (const InputError& error) {
-            fail(d.file, where + " ('" + uri + "') cannot be read: " + error.what());
+            fail(d.file, "the referenced file '" + uri + "' (" + where + ") cannot be read: " + error.what());
         }
     }
     if (bytes.size() < *length)
@@ -384,8 +392,8 @@ struct MeshBuilder {
     {
         const std::set<uint32_t> sets = texCoordSets(material);
         if (sets.size() > 1)
-            warnOnce(where + ": its material's textures read different TEXCOORD sets; vkrt reads all of them "
-                             "through TEXCOORD_" + std::to_string(*sets.begin()));
+            warnOnce(where + ": its material's textures read TEXCOORD_0 and TEXCOORD_1; vkrt reads one set per "
+                             "material: all through TEXCOORD_" + std::to_string(*sets.begin()));
         return sets.empty() ? 0 : *sets.begin();
     }
 
@@ -663,10 +671,16 @@ void walkNodes(const Document& d, GltfModel& model, std::optional<uint32_t> scen
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
     const size_t meshCount = d.array("meshes") ? d.array("meshes")->size() : 0;
     bool singular = false;
-    // checkGltfDocument refused cycles, second parents and deep hierarchies, and bounded the nodes the walk meets.
+    uint64_t visits = 0;
+    // checkedGltfDocument refused cycles, second parents and deep hierarchies, and bounded the default
+    // scene's walk; another scene's is bounded here.
     while (!stack.empty()) {
         const Visit visit = stack.back();
         stack.pop_back();
+        if (++visits > kMaxGltfNodes)
+            fail(d.file, "the scene reaches more than " + withThousands(kMaxGltfNodes) +
+                             " nodes (a node listed more than once among its roots is reached each time, with its "
+                             "children); vkrt reads at most that many");
         const std::string where = indexed("nodes", visit.node);
         const json& node = (*nodes)[visit.node];
         if (!node.is_object()) fail(d.file, where + ": expected an object");
@@ -898,10 +912,11 @@ MeshData flattenGltfModel(GltfModel model)
     }
     if (triangles == 0) fail(model.file, "no triangles in " + model.file.string() + " (its scene places no triangle mesh)");
     if (triangles > kMaxGltfTriangles)
-        fail(model.file, "the node hierarchy instances meshes " + std::to_string(model.instances.size()) + " times, " +
-                             std::to_string(triangles) + " triangles in all; vkrt reads at most " +
-                             std::to_string(kMaxGltfTriangles) +
-                             " triangles after instancing into one mesh (a glTF scene keeps instances instead)");
+        fail(model.file, "the node hierarchy instances meshes " + withThousands(model.instances.size()) + " times, " +
+                             withThousands(triangles) + " triangles in all; vkrt reads at most " +
+                             withThousands(kMaxGltfTriangles) +
+                             " triangles after instancing into one mesh (a glTF scene keeps its instances instead: "
+                             "render the file itself, or `[import] gltf` it)");
     if (vertices > UINT32_MAX) fail(model.file, "more than 2^32 vertices after instancing");
     // Attributes are all or nothing in MeshData: a mesh without one gets neutral values.
     auto any = [&](auto member) {
@@ -930,6 +945,9 @@ MeshData flattenGltfModel(GltfModel model)
                 out.materials.push_back(model.materials[m]);
             }
     // What the file as a whole does not honour reaches the scene's warnings through the first material.
+    if (!model.lights.empty())
+        model.warnings.push_back("KHR_lights_punctual: a mesh object brings no lights (import the file as a scene, "
+                                 "`[import] gltf`, to have them)");
     for (const std::string& warning : model.warnings) out.materials.front().unsupported.push_back(warning);
     out.positions.reserve(vertices);
     out.triangles.reserve(triangles);

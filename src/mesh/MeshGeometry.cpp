@@ -47,6 +47,7 @@ size_t MeshGeometry::gpuBytes() const
     if (!data.uvs.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec2);
     if (!data.tangents.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec4);
     if (!data.triangleMaterials.empty()) bytes += data.triangles.size() * sizeof(uint32_t);
+    if (!data.colors.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec4);
     return bytes;
 }
 

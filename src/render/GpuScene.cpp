@@ -427,7 +427,8 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
                        (mesh.twoSided ? gpu::MESH_FLAG_TWO_SIDED : 0u) |
                        (!g.data.uvs.empty() ? gpu::MESH_FLAG_UVS : 0u) |
                        (!g.data.tangents.empty() ? gpu::MESH_FLAG_TANGENTS : 0u) |
-                       (!mesh.fileMaterials.empty() ? gpu::MESH_FLAG_MATERIALS : 0u);
+                       (!mesh.fileMaterials.empty() ? gpu::MESH_FLAG_MATERIALS : 0u) |
+                       (meshHasVertexColors(mesh) ? gpu::MESH_FLAG_COLORS : 0u);
         record.firstEmitter = firstEmitter;
         data.meshes.push_back(record);
         if (!emissive) continue;
@@ -564,6 +565,12 @@ void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features, GpuS
                                              : gpu::MeshTangents{d.tangents[t.x], d.tangents[t.y], d.tangents[t.z]});
         }
     }
+    if (features.vertexColors) {
+        const glm::vec4 white(1.0f);
+        for (const glm::uvec3& t : d.triangles)
+            fixed.meshColors.push_back(d.colors.empty() ? gpu::MeshColors{white, white, white}
+                                                        : gpu::MeshColors{d.colors[t.x], d.colors[t.y], d.colors[t.z]});
+    }
     if (features.fileMaterials) {
         for (uint32_t slot = 0; slot < d.triangles.size(); ++slot)
             fixed.meshMaterials.push_back(mesh.fileMaterials.empty() ? mesh.material
@@ -586,6 +593,7 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     if (features.textures) fixed.meshUvs.clear();
     if (features.normalMaps) fixed.meshTangents.clear();
     if (features.fileMaterials) fixed.meshMaterials.clear();
+    if (features.vertexColors) fixed.meshColors.clear();
     for (const Mesh& mesh : scene.meshes) {
         const MeshGeometry& g = *mesh.geometry;
         if (fixed.offsets.count(&g)) continue;
@@ -606,9 +614,11 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     checkBufferSize(fixed.meshNormals.size() * sizeof(gpu::MeshNormals), maxBytes, "mesh normals", scene);
     checkBufferSize(fixed.meshUvs.size() * sizeof(gpu::MeshUvs), maxBytes, "mesh texture coordinates", scene);
     checkBufferSize(fixed.meshTangents.size() * sizeof(gpu::MeshTangents), maxBytes, "mesh tangents", scene);
+    checkBufferSize(fixed.meshColors.size() * sizeof(gpu::MeshColors), maxBytes, "mesh vertex colours", scene);
     if (fixed.meshUvs.empty()) fixed.meshUvs.push_back(gpu::MeshUvs{});
     if (fixed.meshTangents.empty()) fixed.meshTangents.push_back(gpu::MeshTangents{});
     if (fixed.meshMaterials.empty()) fixed.meshMaterials.push_back(0u);
+    if (fixed.meshColors.empty()) fixed.meshColors.push_back(gpu::MeshColors{});
     const auto start = std::chrono::steady_clock::now();
     fixed.top = buildTopLevel(scene);
     fixed.topBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -62,6 +62,7 @@ struct GpuSceneStatic {
     std::vector<gpu::MeshUvs> meshUvs{gpu::MeshUvs{}};
     std::vector<gpu::MeshTangents> meshTangents{gpu::MeshTangents{}};
     std::vector<uint32_t> meshMaterials{0u};
+    std::vector<gpu::MeshColors> meshColors{gpu::MeshColors{}};
     /// Every texture's texels and records (one zero record and word without
     /// textures), and per material its texture slots.
     TextureBuffers textures;

@@ -57,6 +57,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
         {meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS), ""});
     list.push_back(
         {meshes && f.fileMaterials, "VKRT_HAS_MESH_MATERIALS", int(gpu::BINDING_MESH_MATERIALS), "file-materials"});
+    list.push_back({meshes && f.vertexColors, "VKRT_HAS_MESH_COLORS", int(gpu::BINDING_MESH_COLORS), "vertex-colors"});
     // The rough plastics' coating tables come with the plastic kind.
     list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});

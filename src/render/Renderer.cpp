@@ -303,6 +303,7 @@ void Renderer::uploadMeshBuffers()
     addBuffer(gpu::BINDING_MESH_UVS, m_static.meshUvs);
     addBuffer(gpu::BINDING_MESH_TANGENTS, m_static.meshTangents);
     addBuffer(gpu::BINDING_MESH_MATERIALS, m_static.meshMaterials);
+    addBuffer(gpu::BINDING_MESH_COLORS, m_static.meshColors);
     // Textures never change with the camera either: uploaded once, here.
     addBuffer(gpu::BINDING_TEXTURE_TEXELS, m_static.textures.texels);
     addBuffer(gpu::BINDING_TEXTURE_RECORDS, m_static.textures.records);

@@ -39,6 +39,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.textures = true;
     all.normalMaps = true;
     all.fileMaterials = true;
+    all.vertexColors = true;
     all.thinLens = true;
     all.orthographic = true;
     all.integrator = integrator;
@@ -67,6 +68,11 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
 
 } // namespace
 
+bool meshHasVertexColors(const Mesh& mesh)
+{
+    return !mesh.fileMaterials.empty() && !mesh.geometry->data.colors.empty();
+}
+
 bool meshEmits(const Scene& scene, const Mesh& mesh)
 {
     if (mesh.emission != Color(0.0)) return true;
@@ -94,6 +100,7 @@ FeatureSet featuresOf(const Scene& scene)
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();
         set.emitters = set.emitters || meshEmits(scene, mesh);
         set.fileMaterials = set.fileMaterials || !mesh.fileMaterials.empty();
+        set.vertexColors = set.vertexColors || meshHasVertexColors(mesh);
     }
     markMaterialsUsed(scene, set);
     return set;

@@ -22,6 +22,7 @@ struct FeatureSet {
     bool textures = false;            ///< some material in use has a texture
     bool normalMaps = false;          ///< ... a normal map
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
+    bool vertexColors = false;        ///< ... and its file's vertex colours (glTF COLOR_0)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
     bool orthographic = false;        ///< the camera projects orthographically (parallel rays)
     Integrator integrator = Integrator::Whitted;
@@ -38,6 +39,10 @@ struct FeatureSet {
 };
 
 FeatureSet featuresOf(const Scene& scene);
+
+/// Whether the mesh's file colours its vertices (glTF COLOR_0) for its file
+/// materials: only a file's own materials take its colours.
+bool meshHasVertexColors(const Mesh& mesh);
 
 /// Whether some triangle of the mesh emits: its own `emission`, or an emissive material.
 bool meshEmits(const Scene& scene, const Mesh& mesh);

@@ -54,8 +54,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     try {
         // The whole mesh path of a scene: load, smooth normals, BVH, leaf
         // order; a glTF file as a whole scene (its camera, lights, materials).
+        // A glTF file both ways: as a scene (instances kept) and as one mesh (instances flattened).
         if (vkrt::isGltfPath(file)) vkrt::parseGltfScene(file.string());
-        else vkrt::makeMeshGeometry(file, vkrt::NormalMode::Smooth);
+        vkrt::makeMeshGeometry(file, vkrt::NormalMode::Smooth);
     } catch (const vkrt::InputError&) {
         // the expected outcome for almost every input
     }

@@ -5,6 +5,7 @@
 // FileMaterials.h). Every input is written here, in a fresh folder.
 #include "mesh/FileMaterials.h"
 #include "mesh/MeshLoader.h"
+#include "scene/GltfScene.h"
 #include "support/GltfTestFiles.h"
 #include "support/TestSupport.h"
 #include "util/Error.h"
@@ -417,28 +418,35 @@ std::string preImportError(const fs::path& file)
     return "";
 }
 
-TEST(MeshInstancing, ManyNodesNamingALargeMeshAreRefusedBeforeImport)
+TEST(MeshInstancing, ManyNodesNamingALargeMeshAreRefusedAsOneMeshButAreInstancesInAScene)
 {
-    // 100,000 triangles (600 KB of indices) named by 5,000 nodes: 500 million triangles after instancing.
+    // 100,000 triangles (600 KB of indices) named by 5,000 nodes: 500 million triangles flattened into one
+    // mesh object is refused before any copy is made; as a glTF scene they are 5,000 instances of one geometry.
     const fs::path file = writeInstanced(testDir(), 300000, 5000);
-    EXPECT_EQ(loadError(file), file.string() + ": the node hierarchy instances meshes 5,000 times, 500,000,000 "
-                                               "triangles in all (mesh 0, 100,000 triangles, 5,000 times); vkrt "
-                                               "reads at most 8,388,608 triangles after instancing");
+    EXPECT_EQ(loadError(file).rfind(file.string() + ": the node hierarchy instances meshes 5,000 times, 500,000,000 "
+                                                    "triangles in all; vkrt reads at most 8,388,608 triangles after "
+                                                    "instancing into one mesh",
+                                    0),
+              0u)
+        << loadError(file);
+    const Scene scene = parseGltfScene(file.string());
+    ASSERT_EQ(scene.meshes.size(), 5000u);
+    EXPECT_EQ(scene.meshes.front().geometry, scene.meshes.back().geometry);
+    EXPECT_EQ(scene.meshes.front().geometry->data.triangles.size(), 100000u);
 }
 
 TEST(MeshInstancing, TheTriangleBoundIsExactForListsStripsAndFans)
 {
     const fs::path dir = testDir();
-    // 4,096 triangles a mesh, 2,048 nodes: exactly 8 Mi triangles; one node more is refused.
-    EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 2048)), "");
-    EXPECT_NE(preImportError(writeInstanced(dir, 3 * 4096, 2049)).find(" 8,392,704 triangles in all"),
-              std::string::npos);
+    // 4,096 triangles a mesh, 2,049 nodes: 8 Mi + 4,096 triangles flattened, refused with the exact count.
+    const fs::path over = writeInstanced(dir, 3 * 4096, 2049);
+    EXPECT_NE(loadError(over).find(" 8,392,704 triangles in all"), std::string::npos) << loadError(over);
     for (int stripOrFan : {5, 6}) { // n indices make n - 2 triangles: 4,097 x 2,048 = 8,390,656
-        EXPECT_EQ(preImportError(writeInstanced(dir, 4098, 2048, stripOrFan)), "") << stripOrFan;
-        EXPECT_NE(preImportError(writeInstanced(dir, 4099, 2048, stripOrFan)).find(" 8,390,656 triangles in all"),
-                  std::string::npos)
-            << stripOrFan;
+        const fs::path file = writeInstanced(dir, 4099, 2048, stripOrFan);
+        EXPECT_NE(loadError(file).find(" 8,390,656 triangles in all"), std::string::npos) << stripOrFan;
     }
+    // The unique triangles a scene places are bounded before anything is read: one mesh over the bound.
+    EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 2048)), ""); // 4,096 unique triangles
     // Points and lines make no triangles, however many.
     for (int pointsOrLines : {0, 1, 2, 3})
         EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 4096, pointsOrLines)), "") << pointsOrLines;
@@ -446,13 +454,13 @@ TEST(MeshInstancing, TheTriangleBoundIsExactForListsStripsAndFans)
 
 TEST(MeshInstancing, RepeatedSceneRootsCountOncePerListing)
 {
-    // Assimp imports a root once per listing, with its subtree: 1,024 instances of 4,096 triangles listed
-    // twice are exactly 8 Mi triangles, three times 12 Mi.
+    // A root is placed once per listing, with its subtree: 1,024 instances of 4,096 triangles listed
+    // three times are 12 Mi triangles flattened.
     const fs::path dir = testDir();
-    EXPECT_EQ(preImportError(writeInstanced(dir, 3 * 4096, 1024, 4, 2)), "");
-    EXPECT_NE(preImportError(writeInstanced(dir, 3 * 4096, 1024, 4, 3))
-                  .find("instances meshes 3,072 times, 12,582,912 triangles in all"),
-              std::string::npos);
+    const fs::path file = writeInstanced(dir, 3 * 4096, 1024, 4, 3);
+    EXPECT_NE(loadError(file).find("instances meshes 3,072 times, 12,582,912 triangles in all"), std::string::npos)
+        << loadError(file);
+    EXPECT_EQ(parseGltfScene(file.string()).meshes.size(), 3072u);
 }
 
 TEST(MeshInstancing, InstancedFileUnderTheBoundLoadsEveryCopy)
@@ -468,11 +476,10 @@ TEST(MeshInstancing, InstancedFileUnderTheBoundLoadsEveryCopy)
 TEST(MeshInstancing, NodeCountsAreBounded)
 {
     const fs::path dir = testDir();
-    // The nodes array: assimp's reader slows with the square of its length, reachable nodes or not.
+    // The nodes array, reachable nodes or not.
     const fs::path many = writeInstanced(dir, 3, uint32_t(kMaxGltfNodes));
-    EXPECT_EQ(loadError(many), many.string() + ": the file has 65,537 nodes; vkrt reads at most 65,536 (the glTF "
-                                               "reader slows with the square of their number)");
-    // One node listed as the scene's root 65,536 times loads (a copy each); once more is refused.
+    EXPECT_EQ(loadError(many), many.string() + ": the file has 65,537 nodes; vkrt reads at most 65,536");
+    // One node listed as the scene's root 65,536 times loads (an instance each); once more is refused.
     const fs::path roots = writeFile(dir / "roots.gltf", gltf(kInlineBuffer));
     std::string text = fileText(roots);
     const std::string listing = R"("nodes": [0])";
@@ -483,8 +490,8 @@ TEST(MeshInstancing, NodeCountsAreBounded)
     EXPECT_EQ(loadMeshFile(roots).triangles.size(), kMaxGltfNodes);
     text.replace(text.find(repeated), repeated.size(), repeated + ",0");
     writeFile(roots, text);
-    EXPECT_EQ(loadError(roots), roots.string() + ": the scene imports 65,537 nodes (a node listed more than once "
-                                                 "among its roots is imported each time, with its children); vkrt "
+    EXPECT_EQ(loadError(roots), roots.string() + ": the scene reaches 65,537 nodes (a node listed more than once "
+                                                 "among its roots is reached each time, with its children); vkrt "
                                                  "reads at most 65,536");
 }
 

@@ -9,12 +9,14 @@
 #include "render/RenderSession.h"
 #include "scene/GltfScene.h"
 #include "scene/SceneParser.h"
+#include "support/GltfTestFiles.h"
 #include "support/TestSupport.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 namespace vkrt::test {
 namespace {
@@ -78,6 +80,76 @@ TEST_F(GltfRender, TextureTransformEqualsTheTransformBakedIntoTheUvs)
     Scene b = parseGltfScene((dir / "texture-transform-baked.gltf").string());
     for (Scene* s : {&a, &b}) applyResolution(s->camera, {160, 120});
     expectStatisticallyEqual(render(a, 1, 128), render(b, 2, 128), "texture_transform");
+}
+
+/// triangleBuffer's 92 bytes, then two instance translations and two scales (48 bytes).
+std::string instanceBuffer()
+{
+    std::string bytes = triangleBuffer();
+    for (float v : {0.f, 1.f, -1.f, 0.5f, 0.4f, 0.3f}) put(bytes, v);
+    for (float v : {1.f, 1.f, 1.f, 0.5f, 0.5f, 0.5f}) put(bytes, v);
+    return bytes;
+}
+
+/// Instances of one triangle: nodes placing it (one mirrored, one moved by
+/// 0.004, one turned), EXT_mesh_gpu_instancing copies, and a camera.
+std::string instancedGltf()
+{
+    return R"({"asset": {"version": "2.0"}, "scene": 0,
+  "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+  "scenes": [{"nodes": [0, 1, 2, 3, 4]}],
+  "nodes": [{"mesh": 0, "translation": [-1.5, -1, 0]},
+            {"mesh": 0, "translation": [1.5, -1, 0], "scale": [-1, 1, 1]},
+            {"mesh": 0, "translation": [-1.496, 0.2, -0.5], "rotation": [0, 0.3826834, 0, 0.9238795]},
+            {"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 4, "SCALE": 5}}}},
+            {"camera": 0, "translation": [0, 0, 5]}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.3333333, "znear": 0.1}}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1], "metallicFactor": 0,
+                                          "roughnessFactor": 0.5}, "doubleSided": true}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 3, "material": 0}]}],
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", instanceBuffer()) + R"(", "byteLength": 140}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24},
+                  {"buffer": 0, "byteOffset": 60, "byteLength": 24}, {"buffer": 0, "byteOffset": 84, "byteLength": 6},
+                  {"buffer": 0, "byteOffset": 92, "byteLength": 24}, {"buffer": 0, "byteOffset": 116, "byteLength": 24}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
+    {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"},
+    {"bufferView": 3, "componentType": 5123, "count": 3, "type": "SCALAR"},
+    {"bufferView": 4, "componentType": 5126, "count": 2, "type": "VEC3"},
+    {"bufferView": 5, "componentType": 5126, "count": 2, "type": "VEC3"}]})";
+}
+
+TEST_F(GltfRender, InstancesRenderAsTheFlattenedMesh)
+{
+    // The same file as a glTF scene (one geometry, six instances) and as one
+    // mesh object of a TOML scene (loadMeshFile flattens the instances into
+    // world-space triangles): the same camera, sky and material, so the same image.
+    const fs::path dir = freshTempDir("gltf-instances");
+    std::ofstream(dir / "instances.gltf") << instancedGltf();
+    Scene instanced = parseGltfScene((dir / "instances.gltf").string());
+    ASSERT_EQ(instanced.meshes.size(), 6u);
+    applyResolution(instanced.camera, {160, 120});
+    const Scene flat = parseSceneString(R"(
+[render]
+integrator = "path"
+max_depth = 8
+[camera]
+eye = [0, 0, 5]
+target = [0, 0, 0]
+fov = 45.836623610465857
+width = 160
+height = 120
+[background]
+color = [1, 1, 1]
+[[objects]]
+shape = "mesh"
+file = ")" + (dir / "instances.gltf").string() + R"("
+material = "file"
+)");
+    ASSERT_EQ(flat.meshes.size(), 1u);
+    EXPECT_EQ(flat.meshes[0].geometry->data.triangles.size(), 6u);
+    expectStatisticallyEqual(render(instanced, 1, 128), render(flat, 2, 128), "instances");
 }
 
 } // namespace

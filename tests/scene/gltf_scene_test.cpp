@@ -71,8 +71,11 @@ TEST(GltfScene, CameraAndLightsAreThoseTheNodesPlace)
     // Lit by its own lights: no sky; the path integrator.
     EXPECT_EQ(gltf.background.color, Color(0.0));
     EXPECT_EQ(gltf.render.integrator, Integrator::Path);
-    ASSERT_EQ(gltf.meshes.size(), 1u);
+    // Four nodes place three meshes (mesh 1 twice): four instances, mesh 1's two sharing one geometry.
+    ASSERT_EQ(gltf.meshes.size(), 4u);
     EXPECT_FALSE(gltf.meshes[0].fileMaterials.empty());
+    EXPECT_EQ(gltf.meshes[1].geometry, gltf.meshes[2].geometry);
+    EXPECT_NE(gltf.meshes[0].geometry, gltf.meshes[1].geometry);
 }
 
 TEST(GltfScene, AnotherCameraByIndexOrNameAndAClearErrorForNone)
@@ -169,7 +172,7 @@ TEST(GltfScene, ImportedIntoATomlSceneKeepsTheTomlCameraAndAddsLights)
     const Scene gltf = parseGltfScene((dir / "lights-camera.gltf").string());
     EXPECT_EQ(scene.pointLights.size(), gltf.pointLights.size() + 1);
     EXPECT_EQ(scene.spotLights.size(), gltf.spotLights.size());
-    EXPECT_EQ(scene.meshes.size(), 1u);
+    EXPECT_EQ(scene.meshes.size(), gltf.meshes.size());
     // Without a [camera], the file's.
     const Scene own = parseSceneString("[import]\ngltf = \"lights-camera.gltf\"\n", (dir / "import.toml").string());
     EXPECT_EQ(own.camera.eye, gltf.camera.eye);

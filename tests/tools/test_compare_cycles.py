@@ -278,3 +278,18 @@ def test_emission_and_lights_are_found():
     assert light["power"] == pytest.approx([2, 1, 0])
     assert light["direction"] == pytest.approx([0, 0, -1])
     assert light["inner"] == 0.0 and light["outer"] == 0.5
+
+
+def test_an_orthographic_first_camera_is_kept_with_vkrts_view_height():
+    gltf = box_gltf(camera=True)
+    gltf["cameras"][0] = {"type": "orthographic", "orthographic": {"xmag": 3, "ymag": 1.5, "znear": 0, "zfar": 9}}
+    gltf["nodes"][1]["scale"] = [1, 2, 1]
+    camera, origin = cc.choose_camera(gltf)
+    assert "orthographic" in origin
+    assert camera["ortho_height"] == pytest.approx(2 * 1.5 * 2)
+    assert "fov_y" not in camera
+    index = cc.add_camera(gltf, camera, 2.0)
+    added = gltf["cameras"][index]
+    assert added["type"] == "orthographic"
+    assert added["orthographic"]["ymag"] == pytest.approx(3.0)
+    assert added["orthographic"]["xmag"] == pytest.approx(6.0)

@@ -176,6 +176,12 @@ void describeMesh(Ray r, HitId id, inout SurfaceHit hit)
 #ifdef VKRT_HAS_MESH_UVS
     describeMeshUv(mesh, id, tri, hit);
 #endif
+#ifdef VKRT_HAS_MESH_COLORS
+    if ((mesh.flags & MESH_FLAG_COLORS) != 0u) {
+        MeshColors c = meshColors[mesh.firstTriangle + id.primitive];
+        hit.color = id.detail.x * c.c0 + id.detail.y * c.c1 + id.detail.z * c.c2;
+    }
+#endif
 #ifdef VKRT_HAS_EMITTERS
     if ((mesh.flags & MESH_FLAG_EMISSIVE) != 0u)
         hit.emitter = mesh.firstEmitter + id.primitive;
