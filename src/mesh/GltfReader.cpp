@@ -6,7 +6,6 @@
 #include "mesh/GltfReader.h"
 
 #include "mesh/FileMaterials.h"
-#include "scene/TomlReader.h"
 #include "util/Error.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -17,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -68,6 +68,22 @@ std::string indexed(const char* array, uint64_t index) { return std::string(arra
 
 // ------------------------------------------------------------------ buffers
 
+/// The bytes of a file the glTF needs (itself, a buffer), at most 2 GiB.
+std::string readBytes(const fs::path& path)
+{
+    std::error_code error;
+    if (fs::is_directory(path, error)) throw InputError(path.string() + ": is a directory");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path.string() + ": no such file, or it cannot be opened");
+    const uint64_t size = fs::file_size(path, error);
+    constexpr uint64_t kMaxBytes = uint64_t(1) << 31;
+    if (error || size > kMaxBytes)
+        throw InputError(path.string() + ": larger than the 2 GiB vkrt reads of a glTF file or buffer");
+    std::string bytes(size_t(size), '\0');
+    if (!in.read(bytes.data(), std::streamsize(size))) throw InputError(path.string() + ": cannot be read");
+    return bytes;
+}
+
 constexpr uint32_t kGlbMagic = 0x46546C67;     // "glTF"
 constexpr uint32_t kGlbJsonChunk = 0x4E4F534A; // "JSON"
 constexpr uint32_t kGlbBinChunk = 0x004E4942;  // "BIN\0"
@@ -83,7 +99,7 @@ uint32_t word(const std::string& bytes, size_t offset)
 /// or a .glb without one.
 std::optional<std::string> glbBinaryChunk(const fs::path& file)
 {
-    const std::string bytes = readFileBytes(file.string(), "glTF file", size_t(1) << 31);
+    const std::string bytes = readBytes(file);
     if (word(bytes, 0) != kGlbMagic) return std::nullopt;
     const uint64_t jsonLength = word(bytes, 12);
     if (word(bytes, 16) != kGlbJsonChunk) fail(file, "the binary glTF's first chunk is not JSON");
@@ -161,9 +177,9 @@ std::string loadBuffer(const Document& d, size_t index, const std::optional<std:
         const fs::path path = d.file.parent_path() / gltfUriPath(uri);
         d.references.check(path, uri, "buffer " + std::to_string(index));
         try {
-            bytes = readFileBytes(path.string(), "glTF buffer", size_t(1) << 31);
+            bytes = readBytes(path);
         } catch (const InputError& error) {
-            fail(d.file, "the referenced file '" + uri + "' (" + where + ") cannot be read: " + error.what());
+            fail(d.file, "the referenced file '" + uri + "' cannot be read: " + error.what());
         }
     }
     if (bytes.size() < *length)
