@@ -193,7 +193,7 @@ TEST(GltfReader, PrimitivesWithAndWithoutTextureCoordinatesShareAFile)
 TEST(GltfReader, StripsAndFansBecomeTrianglesWithTheirWinding)
 {
     GltfBuilder b;
-    const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0}, "VEC3");
+    const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 2, 0}, "VEC3");
     const uint32_t strip = b.mesh({{"POSITION", positions}}, std::nullopt, 5);
     const uint32_t fan = b.mesh({{"POSITION", positions}}, std::nullopt, 6);
     const uint32_t lines = b.mesh({{"POSITION", positions}}, std::nullopt, 1);
@@ -224,13 +224,10 @@ TEST(GltfReader, SparseInterleavedAndNormalizedAccessors)
     const uint32_t sparseIndices = b.accessor(std::vector<uint16_t>{1, 2}, "SCALAR", 5123);
     const uint32_t sparseValues = b.floats({1, 0, 0, 0, 1, 0}, "VEC3");
     json& accessors = b.doc()["accessors"];
-    accessors.push_back({{"componentType", 5126},
-                         {"count", 3},
-                         {"type", "VEC3"},
-                         {"sparse",
-                          {{"count", 2},
-                           {"indices", {{"bufferView", accessors[sparseIndices]["bufferView"]}, {"componentType", 5123}}},
-                           {"values", {{"bufferView", accessors[sparseValues]["bufferView"]}}}}}}});
+    json sparse = {{"count", 2},
+                   {"indices", {{"bufferView", accessors[sparseIndices]["bufferView"]}, {"componentType", 5123}}},
+                   {"values", {{"bufferView", accessors[sparseValues]["bufferView"]}}}};
+    accessors.push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"sparse", sparse}});
     const uint32_t positions = uint32_t(accessors.size() - 1);
     // Colours as normalized unsigned bytes: 255 is 1, 51 is 0.2.
     const uint32_t colors = b.accessor(std::vector<uint8_t>{255, 51, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255}, "VEC4",
@@ -245,7 +242,8 @@ TEST(GltfReader, SparseInterleavedAndNormalizedAccessors)
     ASSERT_EQ(mesh.colors.size(), 3u);
     EXPECT_FLOAT_EQ(mesh.colors[0].r, 1.0f);
     EXPECT_FLOAT_EQ(mesh.colors[0].g, 0.2f);
-    EXPECT_FLOAT_EQ(mesh.colors[1].b, 1.0f);
+    EXPECT_FLOAT_EQ(mesh.colors[1].g, 1.0f);
+    EXPECT_FLOAT_EQ(mesh.colors[2].b, 1.0f);
 
     // Interleaved: position and normal in one view with byteStride 24.
     GltfBuilder i;

@@ -4,6 +4,7 @@
 // are bounded before assimp sees them (src/mesh/ReferencePolicy.h,
 // FileMaterials.h). Every input is written here, in a fresh folder.
 #include "mesh/FileMaterials.h"
+#include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "scene/GltfScene.h"
 #include "support/GltfTestFiles.h"
