@@ -953,13 +953,17 @@ MeshData flattenGltfModel(GltfModel model)
     }
     // The materials the placed triangles use, in order of first use.
     std::vector<uint32_t> materialMap(model.materials.size(), UINT32_MAX);
+    std::vector<bool> seen(model.meshes.size(), false);
     MeshData out;
-    for (const GltfInstance& i : model.instances)
+    for (const GltfInstance& i : model.instances) {
+        if (seen[i.mesh]) continue;
+        seen[i.mesh] = true;
         for (uint32_t m : model.meshes[i.mesh].triangleMaterials)
             if (materialMap[m] == UINT32_MAX) {
                 materialMap[m] = uint32_t(out.materials.size());
                 out.materials.push_back(model.materials[m]);
             }
+    }
     // What the file as a whole does not honour reaches the scene's warnings through the first material.
     if (!model.lights.empty())
         model.warnings.push_back("KHR_lights_punctual: a mesh object brings no lights (import the file as a scene, "

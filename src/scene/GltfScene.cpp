@@ -149,9 +149,11 @@ void addLight(const GltfModel& model, const GltfPlaced& placed, Scene& scene)
 /// material, its scene material (the first used one for unused entries, which no triangle names).
 std::vector<uint32_t> importUsedMaterials(const GltfModel& model, const SourceLocation& where, ParseContext& context)
 {
-    std::vector<bool> used(model.materials.size(), false);
-    for (const GltfInstance& instance : model.instances)
-        for (uint32_t m : model.meshes[instance.mesh].triangleMaterials) used[m] = true;
+    std::vector<bool> used(model.materials.size(), false), placed(model.meshes.size(), false);
+    for (const GltfInstance& instance : model.instances) placed[instance.mesh] = true;
+    for (size_t mesh = 0; mesh < placed.size(); ++mesh) // each mesh once, however often it is placed
+        if (placed[mesh])
+            for (uint32_t m : model.meshes[mesh].triangleMaterials) used[m] = true;
     std::vector<FileMaterial> materials;
     std::vector<uint32_t> position(model.materials.size(), 0);
     for (size_t i = 0; i < used.size(); ++i)

@@ -5,6 +5,7 @@
 // conventions and the file materials together. Likewise a texture under
 // KHR_texture_transform against the same quad with the transform baked into
 // its uvs (scenes/gltf/texture-transform*.gltf).
+#include "mesh/MeshGeometry.h"
 #include "render/Renderer.h"
 #include "render/RenderSession.h"
 #include "scene/GltfScene.h"
@@ -122,13 +123,13 @@ std::string instancedGltf()
 
 TEST_F(GltfRender, InstancesRenderAsTheFlattenedMesh)
 {
-    // The same file as a glTF scene (one geometry, six instances) and as one
+    // The same file as a glTF scene (one geometry, five instances) and as one
     // mesh object of a TOML scene (loadMeshFile flattens the instances into
     // world-space triangles): the same camera, sky and material, so the same image.
     const fs::path dir = freshTempDir("gltf-instances");
     std::ofstream(dir / "instances.gltf") << instancedGltf();
     Scene instanced = parseGltfScene((dir / "instances.gltf").string());
-    ASSERT_EQ(instanced.meshes.size(), 6u);
+    ASSERT_EQ(instanced.meshes.size(), 5u);
     applyResolution(instanced.camera, {160, 120});
     const Scene flat = parseSceneString(R"(
 [render]
@@ -148,8 +149,52 @@ file = ")" + (dir / "instances.gltf").string() + R"("
 material = "file"
 )");
     ASSERT_EQ(flat.meshes.size(), 1u);
-    EXPECT_EQ(flat.meshes[0].geometry->data.triangles.size(), 6u);
+    EXPECT_EQ(flat.meshes[0].geometry->data.triangles.size(), 5u);
     expectStatisticallyEqual(render(instanced, 1, 128), render(flat, 2, 128), "instances");
+}
+
+/// A 2 x 2 quad in the z = 0 plane (a black dielectric) seen by an
+/// orthographic camera `distance` ahead of it on +z, its view 4 wide and 3 tall.
+std::string orthographicQuadGltf(double distance)
+{
+    std::string bytes;
+    for (float v : {-1.f, -1.f, 0.f, 1.f, -1.f, 0.f, 1.f, 1.f, 0.f, -1.f, 1.f, 0.f}) put(bytes, v);
+    for (uint16_t i : {0, 1, 2, 0, 2, 3}) put(bytes, i);
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+  "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, )" + std::to_string(distance) + R"(]}],
+  "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1.5, "znear": 0.01, "zfar": 100}}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", bytes) + R"(", "byteLength": 60}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+}
+
+TEST_F(GltfRender, AnOrthographicCameraSeesTheSameAtEveryDistance)
+{
+    // Parallel rays: the quad covers the same pixels 2 or 20 units away (a
+    // perspective camera would see it ten times smaller), and exactly its
+    // share of the view: 2 x 2 of 4 x 3 (columns 40-119, rows 20-99 of 160 x 120).
+    const fs::path dir = freshTempDir("gltf-orthographic");
+    std::ofstream(dir / "near.gltf") << orthographicQuadGltf(2.0);
+    std::ofstream(dir / "far.gltf") << orthographicQuadGltf(20.0);
+    Scene near = parseGltfScene((dir / "near.gltf").string());
+    Scene far = parseGltfScene((dir / "far.gltf").string());
+    EXPECT_EQ(near.camera.orthographicHeight, 3.0);
+    EXPECT_EQ(double(near.camera.width) / near.camera.height, 640.0 / 480.0);
+    for (Scene* s : {&near, &far}) applyResolution(s->camera, {160, 120});
+    const Rendered a = render(near, 1, 64), b = render(far, 2, 64);
+    expectStatisticallyEqual(a, b, "orthographic");
+    // Inside the quad only its dim reflection of the white sky; outside, the sky (1).
+    auto luminance = [&](uint32_t x, uint32_t y) { return a.mean.rgb[3 * (y * 160 + x) + 1]; };
+    EXPECT_LT(luminance(80, 60), 0.2f);
+    EXPECT_LT(luminance(41, 21), 0.2f);
+    EXPECT_LT(luminance(118, 98), 0.2f);
+    EXPECT_EQ(luminance(38, 60), 1.0f);
+    EXPECT_EQ(luminance(121, 60), 1.0f);
+    EXPECT_EQ(luminance(80, 18), 1.0f);
 }
 
 } // namespace
