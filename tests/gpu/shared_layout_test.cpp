@@ -90,6 +90,8 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(emitters, Emitter, radiance),
         ARRAY_MEMBER(emitters, Emitter, aliasThreshold),
         ARRAY_MEMBER(emitters, Emitter, alias),
+        ARRAY_MEMBER(emitters, Emitter, textures),
+        ARRAY_MEMBER(emitters, Emitter, uvs),
         ARRAY_MEMBER(pointLights, PointLight, position),
         ARRAY_MEMBER(pointLights, PointLight, intensity),
         ARRAY_MEMBER(triangleLights, TriangleLight, v0),
