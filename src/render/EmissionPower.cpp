@@ -14,11 +14,11 @@ glm::dvec2 slotUv(const MaterialTexture& slot, const glm::dvec2& uv)
 
 namespace {
 
-/// The mip level whose texels the footprint (in level-0 texels) covers at most 256 of.
+/// The mip level whose texels the footprint (in level-0 texels) covers at most 64 of.
 uint32_t integrationLevel(double footprintTexels, uint32_t levels)
 {
     uint32_t level = 0;
-    while (level + 1 < levels && footprintTexels > 256.0) {
+    while (level + 1 < levels && footprintTexels > 64.0) {
         footprintTexels /= 4.0;
         ++level;
     }
@@ -38,7 +38,7 @@ glm::dvec3 meanEmissionTexel(const TextureAtlas& atlas, const MaterialTexture& s
     if (!std::isfinite(footprint)) footprint = 0.0;
     const uint32_t level = integrationLevel(footprint, atlas.levelsOf(slot.record));
     const double levelTexels = footprint / std::pow(4.0, double(level));
-    const int k = std::clamp(int(std::ceil(2.0 * std::sqrt(levelTexels))), 4, 32);
+    const int k = std::clamp(int(std::ceil(2.0 * std::sqrt(levelTexels))), 4, 16);
     // Stratified points of the unit square warped onto the triangle as
     // lib/sampling.glsl's sampleTriangle does (barycentrics 1 - s, s (1 - v), s v, s = sqrt(u)).
     glm::dvec3 sum(0.0);

@@ -19,10 +19,11 @@ glm::dvec2 slotUv(const MaterialTexture& slot, const glm::dvec2& uv);
 /// `uvs` (uniform in its area, which is uniform in barycentrics): bilinear
 /// lookups (TextureAtlas::sampleLevel) at k x k stratified points of the
 /// triangle, in the mip level whose texels the triangle's uv footprint covers
-/// at most 256 of (each texel of a level is the box average of level 0's, so
-/// a bright texel anywhere under the footprint shows in it), with k = 4 ... 32
+/// at most 64 of (each texel of a level is the box average of level 0's, so
+/// a bright texel anywhere under the footprint shows in it), with k = 4 ... 16
 /// (about two points per texel side). A footprint over black texels only
-/// gives exactly 0.
+/// gives exactly 0. About 10 us a triangle (DamagedHelmet: 15452 triangles,
+/// 2048^2 emissive map, in 0.15 s on one core).
 glm::dvec3 meanEmissionTexel(const TextureAtlas& atlas, const MaterialTexture& slot,
                              const std::array<glm::dvec2, 3>& uvs);
 

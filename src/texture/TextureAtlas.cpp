@@ -181,12 +181,18 @@ std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t lev
         }
         return texel;
     }
+    // unpackUnorm4x8 rounds code / 255 to float before the EOTF; one table per encoding.
+    static const auto tables = [] {
+        std::array<std::array<double, 256>, 2> t{}; // linear, sRGB
+        for (uint32_t code = 0; code < 256; ++code) {
+            t[0][code] = double(float(code) / 255.0f);
+            t[1][code] = srgbToLinear(t[0][code]);
+        }
+        return t;
+    }();
     const uint32_t word = image.words[levelWord + index];
-    for (int c = 0; c < 4; ++c) {
-        // unpackUnorm4x8 rounds code / 255 to float before the EOTF.
-        texel[c] = double(float((word >> (8 * c)) & 0xffu) / 255.0f);
-        if (image.format == gpu::TEXTURE_FORMAT_RGBA8_SRGB && c < 3) texel[c] = srgbToLinear(texel[c]);
-    }
+    const bool srgb = image.format == gpu::TEXTURE_FORMAT_RGBA8_SRGB;
+    for (int c = 0; c < 4; ++c) texel[c] = tables[srgb && c < 3 ? 1 : 0][(word >> (8 * c)) & 0xffu];
     return texel;
 }
 
