@@ -9,6 +9,7 @@
 #include "render/GpuScene.h"
 #include "render/KernelVariant.h"
 #include "scene/FeatureSet.h"
+#include "scene/GltfScene.h"
 #include "support/GltfTestFiles.h"
 #include "support/TestSupport.h"
 #include "texture/TextureImage.h"
@@ -161,6 +162,36 @@ TEST(EmissionTable, OnlyATexturedEmissionChangesTheKernelVariant)
     EXPECT_NE(std::find(a.begin(), a.end(), "VKRT_HAS_EMISSION_TEXTURES"), a.end());
     EXPECT_EQ(std::find(b.begin(), b.end(), "VKRT_HAS_EMISSION_TEXTURES"), b.end());
     EXPECT_TRUE(FeatureSet::everything(Integrator::Path).emissionTextures);
+}
+
+// glTF import: the emissive texture becomes the material's emission slot
+// (sRGB, with its KHR_texture_transform), without the old "not supported"
+// warning; a file whose only emitters are emissive surfaces keeps the white sky.
+TEST(EmissionTable, TheEmissiveTextureIsImportedWithItsTransformAndTheSkyStaysWhite)
+{
+    const fs::path dir = freshTempDir("emission-import");
+    writeBands(dir / "bands.png");
+    std::string material = emissiveMaterial(true);
+    const std::string plain = R"("emissiveTexture": {"index": 0},)";
+    material.replace(material.find(plain), plain.size(),
+                     R"("emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 3]}}},)");
+    const std::string used = R"("KHR_materials_emissive_strength"])";
+    material.replace(material.find(used), used.size(), R"("KHR_materials_emissive_strength", "KHR_texture_transform"])");
+    writeText(dir / "quads.gltf", quadsGltf({bandQuad(0)}, material));
+    const Scene scene = parseGltfScene((dir / "quads.gltf").string());
+    EXPECT_EQ(scene.background.color, Color(1.0)) << "emissive surfaces alone switched the white sky off";
+    ASSERT_EQ(scene.meshes.size(), 1u);
+    ASSERT_EQ(scene.meshes[0].fileMaterials.size(), 1u);
+    const Material& m = scene.materials[scene.meshes[0].fileMaterials[0]];
+    EXPECT_EQ(m.emission, Color(4.0, 2.0, 1.0));
+    const auto& slot = m.texture(TextureSlot::Emission);
+    ASSERT_TRUE(slot.has_value());
+    EXPECT_EQ(slot->scale, glm::dvec2(2.0, 3.0));
+    ASSERT_NE(scene.textures, nullptr);
+    EXPECT_EQ(scene.textures->widthOf(slot->record), 24u);
+    for (const std::string& warning : scene.warnings)
+        EXPECT_EQ(warning.find("emissiveTexture"), std::string::npos) << warning;
+    EXPECT_TRUE(featuresOf(scene).emissionTextures);
 }
 
 } // namespace
