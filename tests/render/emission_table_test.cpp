@@ -176,7 +176,8 @@ TEST(EmissionTable, TheEmissiveTextureIsImportedWithItsTransformAndTheSkyStaysWh
     material.replace(material.find(plain), plain.size(),
                      R"("emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 3]}}},)");
     const std::string used = R"("KHR_materials_emissive_strength"])";
-    material.replace(material.find(used), used.size(), R"("KHR_materials_emissive_strength", "KHR_texture_transform"])");
+    material.replace(material.find(used), used.size(),
+                     R"("KHR_materials_emissive_strength", "KHR_texture_transform"])");
     writeText(dir / "quads.gltf", quadsGltf({bandQuad(0)}, material));
     const Scene scene = parseGltfScene((dir / "quads.gltf").string());
     EXPECT_EQ(scene.background.color, Color(1.0)) << "emissive surfaces alone switched the white sky off";
