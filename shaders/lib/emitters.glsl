@@ -11,11 +11,41 @@ layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitte
 // Unit normal of an emitter: its counter-clockwise side.
 vec3 emitterNormal(Emitter e) { return normalize(cross(e.v1 - e.v0, e.v2 - e.v0)); }
 
-// Radiance an emitter sends towards direction `towards` (from the emitter).
-vec3 emitterRadiance(Emitter e, vec3 towards)
+// Radiance an emitter sends towards direction `towards` (from the emitter)
+// from its point of texture coordinates `uv` (emitterUvAtHit, emitterUvAt):
+// the emission times its texture's texel there where it has one. Every site
+// that reads an emitter's radiance passes the point's uv.
+vec3 emitterRadiance(Emitter e, vec3 towards, vec2 uv)
 {
     float facing = dot(emitterNormal(e), towards);
-    return (facing > 0.0 || (e.twoSided != 0u && facing < 0.0)) ? e.radiance : vec3(0.0);
+    if (!(facing > 0.0 || (e.twoSided != 0u && facing < 0.0)))
+        return vec3(0.0);
+#ifdef VKRT_HAS_EMISSION_TEXTURES
+    if (e.textures != NO_EMISSION_TEXTURE)
+        return e.radiance * emissionTexel(e.textures, uv);
+#endif
+    return e.radiance;
+}
+
+// The uv of a hit on an emitter (what emitterRadiance reads).
+vec2 emitterUvAtHit(SurfaceHit hit)
+{
+#ifdef VKRT_HAS_EMISSION_TEXTURES
+    return hit.uv;
+#else
+    return vec2(0.0);
+#endif
+}
+
+// The uv of the point of barycentrics b on emitter e: the mesh triangle's uvs
+// interpolated as a hit there interpolates them (lib/surface.glsl: triangleUv).
+vec2 emitterUvAt(Emitter e, vec3 b)
+{
+#ifdef VKRT_HAS_EMISSION_TEXTURES
+    if (e.textures != NO_EMISSION_TEXTURE)
+        return b.x * meshUvs[e.uvs].uv0 + b.y * meshUvs[e.uvs].uv1 + b.z * meshUvs[e.uvs].uv2;
+#endif
+    return vec2(0.0);
 }
 
 // Solid-angle density of choosing emitter e (in proportion to power) and
@@ -36,6 +66,8 @@ LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo
 {
     Emitter e = emitters[pickEmitter(u4.x, u4.y)];
     vec3 point = sampleTriangle(e.v0, e.v1, e.v2, u4.zw);
+    float s = sqrt(u4.z); // sampleTriangle's barycentrics
+    vec2 uv = emitterUvAt(e, vec3(1.0 - s, s * (1.0 - u4.w), s * u4.w));
     // Aim just short of the emitter so it does not shadow itself.
     vec3 target = mix(origin, point, 1.0 - 1.0 / 65536.0);
     vec3 toLight = point - hit.position;
@@ -43,7 +75,7 @@ LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo
     vec3 wi = toLight * inversesqrt(distSq);
     float cosSurface = dot(ns, wi);
     float cosLight = abs(dot(emitterNormal(e), wi));
-    vec3 le = emitterRadiance(e, -wi);
+    vec3 le = emitterRadiance(e, -wi, uv);
     if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0) || !(e.pdf > 0.0) || distSq == 0.0)
         return LightSample(vec3(0.0), target);
     float lightPdf = emitterPdf(e, distSq, cosLight);

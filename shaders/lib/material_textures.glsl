@@ -33,14 +33,35 @@ void setTextureConeScale(uint frameIndex)
 // The angle one pixel subtends at the image centre, narrowed for later samples (above).
 float pixelSpreadAngle() { return g_textureConeScale * 2.0 * length(u.cameraUp) / float(u.height); }
 
+// A slot's lookup coordinates of a surface uv: R (uv * scale) + offset
+// (src/render/EmissionPower.cpp: slotUv, the host's copy).
+vec2 slotUv(TextureSlot slot, vec2 uv)
+{
+    vec2 s = uv * slot.scale;
+    return vec2(slot.rotation.x * s.x + slot.rotation.y * s.y, slot.rotation.x * s.y - slot.rotation.y * s.x) +
+           slot.offset;
+}
+
 vec4 lookupSlot(TextureSlot slot, SurfaceHit hit, float coneWidth, float cosTheta)
 {
     float density = hit.uvDensity * abs(slot.scale.x * slot.scale.y);
     float lod = rayConeTextureLod(slot.record, coneWidth, cosTheta, density);
-    vec2 s = hit.uv * slot.scale;
-    vec2 uv = vec2(slot.rotation.x * s.x + slot.rotation.y * s.y, slot.rotation.x * s.y - slot.rotation.y * s.x);
-    return sampleTexture(slot.record, uv + slot.offset, lod);
+    return sampleTexture(slot.record, slotUv(slot, hit.uv), lod);
 }
+
+#ifdef VKRT_HAS_EMISSION_TEXTURES
+// The emission texture of material `material` at surface uv `uv`, linear RGB
+// (>= 0; an HDR texture may exceed 1). Always level 0 (bilinear), whether the
+// point was hit by a ray or sampled on the emitter: the two estimates MIS
+// weighs against each other must see the same radiance there.
+vec3 emissionTexel(uint material, vec2 uv)
+{
+    TextureSlot slot = materialTextures[material].slots[TEXTURE_SLOT_EMISSION];
+    if (slot.record == NO_TEXTURE)
+        return vec3(1.0);
+    return max(sampleTextureLevel(slot.record, slotUv(slot, uv), 0u).rgb, vec3(0.0));
+}
+#endif
 
 float channelOf(vec4 texel, uint channel) { return clamp(texel[channel], 0.0, 1.0); }
 
@@ -87,8 +108,9 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
         coneWidth = pixelSpreadAngle(); // parallel rays: one pixel's width at any distance
 #endif
     float cosTheta = dot(dir, hit.normal);
+    // The emission slot (last) is the emitters' (emissionTexel), not the BSDF's.
 #ifdef VKRT_HAS_NORMAL_MAPS
-    const uint slots = TEXTURE_SLOT_COUNT;
+    const uint slots = TEXTURE_SLOT_NORMAL + 1u;
 #else
     const uint slots = TEXTURE_SLOT_NORMAL;
 #endif

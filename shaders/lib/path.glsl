@@ -25,7 +25,7 @@ vec3 emitterOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
 {
 #ifdef VKRT_HAS_EMITTERS
     Emitter e = emitters[hit.emitter];
-    vec3 le = emitterRadiance(e, -ray.dir);
+    vec3 le = emitterRadiance(e, -ray.dir, emitterUvAtHit(hit));
     if (path.specular || le == vec3(0.0))
         return le;
     float cosLight = abs(dot(emitterNormal(e), ray.dir));

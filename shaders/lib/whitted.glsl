@@ -29,8 +29,10 @@ struct PathState {
 void addEmitterRadiance(inout PathState path, Ray ray, SurfaceHit hit)
 {
 #ifdef VKRT_HAS_EMITTERS
-    if (path.countEmission && hit.emitter != NO_EMITTER)
-        path.radiance += path.throughput * emitterRadiance(emitters[hit.emitter], -ray.dir);
+    if (path.countEmission && hit.emitter != NO_EMITTER) {
+        Emitter e = emitters[hit.emitter];
+        path.radiance += path.throughput * emitterRadiance(e, -ray.dir, emitterUvAtHit(hit));
+    }
 #endif
 }
 

@@ -149,7 +149,15 @@ struct MeshTangents {
 /// (Mesh::firstEmitter). Emitters are chosen in proportion to power with
 /// Walker's alias method: pick slot i uniformly, keep it if u <
 /// aliasThreshold, else take `alias`; `pdf` is the probability of choosing
-/// this triangle.
+/// this triangle. An emissive mesh triangle whose material has an emission
+/// texture (VKRT_HAS_EMISSION_TEXTURES) names that material in `textures`
+/// (its MaterialTextures, slot TEXTURE_SLOT_EMISSION) and its texture
+/// coordinates in `uvs` (a MeshUvs index, firstTriangle + leaf slot): the
+/// texel at the point's uv multiplies `radiance`, and `pdf` is in proportion
+/// to the texture's mean over the triangle (src/render/EmissionPower.h).
+/// Otherwise `textures` is NO_EMISSION_TEXTURE.
+VKRT_CONSTANT(uint, NO_EMISSION_TEXTURE, 4294967295u)
+
 struct Emitter {
     vec3 v0;
     float area;
@@ -160,6 +168,8 @@ struct Emitter {
     vec3 radiance;
     float aliasThreshold;
     uint alias;
+    uint textures;
+    uint uvs;
 };
 
 struct PointLight {

@@ -73,7 +73,9 @@ VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR, 1)  // specular / reflectance / tint 
 VKRT_CONSTANT(uint, TEXTURE_SLOT_ROUGHNESS, 2) // perceptual roughness: alpha scales by texel^2
 VKRT_CONSTANT(uint, TEXTURE_SLOT_METALLIC, 3)  // pbr metallic
 VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 4)    // tangent-space normal map (rgb = (n + 1) / 2)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 5)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 5)  // emitted radiance (glTF emissiveTexture, sRGB): read by the
+                                               // emitters (lib/emitters.glsl), not by texturedMaterial
+VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 6)
 
 /// The textures of one material (one per Material, same index).
 struct MaterialTextures {

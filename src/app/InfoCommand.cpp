@@ -274,6 +274,7 @@ JsonObject featuresJson(const KernelVariant& variant)
             {"emitters", features.emitters},
             {"textures", features.textures},
             {"normalMaps", features.normalMaps},
+            {"emissionTextures", features.emissionTextures},
             {"fileMaterials", features.fileMaterials}};
 }
 

@@ -61,7 +61,7 @@ static_assert(sizeof(FrameRun) == 8);
 static_assert(sizeof(BvhNode) == 32);
 static_assert(sizeof(MeshTriangle) == 36);
 static_assert(sizeof(MeshNormals) == 36);
-static_assert(sizeof(Emitter) == 68);
+static_assert(sizeof(Emitter) == 76);
 static_assert(sizeof(MeshUvs) == 24);
 static_assert(sizeof(MeshColors) == 48);
 static_assert(sizeof(MeshTangents) == 48);

@@ -14,5 +14,8 @@ static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, le
 static_assert((1u << (TEXTURE_MAX_LEVELS - 1)) == TEXTURE_MAX_SIZE);
 static_assert(sizeof(TextureSlot) == 32);
 static_assert(sizeof(MaterialTextures) == 32 * TEXTURE_SLOT_COUNT + 4);
+// lib/material_textures.glsl's texturedMaterial reads the slots before the
+// emission slot, which must be the last (the emitters read it).
+static_assert(TEXTURE_SLOT_EMISSION == TEXTURE_SLOT_NORMAL + 1 && TEXTURE_SLOT_COUNT == TEXTURE_SLOT_EMISSION + 1);
 
 } // namespace vkrt::gpu

@@ -643,6 +643,7 @@ void readHonouredExtensions(const fs::path& file, const json& material, FileMate
     readTextureTransform(file, pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr, "metallicRoughnessTexture",
                          out.metallicRoughnessTexture);
     readTextureTransform(file, member(material, "normalTexture"), "normalTexture", out.normalTexture);
+    readTextureTransform(file, member(material, "emissiveTexture"), "emissiveTexture", out.emissiveTexture);
     const json* extensions = member(material, "extensions");
     if (!extensions) return;
     if (const json* e = member(*extensions, "KHR_materials_emissive_strength"))

@@ -3,6 +3,7 @@
 #include "material/MicrofacetAlbedo.h"
 
 #include "mesh/MeshGeometry.h"
+#include "render/EmissionPower.h"
 #include "scene/FeatureSet.h"
 #include "scene/kinds/Kinds.h"
 #include "shared/Bindings.h"
@@ -167,11 +168,17 @@ glm::dmat4 toCameraRelative(const Mesh& mesh, const glm::dvec3& eye)
 
 double meanOf(const Color& c) { return (c.r + c.g + c.b) / 3.0; }
 
+/// The material index of a mesh triangle (leaf slot).
+uint32_t triangleMaterialIndex(const Mesh& mesh, uint32_t slot)
+{
+    if (mesh.fileMaterials.empty()) return mesh.material;
+    return mesh.fileMaterials[mesh.geometry->data.triangleMaterials[slot]];
+}
+
 /// The scene material of a mesh triangle (leaf slot).
 const Material& triangleMaterial(const Scene& scene, const Mesh& mesh, uint32_t slot)
 {
-    if (mesh.fileMaterials.empty()) return scene.materials[mesh.material];
-    return scene.materials[mesh.fileMaterials[mesh.geometry->data.triangleMaterials[slot]]];
+    return scene.materials[triangleMaterialIndex(mesh, slot)];
 }
 
 /// A mesh triangle's emitted radiance: the mesh's own `emission`, else its material's.
@@ -179,6 +186,33 @@ Color triangleEmission(const Scene& scene, const Mesh& mesh, uint32_t slot)
 {
     if (mesh.emission != Color(0.0)) return mesh.emission;
     return triangleMaterial(scene, mesh, slot).emission;
+}
+
+/// Whether a mesh triangle's emission is its material's, textured.
+bool triangleEmissionTextured(const Scene& scene, const Mesh& mesh, uint32_t slot)
+{
+    return mesh.emission == Color(0.0) && emissionTextured(triangleMaterial(scene, mesh, slot));
+}
+
+/// A mesh triangle's texture coordinates (zero without uvs, as the kernel's MeshUvs).
+std::array<glm::dvec2, 3> triangleUvs(const MeshGeometry& g, uint32_t slot)
+{
+    if (g.data.uvs.empty()) return {};
+    const glm::uvec3 t = g.data.triangles[slot];
+    return {glm::dvec2(g.data.uvs[t.x]), glm::dvec2(g.data.uvs[t.y]), glm::dvec2(g.data.uvs[t.z])};
+}
+
+/// The mean radiance a mesh triangle emits over its area: the emission,
+/// times its emission texture's mean over the triangle where it has one.
+double meanTriangleRadiance(const Scene& scene, const Mesh& mesh, uint32_t slot)
+{
+    const Color radiance = triangleEmission(scene, mesh, slot);
+    if (!triangleEmissionTextured(scene, mesh, slot)) return meanOf(radiance);
+    VKRT_CHECK(scene.textures != nullptr);
+    const Material& m = triangleMaterial(scene, mesh, slot);
+    const glm::dvec3 texel =
+        meanEmissionTexel(*scene.textures, *m.texture(TextureSlot::Emission), triangleUvs(*mesh.geometry, slot));
+    return (radiance.r * texel.r + radiance.g * texel.g + radiance.b * texel.b) / 3.0;
 }
 
 std::array<glm::dvec3, 3> worldVertices(const Mesh& mesh, const MeshGeometry& g, uint32_t slot, const glm::dvec3& eye)
@@ -226,7 +260,9 @@ EmitterTable aliasTable(const std::vector<double>& power)
 }
 
 /// Every emitter's power, in emitter order: the triangle lights, then each
-/// emissive mesh's triangles.
+/// emissive mesh's triangles (a textured emission's power from the texture's
+/// mean over the triangle: one over black texels only has power 0 and is
+/// never chosen; hit by a BSDF-sampled ray, it keeps the full MIS weight).
 EmitterTable emitterTableOf(const Scene& scene)
 {
     std::vector<double> power;
@@ -238,7 +274,7 @@ EmitterTable emitterTableOf(const Scene& scene)
         for (uint32_t slot = 0; slot < g.data.triangles.size(); ++slot) {
             const double area = triangleArea(worldVertices(mesh, g, slot, glm::dvec3(0.0)));
             const bool emits = area > 0.0 && float(area) > 0.0 && std::isfinite(area);
-            const double radiance = meanOf(triangleEmission(scene, mesh, slot));
+            const double radiance = emits ? meanTriangleRadiance(scene, mesh, slot) : 0.0;
             power.push_back(emits ? radiance * area * sides * glm::pi<double>() : 0.0);
         }
     }
@@ -441,6 +477,9 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
             e.area = float(triangleArea(v));
             e.twoSided = mesh.twoSided ? 1u : 0u;
             e.radiance = toFloat(triangleEmission(scene, mesh, slot));
+            e.textures = triangleEmissionTextured(scene, mesh, slot) ? triangleMaterialIndex(mesh, slot)
+                                                                    : gpu::NO_EMISSION_TEXTURE;
+            e.uvs = at.firstTriangle + slot;
             data.emitters.push_back(withAliasEntry(e, fixed.emitters, firstEmitter));
         }
     }

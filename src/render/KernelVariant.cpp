@@ -55,6 +55,9 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({meshes && f.textures, "VKRT_HAS_MESH_UVS", int(gpu::BINDING_MESH_UVS), ""});
     list.push_back(
         {meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS), ""});
+    // An emission texture is read by the emitters at the mesh triangle's uvs.
+    list.push_back({meshes && f.emitters && f.textures && f.emissionTextures, "VKRT_HAS_EMISSION_TEXTURES", -1,
+                    "emission-textures"});
     list.push_back(
         {meshes && f.fileMaterials, "VKRT_HAS_MESH_MATERIALS", int(gpu::BINDING_MESH_MATERIALS), "file-materials"});
     list.push_back({meshes && f.vertexColors, "VKRT_HAS_MESH_COLORS", int(gpu::BINDING_MESH_COLORS), "vertex-colors"});

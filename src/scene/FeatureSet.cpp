@@ -38,6 +38,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.emitters = true;
     all.textures = true;
     all.normalMaps = true;
+    all.emissionTextures = true;
     all.fileMaterials = true;
     all.vertexColors = true;
     all.thinLens = true;
@@ -82,6 +83,20 @@ bool meshEmits(const Scene& scene, const Mesh& mesh)
     return false;
 }
 
+bool emissionTextured(const Material& material)
+{
+    return material.emission != Color(0.0) && material.texture(TextureSlot::Emission).has_value();
+}
+
+bool meshEmissionTextured(const Scene& scene, const Mesh& mesh)
+{
+    if (mesh.emission != Color(0.0)) return false;
+    if (mesh.fileMaterials.empty()) return emissionTextured(scene.materials[mesh.material]);
+    for (uint32_t index : mesh.fileMaterials)
+        if (emissionTextured(scene.materials[index])) return true;
+    return false;
+}
+
 FeatureSet featuresOf(const Scene& scene)
 {
     FeatureSet set;
@@ -99,6 +114,7 @@ FeatureSet featuresOf(const Scene& scene)
     for (const Mesh& mesh : scene.meshes) {
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();
         set.emitters = set.emitters || meshEmits(scene, mesh);
+        set.emissionTextures = set.emissionTextures || meshEmissionTextured(scene, mesh);
         set.fileMaterials = set.fileMaterials || !mesh.fileMaterials.empty();
         set.vertexColors = set.vertexColors || meshHasVertexColors(mesh);
     }

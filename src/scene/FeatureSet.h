@@ -21,6 +21,7 @@ struct FeatureSet {
     bool emitters = false;            ///< some triangle light or mesh emits (the emitters array: shared/SceneTypes.h)
     bool textures = false;            ///< some material in use has a texture
     bool normalMaps = false;          ///< ... a normal map
+    bool emissionTextures = false;    ///< some emissive mesh's emission is textured (meshEmissionTextured)
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     bool vertexColors = false;        ///< ... and its file's vertex colours (glTF COLOR_0)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
@@ -46,6 +47,12 @@ bool meshHasVertexColors(const Mesh& mesh);
 
 /// Whether some triangle of the mesh emits: its own `emission`, or an emissive material.
 bool meshEmits(const Scene& scene, const Mesh& mesh);
+
+/// Whether the emission of a material an emitting mesh uses is textured: a
+/// non-zero `emission` with an emission texture, on a mesh without an
+/// `emission` of its own (which replaces its materials' emission, texture and all).
+bool emissionTextured(const Material& material);
+bool meshEmissionTextured(const Scene& scene, const Mesh& mesh);
 
 std::string integratorName(Integrator integrator);
 std::string materialTypeName(MaterialType type);

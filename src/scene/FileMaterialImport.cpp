@@ -44,7 +44,8 @@ std::string displayName(const FileMaterial& f, size_t index)
 
 /// glTF 2.0 metallic-roughness as vkrt's pbr kind: the factors are the
 /// constants each texel multiplies (glTF's own rule), G and B of the
-/// metallic-roughness texture are roughness and metallic.
+/// metallic-roughness texture are roughness and metallic, and the emissive
+/// texture (sRGB) multiplies the emission.
 Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path& file, const SourceLocation& where,
                TextureAtlas& atlas)
 {
@@ -65,6 +66,10 @@ Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path&
         set(TextureSlot::Roughness, slot(record, *f.metallicRoughnessTexture, 1));
         set(TextureSlot::Metallic, slot(record, *f.metallicRoughnessTexture, 2));
     }
+    // emissiveFactor already carries KHR_materials_emissive_strength (mesh/FileMaterials).
+    if (f.emissiveTexture)
+        set(TextureSlot::Emission,
+            slot(addFileTexture(*f.emissiveTexture, false, file, where, atlas), *f.emissiveTexture));
     if (f.normalTexture) {
         set(TextureSlot::Normal, slot(addFileTexture(*f.normalTexture, true, file, where, atlas), *f.normalTexture));
         m.normalStrength = f.normalScale;
@@ -110,8 +115,6 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
         if (f.metallicRoughnessTexture)
             warnings.push_back(prefix + "metallicRoughnessTexture is not applied to glass (its roughness factor is)");
     }
-    if (f.emissiveTexture)
-        warnings.push_back(prefix + "emissiveTexture is not supported: the emission is the constant emissiveFactor");
     if (f.baseColorFactor.a < 1.0f && f.alphaMode == AlphaMode::Opaque)
         warnings.push_back(prefix + "baseColorFactor's alpha is ignored (alphaMode OPAQUE)");
 }

@@ -231,10 +231,9 @@ Scene parseGltfScene(const std::string& path, const GltfSceneOptions& options)
     auto textures = std::make_shared<TextureAtlas>();
     ParseContext context{scene, *textures, meshes, {}};
     importGltf(path, options, true, context);
-    const bool emissive = std::any_of(scene.materials.begin(), scene.materials.end(),
-                                      [](const Material& m) { return m.emission != Color(0.0); });
-    const bool lit = !scene.pointLights.empty() || !scene.spotLights.empty() || !scene.directionalLights.empty() ||
-                     emissive;
+    // Only KHR_lights_punctual lights switch the white sky off: emissive
+    // surfaces alone (a lamp, a helmet's display) keep it.
+    const bool lit = !scene.pointLights.empty() || !scene.spotLights.empty() || !scene.directionalLights.empty();
     if (options.environment) {
         EnvironmentMap map;
         map.path = *options.environment;

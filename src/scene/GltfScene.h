@@ -28,7 +28,8 @@ struct GltfSceneOptions {
     /// the scene's nodes.
     std::optional<std::string> camera;
     /// `--environment FILE`: a lat-long map lighting the scene; unset: a
-    /// white constant environment for a file without lights, black otherwise.
+    /// white constant environment for a file without KHR_lights_punctual
+    /// lights (emissive materials alone keep it), black otherwise.
     std::optional<std::string> environment;
     /// `--scene NAME|INDEX`: one of the file's `scenes`; unset: its `scene`, else the first.
     std::optional<std::string> scene;

@@ -173,6 +173,7 @@ enum class TextureSlot : uint32_t {
     Roughness = gpu::TEXTURE_SLOT_ROUGHNESS, ///< perceptual roughness
     Metallic = gpu::TEXTURE_SLOT_METALLIC,   ///< pbr metallic
     Normal = gpu::TEXTURE_SLOT_NORMAL,       ///< tangent-space normal map
+    Emission = gpu::TEXTURE_SLOT_EMISSION,   ///< emitted radiance (glTF emissiveTexture; meshes only)
 };
 inline constexpr size_t kTextureSlotCount = gpu::TEXTURE_SLOT_COUNT;
 

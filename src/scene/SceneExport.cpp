@@ -256,7 +256,7 @@ void parameters(MaterialKindTag<MaterialType::Pbr>, MaterialWriter& w, Integrato
     w.textured("base_color", vec(w.material().diffuse), TextureSlot::Color);
     w.textured("metallic", w.material().metallic, TextureSlot::Metallic);
     w.textured("roughness", w.material().roughness, TextureSlot::Roughness);
-    w.value("emission", vec(w.material().emission));
+    w.textured("emission", vec(w.material().emission), TextureSlot::Emission);
 }
 
 /// Every kind's parameters; a kind added to shared/Kinds.h without an overload above does not compile.

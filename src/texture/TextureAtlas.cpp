@@ -125,6 +125,103 @@ const std::string& TextureAtlas::nameOf(uint32_t record) const
     return m_images[std::get<0>(m_records[record])].name;
 }
 
+uint32_t TextureAtlas::widthOf(uint32_t record) const
+{
+    VKRT_CHECK(record < m_records.size());
+    return m_images[std::get<0>(m_records[record])].width;
+}
+
+uint32_t TextureAtlas::heightOf(uint32_t record) const
+{
+    VKRT_CHECK(record < m_records.size());
+    return m_images[std::get<0>(m_records[record])].height;
+}
+
+uint32_t TextureAtlas::levelsOf(uint32_t record) const
+{
+    VKRT_CHECK(record < m_records.size());
+    return m_images[std::get<0>(m_records[record])].levels;
+}
+
+namespace {
+
+/// lib/texture.glsl's wrapTextureCoordinate: whole periods removed.
+double wrapCoordinate(double s, TextureWrap wrap)
+{
+    if (wrap == TextureWrap::Repeat) return s - std::floor(s);
+    if (wrap == TextureWrap::Mirror) return s - 2.0 * std::floor(0.5 * s);
+    return std::clamp(s, -1.0, 2.0);
+}
+
+/// lib/texture.glsl's wrapTexelIndex.
+uint32_t wrapIndex(int64_t i, int64_t n, TextureWrap wrap)
+{
+    if (wrap == TextureWrap::Mirror) {
+        const int64_t j = ((i % (2 * n)) + 2 * n) % (2 * n);
+        i = j < n ? j : 2 * n - 1 - j;
+    } else if (wrap == TextureWrap::Repeat) {
+        i = ((i % n) + n) % n;
+    }
+    return uint32_t(std::clamp<int64_t>(i, 0, n - 1));
+}
+
+} // namespace
+
+std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t levelWord, uint32_t width, uint32_t x,
+                                          uint32_t y) const
+{
+    const uint64_t index = uint64_t(y) * width + x;
+    std::array<double, 4> texel{};
+    if (image.format == gpu::TEXTURE_FORMAT_RGBA16F) {
+        const uint32_t* words = &image.words[levelWord + 2 * index];
+        for (int c = 0; c < 4; ++c) {
+            Imath::half h;
+            h.setBits(uint16_t(words[c / 2] >> (16 * (c % 2))));
+            texel[c] = double(float(h));
+        }
+        return texel;
+    }
+    // unpackUnorm4x8 rounds code / 255 to float before the EOTF; one table per encoding.
+    static const auto tables = [] {
+        std::array<std::array<double, 256>, 2> t{}; // linear, sRGB
+        for (uint32_t code = 0; code < 256; ++code) {
+            t[0][code] = double(float(code) / 255.0f);
+            t[1][code] = srgbToLinear(t[0][code]);
+        }
+        return t;
+    }();
+    const uint32_t word = image.words[levelWord + index];
+    const bool srgb = image.format == gpu::TEXTURE_FORMAT_RGBA8_SRGB;
+    for (int c = 0; c < 4; ++c) texel[c] = tables[srgb && c < 3 ? 1 : 0][(word >> (8 * c)) & 0xffu];
+    return texel;
+}
+
+std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, double v, uint32_t level) const
+{
+    VKRT_CHECK(record < m_records.size());
+    const auto& [imageIndex, wrapU, wrapV] = m_records[record];
+    const StoredImage& image = m_images[imageIndex];
+    VKRT_CHECK(level < image.levels);
+    const int64_t w = mipSize(image.width, level), h = mipSize(image.height, level);
+    // Continuous texel coordinates, texel centres at integers; y down from the top row.
+    const double s = wrapCoordinate(u, wrapU) * double(w) - 0.5;
+    const double t = wrapCoordinate(1.0 - v, wrapV) * double(h) - 0.5;
+    const double bs = std::floor(s), bt = std::floor(t);
+    const double fs = s - bs, ft = t - bt;
+    const auto i0 = int64_t(bs), j0 = int64_t(bt);
+    const uint32_t x0 = wrapIndex(i0, w, wrapU), x1 = wrapIndex(i0 + 1, w, wrapU);
+    const uint32_t y0 = wrapIndex(j0, h, wrapV), y1 = wrapIndex(j0 + 1, h, wrapV);
+    const uint64_t at = image.levelWords[level];
+    const auto a = fetch(image, at, uint32_t(w), x0, y0), b = fetch(image, at, uint32_t(w), x1, y0);
+    const auto c = fetch(image, at, uint32_t(w), x0, y1), d = fetch(image, at, uint32_t(w), x1, y1);
+    std::array<double, 4> result{};
+    for (int k = 0; k < 4; ++k) {
+        const double top = a[k] + (b[k] - a[k]) * fs, bottom = c[k] + (d[k] - c[k]) * fs;
+        result[k] = top + (bottom - top) * ft;
+    }
+    return result;
+}
+
 uint32_t TextureAtlas::addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV)
 {
     const auto record = std::make_tuple(image, wrapU, wrapV);

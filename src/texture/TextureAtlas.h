@@ -75,6 +75,15 @@ public:
     std::array<double, 4> meanOf(uint32_t record) const;
     /// The name (file) of a record's image, for messages.
     const std::string& nameOf(uint32_t record) const;
+    /// A record's level-0 size and its mip level count.
+    uint32_t widthOf(uint32_t record) const;
+    uint32_t heightOf(uint32_t record) const;
+    uint32_t levelsOf(uint32_t record) const;
+    /// The linear RGBA that lib/texture.glsl's sampleTextureLevel returns for
+    /// the record at (u, v) in mip level `level` (< levelsOf): the stored
+    /// (encoded) texels decoded, the record's wrap modes, bilinear weights;
+    /// in double. For host integrals of a texture (emitters' power).
+    std::array<double, 4> sampleLevel(uint32_t record, double u, double v, uint32_t level) const;
 
     /// The buffers to upload. Throws InputError when the texels exceed
     /// `maxStorageBufferRange` bytes (VkPhysicalDeviceLimits), naming the largest texture.
@@ -95,6 +104,9 @@ private:
     /// Header check, budget, decoding and storing, for a file's bytes.
     uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear);
     uint32_t addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV);
+    /// Texel (x, y) of a level of width `width` starting at word `levelWord`, decoded to linear RGBA.
+    std::array<double, 4> fetch(const StoredImage& image, uint64_t levelWord, uint32_t width, uint32_t x,
+                                uint32_t y) const;
 
     std::vector<StoredImage> m_images;
     std::vector<std::tuple<uint32_t, TextureWrap, TextureWrap>> m_records; ///< image, wrap u, wrap v

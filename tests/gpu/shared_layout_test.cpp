@@ -90,6 +90,8 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(emitters, Emitter, radiance),
         ARRAY_MEMBER(emitters, Emitter, aliasThreshold),
         ARRAY_MEMBER(emitters, Emitter, alias),
+        ARRAY_MEMBER(emitters, Emitter, textures),
+        ARRAY_MEMBER(emitters, Emitter, uvs),
         ARRAY_MEMBER(pointLights, PointLight, position),
         ARRAY_MEMBER(pointLights, PointLight, intensity),
         ARRAY_MEMBER(triangleLights, TriangleLight, v0),
@@ -170,7 +172,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("directionalLights[0].sin2Alpha") + 4, int(sizeof(gpu::DirectionalLight)));
     EXPECT_EQ(offsets.at("spotLights[0].axis") + 12, int(sizeof(gpu::SpotLight)));
     EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));
-    EXPECT_EQ(offsets.at("emitters[0].alias") + 4, int(sizeof(gpu::Emitter)));
+    EXPECT_EQ(offsets.at("emitters[0].uvs") + 4, int(sizeof(gpu::Emitter)));
 }
 
 } // namespace

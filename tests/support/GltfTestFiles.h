@@ -1,9 +1,11 @@
 #pragma once
 // glTF files written by tests: base64 data: URIs, little-endian buffers and a
 // one-triangle glTF whose materials, textures and samplers the test supplies.
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace vkrt::test {
 
@@ -30,5 +32,18 @@ std::string triangleBuffer();
 /// has `material` ("\"material\": 0, " or "") and whose top-level object
 /// ends with `rest` (materials, textures, images, samplers, extensions...).
 std::string triangleGltf(const std::string& rest, const std::string& material = R"("material": 0, )");
+
+/// A quad of a quadsGltf: corners p[0..3] (two triangles 0 1 2 and 0 2 3,
+/// counter-clockwise seen from the side they face) and their TEXCOORD_0 in
+/// glTF's convention (v down from the image's top row).
+struct GltfQuad {
+    std::array<std::array<float, 3>, 4> p;
+    std::array<std::array<float, 2>, 4> uv;
+};
+
+/// A glTF 2.0 of one mesh of quads (buffer inline), every triangle of
+/// material 0; its top-level object ends with `rest` (materials, textures,
+/// images, samplers, extensionsUsed...).
+std::string quadsGltf(const std::vector<GltfQuad>& quads, const std::string& rest);
 
 } // namespace vkrt::test

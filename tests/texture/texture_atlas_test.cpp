@@ -207,5 +207,35 @@ TEST(TextureBudget, LargeButFineTextureStillLoads)
     EXPECT_EQ(atlas.texelBytes(), 4 * (uint64_t(4096) * 4096 * 4 - 1) / 3);
 }
 
+// The host's lookup (emitters' power, render/EmissionPower.h) follows
+// lib/texture.glsl's conventions: texel (x, y) centred at uv ((x + 0.5) / w,
+// 1 - (y + 0.5) / h), bilinear between centres, wrap modes on texel indices.
+TEST(TextureAtlas, HostLookupIsBilinearBetweenTexelCentresWithTheWrapModes)
+{
+    TextureImage image{RgbaImage(4, 2), TexelEncoding::Half}; // half floats: exact for these values
+    for (uint32_t y = 0; y < 2; ++y)
+        for (uint32_t x = 0; x < 4; ++x)
+            for (int c = 0; c < 4; ++c) image.pixels.at(x, y)[c] = float(x + 4 * y) + 0.25f * float(c);
+    TextureAtlas atlas;
+    const uint32_t repeat = atlas.add(image, "grid");
+    const uint32_t clamp = atlas.add(image, "grid", TextureWrap::Clamp, TextureWrap::Clamp);
+    auto value = [](double x, double y) { return x + 4.0 * y; }; // channel 0 at image position (x, y)
+    // Texel centres: row 0 is the top (v near 1).
+    EXPECT_DOUBLE_EQ(atlas.sampleLevel(repeat, 2.5 / 4.0, 1.0 - 0.5 / 2.0, 0)[0], value(2, 0));
+    EXPECT_DOUBLE_EQ(atlas.sampleLevel(repeat, 1.5 / 4.0, 1.0 - 1.5 / 2.0, 0)[3], value(1, 1) + 0.75);
+    // Between centres: the weighted mean of the four.
+    const double four = (value(1, 0) + value(2, 0) + value(1, 1) + value(2, 1)) / 4;
+    EXPECT_NEAR(atlas.sampleLevel(repeat, 2.0 / 4.0, 0.5, 0)[0], four, 1e-12);
+    // At u = 0 repeat mixes the last column with the first; clamp keeps the first.
+    EXPECT_NEAR(atlas.sampleLevel(repeat, 0.0, 1.0 - 0.5 / 2.0, 0)[0], (value(3, 0) + value(0, 0)) / 2, 1e-12);
+    EXPECT_NEAR(atlas.sampleLevel(clamp, 0.0, 1.0 - 0.5 / 2.0, 0)[0], value(0, 0), 1e-12);
+    // Level 1 (2 x 1) is the box average of level 0.
+    EXPECT_NEAR(atlas.sampleLevel(clamp, 0.25, 0.5, 1)[0], (value(0, 0) + value(1, 0) + value(0, 1) + value(1, 1)) / 4,
+                1e-12);
+    EXPECT_EQ(atlas.widthOf(clamp), 4u);
+    EXPECT_EQ(atlas.heightOf(clamp), 2u);
+    EXPECT_EQ(atlas.levelsOf(clamp), 3u);
+}
+
 } // namespace
 } // namespace vkrt::test

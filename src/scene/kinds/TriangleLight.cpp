@@ -53,6 +53,7 @@ gpu::Emitter emitterOf(const TriangleLight& light, const Relativizer& rel)
     e.area = float(triangleArea(light.vertices));
     e.twoSided = light.twoSided ? 1u : 0u;
     e.radiance = glm::vec3(light.radiance);
+    e.textures = gpu::NO_EMISSION_TEXTURE;
     return e;
 }
 
