@@ -145,6 +145,9 @@ bool finishSample(inout AccumPixel sum, uint pixelIndex, uint slot, inout uint f
         return false;
     rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     aovStartSample();
+#ifdef VKRT_HAS_ALPHA
+    alphaStartSample(pixelIndex, frameIndex, frame.seed);
+#endif
     return true;
 }
 
@@ -164,6 +167,9 @@ void main()
     AccumPixel sum = accum[slot];
     Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     aovStartSample();
+#ifdef VKRT_HAS_ALPHA
+    alphaStartSample(pixelIndex, frameIndex, frame.seed);
+#endif
 #ifdef VKRT_INTEGRATOR_PATH
     // Path regeneration (Novak et al. 2010): 8 lanes run in lockstep, so a
     // lane whose path has ended starts its next sample at once instead of

@@ -320,8 +320,6 @@ std::vector<std::string> materialProblems(const json& material)
         for (const std::string& name : extensionNames(*pbr))
             out.push_back(name + " on pbrMetallicRoughness: not supported");
     listTextureProblems(material, out);
-    if (const json* mode = member(material, "alphaMode"); mode && mode->is_string() && *mode != "OPAQUE")
-        out.push_back("alphaMode " + mode->get<std::string>() + ": rendered opaque");
     return out;
 }
 

@@ -40,6 +40,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.normalMaps = true;
     all.fileMaterials = true;
     all.thinLens = true;
+    all.alpha = true;
     all.integrator = integrator;
     return all;
 }
@@ -75,6 +76,14 @@ bool meshEmits(const Scene& scene, const Mesh& mesh)
     return false;
 }
 
+bool meshAlphaTested(const Scene& scene, const Mesh& mesh)
+{
+    if (scene.materials[mesh.material].alphaTested()) return true;
+    for (uint32_t index : mesh.fileMaterials)
+        if (scene.materials[index].alphaTested()) return true;
+    return false;
+}
+
 FeatureSet featuresOf(const Scene& scene)
 {
     FeatureSet set;
@@ -92,6 +101,7 @@ FeatureSet featuresOf(const Scene& scene)
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();
         set.emitters = set.emitters || meshEmits(scene, mesh);
         set.fileMaterials = set.fileMaterials || !mesh.fileMaterials.empty();
+        set.alpha = set.alpha || meshAlphaTested(scene, mesh);
     }
     markMaterialsUsed(scene, set);
     return set;

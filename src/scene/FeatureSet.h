@@ -23,6 +23,7 @@ struct FeatureSet {
     bool normalMaps = false;          ///< ... a normal map
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
+    bool alpha = false;               ///< some mesh material is alpha-tested (glTF alphaMode MASK or BLEND)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).
@@ -40,6 +41,9 @@ FeatureSet featuresOf(const Scene& scene);
 
 /// Whether some triangle of the mesh emits: its own `emission`, or an emissive material.
 bool meshEmits(const Scene& scene, const Mesh& mesh);
+
+/// Whether some material of the mesh is alpha-tested (MASK or BLEND).
+bool meshAlphaTested(const Scene& scene, const Mesh& mesh);
 
 std::string integratorName(Integrator integrator);
 std::string materialTypeName(MaterialType type);
