@@ -155,8 +155,11 @@ TEST_F(AlphaRender, MaskCoversExactlyWhereAlphaReachesTheCutoff)
         for (uint32_t y = 0; y < kSide; ++y) {
             for (uint32_t x = 0; x < kSide; ++x) {
                 const double v = image.at(x, y)[0];
-                if (x < 4) EXPECT_NEAR(v, 1.0, 1e-5) << "kept: pixel " << x << ", " << y;
-                if (x > 4) EXPECT_EQ(v, 0.0) << "cut out: pixel " << x << ", " << y;
+                if (x < 4) {
+                    EXPECT_NEAR(v, 1.0, 1e-5) << "kept: pixel " << x << ", " << y;
+                } else if (x > 4) {
+                    EXPECT_EQ(v, 0.0) << "cut out: pixel " << x << ", " << y;
+                }
             }
             straddle += image.at(4, y)[0] / kSide;
         }
@@ -266,8 +269,11 @@ TEST_F(AlphaRender, BlendShadowTransmitsOneMinusAlpha)
         double mean = 0.0;
         for (uint32_t y = 0; y < kFloorSide; ++y)
             for (uint32_t x = 0; x < kFloorSide; ++x) {
-                if (underQuad(y) && x < 8) mean += image.at(x, y)[0] / 64.0;
-                else EXPECT_NEAR(image.at(x, y)[0], kLit, 1e-4 * kLit) << "lit: pixel " << x << ", " << y;
+                if (underQuad(y) && x < 8) {
+                    mean += image.at(x, y)[0] / 64.0;
+                } else {
+                    EXPECT_NEAR(image.at(x, y)[0], kLit, 1e-4 * kLit) << "lit: pixel " << x << ", " << y;
+                }
             }
         reportStat("blend_shadow_" + backendName(driver), mean / kLit);
         EXPECT_LT(std::abs(mean - (1.0 - alpha) * kLit) / sigma, 4.5)

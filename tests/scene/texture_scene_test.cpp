@@ -156,9 +156,11 @@ TEST_F(SceneParserTextures, UnsupportedGltfFeaturesAreLocatedWarnings)
         EXPECT_EQ(w.rfind(scenePath() + ":8:12: coat.gltf#Coat: ", 0), 0u) << w;
     }
     // KHR_texture_transform itself is honoured; its texCoord override is not.
-    for (const char* named : {"KHR_texture_transform on baseColorTexture reads TEXCOORD_1", "KHR_materials_clearcoat",
-                              "BLEND"})
+    for (const char* named : {"KHR_texture_transform on baseColorTexture reads TEXCOORD_1", "KHR_materials_clearcoat"})
         EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:\n" << all;
+    // alphaMode BLEND is honoured: no warning, and the material keeps it.
+    EXPECT_EQ(all.find("alphaMode"), std::string::npos) << all;
+    EXPECT_EQ(scene.materials[0].alphaMode, AlphaMode::Blend);
 }
 
 TEST_F(SceneParserTextures, FileMaterialsNeedAFileWithMaterials)
