@@ -71,17 +71,24 @@ float alphaAt(Mesh mesh, uint slot, uint material, vec3 bary)
     return alpha;
 }
 
+// The material of triangle `slot` (its leaf slot) of `mesh`.
+uint alphaMaterial(Mesh mesh, uint slot)
+{
+    uint material = mesh.material;
+#ifdef VKRT_HAS_MESH_MATERIALS
+    if ((mesh.flags & MESH_FLAG_MATERIALS) != 0u)
+        material = meshMaterials[mesh.firstTriangle + slot];
+#endif
+    return material;
+}
+
 // Whether a candidate hit on triangle `slot` of mesh instance `instance` is a
 // surface for the (world-space) ray r.
 bool alphaKeeps(Ray r, uint instance, Mesh mesh, uint slot, vec3 bary)
 {
     if ((mesh.flags & MESH_FLAG_ALPHA) == 0u)
         return true;
-    uint material = mesh.material;
-#ifdef VKRT_HAS_MESH_MATERIALS
-    if ((mesh.flags & MESH_FLAG_MATERIALS) != 0u)
-        material = meshMaterials[mesh.firstTriangle + slot];
-#endif
+    uint material = alphaMaterial(mesh, slot);
     uint mode = materialAlpha[material].mode;
     if (mode == ALPHA_MODE_OPAQUE)
         return true;
@@ -90,6 +97,39 @@ bool alphaKeeps(Ray r, uint instance, Mesh mesh, uint slot, vec3 bary)
         return alpha >= materialAlpha[material].cutoff;
     return alphaCoin(r, instance, slot) < alpha;
 }
+
+#ifdef VKRT_HAS_EMITTERS
+// Light sampling's view of the same coverage (lib/emitters.glsl:
+// sampleEmitters): emitter `index` at barycentrics `bary` emits times 1 for
+// a triangle light or a triangle of a mesh without alpha-tested materials; for
+// an alpha-tested one, MASK's 0 or 1 and BLEND's alpha, the probability that
+// a ray reaching that point counts the surface, so that a cut-out's holes do
+// not emit and light sampling and BSDF hits (which meet the surface only
+// where alphaKeeps does) estimate the same light. The mesh owning an emitter
+// is the last emissive one whose firstEmitter is not past it (meshes' emitters
+// follow the triangle lights', in record order, render/GpuScene.cpp).
+float emitterCoverage(uint index, vec3 bary)
+{
+    uint owner = u.meshCount;
+    for (uint i = 0u; i < u.meshCount; ++i) {
+        ++g_loopIterations;
+        if ((meshes[i].flags & MESH_FLAG_EMISSIVE) != 0u && meshes[i].firstEmitter <= index)
+            owner = i;
+    }
+    if (owner == u.meshCount || (meshes[owner].flags & MESH_FLAG_ALPHA) == 0u)
+        return 1.0;
+    Mesh mesh = meshes[owner];
+    uint slot = index - mesh.firstEmitter;
+    uint material = alphaMaterial(mesh, slot);
+    uint mode = materialAlpha[material].mode;
+    if (mode == ALPHA_MODE_OPAQUE)
+        return 1.0;
+    float alpha = alphaAt(mesh, slot, material, bary);
+    if (mode == ALPHA_MODE_MASK)
+        return alpha >= materialAlpha[material].cutoff ? 1.0 : 0.0;
+    return alpha;
+}
+#endif
 #endif
 
 #endif

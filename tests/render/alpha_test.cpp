@@ -13,6 +13,9 @@
 //   the Bernoulli variance);
 // - BLEND shadows: the same sun through a uniform BLEND quad leaves the floor
 //   (1 - alpha) of its lit radiance in expectation;
+// - an emitting MASK cut-out lights a floor as an uncut emitter of its kept
+//   half alone (Welch's z of the two images): light sampling does not emit
+//   from the holes;
 // - the variant: alpha-free scenes get no VKRT_HAS_ALPHA (their kernel is
 //   unchanged), alpha-tested ones get it with its binding.
 #include "render/KernelVariant.h"
@@ -278,6 +281,59 @@ TEST_F(AlphaRender, BlendShadowTransmitsOneMinusAlpha)
         reportStat("blend_shadow_" + backendName(driver), mean / kLit);
         EXPECT_LT(std::abs(mean - (1.0 - alpha) * kLit) / sigma, 4.5)
             << "shadow mean " << mean / kLit << " of lit, expected " << 1.0 - alpha;
+    }
+}
+
+// ------------------------------------------------------ emitting cut-outs
+
+/// Welch's z of two images' region means (sum of differences over the root
+/// of the summed variances of the means).
+double welchZ(const Renderer& a, const Renderer& b)
+{
+    const Image ma = a.mean(), mb = b.mean(), va = a.varianceOfMean(), vb = b.varianceOfMean();
+    double d = 0.0, v = 0.0;
+    for (size_t i = 0; i < ma.rgb.size(); i += 3) {
+        d += double(ma.rgb[i]) - mb.rgb[i];
+        v += double(va.rgb[i]) + vb.rgb[i];
+    }
+    return d / std::sqrt(v);
+}
+
+TEST_F(AlphaRender, AnEmittingCutOutLightsLikeItsKeptPartAlone)
+{
+    // An emitting quad at y = 1 facing a Lambert floor, MASK-cut to
+    // its half x < 0, against a quad of that half alone: light
+    // sampling must not emit from the holes (lib/alpha.glsl: emitterCoverage).
+    const fs::path dir = freshTempDir("alpha-emitter");
+    const std::string view =
+        "[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 3, 4]\ntarget = [0, 0, 0]\n"
+        "fov = 50\nwidth = 24\nheight = 24\n[background]\ncolor = [0, 0, 0]\n[materials.floor]\n"
+        "type = \"lambert\"\nalbedo = 0.5\n[[objects]]\nshape = \"plane\"\npoint = [0, 0, 0]\n"
+        "normal = [0, 1, 0]\nmaterial = \"floor\"\n";
+    // Corners ordered so that the quad faces (and emits) down, u along +x.
+    const std::array<glm::vec3, 4> full{glm::vec3(-1, 1, -1), glm::vec3(1, 1, -1), glm::vec3(1, 1, 1),
+                                        glm::vec3(-1, 1, 1)};
+    const std::array<glm::vec3, 4> half{glm::vec3(-1, 1, -1), glm::vec3(0, 1, -1), glm::vec3(0, 1, 1),
+                                        glm::vec3(-1, 1, 1)};
+    const Scene cut =
+        writeScene(dir, quadGltf(full, material("MASK", 1.0, true, 1.0), alphaTexture(dir, {255, 0})), view);
+    const fs::path halfDir = freshTempDir("alpha-emitter-half");
+    // Kept everywhere (alpha 1), so that both scenes share one kernel variant.
+    const Scene whole =
+        writeScene(halfDir, quadGltf(half, material("MASK", 1.0, true, 1.0), alphaTexture(halfDir, {255, 255})), view);
+    for (bool driver : backends()) {
+        SCOPED_TRACE(backendName(driver));
+        RenderOptions a = statisticalOptions(driver ? 32 : 31), b = statisticalOptions(driver ? 34 : 33);
+        a.driverAccel = b.driverAccel = driver;
+        Renderer cutRenderer(gpu(), cut, a), halfRenderer(gpu(), whole, b);
+        cutRenderer.renderFrames(64);
+        halfRenderer.renderFrames(64);
+        const double z = welchZ(cutRenderer, halfRenderer);
+        reportStat("emitter_cut_z_" + backendName(driver), z);
+        reportStat("emitter_cut_mean_" + backendName(driver), channelMean(cutRenderer.mean(), 0));
+        reportStat("emitter_half_mean_" + backendName(driver), channelMean(halfRenderer.mean(), 0));
+        EXPECT_LT(std::abs(z), 4.5) << "cut-out " << channelMean(cutRenderer.mean(), 0) << ", half quad "
+                                    << channelMean(halfRenderer.mean(), 0);
     }
 }
 
