@@ -148,6 +148,9 @@ bool finishSample(inout AccumPixel sum, uint pixelIndex, uint slot, inout uint f
 #ifdef VKRT_HAS_TEXTURES
     setTextureConeScale(frameIndex);
 #endif
+#ifdef VKRT_HAS_ALPHA
+    alphaStartSample(pixelIndex, frameIndex, frame.seed);
+#endif
     return true;
 }
 
@@ -169,6 +172,9 @@ void main()
     aovStartSample();
 #ifdef VKRT_HAS_TEXTURES
     setTextureConeScale(frameIndex);
+#endif
+#ifdef VKRT_HAS_ALPHA
+    alphaStartSample(pixelIndex, frameIndex, frame.seed);
 #endif
 #ifdef VKRT_INTEGRATOR_PATH
     // Path regeneration (Novak et al. 2010): 8 lanes run in lockstep, so a

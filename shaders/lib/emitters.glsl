@@ -64,7 +64,12 @@ uint pickEmitter(float uSlot, float uAlias)
 // MIS-weighted against BSDF sampling (path integrator).
 LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin)
 {
+#ifdef VKRT_HAS_ALPHA
+    uint index = pickEmitter(u4.x, u4.y);
+    Emitter e = emitters[index];
+#else
     Emitter e = emitters[pickEmitter(u4.x, u4.y)];
+#endif
     vec3 point = sampleTriangle(e.v0, e.v1, e.v2, u4.zw);
     float s = sqrt(u4.z); // sampleTriangle's barycentrics
     vec2 uv = emitterUvAt(e, vec3(1.0 - s, s * (1.0 - u4.w), s * u4.w));
@@ -76,6 +81,11 @@ LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo
     float cosSurface = dot(ns, wi);
     float cosLight = abs(dot(emitterNormal(e), wi));
     vec3 le = emitterRadiance(e, -wi, uv);
+#ifdef VKRT_HAS_ALPHA
+    // An alpha-tested mesh emits where its surface is (lib/alpha.glsl), at
+    // sampleTriangle's barycentrics (1 - s, s (1 - u.w), s u.w).
+    le *= emitterCoverage(index, vec3(1.0 - s, s * (1.0 - u4.w), s * u4.w));
+#endif
     if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0) || !(e.pdf > 0.0) || distSq == 0.0)
         return LightSample(vec3(0.0), target);
     float lightPdf = emitterPdf(e, distSq, cosLight);

@@ -29,6 +29,17 @@ bool hitRecordOfKind(int kind, uint i, Ray r, TriangleRay tr, bool anyHit, float
     return false;
 }
 
+#ifdef VKRT_HAS_ALPHA
+// Whether the alpha test (lib/alpha.glsl) keeps the query's candidate
+// triangle `slot` of mesh instance `instance`, with the same coin as the own
+// backend's walk (the world ray, the instance, the triangle's leaf slot);
+// b: Vulkan's barycentrics (weights of v1 and v2).
+bool driverAlphaKeeps(Ray r, int instance, int slot, vec2 b)
+{
+    return alphaKeeps(r, uint(instance), meshes[uint(instance)], uint(slot), vec3(1.0 - b.x - b.y, b.x, b.y));
+}
+#endif
+
 // The closest bounded record before tMax (written to best), or (anyHit)
 // whether any lies before tMax. Candidates' boxes are tested by their kind
 // against the distance committed so far, and a hit is committed with its own
@@ -43,6 +54,20 @@ bool traceDriver(Ray r, TriangleRay tr, bool anyHit, float tMax, inout HitId bes
     HitId generated = best;
     while (rayQueryProceedEXT(query)) {
         ++g_loopIterations;
+#ifdef VKRT_HAS_ALPHA
+        // A triangle of an alpha-tested instance (not opaque: DriverAccel.cpp)
+        // counts only where its alpha test keeps it.
+        // A candidate beyond the committed hit is left alone.
+        if (rayQueryGetIntersectionTypeEXT(query, false) == gl_RayQueryCandidateIntersectionTriangleEXT) {
+            bool before = rayQueryGetIntersectionTypeEXT(query, true) == gl_RayQueryCommittedIntersectionNoneEXT ||
+                          rayQueryGetIntersectionTEXT(query, false) < rayQueryGetIntersectionTEXT(query, true);
+            if (before && driverAlphaKeeps(r, rayQueryGetIntersectionInstanceCustomIndexEXT(query, false),
+                                           rayQueryGetIntersectionPrimitiveIndexEXT(query, false),
+                                           rayQueryGetIntersectionBarycentricsEXT(query, false)))
+                rayQueryConfirmIntersectionEXT(query);
+            continue;
+        }
+#endif
         if (rayQueryGetIntersectionTypeEXT(query, false) != gl_RayQueryCandidateIntersectionAABBEXT)
             continue;
         int kind = int(rayQueryGetIntersectionInstanceShaderBindingTableRecordOffsetEXT(query, false));

@@ -56,9 +56,15 @@ VKRT_CONSTANT(uint, BINDING_AOVS, BINDING_ENVIRONMENT + 17)
 // The driver traversal backend's top-level acceleration structure
 // (accelerationStructureEXT; lib/ray_query.glsl, render/DriverAccel.h).
 VKRT_CONSTANT(uint, BINDING_TOP_LEVEL, BINDING_ENVIRONMENT + 18)
+VKRT_CONSTANT(uint, BINDING_MATERIAL_ALPHA, BINDING_ENVIRONMENT + 19)
 // Per mesh triangle, beside meshTriangles: vertex colours (MeshColors, meshes with COLOR_0 and file materials).
-VKRT_CONSTANT(uint, BINDING_MESH_COLORS, BINDING_ENVIRONMENT + 19)
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 20)
+VKRT_CONSTANT(uint, BINDING_MESH_COLORS, BINDING_ENVIRONMENT + 20)
+// Host only: a GLSL constant of a new value is emitted into every variant's
+// SPIR-V (glslang keeps folded constants), so a binding added for one feature
+// would change every kernel; the kernels never need the count.
+#ifdef __cplusplus
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 21)
+#endif
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);
 // the host refuses trees deeper than this (src/mesh/MeshGeometry.cpp).

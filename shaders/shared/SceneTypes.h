@@ -91,6 +91,7 @@ VKRT_CONSTANT(uint, MESH_FLAG_UVS, 8)        // meshUvs holds its triangles' tex
 VKRT_CONSTANT(uint, MESH_FLAG_TANGENTS, 16)  // meshTangents holds its triangles' tangents
 VKRT_CONSTANT(uint, MESH_FLAG_MATERIALS, 32) // meshMaterials holds each triangle's material (file materials)
 VKRT_CONSTANT(uint, MESH_FLAG_COLORS, 64)    // meshColors holds its triangles' vertex colours (glTF COLOR_0)
+VKRT_CONSTANT(uint, MESH_FLAG_ALPHA, 128)    // some material of it is alpha-tested (MaterialAlpha: MASK or BLEND)
 
 /// One instance of a mesh (src/scene/Scene.h: Mesh). The matrices are the
 /// object -> camera-relative world transform and its inverse, as three rows
@@ -117,6 +118,22 @@ struct MeshNormals {
     vec3 n0;
     vec3 n1;
     vec3 n2;
+};
+
+// MaterialAlpha::mode: glTF 2.0's alphaMode.
+VKRT_CONSTANT(uint, ALPHA_MODE_OPAQUE, 0) // always a surface
+VKRT_CONSTANT(uint, ALPHA_MODE_MASK, 1)   // a surface where alpha >= cutoff, else rays pass through
+VKRT_CONSTANT(uint, ALPHA_MODE_BLEND, 2)  // a surface with probability alpha (stochastic transparency)
+
+/// A material's coverage (one per Material, same index; variants with
+/// VKRT_HAS_ALPHA only, lib/alpha.glsl): alpha = `alpha` (glTF
+/// baseColorFactor.a) times the A channel of the material's colour texture
+/// (TEXTURE_SLOT_COLOR of its MaterialTextures), tested at every candidate
+/// hit on a mesh triangle, for every kind of ray.
+struct MaterialAlpha {
+    uint mode;
+    float cutoff; // MASK
+    float alpha;
 };
 
 /// Texture coordinates at a mesh triangle's three vertices, stored beside its

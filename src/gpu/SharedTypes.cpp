@@ -41,7 +41,7 @@ constexpr bool bindingsDistinct()
                               BINDING_MATERIAL_TABLES,   BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
                               BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS,       BINDING_MESH_TANGENTS,
                               BINDING_MESH_MATERIALS,    BINDING_FRAME_RUN,      BINDING_AOVS,
-                              BINDING_TOP_LEVEL,         BINDING_MESH_COLORS};
+                              BINDING_TOP_LEVEL,         BINDING_MESH_COLORS,    BINDING_MATERIAL_ALPHA};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -65,6 +65,7 @@ static_assert(sizeof(Emitter) == 76);
 static_assert(sizeof(MeshUvs) == 24);
 static_assert(sizeof(MeshColors) == 48);
 static_assert(sizeof(MeshTangents) == 48);
+static_assert(sizeof(MaterialAlpha) == 12);
 static_assert(offsetof(Mesh, emission) == 96 && offsetof(Mesh, firstEmitter) == 128);
 static_assert(sizeof(AccumPixel) == 28);
 static_assert(sizeof(RenderStats) == 8);

@@ -196,8 +196,6 @@ std::vector<std::string> materialProblems(const json& material)
             if (member(*transmission, "transmissionTexture"))
                 out.push_back("KHR_materials_transmission's transmissionTexture: not applied (its factor is)");
     listTextureProblems(material, out);
-    if (const json* mode = member(material, "alphaMode"); mode && mode->is_string() && *mode != "OPAQUE")
-        out.push_back("alphaMode " + mode->get<std::string>() + ": rendered opaque");
     return out;
 }
 

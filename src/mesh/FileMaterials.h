@@ -15,10 +15,12 @@
 // turned with its uvs).
 // Listed in `unsupported`: every extension the material or its textures use
 // (KHR_texture_transform, KHR_materials_*, ...), extensions the file uses
-// outside its materials, textures read through a TEXCOORD other than 0,
-// alphaMode MASK and BLEND (rendered opaque). Not listed, documented here:
+// outside its materials, textures read through a TEXCOORD other than 0.
+// alphaMode and alphaCutoff are read (MASK and BLEND are honoured: alpha is
+// baseColorFactor.a times the base colour texture's A). Not listed, documented here:
 // occlusionTexture, which a path tracer has no use for (it computes the
 // occlusion), and the samplers' filters (vkrt filters with its own mip maps).
+#include "mesh/AlphaMode.h"
 #include "mesh/ReferencePolicy.h"
 #include "texture/TextureAtlas.h"
 
@@ -49,9 +51,6 @@ struct FileTexture {
     double rotation = 0.0;
     glm::dvec2 scale{1.0};
 };
-
-/// glTF's alphaMode. vkrt renders every mode opaque (MASK and BLEND are listed as unsupported).
-enum class AlphaMode { Opaque, Mask, Blend };
 
 /// One glTF metallic-roughness material; defaults are glTF's (its default material).
 struct FileMaterial {

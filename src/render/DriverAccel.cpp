@@ -160,10 +160,16 @@ void DriverAccel::buildCameraRelative(const Scene& scene, const GpuSceneData& da
     }
 
     std::vector<vk::AccelerationStructureInstanceKHR> instances;
-    for (size_t i = 0; i < data.meshes.size(); ++i)
+    // An instance with alpha-tested materials is not opaque: its candidate
+    // triangles come back to the kernel, which confirms those its alpha test
+    // keeps (lib/ray_query.glsl); every other instance is forced opaque.
+    for (size_t i = 0; i < data.meshes.size(); ++i) {
+        const bool alpha = (data.meshes[i].flags & gpu::MESH_FLAG_ALPHA) != 0u;
         instances.push_back(instance(transformOf(data.meshes[i]), uint32_t(i), gpu::HIT_Mesh,
                                      m_geometries[m_geometryOfMesh[i]].address,
-                                     vk::GeometryInstanceFlagBitsKHR::eForceOpaque));
+                                     alpha ? vk::GeometryInstanceFlagBitsKHR::eForceNoOpaque
+                                           : vk::GeometryInstanceFlagBitsKHR::eForceOpaque));
+    }
     for (size_t k = 0; k < m_kinds.size(); ++k)
         instances.push_back(instance(identity(), 0, m_kindCodes[k], m_kinds[k].address, {}));
     m_instances.reset();

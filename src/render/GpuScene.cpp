@@ -464,7 +464,8 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
                        (!g.data.uvs.empty() ? gpu::MESH_FLAG_UVS : 0u) |
                        (!g.data.tangents.empty() ? gpu::MESH_FLAG_TANGENTS : 0u) |
                        (!mesh.fileMaterials.empty() ? gpu::MESH_FLAG_MATERIALS : 0u) |
-                       (meshHasVertexColors(mesh) ? gpu::MESH_FLAG_COLORS : 0u);
+                       (meshHasVertexColors(mesh) ? gpu::MESH_FLAG_COLORS : 0u) |
+                       (meshAlphaTested(scene, mesh) ? gpu::MESH_FLAG_ALPHA : 0u);
         record.firstEmitter = firstEmitter;
         data.meshes.push_back(record);
         if (!emissive) continue;
@@ -623,6 +624,9 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     prepareMaterialTables(scene, fixed);
     for (const Material& m : scene.materials) fixed.materialTextures.push_back(convertMaterialTextures(m));
     if (fixed.materialTextures.empty()) fixed.materialTextures.push_back(gpu::MaterialTextures{});
+    for (const Material& m : scene.materials)
+        fixed.materialAlpha.push_back(gpu::MaterialAlpha{uint32_t(m.alphaMode), float(m.alphaCutoff), float(m.alpha)});
+    if (fixed.materialAlpha.empty()) fixed.materialAlpha.push_back(gpu::MaterialAlpha{});
     fixed.textures = packTextures(scene, maxBytes);
     fixed.emitters = emitterTableOf(scene);
     checkBufferSize(fixed.emitters.pdf.size() * sizeof(gpu::Emitter), maxBytes, "emitters", scene);

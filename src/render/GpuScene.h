@@ -67,6 +67,8 @@ struct GpuSceneStatic {
     /// textures), and per material its texture slots.
     TextureBuffers textures;
     std::vector<gpu::MaterialTextures> materialTextures;
+    /// Per material its coverage (glTF alphaMode; read by variants with alpha only).
+    std::vector<gpu::MaterialAlpha> materialAlpha;
     std::map<const MeshGeometry*, GeometryOffsets> offsets;
     std::optional<TopLevel> top; ///< only for scenes with meshes
     EmitterTable emitters;

@@ -61,6 +61,9 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back(
         {meshes && f.fileMaterials, "VKRT_HAS_MESH_MATERIALS", int(gpu::BINDING_MESH_MATERIALS), "file-materials"});
     list.push_back({meshes && f.vertexColors, "VKRT_HAS_MESH_COLORS", int(gpu::BINDING_MESH_COLORS), "vertex-colors"});
+    // Alpha-tested mesh materials (glTF MASK, BLEND): each material's coverage,
+    // tested at every candidate triangle hit (lib/alpha.glsl).
+    list.push_back({meshes && f.alpha, "VKRT_HAS_ALPHA", int(gpu::BINDING_MATERIAL_ALPHA), "alpha"});
     // The rough plastics' coating tables come with the plastic kind.
     list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});

@@ -290,10 +290,11 @@ void Renderer::uploadMeshBuffers()
 {
     auto addBuffer = [&](uint32_t binding, const auto& records, vk::BufferUsageFlags extra = {}) {
         if (!m_kernel.uses(binding)) return;
+        VKRT_CHECK(m_meshBuffers.size() < m_meshBuffers.capacity()); // a reallocation would move bound buffers
         m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage | extra));
         m_kernel.bind(binding, m_meshBuffers.back());
     };
-    m_meshBuffers.reserve(9); // bind() keeps references: no reallocation
+    m_meshBuffers.reserve(11); // bind() keeps references: no reallocation (one per addBuffer below)
     addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
     // The driver backend builds its triangle structures from this same buffer.
     addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles,
@@ -308,6 +309,7 @@ void Renderer::uploadMeshBuffers()
     addBuffer(gpu::BINDING_TEXTURE_TEXELS, m_static.textures.texels);
     addBuffer(gpu::BINDING_TEXTURE_RECORDS, m_static.textures.records);
     addBuffer(gpu::BINDING_MATERIAL_TEXTURES, m_static.materialTextures);
+    addBuffer(gpu::BINDING_MATERIAL_ALPHA, m_static.materialAlpha);
 }
 
 void Renderer::bindEnvironment()

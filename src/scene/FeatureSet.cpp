@@ -43,6 +43,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.vertexColors = true;
     all.thinLens = true;
     all.orthographic = true;
+    all.alpha = true;
     all.integrator = integrator;
     return all;
 }
@@ -97,6 +98,14 @@ bool meshEmissionTextured(const Scene& scene, const Mesh& mesh)
     return false;
 }
 
+bool meshAlphaTested(const Scene& scene, const Mesh& mesh)
+{
+    if (scene.materials[mesh.material].alphaTested()) return true;
+    for (uint32_t index : mesh.fileMaterials)
+        if (scene.materials[index].alphaTested()) return true;
+    return false;
+}
+
 FeatureSet featuresOf(const Scene& scene)
 {
     FeatureSet set;
@@ -117,6 +126,7 @@ FeatureSet featuresOf(const Scene& scene)
         set.emissionTextures = set.emissionTextures || meshEmissionTextured(scene, mesh);
         set.fileMaterials = set.fileMaterials || !mesh.fileMaterials.empty();
         set.vertexColors = set.vertexColors || meshHasVertexColors(mesh);
+        set.alpha = set.alpha || meshAlphaTested(scene, mesh);
     }
     markMaterialsUsed(scene, set);
     return set;

@@ -26,6 +26,7 @@ struct FeatureSet {
     bool vertexColors = false;        ///< ... and its file's vertex colours (glTF COLOR_0)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
     bool orthographic = false;        ///< the camera projects orthographically (parallel rays)
+    bool alpha = false;               ///< some mesh material is alpha-tested (glTF alphaMode MASK or BLEND)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).
@@ -53,6 +54,8 @@ bool meshEmits(const Scene& scene, const Mesh& mesh);
 /// `emission` of its own (which replaces its materials' emission, texture and all).
 bool emissionTextured(const Material& material);
 bool meshEmissionTextured(const Scene& scene, const Mesh& mesh);
+/// Whether some material of the mesh is alpha-tested (MASK or BLEND).
+bool meshAlphaTested(const Scene& scene, const Mesh& mesh);
 
 std::string integratorName(Integrator integrator);
 std::string materialTypeName(MaterialType type);

@@ -57,6 +57,10 @@ Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path&
     m.metallic = f.metallicFactor;
     m.roughness = f.roughnessFactor;
     m.emission = Color(f.emissiveFactor);
+    // Coverage: baseColorFactor.a times the colour texture's A (lib/alpha.glsl).
+    m.alphaMode = f.alphaMode;
+    m.alphaCutoff = f.alphaCutoff;
+    m.alpha = f.baseColorFactor.a;
     auto set = [&](TextureSlot which, MaterialTexture texture) { m.textures[size_t(which)] = texture; };
     if (f.baseColorTexture)
         set(TextureSlot::Color,
@@ -92,6 +96,12 @@ Material toGlass(const FileMaterial& f, Material pbr)
     m.roughness = pbr.roughness;
     m.textures[size_t(TextureSlot::Normal)] = pbr.texture(TextureSlot::Normal);
     m.normalStrength = pbr.normalStrength;
+    // Glass keeps its coverage: the alpha test reads the colour slot, so it
+    // carries over with the alpha mode.
+    m.alphaMode = pbr.alphaMode;
+    m.alphaCutoff = pbr.alphaCutoff;
+    m.alpha = pbr.alpha;
+    if (pbr.alphaTested()) m.textures[size_t(TextureSlot::Color)] = pbr.texture(TextureSlot::Color);
     return m;
 }
 

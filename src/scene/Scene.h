@@ -4,6 +4,7 @@
 // render/GpuScene. A Scene is only ever produced by parseScene*, which has
 // already checked every value, so consumers need not re-validate.
 #include "io/Image.h"
+#include "mesh/AlphaMode.h"
 #include "shared/Kinds.h"
 #include "shared/TextureTypes.h"
 #include "util/Error.h"
@@ -197,6 +198,12 @@ struct Material {
     /// (1 for the scene's textures, a glTF file's factor for its own).
     std::array<std::optional<MaterialTexture>, kTextureSlotCount> textures{};
     double normalStrength = 1.0; ///< scales a normal map's tangent-plane components (glTF normalTexture.scale)
+    /// Coverage (glTF alphaMode; meshes only): alpha = `alpha` times the colour
+    /// texture's A channel; MASK keeps the surface where alpha >= alphaCutoff,
+    /// BLEND keeps it with probability alpha (lib/alpha.glsl).
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    double alphaCutoff = 0.5;
+    double alpha = 1.0;
     // Colours reuse the members above: conductor `tint` is specular, plastic
     // `diffuse` and pbr `base_color` are diffuse; plastic and rough_dielectric use ior.
     SourceLocation where; ///< the [materials.NAME] table
@@ -204,6 +211,7 @@ struct Material {
     const std::optional<MaterialTexture>& texture(TextureSlot slot) const { return textures[size_t(slot)]; }
     bool hasTextures() const;
     bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
+    bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
 
 inline double Camera::resolvedFocusDistance() const

@@ -278,6 +278,11 @@ Json material(const Material& m, const TextureTable& textures, Integrator integr
     writer.texture("normal_map", TextureSlot::Normal);
     if (m.hasNormalMap()) out["textures"]["normal_map"]["strength"] = m.normalStrength;
     if (!out.contains("textures")) out["textures"] = Json::object();
+    // glTF alphaMode (file materials only); absent for opaque materials.
+    if (m.alphaTested())
+        out["alpha"] = {{"mode", m.alphaMode == AlphaMode::Mask ? "MASK" : "BLEND"},
+                        {"cutoff", m.alphaCutoff},
+                        {"alpha", m.alpha}};
     out["where"] = m.where.str();
     return out;
 }

@@ -107,6 +107,9 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(spotLights, SpotLight, intensity),
         ARRAY_MEMBER(spotLights, SpotLight, falloffScale),
         ARRAY_MEMBER(spotLights, SpotLight, axis),
+        ARRAY_MEMBER(materialAlpha, MaterialAlpha, mode),
+        ARRAY_MEMBER(materialAlpha, MaterialAlpha, cutoff),
+        ARRAY_MEMBER(materialAlpha, MaterialAlpha, alpha),
         ARRAY_MEMBER(accum, AccumPixel, sum),
         ARRAY_MEMBER(accum, AccumPixel, count),
         ARRAY_MEMBER(accum, AccumPixel, compensation),
@@ -173,6 +176,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("spotLights[0].axis") + 12, int(sizeof(gpu::SpotLight)));
     EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));
     EXPECT_EQ(offsets.at("emitters[0].uvs") + 4, int(sizeof(gpu::Emitter)));
+    EXPECT_EQ(offsets.at("materialAlpha[0].alpha") + 4, int(sizeof(gpu::MaterialAlpha)));
 }
 
 } // namespace

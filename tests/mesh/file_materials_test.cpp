@@ -183,21 +183,26 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     EXPECT_FALSE(mentions(m.unsupported, "KHR_texture_transform")) << joined(m.unsupported);
     // Each unsupported feature named.
     EXPECT_TRUE(mentions(m.unsupported, "KHR_materials_clearcoat")) << joined(m.unsupported);
-    EXPECT_TRUE(mentions(m.unsupported, "alphaMode BLEND")) << joined(m.unsupported);
+    EXPECT_FALSE(mentions(m.unsupported, "alphaMode")) << joined(m.unsupported); // honoured (lib/alpha.glsl)
     EXPECT_TRUE(mentions(m.unsupported, "TEXCOORD_0 and TEXCOORD_1")) << joined(m.unsupported); // one set per material
     // KHR_lights_punctual is implemented, and the file places no light: nothing to say.
     EXPECT_FALSE(mentions(m.unsupported, "KHR_lights_punctual")) << joined(m.unsupported);
-    EXPECT_EQ(m.unsupported.size(), 3u) << joined(m.unsupported);
+    EXPECT_EQ(m.unsupported.size(), 2u) << joined(m.unsupported);
 }
 
-TEST(MeshFileMaterials, MaskIsUnsupportedAndOpaqueIsNot)
+TEST(MeshFileMaterials, MaskAndBlendAreReadAndNotListedAsUnsupported)
 {
     const std::string mask = R"("materials": [{"alphaMode": "MASK", "alphaCutoff": 0.25}])";
     const MeshData masked = loadMeshFile(writeFile(testDir() / "mask.gltf", triangleGltf(mask)));
     ASSERT_EQ(masked.materials.size(), 1u);
     EXPECT_EQ(masked.materials[0].alphaMode, AlphaMode::Mask);
     EXPECT_EQ(masked.materials[0].alphaCutoff, 0.25f);
-    EXPECT_TRUE(mentions(masked.materials[0].unsupported, "alphaMode MASK")) << joined(masked.materials[0].unsupported);
+    EXPECT_TRUE(masked.materials[0].unsupported.empty()) << joined(masked.materials[0].unsupported);
+
+    const std::string blend = R"("materials": [{"alphaMode": "BLEND"}])";
+    const MeshData blended = loadMeshFile(writeFile(testDir() / "blend.gltf", triangleGltf(blend)));
+    EXPECT_EQ(blended.materials.at(0).alphaMode, AlphaMode::Blend);
+    EXPECT_TRUE(blended.materials[0].unsupported.empty()) << joined(blended.materials[0].unsupported);
 
     const std::string opaque = R"("materials": [{"alphaMode": "OPAQUE"}])";
     const MeshData plain = loadMeshFile(writeFile(testDir() / "opaque.gltf", triangleGltf(opaque)));

@@ -156,9 +156,13 @@ TEST_F(SceneParserTextures, UnsupportedGltfFeaturesAreLocatedWarnings)
         EXPECT_EQ(w.rfind(scenePath() + ":8:12: coat.gltf#Coat: ", 0), 0u) << w;
     }
     // KHR_texture_transform is honoured, its texCoord override too (the primitive's TEXCOORD_1 is the uv set read).
-    for (const char* named : {"KHR_materials_clearcoat", "BLEND"})
-        EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:\n" << all;
+    for (const char* named : {"KHR_materials_clearcoat"})
+        EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:
+" << all;
     EXPECT_EQ(all.find("TEXCOORD"), std::string::npos) << all;
+    // alphaMode BLEND is honoured: no warning, and the material keeps it.
+    EXPECT_EQ(all.find("alphaMode"), std::string::npos) << all;
+    EXPECT_EQ(scene.materials[0].alphaMode, AlphaMode::Blend);
 }
 
 TEST_F(SceneParserTextures, FileMaterialsNeedAFileWithMaterials)

@@ -36,9 +36,11 @@ vec3 objectToWorldNormal(Mesh mesh, vec3 n)
     return mesh.toObject0.xyz * n.x + mesh.toObject1.xyz * n.y + mesh.toObject2.xyz * n.z;
 }
 
+#include "lib/alpha.glsl"
+
 #ifndef VKRT_ACCEL_DRIVER
 // The closest (anyHit: any) triangle of mesh instance `index` before best.t
-// (tMax). Returns whether one was found.
+// (tMax) that its alpha test keeps (lib/alpha.glsl). Returns whether one was found.
 bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId best)
 {
     Mesh mesh = meshes[index];
@@ -62,6 +64,10 @@ bool traverseMesh(Ray worldRay, uint index, bool anyHit, float tMax, inout HitId
                 float t;
                 vec3 bary;
                 if (intersectTriangle(tri.v0, tri.v1, tri.v2, r, tr, limit, t, bary)) {
+#ifdef VKRT_HAS_ALPHA
+                    if (!alphaKeeps(worldRay, index, mesh, slot, bary))
+                        continue;
+#endif
                     found = true;
                     if (anyHit)
                         return true;
