@@ -65,8 +65,7 @@ What both renderers are given
   BRDF is single-scatter), view transform Standard, 32-bit float EXR.
 
 Material extensions that differ by design (BY_DESIGN below: sheen, clearcoat,
-specular, iridescence, volume; alphaMode MASK/BLEND, which vkrt renders
-opaque) are stripped from the temporary copy for *both* renderers, so the
+specular, iridescence, volume) are stripped from the temporary copy for *both* renderers, so the
 rest of such a model is still compared; the row's notes say what was
 stripped. --keep-extensions turns that off. Transmission (vkrt: untinted
 glass for transmissionFactor >= 0.5, Cycles: tinted, mixed) and spot lights
@@ -469,8 +468,8 @@ def has_emission(gltf: dict) -> bool:
 
 
 def strip_by_design(gltf: dict) -> list:
-    """Removes BY_DESIGN extensions and non-opaque alpha modes from gltf (in
-    place); returns what was removed, as notes."""
+    """Removes BY_DESIGN extensions from gltf (in place); returns what was
+    removed, as notes. Alpha modes stay: both renderers honour them."""
     removed = set()
     for material in gltf.get("materials", []):
         ext = material.get("extensions", {})
@@ -480,10 +479,6 @@ def strip_by_design(gltf: dict) -> list:
                 removed.add(name)
         if not ext and "extensions" in material:
             del material["extensions"]
-        if material.get("alphaMode", "OPAQUE") != "OPAQUE":
-            removed.add("alphaMode " + material["alphaMode"])
-            del material["alphaMode"]
-            material.pop("alphaCutoff", None)
     for key in ("extensionsUsed", "extensionsRequired"):
         if key in gltf:
             gltf[key] = [e for e in gltf[key] if e not in BY_DESIGN]

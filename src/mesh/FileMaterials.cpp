@@ -644,6 +644,7 @@ void readHonouredExtensions(const fs::path& file, const json& material, FileMate
     readTextureTransform(file, member(material, "emissiveTexture"), "emissiveTexture", out.emissiveTexture);
     const json* extensions = member(material, "extensions");
     if (!extensions) return;
+    out.unlit = member(*extensions, "KHR_materials_unlit") != nullptr;
     if (const json* e = member(*extensions, "KHR_materials_emissive_strength"))
         out.emissiveFactor *= extensionNumber(file, *e, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f,
                                               0.0f, std::numeric_limits<float>::max());

@@ -72,6 +72,8 @@ struct FileMaterial {
     /// ior (glTF's defaults 0 and 1.5): a transmitting material is glass.
     float transmission = 0.0f;
     float ior = 1.5f;
+    /// KHR_materials_unlit: the base colour is what the camera sees, no lighting.
+    bool unlit = false;
     std::vector<std::string> unsupported; ///< what vkrt will not honour, one readable phrase each
 };
 

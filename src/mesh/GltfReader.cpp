@@ -845,6 +845,8 @@ const std::vector<std::string>& implementedGltfExtensions()
     static const std::vector<std::string> names{
         "KHR_lights_punctual",        "KHR_texture_transform", "KHR_materials_emissive_strength",
         "KHR_materials_ior",          "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+        "KHR_materials_unlit",
+        "KHR_materials_transmission", // read as glass or not, each approximation warned (docs/scene-format.md)
     };
     return names;
 }

@@ -105,6 +105,27 @@ Material toGlass(const FileMaterial& f, Material pbr)
     return m;
 }
 
+/// KHR_materials_unlit: the base colour (factor x texture, sRGB) reaches the
+/// camera as it is. An emitter of that radiance with a black Lambert surface:
+/// seen directly it is exactly its colour, and no light it receives changes
+/// it. Like every emitter it also lights its surroundings (Blender's glTF
+/// importer makes unlit materials emission shaders too). The colour texture
+/// stays in its slot for the alpha test (its A channel); its RGB multiplies
+/// the black albedo.
+Material toUnlit(Material pbr)
+{
+    Material m = pbr;
+    m.type = MaterialType::Lambert;
+    m.emission = pbr.diffuse;
+    m.textures[size_t(TextureSlot::Emission)] = pbr.texture(TextureSlot::Color);
+    m.diffuse = Color(0.0);
+    for (TextureSlot slot : {TextureSlot::Specular, TextureSlot::Roughness, TextureSlot::Metallic, TextureSlot::Normal})
+        m.textures[size_t(slot)].reset();
+    m.metallic = 0.0;
+    m.roughness = 0.0;
+    return m;
+}
+
 /// What vkrt does not honour of a file material, one located warning each.
 void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& where,
                std::vector<std::string>& warnings)
@@ -139,7 +160,8 @@ std::vector<uint32_t> importFileMaterials(const std::vector<FileMaterial>& fileM
     std::vector<uint32_t> indices;
     for (size_t i = 0; i < fileMaterials.size(); ++i) {
         Material m = toPbr(fileMaterials[i], i, file, where, atlas);
-        if (transmits(fileMaterials[i])) m = toGlass(fileMaterials[i], std::move(m));
+        if (fileMaterials[i].unlit) m = toUnlit(std::move(m));
+        else if (transmits(fileMaterials[i])) m = toGlass(fileMaterials[i], std::move(m));
         warnAbout(fileMaterials[i], m, where, warnings);
         indices.push_back(uint32_t(materials.size()));
         materials.push_back(std::move(m));

@@ -155,15 +155,19 @@ material = "file"
 
 /// A 2 x 2 quad in the z = 0 plane (a black dielectric) seen by an
 /// orthographic camera `distance` ahead of it on +z, its view 4 wide and 3 tall.
-std::string orthographicQuadGltf(double distance)
+std::string orthographicQuadGltf(double distance,
+                                 const std::string& material = R"({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1],
+                                                                   "metallicFactor": 0}})",
+                                 const std::string& extensionsUsed = "[]")
 {
     std::string bytes;
     for (float v : {-1.f, -1.f, 0.f, 1.f, -1.f, 0.f, 1.f, 1.f, 0.f, -1.f, 1.f, 0.f}) put(bytes, v);
     for (uint16_t i : {0, 1, 2, 0, 2, 3}) put(bytes, i);
-    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}], "extensionsUsed": )" +
+           extensionsUsed + R"(,
   "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, )" + std::to_string(distance) + R"(]}],
   "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1.5, "znear": 0.01, "zfar": 100}}],
-  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}],
+  "materials": [)" + material + R"(],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
   "buffers": [{"uri": ")" + dataUri("application/octet-stream", bytes) + R"(", "byteLength": 60}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
@@ -195,6 +199,26 @@ TEST_F(GltfRender, AnOrthographicCameraSeesTheSameAtEveryDistance)
     EXPECT_EQ(luminance(38, 60), 1.0f);
     EXPECT_EQ(luminance(121, 60), 1.0f);
     EXPECT_EQ(luminance(80, 18), 1.0f);
+}
+
+TEST_F(GltfRender, AnUnlitSurfaceIsItsBaseColourWhateverLightsIt)
+{
+    // KHR_materials_unlit: the camera sees baseColorFactor exactly, under the
+    // white sky and with a sun on it alike (a lit surface would differ).
+    const std::string unlit = R"({"pbrMetallicRoughness": {"baseColorFactor": [0.25, 0.5, 0.75, 1]},
+                                  "extensions": {"KHR_materials_unlit": {}}})";
+    const fs::path dir = freshTempDir("gltf-unlit");
+    std::ofstream(dir / "unlit.gltf") << orthographicQuadGltf(2.0, unlit, R"(["KHR_materials_unlit"])");
+    Scene scene = parseGltfScene((dir / "unlit.gltf").string());
+    ASSERT_EQ(scene.materials.size(), 1u);
+    EXPECT_EQ(scene.materials[0].emission, Color(0.25, 0.5, 0.75));
+    applyResolution(scene.camera, {160, 120});
+    for (bool sun : {false, true}) {
+        if (sun) scene.directionalLights.push_back({glm::normalize(glm::dvec3(-1, -1, -1)), Color(3.0), 0.0});
+        const Rendered r = render(scene, 3, 16);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(r.mean.rgb[3 * (60 * 160 + 80) + size_t(c)], 0.25 * (c + 1), 1e-5) << "sun " << sun;
+    }
 }
 
 } // namespace
