@@ -262,24 +262,35 @@ double componentValue(const char* at, const ElementType& type)
     }
 }
 
-/// Reads elements of an accessor (or a sparse part) from a view: count x components doubles.
+/// Reads elements of an accessor (or a sparse part) from a view: count x
+/// components values. T is float for attributes (exact for every 8- and
+/// 16-bit integer and every float), uint32_t for indices (unsigned types only).
+template <class T>
 void readElements(const Document& d, uint64_t view, uint64_t offset, uint64_t count, const ElementType& type,
-                  uint64_t stride, const std::string& where, double* out)
+                  uint64_t stride, const std::string& where, T* out)
 {
+    if (stride > 252) // glTF's bound; it keeps (count - 1) * stride far from overflow
+        fail(d.file, where + ": its bufferView's byteStride " + std::to_string(stride) + " is over glTF's 252");
     const uint64_t size = uint64_t(componentBytes(type.componentType)) * type.components;
     if (count == 0) return;
     const char* bytes = d.viewBytes(view, offset, (count - 1) * stride + size, where);
     for (uint64_t i = 0; i < count; ++i)
         for (uint32_t c = 0; c < type.components; ++c)
-            out[i * type.components + c] = componentValue(bytes + i * stride + c * componentBytes(type.componentType), type);
+            out[i * type.components + c] =
+                T(componentValue(bytes + i * stride + c * componentBytes(type.componentType), type));
 }
 
+template <class T = float>
 struct Accessor {
     uint64_t count = 0;
     uint32_t components = 0;
-    std::vector<double> values; ///< count x components
-    double at(uint64_t i, uint32_t c) const { return values[i * components + c]; }
+    std::vector<T> values; ///< count x components
+    double at(uint64_t i, uint32_t c) const { return double(values[i * components + c]); }
 };
+
+/// The most values (elements x components) one accessor may hold here: 2 GiB
+/// of floats, beyond the 8 Mi-triangle soup kMaxGltfTriangles allows (75 M).
+constexpr uint64_t kMaxAccessorValues = uint64_t(1) << 27;
 
 uint32_t componentsOf(const std::string& type)
 {
@@ -291,7 +302,8 @@ uint32_t componentsOf(const std::string& type)
 }
 
 /// Accessor `index`, of one of the `allowed` element sizes, sparse substitution applied.
-Accessor readAccessor(const Document& d, uint64_t index, std::initializer_list<uint32_t> allowed,
+template <class T = float>
+Accessor<T> readAccessor(const Document& d, uint64_t index, std::initializer_list<uint32_t> allowed,
                       const std::string& where)
 {
     const std::string name = indexed("accessors", index);
@@ -306,10 +318,13 @@ Accessor readAccessor(const Document& d, uint64_t index, std::initializer_list<u
     if (size == 0) fail(d.file, name + ": unknown componentType");
     const auto count = uintMember(a, "count");
     if (!count || *count == 0) fail(d.file, name + ": count must be at least 1");
-    Accessor out;
+    if (uint64_t(*count) * type.components > kMaxAccessorValues)
+        fail(d.file, name + ": " + std::to_string(*count) + " elements; vkrt reads at most " +
+                         std::to_string(kMaxAccessorValues / type.components) + " of this type");
+    Accessor<T> out;
     out.count = *count;
     out.components = type.components;
-    out.values.assign(size_t(*count) * type.components, 0.0); // no bufferView: zeros (then the sparse values)
+    out.values.assign(size_t(*count) * type.components, T(0)); // no bufferView: zeros (then the sparse values)
     if (const auto view = uintMember(a, "bufferView")) {
         const json& v = d.element("bufferViews", *view, name);
         const uint64_t stride = uintMember(v, "byteStride").value_or(0);
@@ -331,18 +346,19 @@ Accessor readAccessor(const Document& d, uint64_t index, std::initializer_list<u
     const auto indexView = uintMember(*indices, "bufferView");
     const auto valueView = uintMember(*values, "bufferView");
     if (!indexView || !valueView) fail(d.file, sparseName + ": indices and values need a bufferView");
-    std::vector<double> where_(*sparseCount), substitutes(size_t(*sparseCount) * type.components);
+    std::vector<uint32_t> where_(*sparseCount);
+    std::vector<T> substitutes(size_t(*sparseCount) * type.components);
     readElements(d, *indexView, uintMember(*indices, "byteOffset").value_or(0), *sparseCount, indexType,
                  componentBytes(indexType.componentType), sparseName + ".indices", where_.data());
     readElements(d, *valueView, uintMember(*values, "byteOffset").value_or(0), *sparseCount, type,
                  uint64_t(size) * type.components, sparseName + ".values", substitutes.data());
     for (uint64_t i = 0; i < *sparseCount; ++i) {
-        const double target = where_[i];
-        if (!(target < double(*count)))
-            fail(d.file, sparseName + ".indices[" + std::to_string(i) + "] is " + std::to_string(uint64_t(target)) +
+        const uint64_t target = where_[i];
+        if (target >= *count)
+            fail(d.file, sparseName + ".indices[" + std::to_string(i) + "] is " + std::to_string(target) +
                              ", beyond the accessor's " + std::to_string(*count) + " elements");
         std::copy_n(substitutes.begin() + long(i * type.components), type.components,
-                    out.values.begin() + long(uint64_t(target) * type.components));
+                    out.values.begin() + long(target * type.components));
     }
     return out;
 }
@@ -388,14 +404,14 @@ struct MeshBuilder {
         if (std::find(warnings.begin(), warnings.end(), text) == warnings.end()) warnings.push_back(text);
     }
 
-    static bool finite(const Accessor& a, uint64_t i)
+    static bool finite(const Accessor<>& a, uint64_t i)
     {
         for (uint32_t c = 0; c < a.components; ++c)
             if (!std::isfinite(a.at(i, c))) return false;
         return true;
     }
 
-    void checkCount(const Accessor& a, uint64_t count, const std::string& where, const char* name) const
+    void checkCount(const Accessor<>& a, uint64_t count, const std::string& where, const char* name) const
     {
         if (a.count != count)
             fail(d.file, where + ": " + name + " has " + std::to_string(a.count) + " elements, POSITION " +
@@ -424,38 +440,44 @@ struct MeshBuilder {
         const json* attributes = member(primitive, "attributes");
         const auto position = attributes ? uintMember(*attributes, "POSITION") : std::nullopt;
         if (!position) fail(d.file, where + ": a triangle primitive needs a POSITION attribute");
-        const Accessor positions = readAccessor(d, *position, {3}, where + ".attributes.POSITION");
+        const Accessor<> positions = readAccessor(d, *position, {3}, where + ".attributes.POSITION");
         const uint64_t count = positions.count;
         const uint32_t materialIndex = uintMember(primitive, "material").value_or(uint32_t(materials.size() - 1));
         if (materialIndex >= materials.size() - 1 && member(primitive, "material"))
             fail(d.file, where + ".material names a material the file does not have");
         const FileMaterial& material = materials[materialIndex];
-        auto optional = [&](const char* name, std::initializer_list<uint32_t> sizes) -> std::optional<Accessor> {
+        auto optional = [&](const char* name, std::initializer_list<uint32_t> sizes) -> std::optional<Accessor<>> {
             const auto index = uintMember(*attributes, name);
             if (!index) return std::nullopt;
-            Accessor a = readAccessor(d, *index, sizes, where + ".attributes." + name);
+            Accessor<> a = readAccessor(d, *index, sizes, where + ".attributes." + name);
             checkCount(a, count, where, name);
             return a;
         };
-        const std::optional<Accessor> normals = optional("NORMAL", {3});
-        const std::optional<Accessor> tangents = normals ? optional("TANGENT", {4}) : std::nullopt;
+        const std::optional<Accessor<>> normals = optional("NORMAL", {3});
+        const std::optional<Accessor<>> tangents = normals ? optional("TANGENT", {4}) : std::nullopt;
         const uint32_t uvSet = uvSetFor(material, where);
         const std::string uvName = "TEXCOORD_" + std::to_string(uvSet);
-        const std::optional<Accessor> uvs = optional(uvName.c_str(), {2});
-        const std::optional<Accessor> colors = optional("COLOR_0", {3, 4});
+        const std::optional<Accessor<>> uvs = optional(uvName.c_str(), {2});
+        const std::optional<Accessor<>> colors = optional("COLOR_0", {3, 4});
         if (!uvs && !texCoordSets(material).empty())
             fail(d.file, where + ": its material (" + (material.name.empty() ? "unnamed" : "'" + material.name + "'") +
                              ") samples textures through " + uvName + ", which the primitive does not have");
         std::vector<uint32_t> sequence(count);
         if (const auto indices = uintMember(primitive, "indices")) {
-            const Accessor a = readAccessor(d, *indices, {1}, where + ".indices");
+            const json& indexAccessor = d.element("accessors", *indices, where + ".indices");
+            const uint32_t type = uintMember(indexAccessor, "componentType").value_or(0);
+            const json* normalized = member(indexAccessor, "normalized");
+            if ((type != 5121 && type != 5123 && type != 5125) || (normalized && *normalized == true))
+                fail(d.file, where + ".indices: accessor " + std::to_string(*indices) +
+                                 " must hold unsigned bytes, shorts or ints, not normalized");
+            const Accessor<uint32_t> a = readAccessor<uint32_t>(d, *indices, {1}, where + ".indices");
             sequence.resize(a.count);
             for (uint64_t i = 0; i < a.count; ++i) {
-                if (!(a.values[i] < double(count)))
+                if (a.values[i] >= count)
                     fail(d.file, where + ".indices[" + std::to_string(i) + "] is " +
-                                     std::to_string(uint64_t(a.values[i])) + ", beyond the " + std::to_string(count) +
+                                     std::to_string(a.values[i]) + ", beyond the " + std::to_string(count) +
                                      " vertices");
-                sequence[i] = uint32_t(a.values[i]);
+                sequence[i] = a.values[i];
             }
         } else {
             for (uint32_t i = 0; i < count; ++i) sequence[i] = i;
@@ -596,10 +618,14 @@ std::vector<glm::dmat4> instanceTransforms(const Document& d, const json& node, 
     const json* attributes = instancing ? member(*instancing, "attributes") : nullptr;
     if (!attributes) return {glm::dmat4(1.0)};
     const std::string name = where + ".extensions.EXT_mesh_gpu_instancing.attributes";
-    std::optional<Accessor> t, r, s;
+    std::optional<Accessor<>> t, r, s;
     uint64_t count = 0;
-    auto read = [&](const char* key, uint32_t size, std::optional<Accessor>& into) {
+    auto read = [&](const char* key, uint32_t size, std::optional<Accessor<>>& into) {
         if (const auto index = uintMember(*attributes, key)) {
+            const uint64_t declared = uintMember(d.element("accessors", *index, name), "count").value_or(0);
+            if (declared > kMaxGltfInstances)
+                fail(d.file, name + "." + key + ": " + std::to_string(declared) + " instances; vkrt reads at most " +
+                                 std::to_string(kMaxGltfInstances));
             into = readAccessor(d, *index, {size}, name + "." + key);
             if (count != 0 && into->count != count)
                 fail(d.file, name + ": TRANSLATION, ROTATION and SCALE must have the same count");

@@ -157,8 +157,7 @@ TEST_F(SceneParserTextures, UnsupportedGltfFeaturesAreLocatedWarnings)
     }
     // KHR_texture_transform is honoured, its texCoord override too (the primitive's TEXCOORD_1 is the uv set read).
     for (const char* named : {"KHR_materials_clearcoat"})
-        EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:
-" << all;
+        EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:\n" << all;
     EXPECT_EQ(all.find("TEXCOORD"), std::string::npos) << all;
     // alphaMode BLEND is honoured: no warning, and the material keeps it.
     EXPECT_EQ(all.find("alphaMode"), std::string::npos) << all;
