@@ -1,5 +1,6 @@
 #include "mesh/FileMaterials.h"
 
+#include "mesh/GltfJson.h"
 #include "util/Error.h"
 
 #include <nlohmann/json.hpp>
@@ -19,6 +20,7 @@ namespace vkrt {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using namespace gltf_json;
 
 namespace {
 
@@ -47,32 +49,6 @@ std::string percentDecoded(const std::string& uri)
 }
 
 // ---------------------------------------------------------------------------
-// JSON access that never throws on a wrong type: the file is whatever bytes
-// it is, and nothing about one field says anything about another.
-
-const json* member(const json& object, const char* key)
-{
-    if (!object.is_object()) return nullptr;
-    const auto found = object.find(key);
-    return found == object.end() ? nullptr : &*found;
-}
-
-const json* arrayMember(const json& object, const char* key)
-{
-    const json* value = member(object, key);
-    return value && value->is_array() ? value : nullptr;
-}
-
-/// A non-negative integer below 2^32 (glTF's indices and counts).
-std::optional<uint32_t> uintMember(const json& object, const char* key)
-{
-    const json* value = member(object, key);
-    if (!value || !value->is_number_unsigned()) return std::nullopt;
-    const uint64_t number = value->get<uint64_t>();
-    if (number > std::numeric_limits<uint32_t>::max()) return std::nullopt;
-    return uint32_t(number);
-}
-
 const json* element(const json* array, uint32_t index)
 {
     return array && index < array->size() ? &(*array)[index] : nullptr;
@@ -378,13 +354,6 @@ uint64_t saturatingMultiply(uint64_t a, uint64_t b)
     return __builtin_mul_overflow(a, b, &product) ? UINT64_MAX : product;
 }
 
-/// 3456789012 as "3,456,789,012".
-std::string withThousands(uint64_t value)
-{
-    std::string digits = std::to_string(value);
-    for (size_t at = digits.size(); at > 3; at -= 3) digits.insert(at - 3, ",");
-    return digits;
-}
 
 /// An accessor's `count` (clamped far above any bound), or 0 when `index` names none.
 uint64_t accessorCount(const json* accessors, std::optional<uint32_t> index)

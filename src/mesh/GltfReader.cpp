@@ -6,6 +6,7 @@
 #include "mesh/GltfReader.h"
 
 #include "mesh/FileMaterials.h"
+#include "mesh/GltfJson.h"
 #include "util/Error.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -27,42 +28,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using namespace gltf_json;
 
 [[noreturn]] void fail(const fs::path& file, const std::string& what) { throw InputError(file.string() + ": " + what); }
-
-const json* member(const json& object, const char* key)
-{
-    if (!object.is_object()) return nullptr;
-    const auto found = object.find(key);
-    return found == object.end() ? nullptr : &*found;
-}
-
-const json* arrayMember(const json& object, const char* key)
-{
-    const json* value = member(object, key);
-    return value && value->is_array() ? value : nullptr;
-}
-
-std::optional<uint32_t> uintMember(const json& object, const char* key)
-{
-    const json* value = member(object, key);
-    if (!value || !value->is_number_unsigned() || value->get<uint64_t>() > UINT32_MAX) return std::nullopt;
-    return uint32_t(value->get<uint64_t>());
-}
-
-std::string stringMember(const json& object, const char* key)
-{
-    const json* value = member(object, key);
-    return value && value->is_string() ? value->get<std::string>() : "";
-}
-
-/// 3456789012 as "3,456,789,012".
-std::string withThousands(uint64_t value)
-{
-    std::string digits = std::to_string(value);
-    for (size_t at = digits.size(); at > 3; at -= 3) digits.insert(at - 3, ",");
-    return digits;
-}
 
 std::string indexed(const char* array, uint64_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
 
