@@ -476,6 +476,8 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "first)");
     cmd->add_option("--scene", options->gltf.scene,
                     "Which of a glTF file's scenes to render: its name or index (default: the file's `scene`)");
+    cmd->add_option("--variant", options->gltf.variant,
+                    "A glTF file's KHR_materials_variants variant: its name or index (default: the default materials)");
     cmd->add_option("--environment", options->gltf.environment,
                     "A lat-long .exr or .hdr map lighting a glTF scene (default: white for a file without lights, "
                     "else black)");

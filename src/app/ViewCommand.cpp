@@ -19,6 +19,7 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_option("scene", o->scenePath, "Scene file (TOML, or a glTF .gltf/.glb file as a scene)")->required();
     cmd->add_option("--camera", o->gltf.camera, "glTF scene: the camera to look through (name or index)");
     cmd->add_option("--scene", o->gltf.scene, "glTF file: which of its scenes to show (name or index)");
+    cmd->add_option("--variant", o->gltf.variant, "glTF file: a KHR_materials_variants variant (name or index)");
     cmd->add_option("--environment", o->gltf.environment, "glTF scene: a lat-long .exr/.hdr map lighting it");
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--seed", o->seed, "Random seed");

@@ -359,13 +359,39 @@ std::set<uint32_t> texCoordSets(const FileMaterial& m)
     return sets;
 }
 
+/// The material a primitive uses: its KHR_materials_variants mapping's for
+/// the chosen variant, else its own `material`, else glTF's default (last).
+uint32_t primitiveMaterial(const Document& d, const json& primitive, size_t materialCount,
+                           std::optional<uint32_t> variant, const std::string& where)
+{
+    const auto own = uintMember(primitive, "material");
+    if (member(primitive, "material") && (!own || *own + 1 >= materialCount))
+        fail(d.file, where + ".material names a material the file does not have");
+    uint32_t chosen = own.value_or(uint32_t(materialCount - 1));
+    const json* extensions = member(primitive, "extensions");
+    const json* variants = extensions ? member(*extensions, "KHR_materials_variants") : nullptr;
+    const json* mappings = variants ? arrayMember(*variants, "mappings") : nullptr;
+    if (!variant || !mappings) return chosen;
+    for (const json& mapping : *mappings)
+        if (const json* names = arrayMember(mapping, "variants"))
+            for (const json& v : *names)
+                if (v.is_number_unsigned() && v.get<uint64_t>() == *variant) {
+                    const auto material = uintMember(mapping, "material");
+                    if (!material || *material + 1 >= materialCount)
+                        fail(d.file, where + ".extensions.KHR_materials_variants: a mapping names a material the "
+                                             "file does not have");
+                    chosen = *material;
+                }
+    return chosen;
+}
+
 struct MeshBuilder {
     const Document& d;
     const std::vector<FileMaterial>& materials;
     std::vector<std::string>& warnings;
+    std::optional<uint32_t> variant; ///< KHR_materials_variants' chosen variant
     MeshData out;
     bool anyNormals = false, anyUvs = false, anyColors = false, allTangents = true;
-    std::vector<char> hasNormal, hasUv; // per vertex: whether its primitive had them
 
     void warnOnce(const std::string& text)
     {
@@ -410,9 +436,7 @@ struct MeshBuilder {
         if (!position) fail(d.file, where + ": a triangle primitive needs a POSITION attribute");
         const Accessor<> positions = readAccessor(d, *position, {3}, where + ".attributes.POSITION");
         const uint64_t count = positions.count;
-        const uint32_t materialIndex = uintMember(primitive, "material").value_or(uint32_t(materials.size() - 1));
-        if (materialIndex >= materials.size() - 1 && member(primitive, "material"))
-            fail(d.file, where + ".material names a material the file does not have");
+        const uint32_t materialIndex = primitiveMaterial(d, primitive, materials.size(), variant, where);
         const FileMaterial& material = materials[materialIndex];
         auto optional = [&](const char* name, std::initializer_list<uint32_t> sizes) -> std::optional<Accessor<>> {
             const auto index = uintMember(*attributes, name);
@@ -513,13 +537,13 @@ struct MeshBuilder {
 };
 
 MeshData readMesh(const Document& d, uint32_t index, const std::vector<FileMaterial>& materials,
-                  std::vector<std::string>& warnings)
+                  std::optional<uint32_t> variant, std::vector<std::string>& warnings)
 {
     const json& mesh = (*d.array("meshes"))[index];
     const std::string where = indexed("meshes", index);
     const json* primitives = arrayMember(mesh, "primitives");
     if (!primitives || primitives->empty()) fail(d.file, where + ": a mesh needs at least one primitive");
-    MeshBuilder builder{d, materials, warnings, {}};
+    MeshBuilder builder{d, materials, warnings, variant, {}};
     for (size_t p = 0; p < primitives->size(); ++p)
         builder.addPrimitive((*primitives)[p], where + ".primitives[" + std::to_string(p) + "]");
     if (member(mesh, "weights") || std::any_of(primitives->begin(), primitives->end(),
@@ -641,6 +665,26 @@ std::optional<uint32_t> chosenScene(const Document& d, const std::optional<std::
     }
     throw InputError("--scene " + text + ": " + d.file.string() + " has no such scene (" +
                      (count == 0 ? std::string("it has none") : "its scenes: " + known) + ")");
+}
+
+/// KHR_materials_variants' variant `--variant` names (by name or index); nullopt without one.
+std::optional<uint32_t> chosenVariant(const Document& d, const std::optional<std::string>& choice)
+{
+    if (!choice) return std::nullopt;
+    const json* extensions = member(d.doc, "extensions");
+    const json* block = extensions ? member(*extensions, "KHR_materials_variants") : nullptr;
+    const json* variants = block ? arrayMember(*block, "variants") : nullptr;
+    const size_t count = variants ? variants->size() : 0;
+    const std::string& text = *choice;
+    const bool isIndex = !text.empty() && text.size() < 10 && text.find_first_not_of("0123456789") == std::string::npos;
+    std::string known;
+    for (size_t i = 0; i < count; ++i) {
+        const std::string name = stringMember((*variants)[i], "name");
+        if ((isIndex && std::stoul(text) == i) || (!name.empty() && name == text)) return uint32_t(i);
+        known += (known.empty() ? "" : ", ") + std::to_string(i) + (name.empty() ? "" : " ('" + name + "')");
+    }
+    throw InputError("--variant " + text + ": " + d.file.string() + " has no such material variant (" +
+                     (count == 0 ? std::string("it has none") : "its variants: " + known) + ")");
 }
 
 /// The root nodes: the chosen scene's, or without scenes every node that is no child.
@@ -839,7 +883,7 @@ const std::vector<std::string>& implementedGltfExtensions()
     static const std::vector<std::string> names{
         "KHR_lights_punctual",        "KHR_texture_transform", "KHR_materials_emissive_strength",
         "KHR_materials_ior",          "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
-        "KHR_materials_unlit",
+        "KHR_materials_unlit",        "KHR_materials_variants",
         "KHR_materials_transmission", // read as glass or not, each approximation warned (docs/scene-format.md)
     };
     return names;
@@ -859,6 +903,7 @@ GltfModel readGltfModel(const fs::path& file, const GltfReadOptions& options)
     };
     model.materials = readGltfMaterials(d.doc, file, d.references, viewBytes);
     const std::optional<uint32_t> scene = chosenScene(d, options.scene);
+    const std::optional<uint32_t> variant = chosenVariant(d, options.variant);
     model.sceneIndex = scene.value_or(0);
     if (scene) model.sceneName = stringMember((*d.array("scenes"))[*scene], "name");
     walkNodes(d, model, scene);
@@ -871,7 +916,7 @@ GltfModel readGltfModel(const fs::path& file, const GltfReadOptions& options)
     for (const GltfInstance& instance : model.instances) placed[instance.mesh] = true;
     for (uint32_t m = 0; m < meshCount; ++m) {
         model.meshNames[m] = stringMember((*d.array("meshes"))[m], "name");
-        if (placed[m]) model.meshes[m] = readMesh(d, m, model.materials, model.warnings);
+        if (placed[m]) model.meshes[m] = readMesh(d, m, model.materials, variant, model.warnings);
     }
     std::erase_if(model.instances, [&](const GltfInstance& i) { return model.meshes[i.mesh].triangles.empty(); });
     return model;

@@ -80,6 +80,8 @@ struct GltfLight {
 struct GltfReadOptions {
     /// `--scene NAME|INDEX`: one of the file's `scenes`; unset: the file's `scene`, else scene 0.
     std::optional<std::string> scene;
+    /// `--variant NAME|INDEX`: a KHR_materials_variants variant; unset: the primitives' own materials.
+    std::optional<std::string> variant;
     MeshLoadOptions references;
 };
 

@@ -73,8 +73,11 @@ Sampler resolveSampler(SamplerChoice choice, VarianceNeeds needs, uint64_t pixel
 
 Scene loadScene(const std::string& path, const ResolutionOverride& resolution, const GltfSceneOptions& gltf)
 {
-    if (!isGltfPath(path) && (gltf.camera || gltf.environment || gltf.scene))
-        throw InputError(std::string(gltf.camera ? "--camera" : gltf.scene ? "--scene" : "--environment") +
+    if (!isGltfPath(path) && (gltf.camera || gltf.environment || gltf.scene || gltf.variant))
+        throw InputError(std::string(gltf.camera    ? "--camera"
+                                     : gltf.scene   ? "--scene"
+                                     : gltf.variant ? "--variant"
+                                                    : "--environment") +
                          " applies to a glTF scene (.gltf, .glb); " + path + " is a TOML scene");
     Scene scene = isGltfPath(path) ? parseGltfScene(path, gltf) : parseSceneFile(path);
     applyResolution(scene.camera, resolution);

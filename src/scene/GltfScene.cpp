@@ -209,6 +209,7 @@ void importGltf(const fs::path& file, const GltfSceneOptions& options, bool take
     Scene& scene = context.scene;
     GltfReadOptions read;
     read.scene = options.scene;
+    read.variant = options.variant;
     GltfModel model = readGltfModel(file, read);
     if (model.instances.empty()) fail(file, "its scene places no triangle mesh: nothing to render");
     for (const std::string& warning : model.warnings) scene.warnings.push_back(file.string() + ": " + warning);

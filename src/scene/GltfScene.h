@@ -33,6 +33,8 @@ struct GltfSceneOptions {
     std::optional<std::string> environment;
     /// `--scene NAME|INDEX`: one of the file's `scenes`; unset: its `scene`, else the first.
     std::optional<std::string> scene;
+    /// `--variant NAME|INDEX`: a KHR_materials_variants variant; unset: the default materials.
+    std::optional<std::string> variant;
 };
 
 /// Whether `path` names a glTF file (.gltf or .glb, any case).

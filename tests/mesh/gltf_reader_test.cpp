@@ -310,6 +310,34 @@ TEST(GltfReader, RequiredExtensionsMustBeImplementedUsedOnesAreNamedOnce)
     EXPECT_NE(error.find("extensionsRequired names KHR_draco_mesh_compression"), std::string::npos) << error;
 }
 
+TEST(GltfReader, AMaterialVariantReplacesTheMaterialsItMaps)
+{
+    // KHR_materials_variants: --variant picks each primitive's mapped
+    // material; without it, the primitive's own; an unknown one lists them.
+    GltfBuilder b;
+    b.doc()["materials"] = {{{"name", "plain"}}, {{"name", "red"}}, {{"name", "blue"}}};
+    b.doc()["extensionsUsed"] = {"KHR_materials_variants"};
+    b.doc()["extensions"] = {{"KHR_materials_variants", {{"variants", {{{"name", "Red"}}, {{"name", "Blue"}}}}}}};
+    const uint32_t mesh = triangleMesh(b, false, 0);
+    b.doc()["meshes"][mesh]["primitives"][0]["extensions"] = {
+        {"KHR_materials_variants",
+         {{"mappings", {{{"material", 1}, {"variants", {0}}}, {{"material", 2}, {"variants", {1}}}}}}}}};
+    b.node({{"mesh", mesh}});
+    const fs::path file = b.write("variants.gltf");
+    const GltfModel plain = readGltfModel(file);
+    EXPECT_EQ(plain.meshes[0].triangleMaterials[0], 0u);
+    EXPECT_TRUE(plain.warnings.empty()); // the extension is implemented
+    GltfReadOptions options;
+    options.variant = "Blue";
+    EXPECT_EQ(readGltfModel(file, options).meshes[0].triangleMaterials[0], 2u);
+    options.variant = "0";
+    EXPECT_EQ(readGltfModel(file, options).meshes[0].triangleMaterials[0], 1u);
+    options.variant = "Green";
+    const std::string error = errorOf([&] { readGltfModel(file, options); });
+    EXPECT_NE(error.find("--variant Green"), std::string::npos) << error;
+    EXPECT_NE(error.find("1 ('Blue')"), std::string::npos) << error;
+}
+
 TEST(GltfReader, BadAccessorsAndIndicesAreNamed)
 {
     GltfBuilder b;
