@@ -456,7 +456,8 @@ struct MeshBuilder {
                              ") samples textures through " + uvName + ", which the primitive does not have");
         std::vector<uint32_t> sequence(count);
         if (const auto indices = uintMember(primitive, "indices")) {
-            const json& indexAccessor = d.element("accessors", *indices, where + ".indices");
+            const std::string indicesWhere = where + ".indices";
+            const json& indexAccessor = d.element("accessors", *indices, indicesWhere);
             const uint32_t type = uintMember(indexAccessor, "componentType").value_or(0);
             const json* normalized = member(indexAccessor, "normalized");
             if ((type != 5121 && type != 5123 && type != 5125) || (normalized && *normalized == true))
