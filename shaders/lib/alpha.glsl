@@ -5,7 +5,8 @@
 // BVH walk (lib/shapes/mesh.glsl: traverseMesh) and the driver's ray query
 // (lib/ray_query.glsl, which confirms only the candidates kept here).
 //
-// alpha = MaterialAlpha::alpha (glTF baseColorFactor.a) x the A channel of
+// alpha = MaterialAlpha::alpha (glTF baseColorFactor.a) x the vertex colour's
+// A (COLOR_0, where the mesh has it) x the A channel of
 // the material's colour texture (its TEXTURE_SLOT_COLOR slot: the same
 // texture, uv transform and wrap modes the colour uses), read bilinearly at
 // mip level 0: traversal has no ray cone, and the coverage of a cut-out must
@@ -66,6 +67,13 @@ float alphaAt(Mesh mesh, uint slot, uint material, vec3 bary)
         vec2 st = uv * s.scale;
         vec2 at = vec2(s.rotation.x * st.x + s.rotation.y * st.y, s.rotation.x * st.y - s.rotation.y * st.x);
         alpha *= clamp(sampleTextureLevel(s.record, at + s.offset, 0u).a, 0.0, 1.0);
+    }
+#endif
+#ifdef VKRT_HAS_MESH_COLORS
+    // glTF: COLOR_0's alpha multiplies the base colour's too.
+    if ((mesh.flags & MESH_FLAG_COLORS) != 0u) {
+        MeshColors c = meshColors[mesh.firstTriangle + slot];
+        alpha *= clamp(bary.x * c.c0.a + bary.y * c.c1.a + bary.z * c.c2.a, 0.0, 1.0);
     }
 #endif
     return alpha;

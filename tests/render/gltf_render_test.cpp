@@ -8,6 +8,7 @@
 #include "mesh/MeshGeometry.h"
 #include "render/Renderer.h"
 #include "render/RenderSession.h"
+#include "scene/FeatureSet.h"
 #include "scene/GltfScene.h"
 #include "scene/SceneParser.h"
 #include "support/GltfTestFiles.h"
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 namespace vkrt::test {
 namespace {
@@ -155,25 +157,32 @@ material = "file"
 
 /// A 2 x 2 quad in the z = 0 plane (a black dielectric) seen by an
 /// orthographic camera `distance` ahead of it on +z, its view 4 wide and 3 tall.
+/// With `colorAlpha`, the quad's vertices get COLOR_0 = (1, 1, 1, colorAlpha).
 std::string orthographicQuadGltf(double distance,
                                  const std::string& material = R"({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1],
                                                                    "metallicFactor": 0}})",
-                                 const std::string& extensionsUsed = "[]")
+                                 const std::string& extensionsUsed = "[]", std::optional<float> colorAlpha = {})
 {
     std::string bytes;
     for (float v : {-1.f, -1.f, 0.f, 1.f, -1.f, 0.f, 1.f, 1.f, 0.f, -1.f, 1.f, 0.f}) put(bytes, v);
     for (uint16_t i : {0, 1, 2, 0, 2, 3}) put(bytes, i);
+    for (int k = 0; k < 4 && colorAlpha; ++k)
+        for (float v : {1.f, 1.f, 1.f, *colorAlpha}) put(bytes, v); // at 60: 64 bytes
+    const std::string colors = colorAlpha ? R"(, "COLOR_0": 2)" : "";
     return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}], "extensionsUsed": )" +
            extensionsUsed + R"(,
   "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, )" + std::to_string(distance) + R"(]}],
   "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1.5, "znear": 0.01, "zfar": 100}}],
   "materials": [)" + material + R"(],
-  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
-  "buffers": [{"uri": ")" + dataUri("application/octet-stream", bytes) + R"(", "byteLength": 60}],
-  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0)" + colors + R"(}, "indices": 1, "material": 0}]}],
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", bytes) + R"(", "byteLength": )" +
+           std::to_string(bytes.size()) + R"(}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12})" +
+           (colorAlpha ? R"(, {"buffer": 0, "byteOffset": 60, "byteLength": 64})" : "") + R"(],
   "accessors": [
     {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
-    {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+    {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"})" +
+           (colorAlpha ? R"(, {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC4"})" : "") + R"(]})";
 }
 
 TEST_F(GltfRender, AnOrthographicCameraSeesTheSameAtEveryDistance)
@@ -218,6 +227,27 @@ TEST_F(GltfRender, AnUnlitSurfaceIsItsBaseColourWhateverLightsIt)
         const Rendered r = render(scene, 3, 16);
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(r.mean.rgb[3 * (60 * 160 + 80) + size_t(c)], 0.25 * (c + 1), 1e-5) << "sun " << sun;
+    }
+}
+
+TEST_F(GltfRender, VertexColoursTintTheBaseColourAndTheirAlphaCutsOut)
+{
+    // COLOR_0 multiplies the base colour, and its alpha the coverage: a white
+    // lambertian-like quad tinted by (1, 1, 1, a) is there for a >= the MASK
+    // cutoff and gone (the white sky, exactly 1) below it.
+    const std::string mask = R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0},
+                                 "alphaMode": "MASK", "alphaCutoff": 0.5})";
+    const fs::path dir = freshTempDir("gltf-vertex-alpha");
+    std::ofstream(dir / "kept.gltf") << orthographicQuadGltf(2.0, mask, "[]", 0.75f);
+    std::ofstream(dir / "cut.gltf") << orthographicQuadGltf(2.0, mask, "[]", 0.25f);
+    for (const char* name : {"kept.gltf", "cut.gltf"}) {
+        Scene scene = parseGltfScene((dir / name).string());
+        applyResolution(scene.camera, {160, 120});
+        EXPECT_TRUE(featuresOf(scene).vertexColors && featuresOf(scene).alpha) << name;
+        const Rendered r = render(scene, 5, 8);
+        const float centre = r.mean.rgb[3 * (60 * 160 + 80) + 1];
+        if (std::string(name) == "cut.gltf") EXPECT_EQ(centre, 1.0f) << "a vertex alpha of 0.25 under the cutoff";
+        else EXPECT_LT(centre, 0.9f) << "a vertex alpha of 0.75 keeps the (grey) quad";
     }
 }
 
