@@ -209,17 +209,7 @@ uint64_t sizeField(const json& object, const char* key, uint64_t fallback)
 /// Bytes of one accessor element (matrix column padding ignored: it only makes the need larger).
 uint64_t elementBytes(const json& accessor)
 {
-    const uint64_t component = [&]() -> uint64_t {
-        switch (sizeField(accessor, "componentType", 0)) {
-        case 5120:
-        case 5121: return 1;
-        case 5122:
-        case 5123: return 2;
-        case 5125:
-        case 5126: return 4;
-        default: return 0;
-        }
-    }();
+    const uint64_t component = componentBytes(sizeField(accessor, "componentType", 0));
     const json* type = member(accessor, "type");
     const std::string name = type && type->is_string() ? type->get<std::string>() : "";
     const std::pair<const char*, uint64_t> counts[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},

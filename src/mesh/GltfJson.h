@@ -43,6 +43,21 @@ inline std::string stringMember(const json& object, const char* key)
     return value && value->is_string() ? value->get<std::string>() : "";
 }
 
+/// Bytes of one component of an accessor's componentType (glTF's WebGL
+/// enums: byte, unsigned byte, short, unsigned short, unsigned int, float); 0 for another.
+inline uint32_t componentBytes(uint64_t componentType)
+{
+    switch (componentType) {
+    case 5120:
+    case 5121: return 1;
+    case 5122:
+    case 5123: return 2;
+    case 5125:
+    case 5126: return 4;
+    default: return 0;
+    }
+}
+
 /// 3456789012 as "3,456,789,012", for counts in messages.
 inline std::string withThousands(uint64_t value)
 {

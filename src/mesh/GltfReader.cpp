@@ -179,19 +179,6 @@ struct ElementType {
     bool normalized = false;
 };
 
-uint32_t componentBytes(uint32_t componentType)
-{
-    switch (componentType) {
-    case 5120:
-    case 5121: return 1;
-    case 5122:
-    case 5123: return 2;
-    case 5125:
-    case 5126: return 4;
-    default: return 0;
-    }
-}
-
 /// One component as a double: floats as they are, integers as integers or,
 /// normalized, as glTF's normalization says (signed: max(c / max, -1)).
 double componentValue(const char* at, const ElementType& type)
