@@ -138,6 +138,30 @@ TEST(GltfScene, BadCamerasAndLightsNameTheFile)
     EXPECT_NE(error.find("broken.gltf"), std::string::npos) << error;
 }
 
+TEST(GltfScene, CamerasAreListedInFileOrderAndOrthographicOnesKeepTheirView)
+{
+    // Three cameras placed in reverse order by the nodes: --camera's list
+    // still names them 0, 1, 2; an orthographic one is rendered as such.
+    const std::string cameras = R"("cameras": [
+        {"name": "front", "type": "perspective", "perspective": {"yfov": 0.5}},
+        {"name": "side", "type": "perspective", "perspective": {"yfov": 0.6}},
+        {"name": "plan", "type": "orthographic", "orthographic": {"xmag": 3, "ymag": 1.5, "znear": 0.1, "zfar": 9}}])";
+    const fs::path file = writeTriangle("gltf-camera-order", cameras,
+                                        R"("scenes": [{"nodes": [0, 1, 2, 3]}], "nodes": [{"mesh": 0},
+                                           {"camera": 2, "translation": [0, 0, 5]},
+                                           {"camera": 1, "translation": [0, 0, 6]},
+                                           {"camera": 0, "translation": [0, 0, 7]}])");
+    const std::string error = errorOf([&] { parseGltfScene(file.string(), {std::string("top"), std::nullopt}); });
+    EXPECT_NE(error.find("its cameras: 0 ('front'), 1 ('side'), 2 ('plan')"), std::string::npos) << error;
+    const Scene plan = parseGltfScene(file.string(), {std::string("plan"), std::nullopt});
+    EXPECT_EQ(plan.camera.orthographicHeight, 3.0);
+    EXPECT_EQ(plan.camera.width, 640u);
+    EXPECT_EQ(plan.camera.height, 320u); // xmag / ymag = 2
+    EXPECT_TRUE(plan.warnings.empty());
+    // Without --camera, the first camera the node walk meets: node 1's.
+    EXPECT_TRUE(parseGltfScene(file.string()).camera.orthographic());
+}
+
 TEST(GltfScene, SpotAndRangeFromTheFile)
 {
     const std::string spot = R"("extensionsUsed": ["KHR_lights_punctual"],
