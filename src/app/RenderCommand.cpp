@@ -430,7 +430,8 @@ CommandRunner addRenderCommand(CLI::App& app)
         "FINITE");
     auto options = std::make_shared<RenderCommandOptions>();
     CLI::App* cmd = app.add_subcommand("render", "Render a scene file to an OpenEXR image");
-    cmd->add_option("scene", options->scenePath,
+    // "SCENE", not "scene": CLI11 2.4 (Debian 13) refuses a positional named like an option (--scene).
+    cmd->add_option("SCENE", options->scenePath,
                     "Scene file (TOML, see docs/scene-format.md; or a glTF .gltf/.glb file as a scene)")
         ->required();
     cmd->add_option("-o,--output", options->output, "Output EXR (default: SCENE's name with .exr, here)");

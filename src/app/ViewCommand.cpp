@@ -16,7 +16,8 @@ CommandRunner addViewCommand(CLI::App& app)
 {
     auto o = std::make_shared<ViewOptions>();
     CLI::App* cmd = app.add_subcommand("view", "Watch a scene converge in a window (keys: press H)");
-    cmd->add_option("scene", o->scenePath, "Scene file (TOML, or a glTF .gltf/.glb file as a scene)")->required();
+    // "SCENE", not "scene": CLI11 2.4 (Debian 13) refuses a positional named like an option (--scene).
+    cmd->add_option("SCENE", o->scenePath, "Scene file (TOML, or a glTF .gltf/.glb file as a scene)")->required();
     cmd->add_option("--camera", o->gltf.camera, "glTF scene: the camera to look through (name or index)");
     cmd->add_option("--scene", o->gltf.scene, "glTF file: which of its scenes to show (name or index)");
     cmd->add_option("--variant", o->gltf.variant, "glTF file: a KHR_materials_variants variant (name or index)");
