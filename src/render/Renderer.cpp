@@ -32,12 +32,27 @@ void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation
                          "), which several samples would share; use 1 (its default) or Mesa 25's lavapipe");
 }
 
+/// The uber kernel's features: every feature, except that the glTF alpha
+/// test and emission textures come only with a scene that uses them. Measured
+/// on Mesa 26.1's lavapipe (LLVM 19.1): an uber kernel with either, rendering
+/// a scene without them, crashed the driver (SIGSEGV in the dispatch; Mesa
+/// 25.0 ran it), while their own variants render right on both. Until the
+/// cause is found the uber kernel does not carry code for data the scene lacks.
+FeatureSet uberFeatures(const Scene& scene)
+{
+    FeatureSet features = FeatureSet::everything(scene.render.integrator);
+    const FeatureSet own = featuresOf(scene);
+    features.alpha = own.alpha;
+    features.emissionTextures = own.emissionTextures;
+    return features;
+}
+
 KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
     checkSamplesPerInvocation(context.loopCap(), options.samplesPerInvocation); // before any compilation
     checkLoopBudget(scene, context.loopCap());                                  // or allocation
     KernelVariant variant;
-    variant.features = options.uber ? FeatureSet::everything(scene.render.integrator) : featuresOf(scene);
+    variant.features = options.uber ? uberFeatures(scene) : featuresOf(scene);
     variant.variance = options.variance;
     variant.aov = options.aov;
     variant.sobolSampler = options.sobol;
