@@ -64,12 +64,8 @@ std::string lowerExtension(const fs::path& file)
     return extension;
 }
 
-std::string formatName(const std::string& extension)
-{
-    if (extension == ".obj") return "OBJ";
-    if (extension == ".ply") return "PLY";
-    return "glTF";
-}
+/// The format assimp reads for vkrt (PLY and glTF have readers of their own).
+std::string formatName(const std::string&) { return "OBJ"; }
 
 std::string describe(const glm::vec3& v)
 {
@@ -195,7 +191,7 @@ void checkIsMeshFile(const fs::path& file)
 constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure   // first: out-of-range indices, broken buffers
                                   | aiProcess_Triangulate           // polygons -> triangles
                                   | aiProcess_SortByPType           // one primitive type per mesh
-                                  | aiProcess_PreTransformVertices; // glTF node transforms, one flat list
+                                  | aiProcess_PreTransformVertices; // one flat list
 
 [[noreturn]] void failImport(const fs::path& file, const std::string& extension, const std::string& reason)
 {
@@ -268,10 +264,7 @@ const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, con
 struct MeshCheck {
     const fs::path& file;
     std::string extension;
-    const ReferencePolicy& references;
     size_t meshCount = 0;
-
-    bool isGltf() const { return extension == ".gltf" || extension == ".glb"; }
 
     std::string where(size_t mesh, size_t vertex) const
     {
@@ -314,10 +307,7 @@ glm::vec3 unitNormal(const MeshCheck& check, size_t mesh, size_t vertex, const a
 }
 
 /// A file tangent (assimp: tangent and bitangent) as MeshData keeps it: unit,
-/// w from the side of cross(normal, tangent) the bitangent is on. glTF's v
-/// runs down the image and assimp flips it (v = 1 - v_file) while glTF's
-/// bitangent follows v_file (MikkTSpace over the file's uvs; Cube.gltf's data
-/// says so too): relative to MeshData's v that side is the other one.
+/// w from the side of cross(normal, tangent) the bitangent is on.
 glm::vec4 fileTangent(const MeshCheck& check, size_t mesh, size_t vertex, const glm::vec3& normal,
                       const aiVector3D& tangent, const aiVector3D& bitangent)
 {
@@ -330,7 +320,7 @@ glm::vec4 fileTangent(const MeshCheck& check, size_t mesh, size_t vertex, const 
         return glm::vec4(normal == glm::vec3(0.0f) ? glm::vec3(1.0f, 0.0f, 0.0f) : perpendicularTo(normal), 1.0f);
     }
     const float side = glm::dot(glm::cross(normal, t), b) < 0.0f ? -1.0f : 1.0f;
-    return glm::vec4(t / length, check.isGltf() ? -side : side);
+    return glm::vec4(t / length, side);
 }
 
 struct VertexAttributes {
@@ -360,7 +350,7 @@ void appendVertices(MeshData& out, const aiMesh& mesh, size_t meshIndex, const M
     }
 }
 
-void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const MeshCheck& check, bool materials)
+void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const MeshCheck& check)
 {
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
         const aiFace& face = mesh.mFaces[f];
@@ -375,7 +365,6 @@ void appendTriangles(MeshData& out, const aiMesh& mesh, uint32_t base, const Mes
             triangle[corner] = base + face.mIndices[corner];
         }
         out.triangles.push_back(triangle);
-        if (materials) out.triangleMaterials.push_back(mesh.mMaterialIndex);
     }
 }
 
@@ -389,7 +378,7 @@ MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
     VertexAttributes attributes;
     attributes.normals = every([](const aiMesh* m) { return m->HasNormals(); });
     attributes.uvs = every([](const aiMesh* m) { return m->HasTextureCoords(0); });
-    // Tangents belong to uvs and are oriented by normals (glTF has them only with both).
+    // Tangents belong to uvs and are oriented by normals.
     attributes.tangents =
         attributes.normals && attributes.uvs && every([](const aiMesh* m) { return m->HasTangentsAndBitangents(); });
     MeshData out;
@@ -399,7 +388,7 @@ MeshData convertScene(const aiScene& scene, const MeshCheck& baseCheck)
         }
         const auto base = static_cast<uint32_t>(out.positions.size());
         appendVertices(out, *meshes[i], i, check, attributes);
-        appendTriangles(out, *meshes[i], base, check, /*materials=*/false);
+        appendTriangles(out, *meshes[i], base, check);
     }
     if (out.triangles.empty()) fail(check.file, "no triangles in " + check.file.string());
     return out;
@@ -475,7 +464,7 @@ MeshData loadMeshFile(const fs::path& file, const MeshLoadOptions& options)
     const ReferencePolicy policy(file, options);
     Assimp::Importer importer;
     const aiScene* scene = importScene(importer, file, extension, policy);
-    MeshData mesh = convertScene(*scene, MeshCheck{file, extension, policy});
+    MeshData mesh = convertScene(*scene, MeshCheck{file, extension});
     if (extension == ".obj") joinIdenticalCorners(mesh);
     return mesh;
 }
