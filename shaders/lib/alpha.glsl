@@ -114,18 +114,25 @@ bool alphaKeeps(Ray r, uint instance, Mesh mesh, uint slot, vec3 bary)
 // a ray reaching that point counts the surface, so that a cut-out's holes do
 // not emit and light sampling and BSDF hits (which meet the surface only
 // where alphaKeeps does) estimate the same light. The mesh owning an emitter
-// is the last emissive one whose firstEmitter is not past it (meshes' emitters
-// follow the triangle lights', in record order, render/GpuScene.cpp).
+// is the last one whose firstEmitter is not past it: every mesh record holds
+// the running emitter count in firstEmitter (render/GpuScene.cpp), so the
+// values never decrease and a mesh without emitters shares its value only
+// with the records after it; a binary search finds it in O(log meshes).
 float emitterCoverage(uint index, vec3 bary)
 {
-    uint owner = u.meshCount;
-    for (uint i = 0u; i < u.meshCount; ++i) {
+    uint low = 0u, high = u.meshCount; // the owner is in [low, high)
+    while (high - low > 1u) {
         ++g_loopIterations;
-        if ((meshes[i].flags & MESH_FLAG_EMISSIVE) != 0u && meshes[i].firstEmitter <= index)
-            owner = i;
+        uint middle = (low + high) / 2u;
+        if (meshes[middle].firstEmitter <= index)
+            low = middle;
+        else
+            high = middle;
     }
-    if (owner == u.meshCount || (meshes[owner].flags & MESH_FLAG_ALPHA) == 0u)
-        return 1.0;
+    uint owner = low;
+    if (u.meshCount == 0u || (meshes[owner].flags & (MESH_FLAG_ALPHA | MESH_FLAG_EMISSIVE)) !=
+                                 (MESH_FLAG_ALPHA | MESH_FLAG_EMISSIVE) || index < meshes[owner].firstEmitter)
+        return 1.0; // a triangle light, or an emitter of an opaque mesh
     Mesh mesh = meshes[owner];
     uint slot = index - mesh.firstEmitter;
     uint material = alphaMaterial(mesh, slot);
