@@ -58,11 +58,7 @@ float alphaAt(Mesh mesh, uint slot, uint material, vec3 bary)
 #ifdef VKRT_HAS_MESH_UVS
     TextureSlot s = materialTextures[material].slots[TEXTURE_SLOT_COLOR];
     if (s.record != NO_TEXTURE) {
-        vec2 uv = vec2(0.0);
-        if ((mesh.flags & MESH_FLAG_UVS) != 0u) {
-            uint index = mesh.firstTriangle + slot;
-            uv = bary.x * meshUvs[index].uv0 + bary.y * meshUvs[index].uv1 + bary.z * meshUvs[index].uv2;
-        }
+        vec2 uv = meshTriangleUv(mesh.firstTriangle + slot, s.texCoord, bary);
         // lib/material_textures.glsl: lookupSlot's transform.
         vec2 st = uv * s.scale;
         vec2 at = vec2(s.rotation.x * st.x + s.rotation.y * st.y, s.rotation.x * st.y - s.rotation.y * st.x);

@@ -67,6 +67,22 @@ layout(scalar, binding = BINDING_MATERIAL_TEXTURES) readonly buffer MaterialText
 #ifdef VKRT_HAS_MESH_UVS
 layout(scalar, binding = BINDING_MESH_UVS) readonly buffer MeshUvBlock { MeshUvs meshUvs[]; };
 #endif
+#ifdef VKRT_HAS_MESH_UVS1
+layout(scalar, binding = BINDING_MESH_UVS1) readonly buffer MeshUv1Block { MeshUvs meshUvs1[]; };
+#endif
+#ifdef VKRT_HAS_MESH_UVS
+// Mesh triangle `index`'s uv of set `set` (TextureSlot::texCoord) at
+// barycentrics b. Both buffers hold every triangle, zeros where its mesh
+// lacks the set; set 1 reads set 0 in variants without a second set.
+vec2 meshTriangleUv(uint index, uint set, vec3 b)
+{
+#ifdef VKRT_HAS_MESH_UVS1
+    if (set == 1u)
+        return b.x * meshUvs1[index].uv0 + b.y * meshUvs1[index].uv1 + b.z * meshUvs1[index].uv2;
+#endif
+    return b.x * meshUvs[index].uv0 + b.y * meshUvs[index].uv1 + b.z * meshUvs[index].uv2;
+}
+#endif
 #ifdef VKRT_HAS_MESH_TANGENTS
 layout(scalar, binding = BINDING_MESH_TANGENTS) readonly buffer MeshTangentBlock { MeshTangents meshTangents[]; };
 #endif

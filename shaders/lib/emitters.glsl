@@ -30,7 +30,9 @@ vec3 emitterRadiance(Emitter e, vec3 towards, vec2 uv)
 // The uv of a hit on an emitter (what emitterRadiance reads).
 vec2 emitterUvAtHit(SurfaceHit hit)
 {
-#ifdef VKRT_HAS_EMISSION_TEXTURES
+#if defined(VKRT_HAS_EMISSION_TEXTURES) && defined(VKRT_HAS_MESH_UVS1)
+    return materialTextures[hit.material].slots[TEXTURE_SLOT_EMISSION].texCoord == 1u ? hit.uv1 : hit.uv;
+#elif defined(VKRT_HAS_EMISSION_TEXTURES)
     return hit.uv;
 #else
     return vec2(0.0);
@@ -43,7 +45,7 @@ vec2 emitterUvAt(Emitter e, vec3 b)
 {
 #ifdef VKRT_HAS_EMISSION_TEXTURES
     if (e.textures != NO_EMISSION_TEXTURE)
-        return b.x * meshUvs[e.uvs].uv0 + b.y * meshUvs[e.uvs].uv1 + b.z * meshUvs[e.uvs].uv2;
+        return meshTriangleUv(e.uvs, materialTextures[e.textures].slots[TEXTURE_SLOT_EMISSION].texCoord, b);
 #endif
     return vec2(0.0);
 }

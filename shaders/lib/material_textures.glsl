@@ -44,9 +44,17 @@ vec2 slotUv(TextureSlot slot, vec2 uv)
 
 vec4 lookupSlot(TextureSlot slot, SurfaceHit hit, float coneWidth, float cosTheta)
 {
-    float density = hit.uvDensity * abs(slot.scale.x * slot.scale.y);
+    vec2 uv = hit.uv;
+    float uvDensity = hit.uvDensity;
+#ifdef VKRT_HAS_MESH_UVS1
+    if (slot.texCoord == 1u) {
+        uv = hit.uv1;
+        uvDensity = hit.uvDensity1;
+    }
+#endif
+    float density = uvDensity * abs(slot.scale.x * slot.scale.y);
     float lod = rayConeTextureLod(slot.record, coneWidth, cosTheta, density);
-    return sampleTexture(slot.record, slotUv(slot, hit.uv), lod);
+    return sampleTexture(slot.record, slotUv(slot, uv), lod);
 }
 
 #ifdef VKRT_HAS_EMISSION_TEXTURES

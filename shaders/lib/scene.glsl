@@ -155,6 +155,10 @@ SurfaceHit describeHit(Ray r, HitId id)
     hit.uvDensity = 0.0;
     hit.tangent = vec4(1.0, 0.0, 0.0, 1.0);
 #endif
+#ifdef VKRT_HAS_MESH_UVS1
+    hit.uv1 = vec2(0.0);
+    hit.uvDensity1 = 0.0;
+#endif
 #ifdef VKRT_HAS_MESH_COLORS
     hit.color = vec4(1.0);
 #endif

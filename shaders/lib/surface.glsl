@@ -45,6 +45,10 @@ struct SurfaceHit {
     float uvDensity;
     vec4 tangent;
 #endif
+#ifdef VKRT_HAS_MESH_UVS1
+    vec2 uv1; // a mesh's second set (glTF TEXCOORD_1) and its density; zero elsewhere
+    float uvDensity1;
+#endif
 #ifdef VKRT_HAS_MESH_COLORS
     vec4 color; // the interpolated vertex colour (glTF COLOR_0) multiplying the base colour; white elsewhere
 #endif
@@ -138,6 +142,14 @@ vec3 triangleTestError(vec3 v0, vec3 v1, vec3 v2)
 // Triangles with uvs uv0..uv2 at world edges e1 = v1 - v0, e2 = v2 - v0:
 // uv by barycentrics, density from the two areas, the tangent from the uv
 // derivatives (Lengyel 2001) when no vertex tangents are given.
+// uv area per world area of a triangle (0 when degenerate).
+float triangleUvDensity(vec2 uv0, vec2 uv1, vec2 uv2, vec3 e1, vec3 e2)
+{
+    vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+    float worldArea = length(cross(e1, e2));
+    return worldArea > 0.0 ? abs(d1.x * d2.y - d1.y * d2.x) / worldArea : 0.0;
+}
+
 void triangleUv(vec3 bary, vec2 uv0, vec2 uv1, vec2 uv2, vec3 e1, vec3 e2, inout SurfaceHit hit)
 {
     hit.uv = bary.x * uv0 + bary.y * uv1 + bary.z * uv2;

@@ -59,11 +59,14 @@ VKRT_CONSTANT(uint, BINDING_TOP_LEVEL, BINDING_ENVIRONMENT + 18)
 VKRT_CONSTANT(uint, BINDING_MATERIAL_ALPHA, BINDING_ENVIRONMENT + 19)
 // Per mesh triangle, beside meshTriangles: vertex colours (MeshColors, meshes with COLOR_0 and file materials).
 VKRT_CONSTANT(uint, BINDING_MESH_COLORS, BINDING_ENVIRONMENT + 20)
+// Per mesh triangle, beside meshUvs: the second texture coordinate set (MeshUvs
+// of glTF TEXCOORD_1; variants where some texture reads it).
+VKRT_CONSTANT(uint, BINDING_MESH_UVS1, BINDING_ENVIRONMENT + 21)
 // Host only: a GLSL constant of a new value is emitted into every variant's
 // SPIR-V (glslang keeps folded constants), so a binding added for one feature
 // would change every kernel; the kernels never need the count.
 #ifdef __cplusplus
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 21)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 22)
 #endif
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);

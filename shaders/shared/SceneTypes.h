@@ -92,6 +92,7 @@ VKRT_CONSTANT(uint, MESH_FLAG_TANGENTS, 16)  // meshTangents holds its triangles
 VKRT_CONSTANT(uint, MESH_FLAG_MATERIALS, 32) // meshMaterials holds each triangle's material (file materials)
 VKRT_CONSTANT(uint, MESH_FLAG_COLORS, 64)    // meshColors holds its triangles' vertex colours (glTF COLOR_0)
 VKRT_CONSTANT(uint, MESH_FLAG_ALPHA, 128)    // some material of it is alpha-tested (MaterialAlpha: MASK or BLEND)
+VKRT_CONSTANT(uint, MESH_FLAG_UVS1, 256)     // meshUvs1 holds its triangles' second texture coordinates
 
 /// One instance of a mesh (src/scene/Scene.h: Mesh). The matrices are the
 /// object -> camera-relative world transform and its inverse, as three rows

@@ -65,6 +65,7 @@ struct TextureSlot {
     vec2 scale;
     vec2 offset;
     vec2 rotation;
+    uint texCoord; // the surface's uv set it reads: 0, or 1 (a mesh's second set, glTF TEXCOORD_1)
 };
 
 // MaterialTextures::slots, by parameter:

@@ -41,7 +41,8 @@ constexpr bool bindingsDistinct()
                               BINDING_MATERIAL_TABLES,   BINDING_TEXTURE_TEXELS, BINDING_TEXTURE_RECORDS,
                               BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS,       BINDING_MESH_TANGENTS,
                               BINDING_MESH_MATERIALS,    BINDING_FRAME_RUN,      BINDING_AOVS,
-                              BINDING_TOP_LEVEL,         BINDING_MESH_COLORS,    BINDING_MATERIAL_ALPHA};
+                              BINDING_TOP_LEVEL,         BINDING_MESH_COLORS,    BINDING_MATERIAL_ALPHA,
+                              BINDING_MESH_UVS1};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)

@@ -12,8 +12,8 @@ static_assert(sizeof(TextureRecord) == 4 * (6 + TEXTURE_MAX_LEVELS));
 static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, levelOffset) == 24);
 // Level sizes: the largest side has floor(log2(TEXTURE_MAX_SIZE)) + 1 levels.
 static_assert((1u << (TEXTURE_MAX_LEVELS - 1)) == TEXTURE_MAX_SIZE);
-static_assert(sizeof(TextureSlot) == 32);
-static_assert(sizeof(MaterialTextures) == 32 * TEXTURE_SLOT_COUNT + 4);
+static_assert(sizeof(TextureSlot) == 36);
+static_assert(sizeof(MaterialTextures) == 36 * TEXTURE_SLOT_COUNT + 4);
 // lib/material_textures.glsl's texturedMaterial reads the slots before the
 // emission slot, which must be the last (the emitters read it).
 static_assert(TEXTURE_SLOT_EMISSION == TEXTURE_SLOT_NORMAL + 1 && TEXTURE_SLOT_COUNT == TEXTURE_SLOT_EMISSION + 1);

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -378,7 +379,8 @@ struct MeshBuilder {
     std::vector<std::string>& warnings;
     std::optional<uint32_t> variant; ///< KHR_materials_variants' chosen variant
     MeshData out;
-    bool anyNormals = false, anyUvs = false, anyColors = false, allTangents = true;
+    bool anyNormals = false, anyUvs = false, anyUvs1 = false, anyColors = false, allTangents = true;
+    std::optional<uint32_t> normalMapSet; ///< the uv set of the first normal map its primitives' materials have
 
     void warnOnce(const std::string& text)
     {
@@ -399,15 +401,40 @@ struct MeshBuilder {
                              std::to_string(count));
     }
 
-    /// The uv set the primitive's material reads: one set for all its
-    /// textures (MeshData has one); a material mixing sets gets set 0 and a warning.
-    uint32_t uvSetFor(const FileMaterial& material, const std::string& where)
+    /// A primitive's TEXCOORD_n attribute; a set its material's textures read must be there.
+    std::optional<Accessor<>> uvSet(uint32_t set, const FileMaterial& material,
+                                    const std::function<std::optional<Accessor<>>(const char*)>& optional,
+                                    const std::string& where)
     {
-        const std::set<uint32_t> sets = texCoordSets(material);
-        if (sets.size() > 1)
-            warnOnce(where + ": its material's textures read TEXCOORD_0 and TEXCOORD_1; vkrt reads one set per "
-                             "material: all through TEXCOORD_" + std::to_string(*sets.begin()));
-        return sets.empty() ? 0 : *sets.begin();
+        const std::string name = "TEXCOORD_" + std::to_string(set);
+        std::optional<Accessor<>> uvs = optional(name.c_str());
+        if (!uvs && texCoordSets(material).count(set))
+            fail(d.file, where + ": its material (" + (material.name.empty() ? "unnamed" : "'" + material.name + "'") +
+                             ") samples textures through " + name + ", which the primitive does not have");
+        return uvs;
+    }
+
+    /// Notes which uv set the primitive's normal map reads: the mesh's tangents follow it (glTF 3.7.2.1).
+    void noteNormalMapSet(const FileMaterial& material, const std::string& where)
+    {
+        if (!material.normalTexture) return;
+        const uint32_t set = material.normalTexture->texCoord;
+        if (normalMapSet && *normalMapSet != set)
+            warnOnce(where + ": the mesh's normal maps read both TEXCOORD_0 and TEXCOORD_1; its tangents follow "
+                             "TEXCOORD_" + std::to_string(*normalMapSet));
+        if (!normalMapSet) normalMapSet = set;
+    }
+
+    /// Appends one vertex's uv of `uvs` (zero without), v turned up (MeshData.h).
+    void appendUv(std::vector<glm::vec2>& to, const std::optional<Accessor<>>& uvs, uint64_t i, const std::string& where)
+    {
+        glm::vec2 uv(0.0f);
+        if (uvs) {
+            if (!finite(*uvs, i))
+                fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite texture coordinate");
+            uv = glm::vec2(float(uvs->at(i, 0)), float(1.0 - uvs->at(i, 1)));
+        }
+        to.push_back(uv);
     }
 
     void addPrimitive(const json& primitive, const std::string& where)
@@ -432,15 +459,15 @@ struct MeshBuilder {
             checkCount(a, count, where, name);
             return a;
         };
+        auto optionalUv = [&](const char* name) { return optional(name, {2}); };
         const std::optional<Accessor<>> normals = optional("NORMAL", {3});
         const std::optional<Accessor<>> tangents = normals ? optional("TANGENT", {4}) : std::nullopt;
-        const uint32_t uvSet = uvSetFor(material, where);
-        const std::string uvName = "TEXCOORD_" + std::to_string(uvSet);
-        const std::optional<Accessor<>> uvs = optional(uvName.c_str(), {2});
+        const std::optional<Accessor<>> uvs = uvSet(0, material, optionalUv, where);
+        // TEXCOORD_1 is read only where a texture reads it: most files' second set is a lightmap's.
+        const std::optional<Accessor<>> uvs1 =
+            texCoordSets(material).count(1) ? uvSet(1, material, optionalUv, where) : std::nullopt;
         const std::optional<Accessor<>> colors = optional("COLOR_0", {3, 4});
-        if (!uvs && !texCoordSets(material).empty())
-            fail(d.file, where + ": its material (" + (material.name.empty() ? "unnamed" : "'" + material.name + "'") +
-                             ") samples textures through " + uvName + ", which the primitive does not have");
+        noteNormalMapSet(material, where);
         std::vector<uint32_t> sequence(count);
         if (const auto indices = uintMember(primitive, "indices")) {
             const std::string indicesWhere = where + ".indices";
@@ -488,13 +515,8 @@ struct MeshBuilder {
                 t = length > 0.0 ? glm::vec4(glm::vec3(v / length), w) : glm::vec4(0.0f);
             }
             out.tangents.push_back(t);
-            glm::vec2 uv(0.0f);
-            if (uvs) {
-                if (!finite(*uvs, i))
-                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite texture coordinate");
-                uv = glm::vec2(float(uvs->at(i, 0)), float(1.0 - uvs->at(i, 1)));
-            }
-            out.uvs.push_back(uv);
+            appendUv(out.uvs, uvs, i, where);
+            appendUv(out.uvs1, uvs1, i, where);
             glm::vec4 color(1.0f);
             if (colors) {
                 if (!finite(*colors, i))
@@ -505,6 +527,7 @@ struct MeshBuilder {
         }
         anyNormals |= normals.has_value();
         anyUvs |= uvs.has_value();
+        anyUvs1 |= uvs1.has_value();
         anyColors |= colors.has_value();
         allTangents &= tangents.has_value();
         for (const glm::uvec3& t : assembleTriangles(sequence, mode)) {
@@ -518,8 +541,10 @@ struct MeshBuilder {
     {
         if (!anyNormals) out.normals.clear();
         if (!anyUvs) out.uvs.clear();
+        if (!anyUvs1) out.uvs1.clear();
         if (!anyColors) out.colors.clear();
-        if (!allTangents || out.uvs.empty() || out.normals.empty()) out.tangents.clear();
+        out.tangentUvSet = normalMapSet.value_or(0);
+        if (!allTangents || tangentUvs(out).empty() || out.normals.empty()) out.tangents.clear();
         return std::move(out);
     }
 };
@@ -936,6 +961,7 @@ void appendInstance(MeshData& out, const MeshData& mesh, const glm::dmat4& world
                                                                          : glm::vec4(0.0f));
         }
         if (!mesh.uvs.empty()) out.uvs.push_back(mesh.uvs[v]);
+        if (!mesh.uvs1.empty()) out.uvs1.push_back(mesh.uvs1[v]);
         if (!mesh.colors.empty()) out.colors.push_back(mesh.colors[v]);
     }
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -972,11 +998,18 @@ MeshData flattenGltfModel(GltfModel model)
         return std::all_of(model.instances.begin(), model.instances.end(),
                            [&](const GltfInstance& i) { return !(model.meshes[i.mesh].*member).empty(); });
     };
-    const bool normals = any(&MeshData::normals), uvs = any(&MeshData::uvs), colors = any(&MeshData::colors);
-    const bool tangents = all(&MeshData::tangents);
+    const bool normals = any(&MeshData::normals), uvs = any(&MeshData::uvs), uvs1 = any(&MeshData::uvs1);
+    const bool colors = any(&MeshData::colors);
+    // One tangent set for the joined mesh: kept only where every mesh has tangents of the same uv set.
+    const uint32_t tangentSet = model.instances.empty() ? 0 : model.meshes[model.instances.front().mesh].tangentUvSet;
+    const bool tangents = all(&MeshData::tangents) &&
+                          std::all_of(model.instances.begin(), model.instances.end(), [&](const GltfInstance& i) {
+                              return model.meshes[i.mesh].tangentUvSet == tangentSet;
+                          });
     for (MeshData& mesh : model.meshes) {
         if (normals && mesh.normals.empty()) mesh.normals.assign(mesh.positions.size(), glm::vec3(0.0f));
         if (uvs && mesh.uvs.empty()) mesh.uvs.assign(mesh.positions.size(), glm::vec2(0.0f));
+        if (uvs1 && mesh.uvs1.empty()) mesh.uvs1.assign(mesh.positions.size(), glm::vec2(0.0f));
         if (colors && mesh.colors.empty()) mesh.colors.assign(mesh.positions.size(), glm::vec4(1.0f));
         if (!tangents) mesh.tangents.clear();
     }
@@ -1000,6 +1033,7 @@ MeshData flattenGltfModel(GltfModel model)
     for (const std::string& warning : model.warnings) out.materials.front().unsupported.push_back(warning);
     out.positions.reserve(vertices);
     out.triangles.reserve(triangles);
+    out.tangentUvSet = tangentSet;
     for (const GltfInstance& i : model.instances) appendInstance(out, model.meshes[i.mesh], i.world, materialMap);
     return out;
 }

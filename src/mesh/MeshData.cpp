@@ -109,7 +109,7 @@ AttributeKey attributeKey(const MeshData& mesh, uint32_t vertex)
     for (int i = 0; i < 3; ++i) values[i] = mesh.positions[vertex][i];
     if (!mesh.normals.empty())
         for (int i = 0; i < 3; ++i) values[3 + i] = mesh.normals[vertex][i];
-    for (int i = 0; i < 2; ++i) values[6 + i] = mesh.uvs[vertex][i];
+    for (int i = 0; i < 2; ++i) values[6 + i] = tangentUvs(mesh)[vertex][i];
     AttributeKey key;
     for (size_t i = 0; i < values.size(); ++i) {
         const float v = values[i] == 0.0f ? 0.0f : values[i];
@@ -156,7 +156,7 @@ void accumulateTriangle(const MeshData& mesh, const glm::uvec3& triangle, const 
     std::array<glm::dvec2, 3> uv;
     for (int k = 0; k < 3; ++k) {
         p[k] = mesh.positions[triangle[k]];
-        uv[k] = mesh.uvs[triangle[k]];
+        uv[k] = tangentUvs(mesh)[triangle[k]];
     }
     // p - p0 = (u - u0) dp/du + (v - v0) dp/dv, solved for dp/du and dp/dv over two edges.
     const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
@@ -243,7 +243,7 @@ glm::vec3 perpendicularTo(glm::vec3 n)
 void computeTangents(MeshData& mesh)
 {
     mesh.tangents.clear();
-    if (mesh.uvs.empty()) return;
+    if (tangentUvs(mesh).empty()) return;
     const std::vector<glm::vec3> reference = tangentReferenceNormals(mesh);
     const std::vector<uint32_t> weld = weldByAttributes(mesh);
     std::vector<TangentSum> sums(mesh.positions.size());

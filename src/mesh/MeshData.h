@@ -5,8 +5,8 @@
 // file's materials (glTF) with one per triangle. Produced only by
 // loadMeshFile (MeshLoader.h) or the procedural generators (Procedural.h),
 // which guarantee: every index < positions.size(); normals, uvs and
-// tangents are empty or have one entry per position; tangents only where
-// there are uvs; every coordinate is finite; at least one triangle;
+// tangents are empty or have one entry per position (uvs1 too); tangents only where
+// there are tangentUvs; every coordinate is finite; at least one triangle;
 // triangleMaterials is empty exactly when materials is, else has one entry
 // per triangle, each < materials.size(). Normals are unit or (0, 0, 0) (use
 // the face normal); tangents are unit with w = +1 or -1. Degenerate
@@ -25,6 +25,11 @@ struct MeshData {
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals; ///< unit vertex normals, or empty
     std::vector<glm::vec2> uvs;     ///< texture coordinates, or empty
+    /// A second set (glTF TEXCOORD_1, read where a texture samples through it), or empty.
+    std::vector<glm::vec2> uvs1;
+    /// The set (0: uvs, 1: uvs1) whose derivatives the tangents follow: glTF's
+    /// normal texture's (3.7.2.1), computed tangents included.
+    uint32_t tangentUvSet = 0;
     /// Per vertex, or empty: xyz the unit tangent along increasing u (dp/du),
     /// perpendicular to the vertex normal (to the smooth normal where the
     /// mesh has none); w = +1 or -1 so that w * cross(normal, xyz) is the
@@ -38,6 +43,12 @@ struct MeshData {
     /// The file's materials that its triangles use (glTF 2.0 only; OBJ and PLY leave it empty).
     std::vector<FileMaterial> materials;
 };
+
+/// The texture coordinates the tangents belong to (MeshData::tangentUvSet).
+inline const std::vector<glm::vec2>& tangentUvs(const MeshData& mesh)
+{
+    return mesh.tangentUvSet == 1 ? mesh.uvs1 : mesh.uvs;
+}
 
 /// How a mesh's shading normals are chosen (scene format `normals = ...`).
 enum class NormalMode {
@@ -58,7 +69,7 @@ void computeSmoothNormals(MeshData& mesh);
 /// smooth normals for Face), keeping their handedness w.
 void applyNormalMode(MeshData& mesh, NormalMode mode);
 
-/// Fills mesh.tangents from the uvs (which it needs; no uvs: no tangents),
+/// Fills mesh.tangents from tangentUvs(mesh) (which it needs; none: no tangents),
 /// MikkTSpace's construction as far as shading sees it: each triangle's
 /// tangent and bitangent from its uv derivatives, each made perpendicular to
 /// the corner's vertex normal (the smooth normal where the mesh has none or

@@ -45,6 +45,7 @@ size_t MeshGeometry::gpuBytes() const
     if (!data.normals.empty()) bytes += data.triangles.size() * sizeof(gpu::MeshNormals);
     // Uploaded per triangle corner in leaf order: a vec2 uv and a vec4 tangent each, one material index per triangle.
     if (!data.uvs.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec2);
+    if (!data.uvs1.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec2);
     if (!data.tangents.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec4);
     if (!data.triangleMaterials.empty()) bytes += data.triangles.size() * sizeof(uint32_t);
     if (!data.colors.empty()) bytes += data.triangles.size() * 3 * sizeof(glm::vec4);
@@ -58,7 +59,7 @@ std::shared_ptr<const MeshGeometry> makeMeshGeometry(MeshData data, NormalMode n
     geometry->normals = normals;
     applyNormalMode(data, normals);
     // After the normal mode: generated tangents are perpendicular to the normals the mesh keeps.
-    if (!data.uvs.empty() && data.tangents.empty()) computeTangents(data);
+    if (!tangentUvs(data).empty() && data.tangents.empty()) computeTangents(data);
     const std::vector<Aabb> boxes = triangleBoxes(data.positions, data.triangles);
     geometry->bvh = buildBvh(boxes);
     if (geometry->bvh.depth > gpu::BVH_STACK_SIZE)

@@ -61,11 +61,15 @@ gpu::MaterialTextures convertMaterialTextures(const Material& m)
 {
     gpu::MaterialTextures g{};
     for (size_t slot = 0; slot < kTextureSlotCount; ++slot) {
-        g.slots[slot] = gpu::TextureSlot{gpu::NO_TEXTURE, 0u, glm::vec2(1.0f), glm::vec2(0.0f), glm::vec2(1.0f, 0.0f)};
+        g.slots[slot] =
+            gpu::TextureSlot{gpu::NO_TEXTURE, 0u, glm::vec2(1.0f), glm::vec2(0.0f), glm::vec2(1.0f, 0.0f), 0u};
         if (const auto& texture = m.textures[slot])
-            g.slots[slot] = gpu::TextureSlot{
-                texture->record, texture->channel, glm::vec2(texture->scale), glm::vec2(texture->offset),
-                glm::vec2(std::cos(texture->rotation), std::sin(texture->rotation))};
+            g.slots[slot] = gpu::TextureSlot{texture->record,
+                                             texture->channel,
+                                             glm::vec2(texture->scale),
+                                             glm::vec2(texture->offset),
+                                             glm::vec2(std::cos(texture->rotation), std::sin(texture->rotation)),
+                                             texture->texCoord};
     }
     g.normalStrength = float(m.normalStrength);
     return g;
@@ -194,12 +198,13 @@ bool triangleEmissionTextured(const Scene& scene, const Mesh& mesh, uint32_t slo
     return mesh.emission == Color(0.0) && emissionTextured(triangleMaterial(scene, mesh, slot));
 }
 
-/// A mesh triangle's texture coordinates (zero without uvs, as the kernel's MeshUvs).
-std::array<glm::dvec2, 3> triangleUvs(const MeshGeometry& g, uint32_t slot)
+/// A mesh triangle's texture coordinates of uv set `set` (zero without, as the kernel's MeshUvs).
+std::array<glm::dvec2, 3> triangleUvs(const MeshGeometry& g, uint32_t slot, uint32_t set)
 {
-    if (g.data.uvs.empty()) return {};
+    const std::vector<glm::vec2>& uvs = set == 1 ? g.data.uvs1 : g.data.uvs;
+    if (uvs.empty()) return {};
     const glm::uvec3 t = g.data.triangles[slot];
-    return {glm::dvec2(g.data.uvs[t.x]), glm::dvec2(g.data.uvs[t.y]), glm::dvec2(g.data.uvs[t.z])};
+    return {glm::dvec2(uvs[t.x]), glm::dvec2(uvs[t.y]), glm::dvec2(uvs[t.z])};
 }
 
 /// The mean radiance a mesh triangle emits over its area: the emission,
@@ -210,8 +215,9 @@ double meanTriangleRadiance(const Scene& scene, const Mesh& mesh, uint32_t slot)
     if (!triangleEmissionTextured(scene, mesh, slot)) return meanOf(radiance);
     VKRT_CHECK(scene.textures != nullptr);
     const Material& m = triangleMaterial(scene, mesh, slot);
+    const MaterialTexture& texture = *m.texture(TextureSlot::Emission);
     const glm::dvec3 texel =
-        meanEmissionTexel(*scene.textures, *m.texture(TextureSlot::Emission), triangleUvs(*mesh.geometry, slot));
+        meanEmissionTexel(*scene.textures, texture, triangleUvs(*mesh.geometry, slot, texture.texCoord));
     return (radiance.r * texel.r + radiance.g * texel.g + radiance.b * texel.b) / 3.0;
 }
 
@@ -462,6 +468,7 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
         record.flags = (at.normals ? gpu::MESH_FLAG_NORMALS : 0u) | (emissive ? gpu::MESH_FLAG_EMISSIVE : 0u) |
                        (mesh.twoSided ? gpu::MESH_FLAG_TWO_SIDED : 0u) |
                        (!g.data.uvs.empty() ? gpu::MESH_FLAG_UVS : 0u) |
+                       (!g.data.uvs1.empty() ? gpu::MESH_FLAG_UVS1 : 0u) |
                        (!g.data.tangents.empty() ? gpu::MESH_FLAG_TANGENTS : 0u) |
                        (!mesh.fileMaterials.empty() ? gpu::MESH_FLAG_MATERIALS : 0u) |
                        (meshHasVertexColors(mesh) ? gpu::MESH_FLAG_COLORS : 0u) |
@@ -594,10 +601,12 @@ uint64_t emissiveTriangleCount(const Scene& scene)
 void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features, GpuSceneStatic& fixed)
 {
     const MeshData& d = mesh.geometry->data;
-    if (features.textures) {
+    auto appendUvs = [&](const std::vector<glm::vec2>& uvs, std::vector<gpu::MeshUvs>& to) {
         for (const glm::uvec3& t : d.triangles)
-            fixed.meshUvs.push_back(d.uvs.empty() ? gpu::MeshUvs{} : gpu::MeshUvs{d.uvs[t.x], d.uvs[t.y], d.uvs[t.z]});
-    }
+            to.push_back(uvs.empty() ? gpu::MeshUvs{} : gpu::MeshUvs{uvs[t.x], uvs[t.y], uvs[t.z]});
+    };
+    if (features.textures) appendUvs(d.uvs, fixed.meshUvs);
+    if (features.textures && features.secondUvs) appendUvs(d.uvs1, fixed.meshUvs1);
     if (features.normalMaps) {
         for (const glm::uvec3& t : d.triangles) {
             fixed.meshTangents.push_back(d.tangents.empty()
@@ -634,6 +643,7 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     const FeatureSet features = featuresOf(scene);
     // The per-triangle attributes start at index 0 beside meshTriangles: drop the placeholders.
     if (features.textures) fixed.meshUvs.clear();
+    if (features.textures && features.secondUvs) fixed.meshUvs1.clear();
     if (features.normalMaps) fixed.meshTangents.clear();
     if (features.fileMaterials) fixed.meshMaterials.clear();
     if (features.vertexColors) fixed.meshColors.clear();
@@ -656,9 +666,12 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     checkBufferSize(fixed.meshTriangles.size() * sizeof(gpu::MeshTriangle), maxBytes, "mesh triangles", scene);
     checkBufferSize(fixed.meshNormals.size() * sizeof(gpu::MeshNormals), maxBytes, "mesh normals", scene);
     checkBufferSize(fixed.meshUvs.size() * sizeof(gpu::MeshUvs), maxBytes, "mesh texture coordinates", scene);
+    checkBufferSize(fixed.meshUvs1.size() * sizeof(gpu::MeshUvs), maxBytes, "mesh texture coordinates (TEXCOORD_1)",
+                    scene);
     checkBufferSize(fixed.meshTangents.size() * sizeof(gpu::MeshTangents), maxBytes, "mesh tangents", scene);
     checkBufferSize(fixed.meshColors.size() * sizeof(gpu::MeshColors), maxBytes, "mesh vertex colours", scene);
     if (fixed.meshUvs.empty()) fixed.meshUvs.push_back(gpu::MeshUvs{});
+    if (fixed.meshUvs1.empty()) fixed.meshUvs1.push_back(gpu::MeshUvs{});
     if (fixed.meshTangents.empty()) fixed.meshTangents.push_back(gpu::MeshTangents{});
     if (fixed.meshMaterials.empty()) fixed.meshMaterials.push_back(0u);
     if (fixed.meshColors.empty()) fixed.meshColors.push_back(gpu::MeshColors{});

@@ -60,6 +60,7 @@ struct GpuSceneStatic {
     /// features need them (textures, normal maps, file materials); each has
     /// at least one record so the buffer can always be bound.
     std::vector<gpu::MeshUvs> meshUvs{gpu::MeshUvs{}};
+    std::vector<gpu::MeshUvs> meshUvs1{gpu::MeshUvs{}}; ///< the second set, beside meshUvs
     std::vector<gpu::MeshTangents> meshTangents{gpu::MeshTangents{}};
     std::vector<uint32_t> meshMaterials{0u};
     std::vector<gpu::MeshColors> meshColors{gpu::MeshColors{}};

@@ -53,6 +53,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({f.textures, "VKRT_HAS_MATERIAL_TEXTURES", int(gpu::BINDING_MATERIAL_TEXTURES), ""});
     list.push_back({f.textures && f.normalMaps, "VKRT_HAS_NORMAL_MAPS", -1, "normal-maps"});
     list.push_back({meshes && f.textures, "VKRT_HAS_MESH_UVS", int(gpu::BINDING_MESH_UVS), ""});
+    list.push_back({meshes && f.textures && f.secondUvs, "VKRT_HAS_MESH_UVS1", int(gpu::BINDING_MESH_UVS1), "uv1"});
     list.push_back(
         {meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS), ""});
     // An emission texture is read by the emitters at the mesh triangle's uvs.

@@ -33,7 +33,7 @@ void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation
 }
 
 /// The uber kernel's features: every feature, except that the glTF alpha
-/// test and emission textures come only with a scene that uses them. Measured
+/// test, emission textures and second uv set come only with a scene that uses them. Measured
 /// on Mesa 26.1's lavapipe (LLVM 19.1): an uber kernel with either, rendering
 /// a scene without them, crashed the driver (SIGSEGV in the dispatch; Mesa
 /// 25.0 ran it), while their own variants render right on both. Until the
@@ -44,6 +44,7 @@ FeatureSet uberFeatures(const Scene& scene)
     const FeatureSet own = featuresOf(scene);
     features.alpha = own.alpha;
     features.emissionTextures = own.emissionTextures;
+    features.secondUvs = own.secondUvs;
     return features;
 }
 
@@ -309,7 +310,7 @@ void Renderer::uploadMeshBuffers()
         m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage | extra));
         m_kernel.bind(binding, m_meshBuffers.back());
     };
-    m_meshBuffers.reserve(11); // bind() keeps references: no reallocation (one per addBuffer below)
+    m_meshBuffers.reserve(12); // bind() keeps references: no reallocation (one per addBuffer below)
     addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
     // The driver backend builds its triangle structures from this same buffer.
     addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles,
@@ -317,6 +318,7 @@ void Renderer::uploadMeshBuffers()
     if (m_variant.driverAccel && m_kernel.uses(gpu::BINDING_MESH_TRIANGLES)) m_meshTriangles = &m_meshBuffers.back();
     addBuffer(gpu::BINDING_MESH_NORMALS, m_static.meshNormals);
     addBuffer(gpu::BINDING_MESH_UVS, m_static.meshUvs);
+    addBuffer(gpu::BINDING_MESH_UVS1, m_static.meshUvs1);
     addBuffer(gpu::BINDING_MESH_TANGENTS, m_static.meshTangents);
     addBuffer(gpu::BINDING_MESH_MATERIALS, m_static.meshMaterials);
     addBuffer(gpu::BINDING_MESH_COLORS, m_static.meshColors);

@@ -41,6 +41,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.emissionTextures = true;
     all.fileMaterials = true;
     all.vertexColors = true;
+    all.secondUvs = true;
     all.thinLens = true;
     all.orthographic = true;
     all.alpha = true;
@@ -59,6 +60,7 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
         set.materialTypes[size_t(material.type)] = true;
         set.textures = set.textures || material.hasTextures();
         set.normalMaps = set.normalMaps || material.hasNormalMap();
+        set.secondUvs = set.secondUvs || material.readsUvSet(1);
     };
 #define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     for (const auto& shape : scene.array) markUsed(shape.material);

@@ -33,7 +33,7 @@ MaterialTexture slot(uint32_t record, const FileTexture& texture, uint32_t chann
 {
     const double c = std::cos(texture.rotation), s = std::sin(texture.rotation);
     const glm::dvec2 offset(texture.offset.x + s * texture.scale.y, 1.0 - texture.offset.y - c * texture.scale.y);
-    return MaterialTexture{record, channel, texture.scale, offset, -texture.rotation};
+    return MaterialTexture{record, channel, texture.scale, offset, -texture.rotation, texture.texCoord};
 }
 
 std::string displayName(const FileMaterial& f, size_t index)

@@ -165,6 +165,8 @@ struct MaterialTexture {
     /// rotation in radians, counter-clockwise in uv.
     glm::dvec2 offset{0.0};
     double rotation = 0.0;
+    /// The surface's uv set it reads: 0, or 1 (a mesh's MeshData::uvs1, glTF TEXCOORD_1).
+    uint32_t texCoord = 0;
 };
 
 /// Which parameter a texture drives (gpu::TEXTURE_SLOT_*).
@@ -210,6 +212,8 @@ struct Material {
 
     const std::optional<MaterialTexture>& texture(TextureSlot slot) const { return textures[size_t(slot)]; }
     bool hasTextures() const;
+    /// Whether a texture of it reads uv set `set` (MaterialTexture::texCoord).
+    bool readsUvSet(uint32_t set) const;
     bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
     bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
@@ -223,6 +227,13 @@ inline bool Material::hasTextures() const
 {
     for (const auto& t : textures)
         if (t) return true;
+    return false;
+}
+
+inline bool Material::readsUvSet(uint32_t set) const
+{
+    for (const auto& t : textures)
+        if (t && t->texCoord == set) return true;
     return false;
 }
 

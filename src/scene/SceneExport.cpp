@@ -317,7 +317,8 @@ Json geometry(const MeshGeometry& g)
 {
     return {{"vertices", g.data.positions.size()},      {"triangles", g.data.triangles.size()},
             {"has_normals", !g.data.normals.empty()},   {"has_uvs", !g.data.uvs.empty()},
-            {"has_tangents", !g.data.tangents.empty()}, {"bounds", bounds(g.bounds)}};
+            {"has_uvs1", !g.data.uvs1.empty()},         {"has_tangents", !g.data.tangents.empty()},
+            {"bounds", bounds(g.bounds)}};
 }
 
 Json record(const Mesh& m)

@@ -4,6 +4,7 @@
 // in their attributes, strips and fans, sparse and interleaved accessors,
 // normalized vertex colours, negative scales, scenes, and the extension rules.
 #include "mesh/GltfReader.h"
+#include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "scene/GltfScene.h"
 #include "support/GltfTestFiles.h"
@@ -188,6 +189,54 @@ TEST(GltfReader, PrimitivesWithAndWithoutTextureCoordinatesShareAFile)
     const std::string error = errorOf([&] { readGltfModel(bad.write("bad-uvs.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
     EXPECT_NE(error.find("TEXCOORD_0"), std::string::npos) << error;
+}
+
+TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
+{
+    // Material 0 reads its base colour through TEXCOORD_1 and its normal map
+    // through KHR_texture_transform's texCoord override to 1; material 1 reads
+    // set 0 only, so its primitive's TEXCOORD_1 (a lightmap's, say) is not kept.
+    GltfBuilder b;
+    b.doc()["materials"] = json::parse(R"([
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}},
+         "normalTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1}}}},
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])");
+    b.doc()["textures"] = {{{"source", 0}}};
+    b.doc()["images"] = {{{"uri", "texture.png"}}};
+    auto twoSets = [&](uint32_t material) {
+        return b.mesh({{"POSITION", b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3")},
+                       {"NORMAL", b.floats({0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3")},
+                       {"TEXCOORD_0", b.floats({0, 0, 0, 0, 0, 0}, "VEC2")},
+                       {"TEXCOORD_1", b.floats({0, 0, 1, 0, 0, 1}, "VEC2")}},
+                      std::nullopt, 4, material);
+    };
+    b.node({{"mesh", twoSets(0)}});
+    b.node({{"mesh", twoSets(1)}});
+    const GltfModel model = readGltfModel(b.write("second-set.gltf"));
+    ASSERT_EQ(model.meshes.size(), 2u);
+    const MeshData& second = model.meshes[0];
+    ASSERT_EQ(second.uvs1.size(), 3u);
+    // v turned up, as set 0's (MeshData.h): file (1, 0) -> (1, 1), (0, 1) -> (0, 0).
+    EXPECT_EQ(second.uvs1[1], glm::vec2(1.0f, 1.0f));
+    EXPECT_EQ(second.uvs1[2], glm::vec2(0.0f, 0.0f));
+    EXPECT_EQ(second.uvs[1], glm::vec2(0.0f, 1.0f));
+    EXPECT_EQ(second.tangentUvSet, 1u) << "the normal map reads set 1: the tangents follow it";
+    EXPECT_TRUE(model.meshes[1].uvs1.empty());
+    EXPECT_EQ(model.meshes[1].tangentUvSet, 0u);
+    // Set 1's tangent is along its increasing u: +x here (set 0 is degenerate and gives none).
+    const auto geometry = makeMeshGeometry(second, NormalMode::File, "second-set.gltf");
+    ASSERT_EQ(geometry->data.tangents.size(), 3u);
+    EXPECT_NEAR(geometry->data.tangents[0].x, 1.0f, 1e-6f);
+
+    // A primitive without the TEXCOORD_1 its material reads is refused, by name.
+    GltfBuilder bad;
+    bad.doc()["materials"] = b.doc()["materials"];
+    bad.doc()["textures"] = b.doc()["textures"];
+    bad.doc()["images"] = b.doc()["images"];
+    bad.node({{"mesh", triangleMesh(bad, true, 0)}});
+    const std::string error = errorOf([&] { readGltfModel(bad.write("bad-uv1.gltf")); });
+    EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
+    EXPECT_NE(error.find("TEXCOORD_1"), std::string::npos) << error;
 }
 
 TEST(GltfReader, StripsAndFansBecomeTrianglesWithTheirWinding)

@@ -6,7 +6,9 @@
 // - a Lambert floor under a textured emissive quad (light sampling with the
 //   texture at the sampled point, MIS against BSDF-sampled hits that read the
 //   texture at the hit) converges to (albedo / pi) x the irradiance integral
-//   over the texture, computed here by a midpoint rule over bilinear texels.
+//   over the texture, computed here by a midpoint rule over bilinear texels;
+// both with the texture read through TEXCOORD_0 and through TEXCOORD_1.
+#include "mesh/MeshGeometry.h"
 #include "render/Renderer.h"
 #include "scene/SceneParser.h"
 #include "support/GltfTestFiles.h"
@@ -68,13 +70,26 @@ struct BlockTexture {
 /// emissiveFactor (1, 0.5, 0.25) x emissiveStrength 4, black base colour.
 const glm::dvec3 kFactor(4.0, 2.0, 1.0);
 
-std::string emissiveMaterial()
+/// The emissive material, its texture read through TEXCOORD_`uvSet`.
+std::string emissiveMaterial(int uvSet)
 {
     return R"("extensionsUsed": ["KHR_materials_emissive_strength"],
   "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 0.5, 0.25],
-    "emissiveTexture": {"index": 0},
+    "emissiveTexture": {"index": 0, "texCoord": )" +
+           std::to_string(uvSet) + R"(},
     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}],
   "textures": [{"source": 0}], "images": [{"uri": "blocks.png"}])";
+}
+
+/// `quad` with its uvs moved to TEXCOORD_1 for uvSet 1, TEXCOORD_0 then one
+/// constant point of another block (a lookup through the wrong set would show it).
+GltfQuad withUvSet(GltfQuad quad, int uvSet)
+{
+    if (uvSet == 1) {
+        quad.uv1 = quad.uv;
+        quad.uv.fill({0.9f, 0.1f});
+    }
+    return quad;
 }
 
 // ------------------------------------------------------------- seen directly
@@ -83,12 +98,12 @@ constexpr uint32_t kSide = 33; // the view at z = 0 is exactly [-0.5, 0.5]^2
 
 /// The quad [-0.5, 0.5]^2 at z = 0 facing +z, the image upright on it, seen
 /// head-on from +z.
-Scene headOnScene(const fs::path& dir, const std::string& integrator)
+Scene headOnScene(const fs::path& dir, const std::string& integrator, int uvSet = 0)
 {
     BlockTexture::write(dir / "blocks.png");
     const GltfQuad quad{{{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}}},
                         {{{0, 1}, {1, 1}, {1, 0}, {0, 0}}}};
-    writeText(dir / "quad.gltf", quadsGltf({quad}, emissiveMaterial()));
+    writeText(dir / "quad.gltf", quadsGltf({withUvSet(quad, uvSet)}, emissiveMaterial(uvSet)));
     const double fov = 2.0 * std::atan(0.5 / 3.0) * 180.0 / kPi;
     return parseSceneString("[render]\nintegrator = \"" + integrator +
                                 "\"\nmax_depth = 1\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = " +
@@ -141,6 +156,15 @@ TEST_F(EmissionTextureRender, AQuadSeenHeadOnShowsTexelTimesFactorTimesStrength)
         RecordProperty("driver", "skipped: " + gpu().deviceInfo().rayQueryMissing);
 }
 
+TEST_F(EmissionTextureRender, ATextureReadThroughTheSecondUvSetShowsItsTexels)
+{
+    // texCoord 1: the hit reads TEXCOORD_1 (TEXCOORD_0 points at one other block throughout).
+    const fs::path dir = freshTempDir("emission-uv1");
+    const Scene scene = headOnScene(dir, "path", 1);
+    ASSERT_FALSE(scene.meshes.front().geometry->data.uvs1.empty());
+    expectTexels(renderCentres(scene, false), "TEXCOORD_1, path, own BVH");
+}
+
 // ---------------------------------------------------- direct light, MIS
 
 constexpr uint32_t kFloorSide = 24;
@@ -151,12 +175,12 @@ constexpr double kAlbedo = 0.5;
 /// A Lambert floor at z = 0 seen straight down from z = 0.9, lit only by the
 /// textured quad [-0.5, 0.5]^2 at z = 1 facing down (the image upright seen
 /// from above: glTF v down along -y).
-Scene floorScene(const fs::path& dir)
+Scene floorScene(const fs::path& dir, int uvSet)
 {
     BlockTexture::write(dir / "blocks.png");
     const GltfQuad quad{{{{-0.5f, -0.5f, 1}, {-0.5f, 0.5f, 1}, {0.5f, 0.5f, 1}, {0.5f, -0.5f, 1}}},
                         {{{0, 1}, {0, 0}, {1, 0}, {1, 1}}}};
-    writeText(dir / "light.gltf", quadsGltf({quad}, emissiveMaterial()));
+    writeText(dir / "light.gltf", quadsGltf({withUvSet(quad, uvSet)}, emissiveMaterial(uvSet)));
     const double fov = 2.0 * std::atan(kHalfView / kEyeHeight) * 180.0 / kPi;
     return parseSceneString("[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 0, " +
                                 std::to_string(kEyeHeight) + "]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nfov = " +
@@ -199,9 +223,13 @@ std::vector<glm::dvec3> floorReference()
     return reference;
 }
 
-TEST_F(EmissionTextureRender, AFloorUnderATexturedQuadConvergesToTheTextureIntegral)
+class EmissionTextureFloor : public GpuTest, public ::testing::WithParamInterface<int> {};
+
+// Parameter: the uv set the emissive texture reads (1: the emitters' sampled
+// points and the BSDF-sampled hits both read TEXCOORD_1).
+TEST_P(EmissionTextureFloor, AFloorUnderATexturedQuadConvergesToTheTextureIntegral)
 {
-    const Scene scene = floorScene(freshTempDir("emission-floor"));
+    const Scene scene = floorScene(freshTempDir("emission-floor"), GetParam());
     RenderOptions options = statisticalOptions(7);
     options.jitter = false; // each pixel estimates the radiance at its centre's point
     Renderer renderer(gpu(), scene, options);
@@ -229,10 +257,15 @@ TEST_F(EmissionTextureRender, AFloorUnderATexturedQuadConvergesToTheTextureInteg
     EXPECT_EQ(failed, 0u);
     for (int c = 0; c < 3; ++c) {
         const double z = difference[c] / std::sqrt(pooled[c]);
-        reportStat("emission_floor_pooled_z_" + std::to_string(c), z);
+        reportStat("emission_floor_uv" + std::to_string(GetParam()) + "_pooled_z_" + std::to_string(c), z);
         EXPECT_LT(std::abs(z), 4.0) << "channel " << c;
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(UvSet, EmissionTextureFloor, ::testing::Values(0, 1),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                             return "TEXCOORD_" + std::to_string(info.param);
+                         });
 
 } // namespace
 } // namespace vkrt::test

@@ -52,7 +52,8 @@ std::string triangleGltf(const std::string& rest, const std::string& material)
 
 std::string quadsGltf(const std::vector<GltfQuad>& quads, const std::string& rest)
 {
-    std::string positions, uvs, indices;
+    std::string positions, uvs, uvs1, indices;
+    const bool second = !quads.empty() && quads.front().uv1.has_value();
     float lower[3] = {1e30f, 1e30f, 1e30f}, upper[3] = {-1e30f, -1e30f, -1e30f};
     for (size_t q = 0; q < quads.size(); ++q) {
         for (int k = 0; k < 4; ++k) {
@@ -62,30 +63,39 @@ std::string quadsGltf(const std::vector<GltfQuad>& quads, const std::string& res
                 upper[c] = std::max(upper[c], quads[q].p[k][c]);
             }
             for (int c = 0; c < 2; ++c) put(uvs, quads[q].uv[k][c]);
+            for (int c = 0; c < 2 && second; ++c) put(uvs1, quads[q].uv1.value_or(quads[q].uv)[k][c]);
         }
         for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) put(indices, uint32_t(4 * q + i));
     }
-    const std::string bytes = positions + uvs + indices;
+    const std::string bytes = positions + uvs + indices + uvs1;
     const size_t n = 4 * quads.size();
     auto number = [](size_t v) { return std::to_string(v); };
     auto vec3 = [](const float* v) {
         return "[" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + "]";
     };
     return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-  "meshes": [{"primitives": [{"material": 0, "attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2}]}],
+  "meshes": [{"primitives": [{"material": 0, "attributes": {"POSITION": 0, "TEXCOORD_0": 1)" +
+           std::string(second ? R"(, "TEXCOORD_1": 3)" : "") + R"(}, "indices": 2}]}],
   "buffers": [{"uri": ")" +
            dataUri("application/octet-stream", bytes) + R"(", "byteLength": )" + number(bytes.size()) + R"(}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": )" +
            number(positions.size()) + R"(}, {"buffer": 0, "byteOffset": )" + number(positions.size()) +
            R"(, "byteLength": )" + number(uvs.size()) + R"(}, {"buffer": 0, "byteOffset": )" +
-           number(positions.size() + uvs.size()) + R"(, "byteLength": )" + number(indices.size()) + R"(}],
+           number(positions.size() + uvs.size()) + R"(, "byteLength": )" + number(indices.size()) + "}" +
+           (second ? R"(, {"buffer": 0, "byteOffset": )" + number(positions.size() + uvs.size() + indices.size()) +
+                         R"(, "byteLength": )" + number(uvs1.size()) + "}"
+                   : "") +
+           R"(],
   "accessors": [
     {"bufferView": 0, "componentType": 5126, "count": )" +
            number(n) + R"(, "type": "VEC3", "min": )" + vec3(lower) + R"(, "max": )" + vec3(upper) + R"(},
     {"bufferView": 1, "componentType": 5126, "count": )" +
            number(n) + R"(, "type": "VEC2"},
     {"bufferView": 2, "componentType": 5125, "count": )" +
-           number(6 * quads.size()) + R"(, "type": "SCALAR"}],
+           number(6 * quads.size()) + R"(, "type": "SCALAR"})" +
+           (second ? R"(, {"bufferView": 3, "componentType": 5126, "count": )" + number(n) + R"(, "type": "VEC2"})"
+                   : "") +
+           R"(],
   )" + rest + "}";
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,8 @@ std::string triangleGltf(const std::string& rest, const std::string& material = 
 struct GltfQuad {
     std::array<std::array<float, 3>, 4> p;
     std::array<std::array<float, 2>, 4> uv;
+    /// TEXCOORD_1, the same way: written for every quad when the first quad has it.
+    std::optional<std::array<std::array<float, 2>, 4>> uv1 = std::nullopt;
 };
 
 /// A glTF 2.0 of one mesh of quads (buffer inline), every triangle of

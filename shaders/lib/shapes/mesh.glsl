@@ -125,8 +125,16 @@ void describeMeshUv(Mesh mesh, HitId id, MeshTriangle tri, inout SurfaceHit hit)
         uv1 = meshUvs[index].uv1;
         uv2 = meshUvs[index].uv2;
     }
-    triangleUv(id.detail, uv0, uv1, uv2, objectToWorldVector(mesh, tri.v1 - tri.v0),
-               objectToWorldVector(mesh, tri.v2 - tri.v0), hit);
+    vec3 e1 = objectToWorldVector(mesh, tri.v1 - tri.v0), e2 = objectToWorldVector(mesh, tri.v2 - tri.v0);
+    triangleUv(id.detail, uv0, uv1, uv2, e1, e2, hit);
+#ifdef VKRT_HAS_MESH_UVS1
+    // The second set's uv and density (its tangents come with the vertex tangents, MeshData::tangentUvSet).
+    if ((mesh.flags & MESH_FLAG_UVS1) != 0u) {
+        MeshUvs second = meshUvs1[index];
+        hit.uv1 = id.detail.x * second.uv0 + id.detail.y * second.uv1 + id.detail.z * second.uv2;
+        hit.uvDensity1 = triangleUvDensity(second.uv0, second.uv1, second.uv2, e1, e2);
+    }
+#endif
 #ifdef VKRT_HAS_MESH_TANGENTS
     if ((mesh.flags & MESH_FLAG_TANGENTS) != 0u) {
         MeshTangents t = meshTangents[index];

@@ -135,10 +135,13 @@ void checkMeshMaterials(const Mesh& mesh, const Field& materialField, const Scen
 {
     for (uint32_t index : materialsOf(mesh)) {
         const Material& m = scene.materials[index];
-        if (m.hasTextures() && mesh.geometry->data.uvs.empty())
+        if (m.readsUvSet(0) && mesh.geometry->data.uvs.empty())
             materialField.fail("material " + quote(m.name) + " has textures, but the mesh file " +
                                quote(mesh.geometry->file.string()) +
                                " has no texture coordinates (export it with uvs)");
+        if (m.readsUvSet(1) && mesh.geometry->data.uvs1.empty())
+            materialField.fail("material " + quote(m.name) + " samples a texture through TEXCOORD_1, which the mesh " +
+                               quote(mesh.geometry->file.string()) + " does not have");
         if (m.emission != Color(0.0) && mesh.emission != Color(0.0))
             materialField.fail("material " + quote(m.name) +
                                " emits already; give the mesh either `emission` or an emissive material");
