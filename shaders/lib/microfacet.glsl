@@ -49,6 +49,15 @@ float ggxG1Of(vec3 w, vec2 alpha)
     return 2.0 / (1.0 + sqrt(1.0 + a2tan2));
 }
 
+// Smith's Lambda(w) = (sqrt(1 + a^2 tan^2) - 1) / 2, written without the
+// cancellation near normal incidence (the height-correlated G of the pbr material).
+float ggxLambdaOf(vec3 w, vec2 alpha)
+{
+    vec2 aw = alpha * w.xy;
+    float a2tan2 = dot(aw, aw) / max(w.z * w.z, 1e-30);
+    return 0.5 * a2tan2 / (1.0 + sqrt(1.0 + a2tan2));
+}
+
 // G1(w, m): 0 when w sees the back of the microfacet.
 float ggxG1(vec3 w, vec3 m, vec2 alpha)
 {

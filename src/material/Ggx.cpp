@@ -37,6 +37,12 @@ double Ggx::g(const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& m) c
     return g1(wo, m) * g1(wi, m);
 }
 
+double Ggx::gCorrelated(const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& m) const
+{
+    if (glm::dot(wo, m) * wo.z <= 0.0 || glm::dot(wi, m) * wi.z <= 0.0) return 0.0;
+    return 1.0 / (1.0 + lambda(wo) + lambda(wi));
+}
+
 double Ggx::visibleNormalPdf(const glm::dvec3& w, const glm::dvec3& m) const
 {
     if (w.z <= 0.0) return 0.0;

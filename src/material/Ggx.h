@@ -19,6 +19,9 @@ struct Ggx {
     double g1(const glm::dvec3& w, const glm::dvec3& m) const;
     /// Separable masking-shadowing G1(wo, m) * G1(wi, m) (Mitsuba 3's choice).
     double g(const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& m) const;
+    /// Height-correlated masking-shadowing 1 / (1 + Lambda(wo) + Lambda(wi)) (Heitz 2014, eq. 99), zero if
+    /// either direction sees the back of m: glTF 2.0's (Appendix B, V_GGX), which the pbr material follows.
+    double gCorrelated(const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& m) const;
     /// Density of visible normals seen from w (w.z > 0): G1(w, m) max(0, w.m) D(m) / w.z.
     double visibleNormalPdf(const glm::dvec3& w, const glm::dvec3& m) const;
     /// A visible normal seen from w (w.z > 0) for a point (t1, t2) of the unit disk (Heitz 2018, "Sampling

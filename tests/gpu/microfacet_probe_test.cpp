@@ -7,7 +7,7 @@
 //    practice), and a check that a density with a 10 % wrong alpha is
 //    rejected (the test can fail);
 //  - the GLSL pdf and the sample weights agree with eval * cos / pdf;
-//  - white furnace: a conductor with F = 1 and a lossless rough dielectric
+//  - white furnace: a conductor and a glTF (pbr) metal with F = 1 and a lossless rough dielectric
 //    keep exactly the single-scattering albedo computed by quadrature here,
 //    never more than 1; no NaN anywhere, including alpha = 1e-4 and grazing.
 #include "material/Fresnel.h"
@@ -389,7 +389,19 @@ TEST_F(MicrofacetProbe, WhiteFurnaceLosesOnlyWhatSingleScatteringLoses)
                 if (f.reflectance < 1.0 && t.z < 0.0) value += (1.0 - f.reflectance) * ggx.g1(t, m);
                 return value;
             });
-            for (const auto& [c, expected] : {std::pair{metal, metalAlbedo}, std::pair{glass, glassAlbedo}}) {
+            // glTF metal with base colour 1 (F = 1) and the height-correlated G:
+            // E[G2(wo, wi) / G1(wo)], more than the conductor's E[G1(wi)] away from the normal.
+            ProbeCase gltfMetal{"pbr metal F=1", pbr(a, 1.0), cosO, 1.0, {}};
+            gltfMetal.m.diffuse = glm::vec3(1.0f);
+            const double gltfMetalAlbedo = quadratureOverVisibleNormals(ggx, wo, [&](const glm::dvec3& m) {
+                const glm::dvec3 wi = reflect(wo, m);
+                return wi.z > 0.0 ? ggx.gCorrelated(wo, wi, m) / ggx.g1(wo, m) : 0.0;
+            });
+            if (roughness == 1.0 && cosO == 0.05) {
+                EXPECT_GT(gltfMetalAlbedo, 1.1 * metalAlbedo);
+            }
+            for (const auto& [c, expected] : {std::pair{metal, metalAlbedo}, std::pair{glass, glassAlbedo},
+                                              std::pair{gltfMetal, gltfMetalAlbedo}}) {
                 SCOPED_TRACE(c.name + " roughness " + std::to_string(roughness) + " cosO " + std::to_string(cosO));
                 const std::vector<Sample> samples = sampleOnGpu(c, kSamples, 5.0f);
                 double sum = 0.0, sumSquares = 0.0;

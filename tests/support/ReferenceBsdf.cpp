@@ -221,7 +221,7 @@ Rgb GltfPbr::eval(const glm::dvec3& wo, const glm::dvec3& wi) const
     glm::dvec3 h;
     if (!reflectionHalfVector(wo, wi, h)) return Rgb(0.0);
     double schlick = std::pow(1.0 - std::abs(glm::dot(wo, h)), 5.0);
-    double specular = specularFactor(m_ggx, wo, wi, h);
+    double specular = m_ggx.d(h) * m_ggx.gCorrelated(wo, wi, h) / (4.0 * wo.z * wi.z);
     double dielectricF = 0.04 + 0.96 * schlick;
     Rgb metalF = m_base + (Rgb(1.0) - m_base) * schlick;
     Rgb dielectric = (1.0 - dielectricF) * m_base * kInvPi + Rgb(dielectricF * specular);

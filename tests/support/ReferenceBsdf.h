@@ -82,7 +82,7 @@ private:
     double m_specularWeight;
 };
 
-/// glTF 2.0 metallic-roughness (Appendix B) with the separable Smith G; ps = probability of the GGX lobe.
+/// glTF 2.0 metallic-roughness (Appendix B) with its height-correlated Smith G; ps = probability of the GGX lobe.
 class GltfPbr : public ReferenceBsdf {
 public:
     GltfPbr(double alpha, Rgb base, double metallic, double specularProbability)
