@@ -420,6 +420,159 @@ VKRT_ABSENT_MATERIAL(Plastic)
 // visible-normal lobe and the cosine lobe.
 
 #ifdef VKRT_MATERIAL_PBR
+#ifdef VKRT_PBR_LAYERS
+// The glTF extension layers (src/scene/Scene.h: PbrLayers), as the Khronos
+// specifications define them, from the inside out:
+//   dielectric (KHR_materials_specular, KHR_materials_ior): per channel
+//     Fd = f0 + (f90 - f0)(1 - wo.h)^5, f0 = min(((ior - 1) / (ior + 1))^2
+//     specularColor, 1) specular, f90 = specular; Fd S + (1 - max(Fd)) base / pi;
+//   metal: Fm S, Fm = base + (1 - base)(1 - wo.h)^5; the two mixed by metallic;
+//   sheen (KHR_materials_sheen): sheenColor Charlie(wo, wi) + base layers x
+//     min(1 - max(sheenColor) E(cosO), 1 - max(sheenColor) E(cosI)), E the
+//     Charlie lobe's directional albedo (the sheen table);
+//   clearcoat (KHR_materials_clearcoat): (1 - c Fc) below + c Fc Scoat, with
+//     Fc = 0.04 + 0.96 (1 - cosO)^5 at the normal, not at h, as the
+//     specification says (so the coat is not reciprocal; it never adds energy).
+// S is the GGX lobe with the height-correlated G. Sampled as a mixture: the
+// coat's and the base's visible-normal lobes and the cosine lobe (diffuse and
+// sheen), each chosen in proportion to its reflectance seen from wo.
+
+float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+// The dielectric's Fresnel (KHR_materials_specular with KHR_materials_ior) at cosine c.
+vec3 pbrDielectricFresnel(Material m, float c)
+{
+    float r = (m.ior - 1.0) / (m.ior + 1.0);
+    vec3 f0 = min(r * r * m.specular, vec3(1.0)) * m.specularFactor;
+    return f0 + (vec3(m.specularFactor) - f0) * pow5(1.0 - clamp(c, 0.0, 1.0));
+}
+
+// The Charlie sheen (Estevez and Kulla 2017, the form KHR_materials_sheen
+// gives): D and the visibility's Lambda fit.
+float sheenAlpha(Material m) { return max(m.sheenRoughness * m.sheenRoughness, MIN_SHEEN_ALPHA); }
+
+float charlieD(float cosH, float alpha)
+{
+    float sin2h = max(1.0 - cosH * cosH, 0.0);
+    return (2.0 + 1.0 / alpha) * pow(sin2h, 0.5 / alpha) * (0.5 * INV_PI);
+}
+
+float charlieL(float x, float alpha)
+{
+    float t = (1.0 - alpha) * (1.0 - alpha);
+    float a = mix(21.5473, 25.3245, t), b = mix(3.82987, 3.32435, t), c = mix(0.19823, 0.16801, t);
+    float d = mix(-1.97760, -1.27393, t), e = mix(-4.32054, -4.85967, t);
+    return a / (1.0 + b * pow(x, c)) + d * x + e;
+}
+
+float charlieLambda(float cosTheta, float alpha)
+{
+    float c = abs(cosTheta);
+    return c < 0.5 ? exp(charlieL(c, alpha)) : exp(2.0 * charlieL(0.5, alpha) - charlieL(1.0 - c, alpha));
+}
+
+// The sheen lobe, sheenColor excluded.
+float sheenBrdf(vec3 lo, vec3 li, vec3 h, float alpha)
+{
+    return charlieD(h.z, alpha) / ((1.0 + charlieLambda(lo.z, alpha) + charlieLambda(li.z, alpha)) * 4.0 * lo.z * li.z);
+}
+
+// E(mu) of the sheen table (bilinear in roughness and sqrt(cosine)).
+float sheenAlbedo(Material m, float mu)
+{
+#ifdef VKRT_HAS_MATERIAL_TABLES
+    const float last = float(SHEEN_TABLE_SIDE - 1u);
+    float x = sqrt(clamp(mu, 0.0, 1.0)) * last, y = clamp(m.sheenRoughness, 0.0, 1.0) * last;
+    uint i = min(uint(x), SHEEN_TABLE_SIDE - 2u), j = min(uint(y), SHEEN_TABLE_SIDE - 2u);
+    float wx = x - float(i), wy = y - float(j);
+    uint at = m.table + j * SHEEN_TABLE_SIDE + i;
+    float low = mix(materialTables[at], materialTables[at + 1u], wx);
+    float high = mix(materialTables[at + SHEEN_TABLE_SIDE], materialTables[at + SHEEN_TABLE_SIDE + 1u], wx);
+    return mix(low, high, wy);
+#else
+    return 0.0;
+#endif
+}
+
+// The coat's Fresnel weight seen from cosine cosO: clearcoat x Fc.
+float pbrCoatWeight(Material m, float cosO)
+{
+    return m.clearcoat * (0.04 + 0.96 * pow5(1.0 - clamp(cosO, 0.0, 1.0)));
+}
+
+vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    vec3 h = normalize(lo + li);
+    float s = ggxSpecularCorrelated(lo, li, h, ggxAlpha(m));
+    vec3 fd = pbrDielectricFresnel(m, dot(lo, h));
+    vec3 dielectric = fd * s + (1.0 - max3(fd)) * m.diffuse * INV_PI;
+    vec3 fm = m.diffuse + (vec3(1.0) - m.diffuse) * pow5(1.0 - clamp(dot(lo, h), 0.0, 1.0));
+    vec3 value = mix(dielectric, fm * s, m.metallic);
+    if (max3(m.sheenColor) > 0.0) {
+        float strength = max3(m.sheenColor);
+        // The extension's visibility fit puts E above 1 for smooth sheen near
+        // grazing (roughness <= 0.25, cosines below ~0.05): the base then
+        // keeps nothing there, never a negative share.
+        float scaling = min(1.0 - strength * sheenAlbedo(m, lo.z), 1.0 - strength * sheenAlbedo(m, li.z));
+        value = m.sheenColor * sheenBrdf(lo, li, h, sheenAlpha(m)) + value * max(scaling, 0.0);
+    }
+    if (m.clearcoat > 0.0) {
+        float coat = pbrCoatWeight(m, lo.z);
+        value = (1.0 - coat) * value + coat * ggxSpecularCorrelated(lo, li, h, vec2(m.clearcoatAlpha));
+    }
+    return value;
+}
+
+// The lobe probabilities seen from cosO: (coat, base GGX, cosine), summing to 1.
+vec3 pbrLobeProbabilities(Material m, float cosO)
+{
+    float coat = m.clearcoat > 0.0 ? pbrCoatWeight(m, cosO) : 0.0;
+    float fd = max3(pbrDielectricFresnel(m, cosO));
+    float specular = m.metallic + (1.0 - m.metallic) * fd;
+    float diffuse = (1.0 - m.metallic) * (1.0 - fd) * luminance(m.diffuse);
+    float sheen = max3(m.sheenColor) > 0.0 ? max3(m.sheenColor) * sheenAlbedo(m, cosO) : 0.0;
+    float base = specular + diffuse + sheen;
+    float ps = base > 0.0 ? specular / base : 1.0;
+    return vec3(coat, (1.0 - coat) * ps, (1.0 - coat) * (1.0 - ps));
+}
+
+float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
+    vec3 p = pbrLobeProbabilities(m, lo.z);
+    vec3 h = normalize(lo + li);
+    float pdf = p.y * ggxReflectionPdf(lo, h, ggxAlpha(m)) + p.z * li.z * INV_PI;
+    if (p.x > 0.0)
+        pdf += p.x * ggxReflectionPdf(lo, h, vec2(m.clearcoatAlpha));
+    return pdf;
+}
+
+BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
+{
+    LocalFrame f = frameAround(n);
+    vec3 lo = toFrame(f, wo);
+    if (lo.z <= 0.0)
+        return noScatter();
+    vec3 p = pbrLobeProbabilities(m, lo.z);
+    vec3 li;
+    if (u.z < p.x)
+        li = reflect(-lo, sampleGgxVisibleNormal(lo, vec2(m.clearcoatAlpha), u.xy));
+    else if (u.z < p.x + p.y)
+        li = reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy));
+    else
+        li = toFrame(f, sampleCosineHemisphere(n, u.xy));
+    if (li.z <= 0.0)
+        return noScatter();
+    vec3 wi = fromFrame(f, li);
+    float pdf = pdfPbr(m, n, wo, wi, li.z);
+    if (!(pdf > 0.0))
+        return noScatter();
+    return BsdfSample(wi, evalPbr(m, n, wo, wi) * (li.z / pdf), false, false);
+}
+#else
 vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
 {
     LocalFrame f = frameAround(n);
@@ -466,6 +619,7 @@ BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
         return noScatter();
     return BsdfSample(wi, evalPbr(m, n, wo, wi) * (li.z / pdf), false, false);
 }
+#endif // VKRT_PBR_LAYERS
 #else
 VKRT_ABSENT_MATERIAL(Pbr)
 #endif

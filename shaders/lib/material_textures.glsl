@@ -116,14 +116,21 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
         coneWidth = pixelSpreadAngle(); // parallel rays: one pixel's width at any distance
 #endif
     float cosTheta = dot(dir, hit.normal);
-    // The emission slot (last) is the emitters' (emissionTexel), not the BSDF's.
-#ifdef VKRT_HAS_NORMAL_MAPS
-    const uint slots = TEXTURE_SLOT_NORMAL + 1u;
+    // The emission slot (last) is the emitters' (emissionTexel), not the BSDF's;
+    // the pbr layers' slots (before the normal map's) only where the variant has them.
+#ifdef VKRT_PBR_LAYERS
+    const uint layerSlots = TEXTURE_SLOT_NORMAL - TEXTURE_SLOT_SPECULAR_FACTOR;
 #else
-    const uint slots = TEXTURE_SLOT_NORMAL;
+    const uint layerSlots = 0u;
 #endif
-    [[dont_unroll]] for (uint k = 0u; k < slots; ++k) {
+#ifdef VKRT_HAS_NORMAL_MAPS
+    const uint slots = TEXTURE_SLOT_SPECULAR_FACTOR + layerSlots + 1u;
+#else
+    const uint slots = TEXTURE_SLOT_SPECULAR_FACTOR + layerSlots;
+#endif
+    [[dont_unroll]] for (uint i = 0u; i < slots; ++i) {
         ++g_loopIterations;
+        uint k = i < TEXTURE_SLOT_SPECULAR_FACTOR + layerSlots ? i : TEXTURE_SLOT_NORMAL;
         // Slots are read one by one: copying the whole MaterialTextures (a
         // struct with an array) out of the buffer makes glslang emit invalid SPIR-V.
         TextureSlot slot = materialTextures[hit.material].slots[k];
@@ -142,6 +149,20 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
         } else if (k == TEXTURE_SLOT_METALLIC) {
             m.metallic *= channelOf(texel, slot.channel);
         }
+#ifdef VKRT_PBR_LAYERS
+        else if (k == TEXTURE_SLOT_SPECULAR_FACTOR) {
+            m.specularFactor *= channelOf(texel, slot.channel);
+        } else if (k == TEXTURE_SLOT_SHEEN_COLOR) {
+            m.sheenColor *= clamp(texel.rgb, 0.0, 1.0);
+        } else if (k == TEXTURE_SLOT_SHEEN_ROUGHNESS) {
+            m.sheenRoughness *= channelOf(texel, slot.channel);
+        } else if (k == TEXTURE_SLOT_CLEARCOAT) {
+            m.clearcoat *= channelOf(texel, slot.channel);
+        } else if (k == TEXTURE_SLOT_CLEARCOAT_ROUGHNESS) {
+            float r = channelOf(texel, slot.channel);
+            m.clearcoatAlpha = max(m.clearcoatAlpha * r * r, MIN_GGX_ALPHA);
+        }
+#endif
 #ifdef VKRT_HAS_NORMAL_MAPS
         else {
             hit.shading = normalMapped(hit, texel.rgb, materialTextures[hit.material].normalStrength);

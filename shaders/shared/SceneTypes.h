@@ -24,6 +24,16 @@ VKRT_CONSTANT(uint, NO_MATERIAL_TABLE, 4294967295u)
 // coating's transmittance 1 - R(mu) at mu = i / (MATERIAL_TABLE_SIZE - 1),
 // i = 0 ... MATERIAL_TABLE_SIZE - 1 (src/material/MicrofacetAlbedo.h).
 VKRT_CONSTANT(uint, MATERIAL_TABLE_SIZE, 64)
+// The sheen albedo table (pbr materials with sheen share one, its start in
+// their Material::table): E(mu, r), the directional albedo of the Charlie
+// sheen BRDF (KHR_materials_sheen) of roughness r at cosine mu, at
+// r = j / (SHEEN_TABLE_SIDE - 1) and mu = s^2, s = i / (SHEEN_TABLE_SIDE - 1)
+// (E turns sharply near grazing: in sqrt(mu) bilinear lookups stay within
+// 1e-3 of it), entry j * SHEEN_TABLE_SIDE + i (src/material/Sheen.h).
+VKRT_CONSTANT(uint, SHEEN_TABLE_SIDE, 64)
+// The narrowest sheen: alpha_g = roughness^2 kept at or above this (the
+// Charlie distribution divides by it).
+VKRT_CONSTANT(float, MIN_SHEEN_ALPHA, 1e-3)
 
 // Which members a kind reads (the rest are zero):
 //   lambert: diffuse; phong: diffuse, specular, exponent;
@@ -32,7 +42,10 @@ VKRT_CONSTANT(uint, MATERIAL_TABLE_SIZE, 64)
 //   conductor: specular (tint), alphaX, alphaY, eta, k;
 //   rough_dielectric: ior, absorption, fresnel, alphaX = alphaY;
 //   plastic: diffuse, ior, alphaX = alphaY (0: smooth), table, lobeWeight, internalReflectance;
-//   pbr: diffuse (base colour), metallic, alphaX = alphaY.
+//   pbr: diffuse (base colour), metallic, alphaX = alphaY; with the glTF
+//        extension layers (variants with VKRT_PBR_LAYERS) also specular
+//        (KHR_materials_specular's colour), specularFactor, ior, sheenColor,
+//        sheenRoughness, clearcoat, clearcoatAlpha, table (the sheen table).
 // alpha is the GGX width (perceptual roughness squared), never below
 // MIN_GGX_ALPHA where it is used.
 struct Material {
@@ -51,6 +64,11 @@ struct Material {
     vec3 k;
     float lobeWeight;          // plastic: Mitsuba's specular sampling weight s / (s + d)
     float internalReflectance; // plastic: diffuse Fresnel reflectance inside the coating
+    vec3 sheenColor;           // pbr: KHR_materials_sheen's colour (0: no sheen)
+    float sheenRoughness;      // pbr: its roughness (alpha_g = roughness^2)
+    float specularFactor;      // pbr: KHR_materials_specular's strength (dielectric F90; scales F0)
+    float clearcoat;           // pbr: KHR_materials_clearcoat's factor (0: no coat)
+    float clearcoatAlpha;      // pbr: the coat's GGX alpha, clearcoatRoughness^2 (>= MIN_GGX_ALPHA)
 };
 
 // The narrowest GGX lobe a rough material gets: narrower ones lose float
@@ -269,7 +287,7 @@ VKRT_CONSTANT(uint, RENDER_FLAG_ORTHOGRAPHIC, 2)
 // maxUniformBufferRange Vulkan allows; src/gpu/SharedTypes.cpp checks the
 // sizes. Bigger scenes use the storage-buffer variant. The shape and light
 // arrays' capacities (UNIFORM_SPHERES, ...) are in the registry, shared/Kinds.h.
-VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 163) // 16384 / 100
+VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 128) // 16384 / 128
 
 // One record count per shape and light array, in registry order:
 // sphereCount, boxCount, triangleCount, planeCount, pointLightCount, ...

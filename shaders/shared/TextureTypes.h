@@ -73,10 +73,16 @@ VKRT_CONSTANT(uint, TEXTURE_SLOT_COLOR, 0)     // diffuse / albedo / base_color 
 VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR, 1)  // specular / reflectance / tint (Material::specular)
 VKRT_CONSTANT(uint, TEXTURE_SLOT_ROUGHNESS, 2) // perceptual roughness: alpha scales by texel^2
 VKRT_CONSTANT(uint, TEXTURE_SLOT_METALLIC, 3)  // pbr metallic
-VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 4)    // tangent-space normal map (rgb = (n + 1) / 2)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 5)  // emitted radiance (glTF emissiveTexture, sRGB): read by the
+// The pbr material's glTF extension layers (variants with VKRT_PBR_LAYERS):
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR_FACTOR, 4)     // KHR_materials_specular specularTexture (A)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_COLOR, 5)         // KHR_materials_sheen sheenColorTexture (sRGB)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_ROUGHNESS, 6)     // sheenRoughnessTexture (A)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT, 7)           // KHR_materials_clearcoat clearcoatTexture (R)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, 8) // clearcoatRoughnessTexture (G): alpha scales by texel^2
+VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 9)    // tangent-space normal map (rgb = (n + 1) / 2)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 10) // emitted radiance (glTF emissiveTexture, sRGB): read by the
                                                // emitters (lib/emitters.glsl), not by texturedMaterial
-VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 6)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 11)
 
 /// The textures of one material (one per Material, same index).
 struct MaterialTextures {

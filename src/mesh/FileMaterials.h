@@ -74,6 +74,25 @@ struct FileMaterial {
     float ior = 1.5f;
     /// KHR_materials_unlit: the base colour is what the camera sees, no lighting.
     bool unlit = false;
+    /// KHR_materials_specular (glTF's defaults): strength (A of its texture) and F0 colour (sRGB texture).
+    float specularFactor = 1.0f;
+    std::optional<FileTexture> specularTexture;
+    glm::vec3 specularColorFactor{1.0f}; ///< >= 0, may exceed 1
+    std::optional<FileTexture> specularColorTexture;
+    /// KHR_materials_sheen: colour (sRGB texture) and roughness (A of its texture).
+    glm::vec3 sheenColorFactor{0.0f};
+    std::optional<FileTexture> sheenColorTexture;
+    float sheenRoughnessFactor = 0.0f;
+    std::optional<FileTexture> sheenRoughnessTexture;
+    /// KHR_materials_clearcoat: strength (R of its texture), roughness (G of its texture), the coat's own normal map.
+    float clearcoatFactor = 0.0f;
+    std::optional<FileTexture> clearcoatTexture;
+    float clearcoatRoughnessFactor = 0.0f;
+    std::optional<FileTexture> clearcoatRoughnessTexture;
+    std::optional<FileTexture> clearcoatNormalTexture;
+    /// Every texture slot above, in one list (for what reads every texture: uv sets, transforms).
+    std::vector<const std::optional<FileTexture>*> textureSlots() const;
+    std::vector<std::optional<FileTexture>*> textureSlots();
     std::vector<std::string> unsupported; ///< what vkrt will not honour, one readable phrase each
 };
 

@@ -341,8 +341,7 @@ std::vector<glm::uvec3> assembleTriangles(const std::vector<uint32_t>& v, uint32
 std::set<uint32_t> texCoordSets(const FileMaterial& m)
 {
     std::set<uint32_t> sets;
-    for (const std::optional<FileTexture>* t :
-         {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture})
+    for (const std::optional<FileTexture>* t : m.textureSlots())
         if (*t) sets.insert((*t)->texCoord);
     return sets;
 }
@@ -898,6 +897,7 @@ const std::vector<std::string>& implementedGltfExtensions()
         "KHR_materials_ior",          "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
         "KHR_materials_unlit",        "KHR_materials_variants",
         "KHR_materials_transmission", // read as glass or not, each approximation warned (docs/scene-format.md)
+        "KHR_materials_specular",     "KHR_materials_sheen",   "KHR_materials_clearcoat",
     };
     return names;
 }

@@ -1,6 +1,7 @@
 #include "render/GpuScene.h"
 
 #include "material/MicrofacetAlbedo.h"
+#include "material/Sheen.h"
 
 #include "mesh/MeshGeometry.h"
 #include "render/EmissionPower.h"
@@ -115,6 +116,15 @@ gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t
     g.table = tableStart;
     g.internalReflectance = internalReflectance;
     if (m.type == MaterialType::Plastic) g.lobeWeight = coatingLobeWeight(m, textures);
+    if (m.type == MaterialType::Pbr) {
+        g.specular = toFloat(m.layers.specularColor);
+        g.specularFactor = float(m.layers.specular);
+        g.sheenColor = toFloat(m.layers.sheenColor);
+        g.sheenRoughness = float(m.layers.sheenRoughness);
+        g.clearcoat = float(m.layers.clearcoat);
+        g.clearcoatAlpha =
+            float(std::max(m.layers.clearcoatRoughness * m.layers.clearcoatRoughness, double(gpu::MIN_GGX_ALPHA)));
+    }
     return g;
 }
 
@@ -131,10 +141,18 @@ uint32_t appendCoatingTable(const Material& m, std::vector<float>& tables)
 /// The plastics' coating data, once per scene (tens of milliseconds each).
 void prepareMaterialTables(const Scene& scene, GpuSceneStatic& fixed)
 {
+    uint32_t sheenTable = gpu::NO_MATERIAL_TABLE; // one for every material with sheen
     for (const Material& m : scene.materials) {
         uint32_t start = gpu::NO_MATERIAL_TABLE;
         float internal = 0.0f;
-        if (m.type == MaterialType::Plastic && m.roughness > 0.0) {
+        if (m.type == MaterialType::Pbr && m.layers.sheen()) {
+            if (sheenTable == gpu::NO_MATERIAL_TABLE) {
+                sheenTable = uint32_t(fixed.materialTables.size());
+                const std::vector<float>& table = sheenAlbedoTable();
+                fixed.materialTables.insert(fixed.materialTables.end(), table.begin(), table.end());
+            }
+            start = sheenTable;
+        } else if (m.type == MaterialType::Plastic && m.roughness > 0.0) {
             start = appendCoatingTable(m, fixed.materialTables);
             internal = float(internalDiffuseReflectance(ggxAlphas(m).x, m.ior));
         } else if (m.type == MaterialType::Plastic) {

@@ -66,7 +66,10 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     // tested at every candidate triangle hit (lib/alpha.glsl).
     list.push_back({meshes && f.alpha, "VKRT_HAS_ALPHA", int(gpu::BINDING_MATERIAL_ALPHA), "alpha"});
     // The rough plastics' coating tables come with the plastic kind.
-    list.push_back({f.has(MaterialType::Plastic), "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
+    // The glTF extension layers of pbr materials (their sheen table is a material table too).
+    list.push_back({f.has(MaterialType::Pbr) && f.pbrLayers, "VKRT_PBR_LAYERS", -1, "pbr-layers"});
+    list.push_back({f.has(MaterialType::Plastic) || (f.has(MaterialType::Pbr) && f.pbrLayers),
+                    "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});
     list.push_back({f.orthographic, "VKRT_ORTHOGRAPHIC", -1, "orthographic"});
     list.push_back({f.cubemap, "VKRT_HAS_CUBEMAP", int(gpu::BINDING_ENVIRONMENT), "cubemap"});

@@ -42,6 +42,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.fileMaterials = true;
     all.vertexColors = true;
     all.secondUvs = true;
+    all.pbrLayers = true;
     all.thinLens = true;
     all.orthographic = true;
     all.alpha = true;
@@ -61,6 +62,7 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
         set.textures = set.textures || material.hasTextures();
         set.normalMaps = set.normalMaps || material.hasNormalMap();
         set.secondUvs = set.secondUvs || material.readsUvSet(1);
+        set.pbrLayers = set.pbrLayers || material.hasPbrLayers();
     };
 #define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     for (const auto& shape : scene.array) markUsed(shape.material);

@@ -24,6 +24,7 @@ struct FeatureSet {
     bool emissionTextures = false;    ///< some emissive mesh's emission is textured (meshEmissionTextured)
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     bool vertexColors = false;        ///< ... and its file's vertex colours (glTF COLOR_0)
+    bool pbrLayers = false;           ///< some pbr material has a glTF extension layer (Material::hasPbrLayers)
     bool secondUvs = false;           ///< some material in use reads a mesh's second uv set (glTF TEXCOORD_1)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
     bool orthographic = false;        ///< the camera projects orthographically (parallel rays)

@@ -42,6 +42,30 @@ std::string displayName(const FileMaterial& f, size_t index)
     return f.fileIndex < 0 ? "default material" : "material " + std::to_string(index);
 }
 
+/// KHR_materials_ior, _specular, _sheen and _clearcoat as the pbr material's
+/// layers: factors as constants, each texture's channel as the extension says
+/// (sRGB colours, strengths in A, the coat in R and its roughness in G).
+void addLayers(const FileMaterial& f, const std::filesystem::path& file, const SourceLocation& where,
+               TextureAtlas& atlas, Material& m)
+{
+    m.ior = f.ior;
+    m.layers.specular = f.specularFactor;
+    m.layers.specularColor = Color(f.specularColorFactor);
+    m.layers.sheenColor = Color(f.sheenColorFactor);
+    m.layers.sheenRoughness = f.sheenRoughnessFactor;
+    m.layers.clearcoat = f.clearcoatFactor;
+    m.layers.clearcoatRoughness = f.clearcoatRoughnessFactor;
+    auto add = [&](const std::optional<FileTexture>& texture, bool linear, TextureSlot which, uint32_t channel) {
+        if (texture) m.textures[size_t(which)] = slot(addFileTexture(*texture, linear, file, where, atlas), *texture, channel);
+    };
+    add(f.specularTexture, true, TextureSlot::SpecularFactor, 3);
+    add(f.specularColorTexture, false, TextureSlot::Specular, 0);
+    add(f.sheenColorTexture, false, TextureSlot::SheenColor, 0);
+    add(f.sheenRoughnessTexture, true, TextureSlot::SheenRoughness, 3);
+    add(f.clearcoatTexture, true, TextureSlot::Clearcoat, 0);
+    add(f.clearcoatRoughnessTexture, true, TextureSlot::ClearcoatRoughness, 1);
+}
+
 /// glTF 2.0 metallic-roughness as vkrt's pbr kind: the factors are the
 /// constants each texel multiplies (glTF's own rule), G and B of the
 /// metallic-roughness texture are roughness and metallic, and the emissive
@@ -78,6 +102,7 @@ Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path&
         set(TextureSlot::Normal, slot(addFileTexture(*f.normalTexture, true, file, where, atlas), *f.normalTexture));
         m.normalStrength = f.normalScale;
     }
+    addLayers(f, file, where, atlas, m);
     return m;
 }
 
@@ -119,8 +144,11 @@ Material toUnlit(Material pbr)
     m.emission = pbr.diffuse;
     m.textures[size_t(TextureSlot::Emission)] = pbr.texture(TextureSlot::Color);
     m.diffuse = Color(0.0);
-    for (TextureSlot slot : {TextureSlot::Specular, TextureSlot::Roughness, TextureSlot::Metallic, TextureSlot::Normal})
+    for (TextureSlot slot : {TextureSlot::Specular, TextureSlot::Roughness, TextureSlot::Metallic, TextureSlot::Normal,
+                             TextureSlot::SpecularFactor, TextureSlot::SheenColor, TextureSlot::SheenRoughness,
+                             TextureSlot::Clearcoat, TextureSlot::ClearcoatRoughness})
         m.textures[size_t(slot)].reset();
+    m.layers = PbrLayers{};
     m.metallic = 0.0;
     m.roughness = 0.0;
     return m;
@@ -146,6 +174,13 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
         if (f.metallicRoughnessTexture)
             warnings.push_back(prefix + "metallicRoughnessTexture is not applied to glass (its roughness factor is)");
     }
+    if (f.clearcoatNormalTexture && m.type == MaterialType::Pbr)
+        warnings.push_back(prefix + "clearcoatNormalTexture is not applied: the coat takes the base's shading normal");
+    else if (f.clearcoatFactor > 0.0f && f.normalTexture && m.type == MaterialType::Pbr)
+        warnings.push_back(prefix + "the clear coat takes the base's normal map (glTF: a coat without "
+                                    "clearcoatNormalTexture is not normal-mapped)");
+    if (f.clearcoatFactor > 0.0f && f.emissiveFactor != glm::vec3(0.0f))
+        warnings.push_back(prefix + "the emission is not darkened by the clear coat's Fresnel");
     if (f.baseColorFactor.a < 1.0f && f.alphaMode == AlphaMode::Opaque)
         warnings.push_back(prefix + "baseColorFactor's alpha is ignored (alphaMode OPAQUE)");
 }

@@ -175,10 +175,30 @@ enum class TextureSlot : uint32_t {
     Specular = gpu::TEXTURE_SLOT_SPECULAR,   ///< specular / reflectance / tint
     Roughness = gpu::TEXTURE_SLOT_ROUGHNESS, ///< perceptual roughness
     Metallic = gpu::TEXTURE_SLOT_METALLIC,   ///< pbr metallic
+    SpecularFactor = gpu::TEXTURE_SLOT_SPECULAR_FACTOR,         ///< pbr specular (A)
+    SheenColor = gpu::TEXTURE_SLOT_SHEEN_COLOR,                 ///< pbr sheen_color
+    SheenRoughness = gpu::TEXTURE_SLOT_SHEEN_ROUGHNESS,         ///< pbr sheen_roughness (A)
+    Clearcoat = gpu::TEXTURE_SLOT_CLEARCOAT,                    ///< pbr clearcoat (R)
+    ClearcoatRoughness = gpu::TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, ///< pbr clearcoat_roughness (G)
     Normal = gpu::TEXTURE_SLOT_NORMAL,       ///< tangent-space normal map
     Emission = gpu::TEXTURE_SLOT_EMISSION,   ///< emitted radiance (glTF emissiveTexture; meshes only)
 };
 inline constexpr size_t kTextureSlotCount = gpu::TEXTURE_SLOT_COUNT;
+
+/// The glTF PBR extension layers of a pbr material (the Khronos extensions'
+/// names and defaults; lib/bsdf.glsl evaluates them). The defaults leave the
+/// plain metallic-roughness material, and its kernel (FeatureSet::pbrLayers).
+struct PbrLayers {
+    double specular = 1.0;       ///< KHR_materials_specular specularFactor: dielectric F90, scales F0
+    Color specularColor{1.0};    ///< specularColorFactor: scales the dielectric F0 (may exceed 1)
+    Color sheenColor{0.0};       ///< KHR_materials_sheen sheenColorFactor
+    double sheenRoughness = 0.0; ///< sheenRoughnessFactor
+    double clearcoat = 0.0;      ///< KHR_materials_clearcoat clearcoatFactor
+    double clearcoatRoughness = 0.0; ///< clearcoatRoughnessFactor (perceptual; alpha = roughness^2)
+
+    bool sheen() const { return sheenColor != Color(0.0); }
+    bool operator==(const PbrLayers&) const = default;
+};
 
 struct Material {
     std::string name;
@@ -196,6 +216,8 @@ struct Material {
     Color k{0.0};            ///< conductor: imaginary part (extinction)
     double metallic = 0.0;   ///< pbr
     Color emission{0.0};     ///< pbr: emitted radiance (meshes only: their triangles become lights)
+    /// pbr, the glTF extension layers (defaults: none; `ior` above is KHR_materials_ior's):
+    PbrLayers layers;
     /// Textured parameters; a texel multiplies the parameter's constant above
     /// (1 for the scene's textures, a glTF file's factor for its own).
     std::array<std::optional<MaterialTexture>, kTextureSlotCount> textures{};
@@ -215,6 +237,8 @@ struct Material {
     /// Whether a texture of it reads uv set `set` (MaterialTexture::texCoord).
     bool readsUvSet(uint32_t set) const;
     bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
+    /// A pbr material with a glTF extension layer (or a KHR_materials_ior index other than 1.5).
+    bool hasPbrLayers() const;
     bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
 
@@ -228,6 +252,11 @@ inline bool Material::hasTextures() const
     for (const auto& t : textures)
         if (t) return true;
     return false;
+}
+
+inline bool Material::hasPbrLayers() const
+{
+    return type == MaterialType::Pbr && (layers != PbrLayers{} || ior != 1.5);
 }
 
 inline bool Material::readsUvSet(uint32_t set) const

@@ -257,6 +257,14 @@ void parameters(MaterialKindTag<MaterialType::Pbr>, MaterialWriter& w, Integrato
     w.textured("metallic", w.material().metallic, TextureSlot::Metallic);
     w.textured("roughness", w.material().roughness, TextureSlot::Roughness);
     w.textured("emission", vec(w.material().emission), TextureSlot::Emission);
+    const PbrLayers& layers = w.material().layers;
+    w.value("ior", w.material().ior);
+    w.textured("specular", layers.specular, TextureSlot::SpecularFactor);
+    w.textured("specular_color", vec(layers.specularColor), TextureSlot::Specular);
+    w.textured("sheen_color", vec(layers.sheenColor), TextureSlot::SheenColor);
+    w.textured("sheen_roughness", layers.sheenRoughness, TextureSlot::SheenRoughness);
+    w.textured("clearcoat", layers.clearcoat, TextureSlot::Clearcoat);
+    w.textured("clearcoat_roughness", layers.clearcoatRoughness, TextureSlot::ClearcoatRoughness);
 }
 
 /// Every kind's parameters; a kind added to shared/Kinds.h without an overload above does not compile.

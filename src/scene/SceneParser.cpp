@@ -138,8 +138,10 @@ constexpr std::array<std::string_view, 8> conductorKeys{"type", "roughness", "an
 constexpr std::array<std::string_view, 6> rough_dielectricKeys{"type",       "roughness", "ior",
                                                                "absorption", "fresnel",   "normal_map"};
 constexpr std::array<std::string_view, 5> plasticKeys{"type", "diffuse", "roughness", "ior", "normal_map"};
-constexpr std::array<std::string_view, 6> pbrKeys{"type",      "base_color", "metallic",
-                                                  "roughness", "emission",   "normal_map"};
+constexpr std::array<std::string_view, 13> pbrKeys{
+    "type",           "base_color",      "metallic",  "roughness",           "emission",
+    "normal_map",     "ior",             "specular",  "specular_color",      "sheen_color",
+    "sheen_roughness", "clearcoat",      "clearcoat_roughness"};
 
 /// A colour parameter: a value, or a texture table whose texel is the colour
 /// (the constant becomes 1, which the texel multiplies on the GPU).
@@ -302,6 +304,30 @@ void readPlastic(const TableField& table, Material& material, ParseContext& cont
     if (material.ior == 1.0) table.find("ior")->fail("must differ from 1 (a coating of index 1 is no coating)");
 }
 
+/// The glTF extension layers (KHR_materials_ior, _specular, _sheen, _clearcoat; their defaults).
+/// specular_color may exceed 1, as specularColorFactor may (the F0 it scales stays at most 1).
+void readPbrLayers(const TableField& table, Material& material, ParseContext& context)
+{
+    material.ior = readOr(table, "ior", 1.5, readIor);
+    PbrLayers& layers = material.layers;
+    layers.specular = readUnitParameter(table, "specular", 1.0, material, TextureSlot::SpecularFactor, context.textures);
+    if (const std::optional<Field> color = table.find("specular_color")) {
+        if (isTextureTable(*color)) {
+            material.textures[size_t(TextureSlot::Specular)] =
+                readTextureTable(*color, TextureUse::Color, context.textures);
+        } else {
+            layers.specularColor = readRadiance(*color);
+        }
+    }
+    layers.sheenColor =
+        readColorParameter(table, "sheen_color", Color(0.0), material, TextureSlot::SheenColor, context.textures);
+    layers.sheenRoughness =
+        readUnitParameter(table, "sheen_roughness", 0.0, material, TextureSlot::SheenRoughness, context.textures);
+    layers.clearcoat = readUnitParameter(table, "clearcoat", 0.0, material, TextureSlot::Clearcoat, context.textures);
+    layers.clearcoatRoughness = readUnitParameter(table, "clearcoat_roughness", 0.0, material,
+                                                  TextureSlot::ClearcoatRoughness, context.textures);
+}
+
 /// glTF 2.0's defaults: base colour 1, metallic 1, roughness 1.
 void readPbr(const TableField& table, Material& material, ParseContext& context)
 {
@@ -310,6 +336,7 @@ void readPbr(const TableField& table, Material& material, ParseContext& context)
     material.metallic = readUnitParameter(table, "metallic", 1.0, material, TextureSlot::Metallic, context.textures);
     material.roughness = readUnitParameter(table, "roughness", 1.0, material, TextureSlot::Roughness, context.textures);
     material.emission = readOr(table, "emission", Color(0.0), readRadiance);
+    readPbrLayers(table, material, context);
 }
 
 struct MaterialKind {

@@ -239,6 +239,51 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
     EXPECT_NE(error.find("TEXCOORD_1"), std::string::npos) << error;
 }
 
+TEST(GltfReader, PbrExtensionLayersAreReadWithTheirTextures)
+{
+    // KHR_materials_specular, _sheen and _clearcoat: every factor, and each
+    // texture with its own uv set; the pbr material gets them as its layers.
+    GltfBuilder b;
+    b.doc()["extensionsUsed"] = {"KHR_materials_specular", "KHR_materials_sheen", "KHR_materials_clearcoat"};
+    b.doc()["materials"] = json::parse(R"([{
+        "extensions": {
+          "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [2, 1, 0.5],
+                                     "specularTexture": {"index": 0}, "specularColorTexture": {"index": 0}},
+          "KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.4, 0.2], "sheenRoughnessFactor": 0.6,
+                                  "sheenColorTexture": {"index": 0, "texCoord": 1}},
+          "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.1,
+                                      "clearcoatRoughnessTexture": {"index": 0},
+                                      "clearcoatNormalTexture": {"index": 0}}}}])");
+    b.doc()["textures"] = {{{"source", 0}}};
+    b.doc()["images"] = {{{"uri", "texture.png"}}};
+    b.node({{"mesh", b.mesh({{"POSITION", b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3")},
+                             {"TEXCOORD_0", b.floats({0, 0, 1, 0, 0, 1}, "VEC2")},
+                             {"TEXCOORD_1", b.floats({0, 0, 1, 0, 0, 1}, "VEC2")}},
+                            std::nullopt, 4, 0)}});
+    const GltfModel model = readGltfModel(b.write("layers.gltf"));
+    EXPECT_TRUE(model.warnings.empty()) << model.warnings.front();
+    const FileMaterial& m = model.materials.at(0);
+    EXPECT_EQ(m.specularFactor, 0.5f);
+    EXPECT_EQ(m.specularColorFactor, glm::vec3(2.0f, 1.0f, 0.5f));
+    EXPECT_TRUE(m.specularTexture && m.specularColorTexture);
+    EXPECT_EQ(m.sheenColorFactor, glm::vec3(0.9f, 0.4f, 0.2f));
+    EXPECT_EQ(m.sheenRoughnessFactor, 0.6f);
+    ASSERT_TRUE(m.sheenColorTexture);
+    EXPECT_EQ(m.sheenColorTexture->texCoord, 1u);
+    EXPECT_FALSE(model.meshes.at(0).uvs1.empty()) << "the sheen texture reads TEXCOORD_1";
+    EXPECT_EQ(m.clearcoatFactor, 1.0f);
+    EXPECT_EQ(m.clearcoatRoughnessFactor, 0.1f);
+    EXPECT_TRUE(m.clearcoatRoughnessTexture && m.clearcoatNormalTexture && !m.clearcoatTexture);
+
+    // Out of range factors are errors naming the file and the material.
+    GltfBuilder bad;
+    bad.doc()["materials"] = json::parse(R"([{"extensions": {"KHR_materials_sheen": {"sheenRoughnessFactor": 2}}}])");
+    bad.node({{"mesh", triangleMesh(bad, false, 0)}});
+    const std::string error = errorOf([&] { readGltfModel(bad.write("bad-sheen.gltf")); });
+    EXPECT_NE(error.find("bad-sheen.gltf"), std::string::npos) << error;
+    EXPECT_NE(error.find("sheenRoughnessFactor"), std::string::npos) << error;
+}
+
 TEST(GltfReader, StripsAndFansBecomeTrianglesWithTheirWinding)
 {
     GltfBuilder b;
@@ -350,10 +395,10 @@ TEST(GltfReader, RequiredExtensionsMustBeImplementedUsedOnesAreNamedOnce)
 {
     GltfBuilder b;
     b.node({{"mesh", triangleMesh(b)}});
-    b.doc()["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_lights_punctual"};
+    b.doc()["extensionsUsed"] = {"KHR_materials_iridescence", "KHR_lights_punctual"};
     const GltfModel model = readGltfModel(b.write("used.gltf"));
     ASSERT_EQ(model.warnings.size(), 1u);
-    EXPECT_NE(model.warnings[0].find("KHR_materials_clearcoat"), std::string::npos);
+    EXPECT_NE(model.warnings[0].find("KHR_materials_iridescence"), std::string::npos);
     b.doc()["extensionsRequired"] = {"KHR_draco_mesh_compression"};
     const std::string error = errorOf([&] { readGltfModel(b.write("required.gltf")); });
     EXPECT_NE(error.find("extensionsRequired names KHR_draco_mesh_compression"), std::string::npos) << error;

@@ -1,5 +1,6 @@
 // Tests of the scene-file parser: valid files produce the expected Scene, and
 // every kind of bad input produces a SceneError at the exact offending position.
+#include "scene/FeatureSet.h"
 #include "scene/SceneParser.h"
 
 #include "scene/TomlTraps.h"
@@ -219,6 +220,42 @@ TEST(SceneParserValid, MaterialsKeepFileOrderAndValues)
     EXPECT_DOUBLE_EQ(glass.ior, 1.5);
     expectVec(glass.absorption, {0.1, 0, 2});
     EXPECT_EQ(glass.fresnel, FresnelMode::Exact);
+}
+
+TEST(SceneParserValid, PbrLayersAreReadWithTheExtensionsDefaults)
+{
+    const Scene scene = parseSceneString(kCamera + R"([materials.plain]
+type = "pbr"
+[materials.layered]
+type = "pbr"
+ior = 1.8
+specular = 0.5
+specular_color = [2, 1, 0.5]
+sheen_color = [0.9, 0.4, 0.2]
+sheen_roughness = 0.6
+clearcoat = 1
+clearcoat_roughness = 0.1
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "layered"
+)",
+                                         "layers.toml");
+    const Material& plain = scene.materials.at(0);
+    EXPECT_EQ(plain.layers, PbrLayers{});
+    EXPECT_DOUBLE_EQ(plain.ior, 1.5);
+    EXPECT_FALSE(plain.hasPbrLayers()) << "the defaults keep the plain kernel";
+    const Material& layered = scene.materials.at(1);
+    EXPECT_TRUE(layered.hasPbrLayers());
+    EXPECT_DOUBLE_EQ(layered.ior, 1.8);
+    EXPECT_DOUBLE_EQ(layered.layers.specular, 0.5);
+    expectVec(layered.layers.specularColor, {2, 1, 0.5});
+    expectVec(layered.layers.sheenColor, {0.9, 0.4, 0.2});
+    EXPECT_DOUBLE_EQ(layered.layers.sheenRoughness, 0.6);
+    EXPECT_DOUBLE_EQ(layered.layers.clearcoat, 1.0);
+    EXPECT_DOUBLE_EQ(layered.layers.clearcoatRoughness, 0.1);
+    EXPECT_TRUE(featuresOf(scene).pbrLayers);
 }
 
 TEST(SceneParserValid, ShapesReferToMaterialIndices)
@@ -523,6 +560,12 @@ const std::vector<BadScene> kBadScenes = {
     {"PlasticIorOne", kCamera + "[materials.m]\ntype = \"plastic\"\nior = 1\n", 7, 7, "must differ from 1"},
     {"MetallicAboveOne", kCamera + "[materials.m]\ntype = \"pbr\"\nmetallic = 2\n", 7, 12,
      "materials.m.metallic: must be in [0, 1]"},
+    {"SheenColorAboveOne", kCamera + "[materials.m]\ntype = \"pbr\"\nsheen_color = 2\n", 7, 15,
+     "materials.m.sheen_color"},
+    {"ClearcoatNegative", kCamera + "[materials.m]\ntype = \"pbr\"\nclearcoat = -0.5\n", 7, 13,
+     "materials.m.clearcoat: must be in [0, 1]"},
+    {"SpecularColorNegative", kCamera + "[materials.m]\ntype = \"pbr\"\nspecular_color = [1, -1, 1]\n", 7, 22,
+     "materials.m.specular_color[1]: must be >= 0"},
     {"KeyOfOtherMaterialType", kCamera + "[materials.red]\ntype = \"lambert\"\nshininess = 3\n", 7, 1,
      "materials.red: key 'shininess' is not used by material type 'lambert'"},
     {"LambertRejectsFresnel", kCamera + "[materials.red]\ntype = \"lambert\"\nfresnel = \"schlick\"\n", 7, 1,

@@ -9,6 +9,10 @@
 // pdfBsdf(dir) (reflection only; 0 for transmitted and delta samples),
 // flags (1 specular, 2 transmitted, 4 no sample). Mode 1: evaluates at
 // wi = inputs[128 + 3i ..]: outputs[8i ..] = evalBsdf(wi).xyz, pdfBsdf(wi).
+// With VKRT_PBR_LAYERS defined (tests/gpu/pbr_layers_probe_test.cpp): the pbr
+// layers at inputs[31 .. 37] (sheenColor, sheenRoughness, specularFactor,
+// clearcoat, clearcoatAlpha), the sheen table at inputs[128 ..] (Material::table
+// = 128) and mode 1's directions after it, at inputs[kDirectionsAt ..].
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "probe.glsl"
@@ -23,6 +27,12 @@
 #include "lib/sampling.glsl"
 #include "lib/microfacet.glsl"
 #include "lib/bsdf.glsl"
+
+#ifdef VKRT_PBR_LAYERS
+const uint kDirectionsAt = 128u + SHEEN_TABLE_SIDE * SHEEN_TABLE_SIDE;
+#else
+const uint kDirectionsAt = 128u;
+#endif
 
 Material probeMaterial()
 {
@@ -42,6 +52,13 @@ Material probeMaterial()
     m.k = vec3(inputs[20], inputs[21], inputs[22]);
     m.lobeWeight = inputs[23];
     m.internalReflectance = inputs[24];
+#ifdef VKRT_PBR_LAYERS
+    m.sheenColor = vec3(inputs[31], inputs[32], inputs[33]);
+    m.sheenRoughness = inputs[34];
+    m.specularFactor = inputs[35];
+    m.clearcoat = inputs[36];
+    m.clearcoatAlpha = inputs[37];
+#endif
     return m;
 }
 
@@ -72,7 +89,8 @@ void main()
         outputs[8 * i + 6] = pdf;
         outputs[8 * i + 7] = float((s.specular ? 1u : 0u) | (s.transmitted ? 2u : 0u) | (none ? 4u : 0u));
     } else {
-        vec3 wi = vec3(inputs[128 + 3 * i], inputs[129 + 3 * i], inputs[130 + 3 * i]);
+        vec3 wi = vec3(inputs[kDirectionsAt + 3u * i], inputs[kDirectionsAt + 3u * i + 1u],
+                       inputs[kDirectionsAt + 3u * i + 2u]);
         vec3 f = evalBsdf(m, n, wo, wi);
         outputs[8 * i + 0] = f.x;
         outputs[8 * i + 1] = f.y;

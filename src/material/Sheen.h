@@ -1,0 +1,32 @@
+#pragma once
+// The Charlie sheen of KHR_materials_sheen (Estevez and Kulla 2017, "Production
+// Friendly Microfacet Sheen BRDF", in the form the extension gives) in double
+// precision, and the table of its directional albedo E(mu, roughness) that the
+// pbr material's albedo scaling reads (shared/SceneTypes.h: SHEEN_TABLE_SIDE).
+#include <vector>
+
+namespace vkrt {
+
+/// alpha_g = roughness^2, kept at or above gpu::MIN_SHEEN_ALPHA (the distribution divides by it).
+double sheenAlpha(double roughness);
+
+/// The Charlie distribution D(h) at cos(theta_h) = cosH.
+double charlieDistribution(double cosH, double alpha);
+
+/// The Charlie visibility's Lambda(cos theta) (the extension's fit).
+double charlieLambda(double cosTheta, double alpha);
+
+/// The sheen BRDF (colour 1) D V for directions at cosines cosO, cosI > 0 with half vector at cosH.
+double sheenBrdf(double cosO, double cosI, double cosH, double alpha);
+
+/// E(mu) = integral over the hemisphere of sheenBrdf cos(theta_i) for a direction at cosine mu,
+/// by a product midpoint rule in (sqrt(cos theta_i), phi) (nodes clustered at grazing, where the
+/// lobe lives); within 3e-4 of a 16 times finer grid near grazing, 1e-5 elsewhere (0.4 s for the whole
+/// table, once per process).
+double sheenDirectionalAlbedo(double mu, double roughness);
+
+/// The SHEEN_TABLE_SIDE^2 entries of the sheen table: E at roughness j / (side - 1) and
+/// cosine (i / (side - 1))^2 (cosine 0 taken as 1e-4), entry j * side + i. Computed once, then cached.
+const std::vector<float>& sheenAlbedoTable();
+
+} // namespace vkrt
