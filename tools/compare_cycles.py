@@ -151,7 +151,7 @@ CYCLES_BOUNCES = VKRT_MAX_DEPTH - 1
 # layer, yet the Khronos test models agree within the tool's rule.)
 BY_DESIGN = {
     "KHR_materials_iridescence": "iridescence: vkrt ignores it; Principled's thin film differs",
-    "KHR_materials_volume": "volume: vkrt has no attenuation from glTF; Blender adds a volume absorption",
+    "KHR_materials_volume": "volume: vkrt's glass absorbs as it says, untinted at its surface; Blender's volume differs",
 }
 # Features that exclude a model from the verdict (the model is rendered as it is).
 EXCLUDING = {

@@ -792,6 +792,19 @@ struct MaterialReader {
             out.sheenRoughnessFactor = unitFactor(e, "sheenRoughnessFactor", out.sheenRoughnessFactor);
             out.sheenRoughnessTexture = texture(member(*e, "sheenRoughnessTexture"), "sheenRoughnessTexture");
         }
+        if (const json* e = member(extensions, "KHR_materials_volume")) {
+            if (const json* t = member(*e, "thicknessFactor")) {
+                if (!t->is_number() || !(t->get<double>() >= 0.0) || !std::isfinite(t->get<double>()))
+                    malformed("KHR_materials_volume.thicknessFactor must be a finite number >= 0");
+                out.thicknessFactor = float(t->get<double>());
+            }
+            if (const json* d = member(*e, "attenuationDistance")) {
+                if (!d->is_number() || !(d->get<double>() > 0.0))
+                    malformed("KHR_materials_volume.attenuationDistance must be a number > 0");
+                out.attenuationDistance = float(std::min(d->get<double>(), double(std::numeric_limits<float>::max())));
+            }
+            out.attenuationColor = glm::vec3(colour(e, "attenuationColor", glm::vec4(1.0f), 3, false));
+        }
         if (const json* e = member(extensions, "KHR_materials_clearcoat")) {
             out.clearcoatFactor = unitFactor(e, "clearcoatFactor", out.clearcoatFactor);
             out.clearcoatTexture = texture(member(*e, "clearcoatTexture"), "clearcoatTexture");

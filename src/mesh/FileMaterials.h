@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -90,6 +91,10 @@ struct FileMaterial {
     float clearcoatRoughnessFactor = 0.0f;
     std::optional<FileTexture> clearcoatRoughnessTexture;
     std::optional<FileTexture> clearcoatNormalTexture;
+    /// KHR_materials_volume: thickness (0: thin-walled) and Beer-Lambert attenuation (world units).
+    float thicknessFactor = 0.0f;
+    float attenuationDistance = std::numeric_limits<float>::infinity();
+    glm::vec3 attenuationColor{1.0f};
     /// Every texture slot above, in one list (for what reads every texture: uv sets, transforms).
     std::vector<const std::optional<FileTexture>*> textureSlots() const;
     std::vector<std::optional<FileTexture>*> textureSlots();

@@ -898,6 +898,7 @@ const std::vector<std::string>& implementedGltfExtensions()
         "KHR_materials_unlit",        "KHR_materials_variants",
         "KHR_materials_transmission", // read as glass or not, each approximation warned (docs/scene-format.md)
         "KHR_materials_specular",     "KHR_materials_sheen",   "KHR_materials_clearcoat",
+        "KHR_materials_volume", // its attenuation, inside glass (the thickness only decides thin or not)
     };
     return names;
 }

@@ -3,6 +3,7 @@
 #include "mesh/FileMaterials.h"
 #include "mesh/MeshGeometry.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vkrt {
@@ -111,6 +112,18 @@ Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path&
 /// roughness) unless the roughness is 0. Only its normal map carries over.
 bool transmits(const FileMaterial& f) { return f.transmission >= 0.5f; }
 
+/// KHR_materials_volume's Beer-Lambert coefficient per world unit, -ln(attenuationColor) /
+/// attenuationDistance, inside a volumetric (thickness > 0) material; 0 for a thin-walled one or
+/// without attenuation. A colour component of 0 absorbs as one of 1e-9 does (opaque within a few
+/// attenuation distances) rather than infinitely.
+Color volumeAbsorption(const FileMaterial& f)
+{
+    if (!(f.thicknessFactor > 0.0f) || !std::isfinite(f.attenuationDistance)) return Color(0.0);
+    Color sigma;
+    for (int c = 0; c < 3; ++c) sigma[c] = -std::log(std::max(double(f.attenuationColor[c]), 1e-9)) / f.attenuationDistance;
+    return sigma;
+}
+
 Material toGlass(const FileMaterial& f, Material pbr)
 {
     Material m;
@@ -119,6 +132,7 @@ Material toGlass(const FileMaterial& f, Material pbr)
     m.where = pbr.where;
     m.ior = f.ior;
     m.roughness = pbr.roughness;
+    m.absorption = volumeAbsorption(f);
     m.textures[size_t(TextureSlot::Normal)] = pbr.texture(TextureSlot::Normal);
     m.normalStrength = pbr.normalStrength;
     // Glass keeps its coverage: the alpha test reads the colour slot, so it
@@ -168,6 +182,9 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
                            (transmits(f) ? "1 (glass)" : "0 (opaque)") +
                            ": vkrt does not mix transmission with the base material");
     if (transmits(f)) {
+        if (!(f.thicknessFactor > 0.0f))
+            warnings.push_back(prefix + "thin-walled transmission (no KHR_materials_volume thickness) is rendered "
+                                        "as refracting glass, its volume without attenuation");
         const glm::vec3 base(f.baseColorFactor);
         if (base != glm::vec3(1.0f) || f.baseColorTexture)
             warnings.push_back(prefix + "the base colour does not tint transmitted light (vkrt's glass is clear)");

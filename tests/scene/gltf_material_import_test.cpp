@@ -1,0 +1,98 @@
+// glTF materials as vkrt materials (scene/FileMaterialImport.cpp), through
+// parseGltfScene on files written here: the PBR extension layers with their
+// factors and each texture in the slot and channel its extension names, and
+// transmitting materials as glass with KHR_materials_volume's attenuation.
+#include "scene/GltfScene.h"
+#include "support/GltfTestFiles.h"
+#include "support/TestSupport.h"
+#include "texture/TextureTestFiles.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace vkrt::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One triangle with TEXCOORD_0 and TEXCOORD_1 whose material is `material`
+/// (textures index 0 is a 2 x 2 PNG beside the file).
+Scene importOne(const std::string& name, const std::string& material, const std::string& used)
+{
+    const fs::path dir = freshTempDir("gltf-material-import");
+    write8BitPng(dir / "grey.png", 2, 2, 4, std::vector<uint8_t>(16, 128));
+    writeText(dir / (name + ".gltf"),
+              triangleGltf(R"("materials": [)" + material + R"(], "textures": [{"source": 0}],
+                             "images": [{"uri": "grey.png"}], "extensionsUsed": )" + used));
+    return parseGltfScene((dir / (name + ".gltf")).string());
+}
+
+TEST(GltfMaterialImport, PbrLayersTakeTheirFactorsAndTexturesInTheirChannels)
+{
+    const Scene scene = importOne("layers", R"({"extensions": {
+        "KHR_materials_ior": {"ior": 1.7},
+        "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [2, 1, 0.5],
+                                   "specularTexture": {"index": 0}, "specularColorTexture": {"index": 0}},
+        "KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.4, 0.2], "sheenRoughnessFactor": 0.6,
+                                "sheenRoughnessTexture": {"index": 0}},
+        "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.1,
+                                    "clearcoatTexture": {"index": 0}, "clearcoatRoughnessTexture": {"index": 0}}}})",
+                                   R"(["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_sheen",
+                                       "KHR_materials_clearcoat"])");
+    ASSERT_EQ(scene.materials.size(), 1u);
+    const Material& m = scene.materials[0];
+    EXPECT_EQ(m.type, MaterialType::Pbr);
+    EXPECT_TRUE(m.hasPbrLayers());
+    EXPECT_DOUBLE_EQ(m.ior, 1.7f);
+    EXPECT_DOUBLE_EQ(m.layers.specular, 0.5);
+    EXPECT_EQ(m.layers.specularColor, Color(2.0, 1.0, 0.5));
+    EXPECT_EQ(m.layers.sheenColor, Color(0.9f, 0.4f, 0.2f));
+    EXPECT_DOUBLE_EQ(m.layers.sheenRoughness, 0.6f);
+    EXPECT_DOUBLE_EQ(m.layers.clearcoat, 1.0);
+    EXPECT_DOUBLE_EQ(m.layers.clearcoatRoughness, 0.1f);
+    // The channels the extensions name: specular strength A, sheen roughness A, coat R, coat roughness G.
+    const std::pair<TextureSlot, uint32_t> channels[] = {{TextureSlot::SpecularFactor, 3},
+                                                         {TextureSlot::SheenRoughness, 3},
+                                                         {TextureSlot::Clearcoat, 0},
+                                                         {TextureSlot::ClearcoatRoughness, 1}};
+    for (const auto& [slot, channel] : channels) {
+        ASSERT_TRUE(m.texture(slot).has_value()) << int(slot);
+        EXPECT_EQ(m.texture(slot)->channel, channel) << int(slot);
+    }
+    EXPECT_TRUE(m.texture(TextureSlot::Specular).has_value()) << "specularColorTexture multiplies the F0 colour";
+    EXPECT_FALSE(m.texture(TextureSlot::SheenColor).has_value());
+}
+
+TEST(GltfMaterialImport, TransmittingVolumesAbsorbAsTheirAttenuationSays)
+{
+    // sigma = -ln(attenuationColor) / attenuationDistance per channel, inside glass of the file's index.
+    const std::string volume = R"({"pbrMetallicRoughness": {"roughnessFactor": 0}, "extensions": {
+        "KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.4},
+        "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 2,
+                                 "attenuationColor": [0.5, 1, 0.25]}}})";
+    const std::string used = R"(["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"])";
+    const Scene scene = importOne("volume", volume, used);
+    ASSERT_EQ(scene.materials.size(), 1u);
+    const Material& glass = scene.materials[0];
+    EXPECT_EQ(glass.type, MaterialType::Dielectric);
+    EXPECT_NEAR(glass.ior, 1.4, 1e-6);
+    EXPECT_NEAR(glass.absorption.r, std::log(2.0) / 2.0, 1e-7);
+    EXPECT_EQ(glass.absorption.g, 0.0);
+    EXPECT_NEAR(glass.absorption.b, std::log(4.0) / 2.0, 1e-7);
+
+    // Thin-walled (thickness 0): no volume to absorb in, and vkrt says that its glass refracts anyway.
+    std::string thin = volume;
+    thin.replace(thin.find("\"thicknessFactor\": 1"), 20, "\"thicknessFactor\": 0");
+    const Scene thinScene = importOne("thin", thin, used);
+    EXPECT_EQ(thinScene.materials.at(0).absorption, Color(0.0));
+    std::string all;
+    for (const std::string& w : thinScene.warnings) all += w + "\n";
+    EXPECT_NE(all.find("thin-walled"), std::string::npos) << all;
+}
+
+} // namespace
+} // namespace vkrt::test
