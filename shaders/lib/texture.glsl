@@ -1,4 +1,4 @@
-// Image texture lookups from the packed texel buffer (shared/TextureTypes.h,
+// Image texture lookups from the packed texel words (shared/TextureTypes.h,
 // src/texture/TextureAtlas.h). Include lib/texture_bindings.glsl first, with
 // VKRT_HAS_TEXTURES defined.
 //
@@ -62,9 +62,9 @@ vec4 fetchTexel(uint format, uint offset, uint width, uint x, uint y)
     uint index = y * width + x;
     if (format == TEXTURE_FORMAT_RGBA16F) {
         uint word = offset + 2u * index;
-        return vec4(unpackHalf2x16(textureTexels[word]), unpackHalf2x16(textureTexels[word + 1u]));
+        return vec4(unpackHalf2x16(textureWord(word)), unpackHalf2x16(textureWord(word + 1u)));
     }
-    vec4 texel = unpackUnorm4x8(textureTexels[offset + index]);
+    vec4 texel = unpackUnorm4x8(textureWord(offset + index));
     if (format == TEXTURE_FORMAT_RGBA8_SRGB)
         texel.rgb = srgbToLinear(texel.rgb);
     return texel;

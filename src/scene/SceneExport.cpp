@@ -101,8 +101,8 @@ struct TextureTable {
 TextureTable textureTable(const Scene& scene)
 {
     TextureTable table{scene.textures.get(), {}};
-    // The atlas keeps each record's size, encoding and wrap modes only in its packed form.
-    if (table.atlas) table.records = table.atlas->pack(std::numeric_limits<uint64_t>::max()).records;
+    // The atlas keeps each record's size, encoding and wrap modes only in its GPU form.
+    if (table.atlas) table.records = table.atlas->records();
     return table;
 }
 

@@ -5,6 +5,7 @@
 #include <Imath/half.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <sstream>
 
@@ -107,6 +108,9 @@ uint32_t TextureAtlas::addImage(TextureImage image, const std::string& name)
     }
     stored.levels = uint32_t(stored.levelWords.size());
     VKRT_CHECK(stored.levels <= gpu::TEXTURE_MAX_LEVELS);
+    // Half-float images start at an even word, so that no two-word texel
+    // straddles two chunks (each holds an even number of words).
+    if (stored.format == gpu::TEXTURE_FORMAT_RGBA16F) m_words += m_words % 2;
     stored.firstWord = m_words;
     m_words += stored.words.size();
     m_images.push_back(std::move(stored));
@@ -264,30 +268,75 @@ uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, T
     return addRecord(addImage(image, name), wrapU, wrapV);
 }
 
-TextureBuffers TextureAtlas::pack(uint64_t maxStorageBufferRange) const
+TextureChunking textureChunkingFor(uint64_t words, const TextureStorageLimits& limits)
 {
-    if (texelBytes() > maxStorageBufferRange) {
-        const auto largest = std::max_element(m_images.begin(), m_images.end(), [](const auto& a, const auto& b) {
-            return a.words.size() < b.words.size();
-        });
-        throw InputError("textures need " + mebibytes(texelBytes()) + " of GPU storage (all mip levels), more than " +
-                         "this device's limit of " + mebibytes(maxStorageBufferRange) +
-                         " for one storage buffer (maxStorageBufferRange); the largest is " + largest->name + " (" +
-                         std::to_string(largest->width) + "x" + std::to_string(largest->height) + ", " +
-                         mebibytes(largest->words.size() * 4) + ")");
-    }
-    TextureBuffers buffers;
-    buffers.texels.reserve(m_words);
-    for (const StoredImage& image : m_images)
-        buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
+    // One buffer whenever it fits: the kernels of such scenes stay as they were.
+    if (words <= limits.maxBufferBytes / 4) return {};
+    const uint64_t chunkWords = std::min(limits.maxBufferBytes, TextureAtlas::kMaxChunkBytes) / 4;
+    VKRT_CHECK(chunkWords >= 2); // a half-float texel's two words fit one chunk
+    const auto shift = uint32_t(std::bit_width(chunkWords) - 1);
+    return {uint32_t((words + (uint64_t(1) << shift) - 1) >> shift), shift};
+}
+
+std::span<const uint32_t> TextureBuffers::chunk(uint32_t index) const
+{
+    VKRT_CHECK(index < chunking.count);
+    if (chunking.count == 1) return texels;
+    const size_t first = size_t(index) << chunking.shift;
+    VKRT_CHECK(first < texels.size());
+    return std::span(texels).subspan(first, std::min(size_t(1) << chunking.shift, texels.size() - first));
+}
+
+TextureChunking TextureAtlas::chunking(const TextureStorageLimits& limits) const
+{
+    const TextureChunking chunks = textureChunkingFor(m_words, limits);
+    if (chunks.count <= limits.maxBuffers && texelBytes() <= limits.memoryBytes) return chunks;
+    const auto largest = std::max_element(m_images.begin(), m_images.end(),
+                                          [](const auto& a, const auto& b) { return a.words.size() < b.words.size(); });
+    const std::string room = chunks.count > limits.maxBuffers
+                                 ? std::to_string(chunks.count) + " storage buffers of " +
+                                       mebibytes(uint64_t(4) << chunks.shift) +
+                                       " (maxStorageBufferRange), and the kernel can bind " +
+                                       std::to_string(limits.maxBuffers) + " more (maxPerStageDescriptorStorageBuffers)"
+                                 : "the device's " + mebibytes(limits.memoryBytes) + " of memory";
+    throw InputError("textures need " + mebibytes(texelBytes()) + " of GPU storage (all mip levels), more than " +
+                     "this device can hold: " + room + "; the largest is " + largest->name + " (" +
+                     std::to_string(largest->width) + "x" + std::to_string(largest->height) + ", " +
+                     mebibytes(largest->words.size() * 4) + ")");
+}
+
+std::vector<gpu::TextureRecord> TextureAtlas::records() const
+{
+    std::vector<gpu::TextureRecord> records;
     for (const auto& [imageIndex, wrapU, wrapV] : m_records) {
         const StoredImage& image = m_images[imageIndex];
         gpu::TextureRecord record{
             image.width, image.height, image.levels, image.format, uint32_t(wrapU), uint32_t(wrapV), {}};
         for (uint32_t level = 0; level < image.levels; ++level)
             record.levelOffset[level] = uint32_t(image.firstWord + image.levelWords[level]);
-        buffers.records.push_back(record);
+        records.push_back(record);
     }
+    return records;
+}
+
+TextureBuffers TextureAtlas::pack(const TextureChunking& chunking) const
+{
+    // Word addresses are 32-bit (TextureRecord::levelOffset). A level-0
+    // texel takes at most 5 words: 2 (half floats), as many again for its
+    // mip chain (a 1-texel-high image's levels halve one side only), and one
+    // of padding before its image. So the scene's texel budget keeps them
+    // below 2^32; the check stands for an atlas made with a larger budget.
+    static_assert(5 * TextureAtlas::kMaxSceneTexels < (uint64_t(1) << 32));
+    VKRT_CHECK(m_words <= uint64_t(UINT32_MAX));
+    VKRT_CHECK(chunking.count == 1 || ((m_words - 1) >> chunking.shift) + 1 == chunking.count);
+    TextureBuffers buffers;
+    buffers.texels.reserve(m_words);
+    for (const StoredImage& image : m_images) {
+        buffers.texels.resize(image.firstWord, 0u); // the padding before a half-float image
+        buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
+    }
+    buffers.records = records();
+    buffers.chunking = chunking;
     return buffers;
 }
 

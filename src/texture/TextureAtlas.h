@@ -1,8 +1,10 @@
 #pragma once
-// Every texture of a scene, all mip levels, packed into one buffer of 32-bit
-// words plus a table of gpu::TextureRecord (shared/TextureTypes.h) that
-// lib/texture.glsl reads. One buffer means no descriptor-count limit; its size
-// is checked against the device's maxStorageBufferRange instead.
+// Every texture of a scene, all mip levels, packed into one address space of
+// 32-bit words plus a table of gpu::TextureRecord (shared/TextureTypes.h) that
+// lib/texture.glsl reads. The words are one storage buffer when they fit the
+// device's maxStorageBufferRange, else chunks of 2^k words, one buffer each
+// (TextureChunking): a few buffers however many textures, so the texture
+// count never meets a descriptor limit.
 #include "shared/TextureTypes.h"
 #include "texture/TextureImage.h"
 #include "util/Error.h"
@@ -32,10 +34,42 @@ struct TextureRequest {
     TextureWrap wrapV = TextureWrap::Repeat;
 };
 
-/// What the kernels bind: BINDING_TEXTURE_TEXELS and BINDING_TEXTURE_RECORDS.
+/// How the texel words are split into storage buffers. Word w lives in
+/// chunk w >> shift at index w & (2^shift - 1) (lib/texture_bindings.glsl).
+struct TextureChunking {
+    uint32_t count = 1; ///< buffers; 1: every word in one buffer, whatever its size (shift unused)
+    uint32_t shift = 0; ///< with several: log2 of the words each holds (the last may hold fewer)
+
+    bool operator==(const TextureChunking&) const = default;
+};
+
+/// What the device allows the texel words.
+struct TextureStorageLimits {
+    /// Bytes of one buffer: maxStorageBufferRange and maxMemoryAllocationSize
+    /// (tests ask for less, to split small scenes).
+    uint64_t maxBufferBytes = UINT64_MAX;
+    /// Buffers the kernel can bind for texels (the per-stage storage-buffer
+    /// descriptors its other bindings leave).
+    uint32_t maxBuffers = UINT32_MAX;
+    /// Memory there is for them at all (the largest device-local heap).
+    uint64_t memoryBytes = UINT64_MAX;
+};
+
+/// The chunks for `words` texel words: one buffer when they fit
+/// maxBufferBytes, else the largest even power of two words that fits
+/// maxBufferBytes and TextureAtlas::kMaxChunkBytes. The count may exceed
+/// limits.maxBuffers (TextureAtlas::chunking refuses that).
+TextureChunking textureChunkingFor(uint64_t words, const TextureStorageLimits& limits);
+
+/// What the kernels bind: BINDING_TEXTURE_TEXELS (the words, in chunking.count
+/// buffers) and BINDING_TEXTURE_RECORDS.
 struct TextureBuffers {
-    std::vector<uint32_t> texels;
+    std::vector<uint32_t> texels; ///< every word, in one address space (TextureRecord::levelOffset)
     std::vector<gpu::TextureRecord> records;
+    TextureChunking chunking;
+
+    /// The words of buffer `chunk` (< chunking.count).
+    std::span<const uint32_t> chunk(uint32_t chunk) const;
 };
 
 class TextureAtlas {
@@ -46,6 +80,10 @@ public:
     /// a texel (float RGBA and its mip chain) and the atlas keeps 5.3 (8-bit)
     /// or 10.7 (half) bytes a texel on the GPU. At most 683 MiB of GPU storage.
     static constexpr uint64_t kMaxSceneTexels = uint64_t(64) << 20;
+    /// The largest chunk of several (1 GiB): a shift of at most 28, and
+    /// buffers of a size every driver allocates. A scene's texels (683 MiB at
+    /// most) need more than one chunk only on a device whose buffers are smaller.
+    static constexpr uint64_t kMaxChunkBytes = uint64_t(1) << 30;
 
     /// `maxTexels`: the budget (tests use a small one).
     explicit TextureAtlas(uint64_t maxTexels = kMaxSceneTexels) : m_maxTexels(maxTexels) {}
@@ -85,9 +123,14 @@ public:
     /// in double. For host integrals of a texture (emitters' power).
     std::array<double, 4> sampleLevel(uint32_t record, double u, double v, uint32_t level) const;
 
-    /// The buffers to upload. Throws InputError when the texels exceed
-    /// `maxStorageBufferRange` bytes (VkPhysicalDeviceLimits), naming the largest texture.
-    TextureBuffers pack(uint64_t maxStorageBufferRange) const;
+    /// How the texels will be split (textureChunkingFor). Throws InputError,
+    /// naming the largest texture, when they need more buffers or memory
+    /// than `limits` allow.
+    TextureChunking chunking(const TextureStorageLimits& limits) const;
+    /// The buffers to upload, split as `chunking` (from chunking()) says.
+    TextureBuffers pack(const TextureChunking& chunking = {}) const;
+    /// The records alone (what pack returns in TextureBuffers::records).
+    std::vector<gpu::TextureRecord> records() const;
 
 private:
     struct StoredImage {

@@ -17,6 +17,7 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -310,6 +311,120 @@ intensity = [30, 30, 30]
     }
     EXPECT_EQ(differing, 0u);
     EXPECT_GT(lit, a.rgb.size() / 2) << "most of the image should be lit";
+}
+
+// ------------------------------------------------- texels in several buffers
+
+/// Words a texel of `format` takes.
+uint32_t wordsPerTexel(uint32_t format) { return format == gpu::TEXTURE_FORMAT_RGBA16F ? 2u : 1u; }
+
+/// Levels of `format` (among `records`) whose words straddle a boundary of chunks of 2^shift words.
+int straddlingLevels(const std::vector<gpu::TextureRecord>& records, uint32_t shift, uint32_t format)
+{
+    int count = 0;
+    for (const gpu::TextureRecord& r : records) {
+        if (r.format != format) continue;
+        for (uint32_t level = 0; level < r.levels; ++level) {
+            const uint64_t words =
+                uint64_t(std::max(1u, r.width >> level)) * std::max(1u, r.height >> level) * wordsPerTexel(r.format);
+            const uint64_t first = r.levelOffset[level], last = first + words - 1;
+            count += (first >> shift) != (last >> shift);
+        }
+    }
+    return count;
+}
+
+// Texels split into many small buffers (RenderOptions::maxTextureChunkBytes,
+// as a scene beyond maxStorageBufferRange is) render exactly as in one: the
+// same words read, the same arithmetic. Levels of 8-bit sRGB, 8-bit linear
+// and half-float textures straddle the chunks' boundaries.
+TEST_F(TextureRender, TexelsInSmallChunksRenderBitForBitAsInOneBuffer)
+{
+    const auto dir = freshTempDir("texture-chunks");
+    writeChecker(dir, 64);
+    writeQuadrantTexture(dir);
+    std::vector<uint16_t> wide;
+    for (uint32_t y = 0; y < 10; ++y)
+        for (uint32_t x = 0; x < 12; ++x)
+            wide.insert(wide.end(), {uint16_t(x * 5000), uint16_t(y * 6000), uint16_t(30000 + x * y * 300), 65535});
+    writePng(dir / "wide.png", 12, 10, 16, 6, wide); // 16-bit: half floats
+    std::vector<uint8_t> rough;
+    for (uint32_t i = 0; i < 7 * 5; ++i) rough.push_back(uint8_t(40 + 5 * i));
+    write8BitPng(dir / "rough.png", 7, 5, 1, rough);
+    const std::string text = R"([render]
+integrator = "path"
+max_depth = 2
+[camera]
+eye = [0, 1.5, 4]
+target = [0, 0.5, 0]
+fov = 40
+width = 40
+height = 30
+[background]
+color = [0.8, 0.9, 1.0]
+[materials.floor]
+type = "lambert"
+albedo = { texture = "checker.png", scale = 3 }
+[materials.ball]
+type = "lambert"
+albedo = { texture = "quadrants.png", wrap = "mirror" }
+[materials.wide]
+type = "lambert"
+albedo = { texture = "wide.png", scale = [2, 1] }
+[materials.metal]
+type = "conductor"
+metal = "Au"
+roughness = { texture = "rough.png", linear = true }
+[[objects]]
+shape = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+[[objects]]
+shape = "sphere"
+center = [-0.8, 0.6, 0]
+radius = 0.6
+material = "ball"
+[[objects]]
+shape = "box"
+min = [0.2, 0, -0.5]
+max = [1.2, 1, 0.5]
+material = "wide"
+[[objects]]
+shape = "sphere"
+center = [0.2, 0.3, 1.2]
+radius = 0.3
+material = "metal"
+[[lights]]
+type = "point"
+position = [2, 4, 3]
+intensity = [30, 30, 30]
+)";
+    const Scene scene = parseSceneString(text, (dir / "scene.toml").string());
+    RenderOptions oneOptions = pixelCentreOptions(), splitOptions = pixelCentreOptions();
+    splitOptions.maxTextureChunkBytes = 1024; // 256 words a buffer
+    Renderer one(gpu(), scene, oneOptions), split(gpu(), scene, splitOptions);
+    EXPECT_EQ(one.variant().textureChunks, 1u);
+    const TextureBuffers& textures = split.meshData().textures;
+    ASSERT_EQ(split.variant().textureChunks, textures.chunking.count);
+    EXPECT_EQ(textures.chunking.shift, 8u);
+    EXPECT_EQ(textures.chunking.count, (textures.texels.size() + 255) / 256);
+    EXPECT_GT(textures.chunking.count, 20u);
+    for (uint32_t format :
+         {gpu::TEXTURE_FORMAT_RGBA8_SRGB, gpu::TEXTURE_FORMAT_RGBA8_UNORM, gpu::TEXTURE_FORMAT_RGBA16F})
+        EXPECT_GT(straddlingLevels(textures.records, 8, format), 0) << "format " << format;
+    one.renderFrames(2);
+    split.renderFrames(2);
+    const Image a = one.mean(), b = split.mean();
+    size_t differing = 0;
+    std::vector<float> values;
+    for (size_t i = 0; i < a.rgb.size(); ++i) {
+        differing += a.rgb[i] != b.rgb[i];
+        values.push_back(a.rgb[i]);
+    }
+    EXPECT_EQ(differing, 0u);
+    std::sort(values.begin(), values.end());
+    EXPECT_GT(std::unique(values.begin(), values.end()) - values.begin(), 500) << "the textures should show";
 }
 
 // --------------------------------------------------------- glTF file materials

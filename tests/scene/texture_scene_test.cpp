@@ -61,7 +61,7 @@ TEST_F(SceneParserTextures, ATextureTableSetsTheSlotAndReplacesTheConstant)
     EXPECT_EQ(m.diffuse, Color(1.0)) << "the texel is the albedo: the constant it multiplies is 1";
     EXPECT_EQ(m.texture(TextureSlot::Color)->scale, glm::dvec2(4, 2));
     ASSERT_TRUE(scene.textures);
-    const TextureBuffers buffers = scene.textures->pack(~0ull);
+    const TextureBuffers buffers = scene.textures->pack();
     ASSERT_EQ(buffers.records.size(), 1u);
     EXPECT_EQ(buffers.records[0].wrapU, gpu::TEXTURE_WRAP_CLAMP);
     EXPECT_EQ(buffers.records[0].wrapV, gpu::TEXTURE_WRAP_MIRROR);

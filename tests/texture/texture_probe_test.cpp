@@ -137,7 +137,7 @@ protected:
         m_atlas.add(randomImage(13, 1, TexelEncoding::Srgb8, random, 0, 1), "d", W::Mirror, W::Mirror);
         m_atlas.add(randomImage(1, 1, TexelEncoding::Half, random, 0, 1), "e", W::Repeat, W::Repeat);
         m_atlas.add(randomImage(16, 16, TexelEncoding::Srgb8, random, 0, 1), "f", W::Repeat, W::Repeat);
-        m_buffers = m_atlas.pack(1u << 30);
+        m_buffers = m_atlas.pack();
     }
 
     /// Random uv over several periods, lod over and beyond [0, levels - 1].
@@ -250,7 +250,7 @@ TEST_F(TextureProbe, ShaderDecodesEverySrgbCode)
     }
     TextureAtlas atlas;
     atlas.add(ramp, "ramp", TextureWrap::Clamp, TextureWrap::Clamp);
-    const TextureBuffers buffers = atlas.pack(1u << 20);
+    const TextureBuffers buffers = atlas.pack();
     for (uint32_t code = 0; code < 256; ++code) ASSERT_EQ(buffers.texels[code] & 0xffu, code);
     std::vector<Lookup> lookups;
     for (uint32_t code = 0; code < 256; ++code) lookups.push_back({0, (code + 0.5f) / 256.0f, 0.5f, 0.0f});
@@ -275,7 +275,7 @@ TEST_F(TextureProbe, FiltersDecodedValues)
     std::fill(pair.pixels.rgba.begin() + 4, pair.pixels.rgba.end(), 1.0f);
     TextureAtlas atlas;
     atlas.add(pair, "pair", TextureWrap::Clamp, TextureWrap::Clamp);
-    const std::vector<Rgba> results = sampleOnGpu(atlas.pack(1u << 20), {{0, 0.5f, 0.5f, 0.0f}, {0, 0.5f, 0.5f, 1.0f}});
+    const std::vector<Rgba> results = sampleOnGpu(atlas.pack(), {{0, 0.5f, 0.5f, 0.0f}, {0, 0.5f, 0.5f, 1.0f}});
     EXPECT_NEAR(results[0][0], 0.5, 1e-6);
     // The 1x1 level: the linear mean 0.5, stored as sRGB code 188.
     EXPECT_NEAR(results[1][0], srgbReference(188 / 255.0), 1e-6);
