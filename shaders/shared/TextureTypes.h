@@ -26,6 +26,14 @@ VKRT_CONSTANT(uint, TEXTURE_WRAP_REPEAT, 0) // i mod n
 VKRT_CONSTANT(uint, TEXTURE_WRAP_CLAMP, 1)  // clamp(i, 0, n - 1): the edge texel continues
 VKRT_CONSTANT(uint, TEXTURE_WRAP_MIRROR, 2) // reflected at each edge, period 2n (GL_MIRRORED_REPEAT)
 
+// TextureRecord::filters, bits (glTF's sampler magFilter and minFilter;
+// lib/texture.glsl's sampleTexture). 0 is vkrt's default, glTF's LINEAR and
+// LINEAR_MIPMAP_LINEAR: bilinear when magnified, trilinear when minified.
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MAG_NEAREST, 1) // magnified: the nearest texel of level 0
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MIN_NEAREST, 2) // minified: the nearest texel within a level
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MIP_NEAREST, 4) // minified: the nearest level (round(lod)), not two blended
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MIP_NONE, 8)    // minified: level 0 alone (no mip maps)
+
 // TextureRecord::format
 VKRT_CONSTANT(uint, TEXTURE_FORMAT_RGBA8_SRGB, 0)
 VKRT_CONSTANT(uint, TEXTURE_FORMAT_RGBA8_UNORM, 1)
@@ -52,6 +60,7 @@ struct TextureRecord {
     uint format;
     uint wrapU;
     uint wrapV;
+    uint filters; // TEXTURE_FILTER_* bits
     uint levelOffset[TEXTURE_MAX_LEVELS];
 };
 

@@ -120,31 +120,31 @@ uint32_t TextureAtlas::addImage(TextureImage image, const std::string& name)
 std::array<double, 4> TextureAtlas::meanOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].mean;
+    return m_images[m_records[record].image].mean;
 }
 
 const std::string& TextureAtlas::nameOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].name;
+    return m_images[m_records[record].image].name;
 }
 
 uint32_t TextureAtlas::widthOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].width;
+    return m_images[m_records[record].image].width;
 }
 
 uint32_t TextureAtlas::heightOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].height;
+    return m_images[m_records[record].image].height;
 }
 
 uint32_t TextureAtlas::levelsOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].levels;
+    return m_images[m_records[record].image].levels;
 }
 
 namespace {
@@ -203,10 +203,17 @@ std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t lev
 std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, double v, uint32_t level) const
 {
     VKRT_CHECK(record < m_records.size());
-    const auto& [imageIndex, wrapU, wrapV] = m_records[record];
+    const auto& [imageIndex, wrapU, wrapV, filter] = m_records[record];
     const StoredImage& image = m_images[imageIndex];
     VKRT_CHECK(level < image.levels);
     const int64_t w = mipSize(image.width, level), h = mipSize(image.height, level);
+    const uint64_t at = image.levelWords[level];
+    if (filter.magNearest) {
+        // Texel i spans [i, i + 1) of the continuous coordinates.
+        const auto i = int64_t(std::floor(wrapCoordinate(u, wrapU) * double(w)));
+        const auto j = int64_t(std::floor(wrapCoordinate(1.0 - v, wrapV) * double(h)));
+        return fetch(image, at, uint32_t(w), wrapIndex(i, w, wrapU), wrapIndex(j, h, wrapV));
+    }
     // Continuous texel coordinates, texel centres at integers; y down from the top row.
     const double s = wrapCoordinate(u, wrapU) * double(w) - 0.5;
     const double t = wrapCoordinate(1.0 - v, wrapV) * double(h) - 0.5;
@@ -215,7 +222,6 @@ std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, doubl
     const auto i0 = int64_t(bs), j0 = int64_t(bt);
     const uint32_t x0 = wrapIndex(i0, w, wrapU), x1 = wrapIndex(i0 + 1, w, wrapU);
     const uint32_t y0 = wrapIndex(j0, h, wrapV), y1 = wrapIndex(j0 + 1, h, wrapV);
-    const uint64_t at = image.levelWords[level];
     const auto a = fetch(image, at, uint32_t(w), x0, y0), b = fetch(image, at, uint32_t(w), x1, y0);
     const auto c = fetch(image, at, uint32_t(w), x0, y1), d = fetch(image, at, uint32_t(w), x1, y1);
     std::array<double, 4> result{};
@@ -226,12 +232,18 @@ std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, doubl
     return result;
 }
 
-uint32_t TextureAtlas::addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV)
+uint32_t TextureFilter::bits() const
 {
-    const auto record = std::make_tuple(image, wrapU, wrapV);
-    const auto found = std::find(m_records.begin(), m_records.end(), record);
+    return (magNearest ? gpu::TEXTURE_FILTER_MAG_NEAREST : 0u) | (minNearest ? gpu::TEXTURE_FILTER_MIN_NEAREST : 0u) |
+           (mip == Mip::Nearest ? gpu::TEXTURE_FILTER_MIP_NEAREST : 0u) |
+           (mip == Mip::None ? gpu::TEXTURE_FILTER_MIP_NONE : 0u);
+}
+
+uint32_t TextureAtlas::addRecord(const RecordKey& key)
+{
+    const auto found = std::find(m_records.begin(), m_records.end(), key);
     if (found != m_records.end()) return uint32_t(found - m_records.begin());
-    m_records.push_back(record);
+    m_records.push_back(key);
     return uint32_t(m_records.size() - 1);
 }
 
@@ -251,21 +263,22 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
         }
         found = m_imageByFile.emplace(key, image).first;
     }
-    return addRecord(found->second, request.wrapU, request.wrapV);
+    return addRecord({found->second, request.wrapU, request.wrapV, request.filter});
 }
 
 uint32_t TextureAtlas::addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
-                                  TextureWrap wrapU, TextureWrap wrapV)
+                                  TextureWrap wrapU, TextureWrap wrapV, const TextureFilter& filter)
 {
-    return addRecord(addDecoded(bytes, name, linear), wrapU, wrapV);
+    return addRecord({addDecoded(bytes, name, linear), wrapU, wrapV, filter});
 }
 
-uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV)
+uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV,
+                           const TextureFilter& filter)
 {
     VKRT_CHECK(image.pixels.width >= 1 && image.pixels.width <= gpu::TEXTURE_MAX_SIZE);
     VKRT_CHECK(image.pixels.height >= 1 && image.pixels.height <= gpu::TEXTURE_MAX_SIZE);
     reserveTexels({image.pixels.width, image.pixels.height, image.encoding}, name);
-    return addRecord(addImage(image, name), wrapU, wrapV);
+    return addRecord({addImage(image, name), wrapU, wrapV, filter});
 }
 
 TextureChunking textureChunkingFor(uint64_t words, const TextureStorageLimits& limits)
@@ -308,10 +321,10 @@ TextureChunking TextureAtlas::chunking(const TextureStorageLimits& limits) const
 std::vector<gpu::TextureRecord> TextureAtlas::records() const
 {
     std::vector<gpu::TextureRecord> records;
-    for (const auto& [imageIndex, wrapU, wrapV] : m_records) {
+    for (const auto& [imageIndex, wrapU, wrapV, filter] : m_records) {
         const StoredImage& image = m_images[imageIndex];
-        gpu::TextureRecord record{
-            image.width, image.height, image.levels, image.format, uint32_t(wrapU), uint32_t(wrapV), {}};
+        gpu::TextureRecord record{image.width,     image.height,    image.levels,  image.format,
+                                  uint32_t(wrapU), uint32_t(wrapV), filter.bits(), {}};
         for (uint32_t level = 0; level < image.levels; ++level)
             record.levelOffset[level] = uint32_t(image.firstWord + image.levelWords[level]);
         records.push_back(record);

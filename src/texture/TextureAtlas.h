@@ -15,7 +15,6 @@
 #include <map>
 #include <span>
 #include <string>
-#include <tuple>
 #include <vector>
 
 namespace vkrt {
@@ -26,12 +25,31 @@ enum class TextureWrap : uint32_t {
     Mirror = gpu::TEXTURE_WRAP_MIRROR,
 };
 
+/// How lookups filter a texture (glTF's sampler magFilter and minFilter;
+/// gpu::TextureRecord::filters). The default is vkrt's own: bilinear when
+/// magnified, trilinear when minified (glTF's LINEAR, LINEAR_MIPMAP_LINEAR).
+struct TextureFilter {
+    enum class Mip : uint8_t {
+        Linear,  ///< two levels blended
+        Nearest, ///< the nearest level
+        None,    ///< level 0 alone
+    };
+    bool magNearest = false; ///< magnified: the nearest texel, not bilinear
+    bool minNearest = false; ///< minified: the nearest texel within a level, not bilinear
+    Mip mip = Mip::Linear;   ///< minified: which levels
+
+    /// The gpu::TEXTURE_FILTER_* bits.
+    uint32_t bits() const;
+    bool operator==(const TextureFilter&) const = default;
+};
+
 /// A texture as a scene names it.
 struct TextureRequest {
     std::filesystem::path file; ///< already resolved against the scene file's folder
     bool linear = false;        ///< 8/16-bit data that is not sRGB (roughness, normal maps)
     TextureWrap wrapU = TextureWrap::Repeat;
     TextureWrap wrapV = TextureWrap::Repeat;
+    TextureFilter filter;
 };
 
 /// How the texel words are split into storage buffers. Word w lives in
@@ -89,7 +107,8 @@ public:
     explicit TextureAtlas(uint64_t maxTexels = kMaxSceneTexels) : m_maxTexels(maxTexels) {}
 
     /// Loads the file (once per (file, linear) pair) and returns the index of
-    /// its record (one per distinct pair and wrap modes). Load errors are
+    /// its record (one per distinct pair, wrap modes and filter: records of
+    /// one image share its texels). Load errors are
     /// InputErrors naming the file; given a location (the scene's `texture`
     /// key), a SceneError starting "file:line:column: ".
     uint32_t add(const TextureRequest& request, const SourceLocation& where = {});
@@ -97,11 +116,12 @@ public:
     /// An image file's bytes already in memory (embedded in a .glb, a data:
     /// URI): its header checked against the budget before it is decoded.
     uint32_t addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
-                        TextureWrap wrapU = TextureWrap::Repeat, TextureWrap wrapV = TextureWrap::Repeat);
+                        TextureWrap wrapU = TextureWrap::Repeat, TextureWrap wrapV = TextureWrap::Repeat,
+                        const TextureFilter& filter = {});
 
     /// An image made in memory (procedural textures, tests); `name` is used in messages.
     uint32_t add(const TextureImage& image, const std::string& name, TextureWrap wrapU = TextureWrap::Repeat,
-                 TextureWrap wrapV = TextureWrap::Repeat);
+                 TextureWrap wrapV = TextureWrap::Repeat, const TextureFilter& filter = {});
 
     size_t recordCount() const { return m_records.size(); }
     /// Distinct images loaded (each with its mip chain).
@@ -119,8 +139,9 @@ public:
     uint32_t levelsOf(uint32_t record) const;
     /// The linear RGBA that lib/texture.glsl's sampleTextureLevel returns for
     /// the record at (u, v) in mip level `level` (< levelsOf): the stored
-    /// (encoded) texels decoded, the record's wrap modes, bilinear weights;
-    /// in double. For host integrals of a texture (emitters' power).
+    /// (encoded) texels decoded, the record's wrap modes, bilinear weights
+    /// (the nearest texel with a nearest magnification filter); in double.
+    /// For host integrals of a texture (emitters' power).
     std::array<double, 4> sampleLevel(uint32_t record, double u, double v, uint32_t level) const;
 
     /// How the texels will be split (textureChunkingFor). Throws InputError,
@@ -146,14 +167,21 @@ private:
     void reserveTexels(const TextureHeader& header, const std::string& name);
     /// Header check, budget, decoding and storing, for a file's bytes.
     uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear);
-    uint32_t addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV);
+    /// What makes a record: its image and how lookups read it.
+    struct RecordKey {
+        uint32_t image = 0;
+        TextureWrap wrapU = TextureWrap::Repeat, wrapV = TextureWrap::Repeat;
+        TextureFilter filter;
+        bool operator==(const RecordKey&) const = default;
+    };
+    uint32_t addRecord(const RecordKey& key);
     /// Texel (x, y) of a level of width `width` starting at word `levelWord`, decoded to linear RGBA.
     std::array<double, 4> fetch(const StoredImage& image, uint64_t levelWord, uint32_t width, uint32_t x,
                                 uint32_t y) const;
 
     std::vector<StoredImage> m_images;
-    std::vector<std::tuple<uint32_t, TextureWrap, TextureWrap>> m_records; ///< image, wrap u, wrap v
-    std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile;        ///< (canonical path, linear)
+    std::vector<RecordKey> m_records;
+    std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile; ///< (canonical path, linear)
     uint64_t m_words = 0;
     uint64_t m_maxTexels = kMaxSceneTexels;
     uint64_t m_texels = 0; ///< level 0, of every image added

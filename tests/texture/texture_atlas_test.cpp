@@ -362,5 +362,51 @@ TEST(TextureAtlas, HostLookupIsBilinearBetweenTexelCentresWithTheWrapModes)
     EXPECT_EQ(atlas.levelsOf(clamp), 3u);
 }
 
+// TextureRecord::filters: glTF's filters as bits, vkrt's trilinear default 0.
+TEST(TextureFilters, RecordBitsSayWhatIsNearest)
+{
+    using Mip = TextureFilter::Mip;
+    EXPECT_EQ(TextureFilter{}.bits(), 0u);
+    EXPECT_EQ((TextureFilter{true, false, Mip::Linear}.bits()), gpu::TEXTURE_FILTER_MAG_NEAREST);
+    EXPECT_EQ((TextureFilter{false, true, Mip::Linear}.bits()), gpu::TEXTURE_FILTER_MIN_NEAREST);
+    EXPECT_EQ((TextureFilter{false, false, Mip::Nearest}.bits()), gpu::TEXTURE_FILTER_MIP_NEAREST);
+    EXPECT_EQ((TextureFilter{true, true, Mip::None}.bits()),
+              gpu::TEXTURE_FILTER_MAG_NEAREST | gpu::TEXTURE_FILTER_MIN_NEAREST | gpu::TEXTURE_FILTER_MIP_NONE);
+}
+
+// One image under two filters: two records over the same texels; the same
+// filter again: the same record.
+TEST(TextureFilters, OtherFiltersGetTheirOwnRecordOverTheSameTexels)
+{
+    const fs::path file = write8BitPng(textureTestDir() / "grey.png", 4, 4, 3, std::vector<uint8_t>(48, 100));
+    TextureAtlas atlas;
+    const TextureFilter nearest{true, true, TextureFilter::Mip::Nearest};
+    const uint32_t plain = atlas.add(TextureRequest{file});
+    const uint32_t sharp = atlas.add(TextureRequest{file, false, TextureWrap::Repeat, TextureWrap::Repeat, nearest});
+    EXPECT_NE(sharp, plain);
+    EXPECT_EQ(atlas.add(TextureRequest{file, false, TextureWrap::Repeat, TextureWrap::Repeat, nearest}), sharp);
+    EXPECT_EQ(atlas.imageCount(), 1u);
+    const TextureBuffers buffers = atlas.pack();
+    EXPECT_EQ(buffers.records[plain].filters, 0u);
+    EXPECT_EQ(buffers.records[sharp].filters, nearest.bits());
+    EXPECT_EQ(buffers.records[sharp].levelOffset[0], buffers.records[plain].levelOffset[0]);
+}
+
+// The host's level lookup follows the magnification filter, as
+// lib/texture.glsl's sampleTextureLevel does: nearest, the texel whose square holds the point.
+TEST(TextureFilters, HostLookupWithNearestMagnificationTakesTheTexelUnderThePoint)
+{
+    TextureImage image{RgbaImage(4, 2), TexelEncoding::Half};
+    for (uint32_t y = 0; y < 2; ++y)
+        for (uint32_t x = 0; x < 4; ++x)
+            for (int c = 0; c < 4; ++c) image.pixels.at(x, y)[c] = float(x + 4 * y);
+    TextureAtlas atlas;
+    const uint32_t nearest = atlas.add(image, "grid", TextureWrap::Repeat, TextureWrap::Repeat, {true, false});
+    EXPECT_EQ(atlas.sampleLevel(nearest, 0.49, 0.9, 0)[0], 1.0);  // x = 1.96, row 0
+    EXPECT_EQ(atlas.sampleLevel(nearest, 0.51, 0.9, 0)[0], 2.0);  // x = 2.04
+    EXPECT_EQ(atlas.sampleLevel(nearest, 0.51, 0.1, 0)[0], 6.0);  // row 1
+    EXPECT_EQ(atlas.sampleLevel(nearest, -0.01, 0.9, 0)[0], 3.0); // repeat: the last column
+}
+
 } // namespace
 } // namespace vkrt::test
