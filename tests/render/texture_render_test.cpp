@@ -167,6 +167,40 @@ TEST_F(TextureRender, DistantCheckerIsFilteredToItsLinearMeanNearOneKeepsItsCont
     EXPECT_GT(nearMax, 0.95) << "the near checker lost its white texels: blurred although magnified";
 }
 
+// ------------------------------------------------------------ filters
+
+// A 2 x 2 checker (black and white texels) filling the view, magnified about
+// 16 times: with `filter = "nearest"` every pixel shows a texel exactly, 0 or
+// 1, the edges between them sharp; bilinear (the default) blends the texels
+// between their centres.
+TEST_F(TextureRender, NearestMagnificationShowsTheTexelsBilinearBlendsThem)
+{
+    const auto dir = freshTempDir("texture-nearest");
+    write8BitPng(dir / "checker.png", 2, 2, 1, {0, 255, 255, 0});
+    auto render = [&](const std::string& filter) {
+        std::string text = frontCamera();
+        const std::string quadrants = "texture = \"quadrants.png\"";
+        text.replace(text.find(quadrants), quadrants.size(), "texture = \"checker.png\"" + filter);
+        text +=
+            "[[objects]]\nshape = \"plane\"\npoint = [-0.5, -0.5, 0]\nnormal = [0, 0, 1]\nmaterial = \"textured\"\n";
+        return renderCentres(parseSceneString(text, (dir / "scene.toml").string()));
+    };
+    const Image nearest = render(", filter = \"nearest\""), linear = render("");
+    size_t blended = 0, off = 0;
+    for (uint32_t y = 0; y < kSide; ++y)
+        for (uint32_t x = 0; x < kSide; ++x) {
+            // The pixel's centre in texels: the texel it lies in is black where x and y are on the same side.
+            const bool left = x < kSide / 2, top = y < kSide / 2;
+            if (x == kSide / 2 || y == kSide / 2) continue; // the centre row and column look at the edge itself
+            const float expected = left == top ? 0.0f : 1.0f;
+            for (int c = 0; c < 3; ++c) off += std::abs(nearest.at(x, y)[c] - expected) > 1e-5f;
+            const float l = linear.at(x, y)[0];
+            blended += l > 0.01f && l < 0.99f;
+        }
+    EXPECT_EQ(off, 0u) << "nearest: every pixel is its texel, 0 or 1 (up to float rounding)";
+    EXPECT_GT(blended, kSide * kSide / 2) << "bilinear blends between the texel centres";
+}
+
 // ------------------------------------------------------------ normal maps
 
 /// A 4 x 4 linear normal map of one tangent-space normal, given as 8-bit codes.

@@ -212,6 +212,21 @@ TEST_F(SceneParserTextures, GltfSamplerFiltersReachTheTextureRecords)
     EXPECT_EQ(scene.textures->imageCount(), 2u); // grey.png as sRGB and as linear data
 }
 
+TEST_F(SceneParserTextures, FilterNearestTurnsOffEveryInterpolation)
+{
+    const Scene scene = parse("[materials.m]\ntype = \"lambert\"\n"
+                              "albedo = { texture = \"grey.png\", filter = \"nearest\" }\n" +
+                              kSphere);
+    const std::vector<gpu::TextureRecord> records = scene.textures->records();
+    ASSERT_EQ(records.size(), 1u);
+    EXPECT_EQ(records[0].filters,
+              gpu::TEXTURE_FILTER_MAG_NEAREST | gpu::TEXTURE_FILTER_MIN_NEAREST | gpu::TEXTURE_FILTER_MIP_NEAREST);
+    const Scene linear = parse("[materials.m]\ntype = \"lambert\"\n"
+                               "albedo = { texture = \"grey.png\", filter = \"linear\" }\n" +
+                               kSphere);
+    EXPECT_EQ(linear.textures->records()[0].filters, 0u);
+}
+
 // ---------------------------------------------------------------------------
 // Images embedded in a glTF (data: URIs, .glb) meet the texture budget from
 // their header, before they are decoded, as image files do (issue 26).
@@ -314,6 +329,8 @@ const BadTexture kBadTextures[] = {
      "unknown channel 'x'"},
     {"UnknownWrapMode", kLambert + "albedo = { texture = \"grey.png\", wrap = \"repet\" }\n" + kSphere, "7:41",
      "unknown wrap mode 'repet'; did you mean 'repeat'?"},
+    {"UnknownFilter", kLambert + "albedo = { texture = \"grey.png\", filter = \"nearst\" }\n" + kSphere, "7:43",
+     "unknown filter 'nearst'; did you mean 'nearest'?"},
     {"ZeroScale", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 0] }\n" + kSphere, "7:46",
      "must not be zero"},
     {"ScaleTriple", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 2, 3] }\n" + kSphere, "7:42",
