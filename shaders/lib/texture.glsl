@@ -1,4 +1,4 @@
-// Image texture lookups from the packed texel buffer (shared/TextureTypes.h,
+// Image texture lookups from the packed texel words (shared/TextureTypes.h,
 // src/texture/TextureAtlas.h). Include lib/texture_bindings.glsl first, with
 // VKRT_HAS_TEXTURES defined.
 //
@@ -17,6 +17,9 @@
 // - Wrap modes apply to texel indices, on each axis separately:
 //   TEXTURE_WRAP_REPEAT (period n), _CLAMP (edge texel continues), _MIRROR
 //   (period 2n, edge texels doubled as in GL_MIRRORED_REPEAT).
+// - Filters (TextureRecord::filters, glTF's sampler filters): bilinear when
+//   magnified and trilinear when minified unless the record says nearest
+//   texels, the nearest mip level, or level 0 only (sampleTexture).
 #ifndef VKRT_TEXTURE_GLSL
 #define VKRT_TEXTURE_GLSL
 
@@ -62,49 +65,74 @@ vec4 fetchTexel(uint format, uint offset, uint width, uint x, uint y)
     uint index = y * width + x;
     if (format == TEXTURE_FORMAT_RGBA16F) {
         uint word = offset + 2u * index;
-        return vec4(unpackHalf2x16(textureTexels[word]), unpackHalf2x16(textureTexels[word + 1u]));
+        return vec4(unpackHalf2x16(textureWord(word)), unpackHalf2x16(textureWord(word + 1u)));
     }
-    vec4 texel = unpackUnorm4x8(textureTexels[offset + index]);
+    vec4 texel = unpackUnorm4x8(textureWord(offset + index));
     if (format == TEXTURE_FORMAT_RGBA8_SRGB)
         texel.rgb = srgbToLinear(texel.rgb);
     return texel;
 }
 
-/// Bilinear lookup in one mip level.
-vec4 sampleTextureLevel(uint textureIndex, vec2 uv, uint level)
+/// Lookup in one mip level: the nearest texel, or bilinear between the four nearest.
+vec4 filterTextureLevel(uint textureIndex, vec2 uv, uint level, bool nearest)
 {
     uint format = textureRecords[textureIndex].format;
     uint offset = textureRecords[textureIndex].levelOffset[level];
     ivec2 size = ivec2(max(uvec2(1u), uvec2(textureRecords[textureIndex].width, textureRecords[textureIndex].height)
                                           >> level));
     uint wrapU = textureRecords[textureIndex].wrapU, wrapV = textureRecords[textureIndex].wrapV;
-    // Continuous texel coordinates, texel centres at integers; y down from the top row.
+    // Continuous texel coordinates, y down from the top row: texel i spans [i, i + 1).
     vec2 image = vec2(wrapTextureCoordinate(uv.x, wrapU), wrapTextureCoordinate(1.0 - uv.y, wrapV));
+    uint w = uint(size.x);
+    if (nearest) {
+        ivec2 i = ivec2(floor(image * vec2(size)));
+        return fetchTexel(format, offset, w, uint(wrapTexelIndex(i.x, size.x, wrapU)),
+                          uint(wrapTexelIndex(i.y, size.y, wrapV)));
+    }
+    // Bilinear: texel centres at integers.
     vec2 st = image * vec2(size) - 0.5;
     vec2 base = floor(st);
     vec2 f = st - base;
     ivec2 i0 = ivec2(base);
     uint x0 = uint(wrapTexelIndex(i0.x, size.x, wrapU)), x1 = uint(wrapTexelIndex(i0.x + 1, size.x, wrapU));
     uint y0 = uint(wrapTexelIndex(i0.y, size.y, wrapV)), y1 = uint(wrapTexelIndex(i0.y + 1, size.y, wrapV));
-    uint w = uint(size.x);
     vec4 top = mix(fetchTexel(format, offset, w, x0, y0), fetchTexel(format, offset, w, x1, y0), f.x);
     vec4 bottom = mix(fetchTexel(format, offset, w, x0, y1), fetchTexel(format, offset, w, x1, y1), f.x);
     return mix(top, bottom, f.y);
 }
 
-/// Trilinear lookup: bilinear in levels floor(lod) and floor(lod) + 1, mixed
-/// by the fraction. `lod` is log2 of the footprint in level-0 texels (see
-/// rayConeTextureLod), clamped to [0, levels - 1]; NaN counts as 0.
+/// Lookup in one mip level with the record's magnification filter (bilinear
+/// unless TEXTURE_FILTER_MAG_NEAREST): for lookups without a footprint, read
+/// at level 0 as a magnified texture is (the emitters', the alpha test's).
+vec4 sampleTextureLevel(uint textureIndex, vec2 uv, uint level)
+{
+    bool nearest = (textureRecords[textureIndex].filters & TEXTURE_FILTER_MAG_NEAREST) != 0u;
+    return filterTextureLevel(textureIndex, uv, level, nearest);
+}
+
+/// Lookup at level of detail `lod`, log2 of the footprint in level-0 texels
+/// (see rayConeTextureLod), with the record's filters (shared/TextureTypes.h):
+/// - magnified (lod <= 0; NaN counts as 0): level 0, bilinear or nearest;
+/// - minified, by default trilinear: levels floor(lod) and floor(lod) + 1
+///   mixed by the fraction (lod clamped to levels - 1), bilinear or nearest
+///   within each; or the nearest level (round(lod)) alone; or level 0 alone.
 vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
 {
-    float top = float(textureRecords[textureIndex].levels - 1u);
-    lod = lod > 0.0 ? min(lod, top) : 0.0;
+    uint filters = textureRecords[textureIndex].filters;
+    if (!(lod > 0.0))
+        return filterTextureLevel(textureIndex, uv, 0u, (filters & TEXTURE_FILTER_MAG_NEAREST) != 0u);
+    bool nearest = (filters & TEXTURE_FILTER_MIN_NEAREST) != 0u;
+    if ((filters & TEXTURE_FILTER_MIP_NONE) != 0u)
+        return filterTextureLevel(textureIndex, uv, 0u, nearest);
+    lod = min(lod, float(textureRecords[textureIndex].levels - 1u));
+    if ((filters & TEXTURE_FILTER_MIP_NEAREST) != 0u)
+        return filterTextureLevel(textureIndex, uv, uint(floor(lod + 0.5)), nearest);
     float level0 = floor(lod);
     float t = lod - level0;
-    vec4 fine = sampleTextureLevel(textureIndex, uv, uint(level0));
+    vec4 fine = filterTextureLevel(textureIndex, uv, uint(level0), nearest);
     if (t == 0.0)
         return fine;
-    return mix(fine, sampleTextureLevel(textureIndex, uv, uint(level0) + 1u), t);
+    return mix(fine, filterTextureLevel(textureIndex, uv, uint(level0) + 1u, nearest), t);
 }
 
 /// Mip level from a ray cone (Akenine-Möller et al. 2019, "Texture Level of

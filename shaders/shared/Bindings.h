@@ -38,7 +38,8 @@ VKRT_CONSTANT(uint, BINDING_EMITTERS, BINDING_ENVIRONMENT + 8)
 // float[]: the rough plastics' coating tables (shared/SceneTypes.h: MATERIAL_TABLE_SIZE)
 VKRT_CONSTANT(uint, BINDING_MATERIAL_TABLES, BINDING_ENVIRONMENT + 9)
 // Image textures (shared/TextureTypes.h, variants with textures only): every
-// texel of every texture in one buffer of words, the TextureRecord table, and
+// texel of every texture in one buffer of words (an array of buffers, chunks
+// of those words, where they exceed one buffer), the TextureRecord table, and
 // per material its MaterialTextures.
 VKRT_CONSTANT(uint, BINDING_TEXTURE_TEXELS, BINDING_ENVIRONMENT + 10)
 VKRT_CONSTANT(uint, BINDING_TEXTURE_RECORDS, BINDING_ENVIRONMENT + 11)

@@ -1,7 +1,10 @@
 // GPU texture records (src/texture/TextureAtlas.h packs them). Every texture
-// of a scene, every mip level, lives in ONE storage buffer of 32-bit words
-// (`textureTexels`), so a scene's texture count never meets a descriptor
-// limit; a table of TextureRecord says where each texture's levels start.
+// of a scene, every mip level, lives in ONE address space of 32-bit words, so
+// a scene's texture count never meets a descriptor limit; a table of
+// TextureRecord says at which word each texture's levels start. The words are
+// one storage buffer (`textureTexels`) unless they exceed the device's
+// maxStorageBufferRange; then they are split into chunks of 2^k words, one
+// buffer each (lib/texture_bindings.glsl, VKRT_TEXTURE_CHUNKS).
 // Layout rule: GLSL `scalar` block layout, as shared/SceneTypes.h; the host
 // static_asserts the size (src/gpu/TextureLayout.cpp).
 //
@@ -23,6 +26,14 @@ VKRT_CONSTANT(uint, TEXTURE_WRAP_REPEAT, 0) // i mod n
 VKRT_CONSTANT(uint, TEXTURE_WRAP_CLAMP, 1)  // clamp(i, 0, n - 1): the edge texel continues
 VKRT_CONSTANT(uint, TEXTURE_WRAP_MIRROR, 2) // reflected at each edge, period 2n (GL_MIRRORED_REPEAT)
 
+// TextureRecord::filters, bits (glTF's sampler magFilter and minFilter;
+// lib/texture.glsl's sampleTexture). 0 is vkrt's default, glTF's LINEAR and
+// LINEAR_MIPMAP_LINEAR: bilinear when magnified, trilinear when minified.
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MAG_NEAREST, 1) // magnified: the nearest texel of level 0
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MIN_NEAREST, 2) // minified: the nearest texel within a level
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MIP_NEAREST, 4) // minified: the nearest level (round(lod)), not two blended
+VKRT_CONSTANT(uint, TEXTURE_FILTER_MIP_NONE, 8)    // minified: level 0 alone (no mip maps)
+
 // TextureRecord::format
 VKRT_CONSTANT(uint, TEXTURE_FORMAT_RGBA8_SRGB, 0)
 VKRT_CONSTANT(uint, TEXTURE_FORMAT_RGBA8_UNORM, 1)
@@ -32,14 +43,16 @@ VKRT_CONSTANT(uint, TEXTURE_FORMAT_RGBA16F, 2)
 VKRT_CONSTANT(uint, TEXTURE_MAX_SIZE, 16384)
 VKRT_CONSTANT(uint, TEXTURE_MAX_LEVELS, 15)
 
-// The bindings (BINDING_TEXTURE_TEXELS: uint textureTexels[],
+// The bindings (BINDING_TEXTURE_TEXELS: uint textureTexels[], or an array of
+// chunks of it,
 // BINDING_TEXTURE_RECORDS: TextureRecord textureRecords[],
 // BINDING_MATERIAL_TEXTURES: MaterialTextures materialTextures[]) are in
 // shared/Bindings.h.
 
 /// One texture as the kernels see it. Level l is max(1, width >> l) x
-/// max(1, height >> l) texels starting at word levelOffset[l] of textureTexels
-/// (entries at and past `levels` are 0).
+/// max(1, height >> l) texels starting at word levelOffset[l] of the texel
+/// words (entries at and past `levels` are 0). A level may straddle two
+/// chunks; a texel never does (chunks hold an even number of words).
 struct TextureRecord {
     uint width;
     uint height;
@@ -47,6 +60,7 @@ struct TextureRecord {
     uint format;
     uint wrapU;
     uint wrapV;
+    uint filters; // TEXTURE_FILTER_* bits
     uint levelOffset[TEXTURE_MAX_LEVELS];
 };
 

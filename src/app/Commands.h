@@ -32,6 +32,11 @@ std::vector<Define> parseKernelDefines(const std::vector<std::string>& texts);
 /// AccelChoice) to a command, writing the choice to `choice`.
 void addAccelOption(CLI::App& command, AccelChoice& choice);
 
+/// Adds the hidden test hook `--max-texture-chunk-bytes N` (RenderOptions::
+/// maxTextureChunkBytes: a scene's texels split into buffers of at most N
+/// bytes) to a command, writing N to `bytes`.
+void addTextureChunkOption(CLI::App& command, uint64_t& bytes);
+
 /// Process exit codes.
 enum ExitCode : int {
     kExitOk = 0,

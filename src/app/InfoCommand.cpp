@@ -28,6 +28,7 @@ struct InfoOptions {
     AccelChoice accel = AccelChoice::Auto;
     std::string json;      ///< --json FILE, or "-" for standard output
     std::string sceneJson; ///< --scene-json FILE, or "-" for standard output
+    uint64_t maxTextureChunkBytes = 0; ///< test hook: texel buffers of at most this many bytes
 };
 
 /// --scene-json as an output for the checks ("-" is no file).
@@ -170,18 +171,27 @@ JsonObject meshJson(const MeshFacts& facts)
 
 // ---------------------------------------------------------------- textures
 
-/// Distinct images, records (image and wrap modes) and texel memory.
-void printTextures(std::FILE* out, const TextureAtlas& textures)
+/// Distinct images, records (image and wrap modes), texel memory and the storage buffers it takes.
+void printTextures(std::FILE* out, const TextureAtlas& textures, const TextureChunking& chunking)
 {
-    std::fprintf(out, "textures:       %zu images, %zu records, %.1f MiB of texels (all mip levels)\n",
-                 textures.imageCount(), textures.recordCount(), double(textures.texelBytes()) / (1024.0 * 1024.0));
+    std::fprintf(out, "textures:       %zu images, %zu records, %.1f MiB of texels (all mip levels) in %u %s\n",
+                 textures.imageCount(), textures.recordCount(), double(textures.texelBytes()) / (1024.0 * 1024.0),
+                 chunking.count, chunking.count == 1 ? "buffer" : "buffers");
 }
 
-JsonObject texturesJson(const TextureAtlas& textures)
+/// Bytes of each texel buffer but the last (all of them in one).
+uint64_t textureBufferBytes(const TextureAtlas& textures, const TextureChunking& chunking)
+{
+    return chunking.count == 1 ? textures.texelBytes() : uint64_t(4) << chunking.shift;
+}
+
+JsonObject texturesJson(const TextureAtlas& textures, const TextureChunking& chunking)
 {
     return {{"images", textures.imageCount()},
             {"records", textures.recordCount()},
-            {"texelBytes", textures.texelBytes()}};
+            {"texelBytes", textures.texelBytes()},
+            {"buffers", chunking.count},
+            {"bufferBytes", textureBufferBytes(textures, chunking)}};
 }
 
 // ---------------------------------------------------------------- the whole report
@@ -248,7 +258,7 @@ void printInfo(std::FILE* out, const RenderSession& session, const InfoOptions& 
                  session.renderer().driverAccel() ? ", driver structures rebuilt" : "");
     printLoopPasses(out, scene, session.context().loopCap());
     if (!scene.meshes.empty()) printMeshes(out, meshFacts(scene, session.renderer().meshData()), times.parse);
-    if (scene.textures) printTextures(out, *scene.textures);
+    if (scene.textures) printTextures(out, *scene.textures, session.renderer().meshData().textures.chunking);
     std::fprintf(out, "device:         %s\n", session.context().deviceInfo().name.c_str());
 }
 
@@ -319,7 +329,8 @@ JsonObject infoJson(const RenderSession& session, const InfoOptions& options, co
     json["loopPassesWorstCase"] = valueOrNull(staticLoopBound(scene));
     json["meshes"] =
         scene.meshes.empty() ? JsonObject(nullptr) : meshJson(meshFacts(scene, session.renderer().meshData()));
-    json["textures"] = scene.textures ? texturesJson(*scene.textures) : JsonObject(nullptr);
+    json["textures"] = scene.textures ? texturesJson(*scene.textures, session.renderer().meshData().textures.chunking)
+                                      : JsonObject(nullptr);
     return json;
 }
 
@@ -339,6 +350,7 @@ int runInfo(const InfoOptions& options)
     config.uber = options.uber;
     config.accel = options.accel;
     config.warmUp = false; // the first frame's time is what info measures
+    config.maxTextureChunkBytes = options.maxTextureChunkBytes;
     // The variant info has always described: independent samples, no variance.
     config.sampler = SamplerChoice::Independent;
     auto start = std::chrono::steady_clock::now();
@@ -372,6 +384,7 @@ CommandRunner addInfoCommand(CLI::App& app)
     cmd->add_option("--scene-json", options->sceneJson,
                     "Write the scene as vkrt parsed it, as JSON, to FILE or to standard output for -, and stop "
                     "there: no device is needed (docs/scene-json.md)");
+    addTextureChunkOption(*cmd, options->maxTextureChunkBytes);
     return [options] { return runInfo(*options); };
 }
 

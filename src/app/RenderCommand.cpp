@@ -59,6 +59,7 @@ struct RenderCommandOptions {
     uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
     uint64_t maxBandBytes = 0;              ///< test hook: bands of at most this many bytes per buffer
+    uint64_t maxTextureChunkBytes = 0;      ///< test hook: texel buffers of at most this many bytes
     std::vector<std::string> aovs;          ///< --aov albedo,normal,depth,position
     GltfSceneOptions gltf;                  ///< --camera, --scene, --environment (a glTF scene)
 
@@ -135,6 +136,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
     config.samplesPerInvocation = options.samplesPerInvocation;
     config.extraDefines = parseKernelDefines(options.kernelDefines);
     config.maxBandBytes = options.maxBandBytes;
+    config.maxTextureChunkBytes = options.maxTextureChunkBytes;
     if (shard) config.firstFrame = shard->begin;
     config.jitter = !options.pixelCenters;
     config.uber = options.uber;
@@ -503,6 +505,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                     "device's maxStorageBufferRange)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40))
         ->group("");
+    addTextureChunkOption(*cmd, options->maxTextureChunkBytes);
     return [options] { return exitCodeFor(runRender(*options)); };
 }
 

@@ -41,15 +41,21 @@ private:
     void* m_mapped = nullptr;
 };
 
-/// A storage or uniform buffer initialised from a vector of GPU records.
+/// A storage or uniform buffer initialised from GPU records.
 template <typename T>
-Buffer makeBufferFrom(const VulkanContext& context, const std::vector<T>& records, vk::BufferUsageFlags usage)
+Buffer makeBufferFrom(const VulkanContext& context, std::span<const T> records, vk::BufferUsageFlags usage)
 {
     // Vulkan forbids zero-sized buffers; an empty array still gets one record.
     vk::DeviceSize size = std::max<vk::DeviceSize>(sizeof(T), records.size() * sizeof(T));
     Buffer buffer(context, size, usage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Device);
-    buffer.upload(context, std::as_bytes(std::span(records)));
+    buffer.upload(context, std::as_bytes(records));
     return buffer;
+}
+
+template <typename T>
+Buffer makeBufferFrom(const VulkanContext& context, const std::vector<T>& records, vk::BufferUsageFlags usage)
+{
+    return makeBufferFrom(context, std::span<const T>(records), usage);
 }
 
 } // namespace vkrt

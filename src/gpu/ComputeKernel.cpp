@@ -35,8 +35,8 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
     std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
     std::vector<vk::DescriptorPoolSize> poolSizes;
     for (const KernelBinding& binding : m_bindings) {
-        layoutBindings.emplace_back(binding.index, binding.type, 1, vk::ShaderStageFlagBits::eCompute);
-        poolSizes.emplace_back(binding.type, setCount);
+        layoutBindings.emplace_back(binding.index, binding.type, binding.count, vk::ShaderStageFlagBits::eCompute);
+        poolSizes.emplace_back(binding.type, setCount * binding.count);
     }
     m_setLayout = vk::raii::DescriptorSetLayout(device, vk::DescriptorSetLayoutCreateInfo({}, layoutBindings));
 
@@ -73,6 +73,13 @@ vk::DescriptorType ComputeKernel::typeOf(uint32_t binding) const
     throw InternalError("kernel has no binding " + std::to_string(binding));
 }
 
+uint32_t ComputeKernel::countOf(uint32_t binding) const
+{
+    for (const KernelBinding& b : m_bindings)
+        if (b.index == binding) return b.count;
+    throw InternalError("kernel has no binding " + std::to_string(binding));
+}
+
 void ComputeKernel::bind(uint32_t binding, const Buffer& buffer)
 {
     for (uint32_t set = 0; set < m_sets.size(); ++set) bindInSet(set, binding, buffer);
@@ -83,6 +90,17 @@ void ComputeKernel::bindInSet(uint32_t set, uint32_t binding, const Buffer& buff
     vk::DescriptorBufferInfo info(buffer.handle(), 0, VK_WHOLE_SIZE);
     vk::WriteDescriptorSet write(*m_sets.at(set), binding, 0, typeOf(binding), nullptr, info);
     m_context.device().updateDescriptorSets(write, nullptr);
+}
+
+void ComputeKernel::bind(uint32_t binding, std::span<const Buffer> buffers)
+{
+    VKRT_CHECK(buffers.size() == countOf(binding)); // an element left unwritten would be invalid
+    std::vector<vk::DescriptorBufferInfo> infos;
+    for (const Buffer& buffer : buffers) infos.emplace_back(buffer.handle(), 0, VK_WHOLE_SIZE);
+    for (const auto& set : m_sets) {
+        vk::WriteDescriptorSet write(*set, binding, 0, typeOf(binding), nullptr, infos);
+        m_context.device().updateDescriptorSets(write, nullptr);
+    }
 }
 
 void ComputeKernel::bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler)

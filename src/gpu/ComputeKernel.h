@@ -12,10 +12,11 @@
 
 namespace vkrt {
 
-/// One descriptor of a kernel's set 0.
+/// One binding of a kernel's set 0: `count` descriptors (an array when more than one).
 struct KernelBinding {
     uint32_t index;
     vk::DescriptorType type;
+    uint32_t count = 1;
 };
 
 /// The render kernels' bindings: indices from shaders/shared/Bindings.h with their types.
@@ -31,6 +32,8 @@ public:
     void bind(uint32_t binding, const Buffer& buffer);
     /// Points `binding` of set `set` alone at `buffer`.
     void bindInSet(uint32_t set, uint32_t binding, const Buffer& buffer);
+    /// Points the elements of an array `binding` at `buffers` (one each, whole) in every set.
+    void bind(uint32_t binding, std::span<const Buffer> buffers);
     /// Points a combined image-sampler `binding` at an image view.
     void bind(uint32_t binding, vk::ImageView view, vk::Sampler sampler);
     /// Points an acceleration-structure `binding` at `structure` in every set.
@@ -47,6 +50,8 @@ public:
     void recordDispatchAt(vk::CommandBuffer cmd, vk::Offset2D base, uint32_t baseZ, vk::Extent2D groups) const;
     bool uses(uint32_t binding) const;
     vk::DescriptorType typeOf(uint32_t binding) const;
+    /// Descriptors `binding` holds (KernelBinding::count).
+    uint32_t countOf(uint32_t binding) const;
 
 private:
     const VulkanContext& m_context;

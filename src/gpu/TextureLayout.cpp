@@ -8,8 +8,9 @@
 
 namespace vkrt::gpu {
 
-static_assert(sizeof(TextureRecord) == 4 * (6 + TEXTURE_MAX_LEVELS));
-static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, levelOffset) == 24);
+static_assert(sizeof(TextureRecord) == 4 * (7 + TEXTURE_MAX_LEVELS));
+static_assert(offsetof(TextureRecord, wrapV) == 20 && offsetof(TextureRecord, filters) == 24 &&
+              offsetof(TextureRecord, levelOffset) == 28);
 // Level sizes: the largest side has floor(log2(TEXTURE_MAX_SIZE)) + 1 levels.
 static_assert((1u << (TEXTURE_MAX_LEVELS - 1)) == TEXTURE_MAX_SIZE);
 static_assert(sizeof(TextureSlot) == 36);

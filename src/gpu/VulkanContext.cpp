@@ -96,6 +96,17 @@ std::string rayQueryMissing(const vk::raii::PhysicalDevice& device)
     return {};
 }
 
+/// What the device lacks to index arrays of storage buffers per invocation (empty: nothing).
+std::string bufferArraysMissing(const vk::raii::PhysicalDevice& device)
+{
+    auto features = device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features>();
+    if (!features.get<vk::PhysicalDeviceFeatures2>().features.shaderStorageBufferArrayDynamicIndexing)
+        return "the shaderStorageBufferArrayDynamicIndexing feature";
+    if (!features.get<vk::PhysicalDeviceVulkan12Features>().shaderStorageBufferArrayNonUniformIndexing)
+        return "the shaderStorageBufferArrayNonUniformIndexing feature";
+    return {};
+}
+
 DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index, vk::SurfaceKHR surface = {})
 {
     auto chain = device.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
@@ -111,6 +122,7 @@ DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index
     info.computeQueueFamily = findComputeQueueFamily(device, surface);
     info.unsuitableReason = unsuitableReason(device, info, surface);
     if (info.suitable()) info.rayQueryMissing = rayQueryMissing(device);
+    if (info.suitable()) info.bufferArraysMissing = bufferArraysMissing(device);
     return info;
 }
 
@@ -234,6 +246,14 @@ void VulkanContext::createDevice()
     std::vector<const char*> extensions;
     if (*m_surface) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     chain.get<vk::PhysicalDeviceVulkan12Features>().setScalarBlockLayout(true);
+    // Several texture buffers, indexed per texel, for scenes whose texels
+    // exceed one buffer: enabled wherever they exist, as the driver backend's.
+    vk::PhysicalDeviceFeatures core;
+    if (deviceInfo().bufferArraysMissing.empty()) {
+        core.setShaderStorageBufferArrayDynamicIndexing(true);
+        chain.get<vk::PhysicalDeviceVulkan12Features>().setShaderStorageBufferArrayNonUniformIndexing(true);
+    }
+    chain.get<vk::DeviceCreateInfo>().setPEnabledFeatures(&core);
     // The driver backend's extensions are enabled wherever they exist, so
     // that one context serves either backend (they cost nothing unused).
     const bool rayQuery = deviceInfo().rayQuery();

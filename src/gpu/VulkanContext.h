@@ -31,6 +31,12 @@ struct DeviceInfo {
     std::string rayQueryMissing = "not checked";
 
     bool rayQuery() const { return rayQueryMissing.empty(); }
+    /// Arrays of storage buffers indexed per invocation (the features
+    /// shaderStorageBufferArrayDynamicIndexing and
+    /// shaderStorageBufferArrayNonUniformIndexing), which a scene whose
+    /// texels exceed one storage buffer needs (texture/TextureAtlas.h). Empty
+    /// when present; otherwise what is missing.
+    std::string bufferArraysMissing = "not checked";
 
     bool suitable() const { return unsuitableReason.empty(); }
     std::string typeName() const;

@@ -685,6 +685,35 @@ struct MaterialReader {
         return out;
     }
 
+    /// A sampler's magFilter and minFilter (glTF 2.0, 5.26); an absent one
+    /// keeps vkrt's default, any other value than glTF's is an error.
+    TextureFilter filterOf(const json& sampler, uint32_t index, const char* slot) const
+    {
+        TextureFilter filter;
+        const std::string which = std::string(slot) + "'s sampler " + std::to_string(index) + ": ";
+        if (const json* mag = member(sampler, "magFilter")) {
+            const uint32_t code = uintMember(sampler, "magFilter").value_or(0);
+            if (code != 9728 && code != 9729)
+                malformed(which + "magFilter is " + mag->dump() + "; glTF allows 9728 (NEAREST) and 9729 (LINEAR)");
+            filter.magNearest = code == 9728;
+        }
+        const json* min = member(sampler, "minFilter");
+        if (!min) return filter;
+        using Mip = TextureFilter::Mip;
+        switch (uintMember(sampler, "minFilter").value_or(0)) {
+        case 9728: filter.minNearest = true, filter.mip = Mip::None; break;    // NEAREST
+        case 9729: filter.mip = Mip::None; break;                              // LINEAR
+        case 9984: filter.minNearest = true, filter.mip = Mip::Nearest; break; // NEAREST_MIPMAP_NEAREST
+        case 9985: filter.mip = Mip::Nearest; break;                           // LINEAR_MIPMAP_NEAREST
+        case 9986: filter.minNearest = true; break;                            // NEAREST_MIPMAP_LINEAR
+        case 9987: break;                                                      // LINEAR_MIPMAP_LINEAR
+        default:
+            malformed(which + "minFilter is " + min->dump() +
+                      "; glTF allows 9728 (NEAREST), 9729 (LINEAR) and 9984 to 9987 (the MIPMAP filters)");
+        }
+        return filter;
+    }
+
     /// The image of a texture: a file beside the glTF, or bytes inside it.
     void readImage(uint32_t index, FileTexture& texture) const
     {
@@ -729,6 +758,7 @@ struct MaterialReader {
             if (!s) malformed(std::string(slot) + "'s texture names a sampler the file does not have");
             texture.wrapU = wrapMode(uintMember(*s, "wrapS").value_or(10497));
             texture.wrapV = wrapMode(uintMember(*s, "wrapT").value_or(10497));
+            texture.filter = filterOf(*s, *sampler, slot);
         }
         texture.texCoord = uintMember(*info, "texCoord").value_or(0);
         const json* extensions = member(*info, "extensions");

@@ -8,7 +8,9 @@
 //
 // Honoured: baseColorFactor/Texture, metallicFactor, roughnessFactor,
 // metallicRoughnessTexture (G = roughness, B = metallic), normalTexture and
-// its scale, emissiveFactor/Texture, doubleSided, the samplers' wrap modes,
+// its scale, emissiveFactor/Texture, doubleSided, the samplers' wrap modes and
+// filters (an undefined filter is vkrt's default: bilinear magnification,
+// trilinear minification over vkrt's own mip maps),
 // KHR_materials_emissive_strength, KHR_materials_transmission's factor,
 // KHR_materials_ior (scene/FileMaterialImport.cpp makes glass of them) and
 // KHR_texture_transform on TEXCOORD_0 (a normal map's tangent frame is not
@@ -19,7 +21,7 @@
 // alphaMode and alphaCutoff are read (MASK and BLEND are honoured: alpha is
 // baseColorFactor.a times the base colour texture's A). Not listed, documented here:
 // occlusionTexture, which a path tracer has no use for (it computes the
-// occlusion), and the samplers' filters (vkrt filters with its own mip maps).
+// occlusion).
 #include "mesh/AlphaMode.h"
 #include "mesh/ReferencePolicy.h"
 #include "texture/TextureAtlas.h"
@@ -47,6 +49,7 @@ struct FileTexture {
     uint32_t texCoord = 0;         ///< the TEXCOORD_n set it reads (KHR_texture_transform's override applied)
     TextureWrap wrapU = TextureWrap::Repeat;
     TextureWrap wrapV = TextureWrap::Repeat;
+    TextureFilter filter; ///< the sampler's magFilter and minFilter (absent: vkrt's trilinear default)
     /// KHR_texture_transform (MaterialTexture's convention): offset, rotation (radians), scale.
     glm::dvec2 offset{0.0};
     double rotation = 0.0;

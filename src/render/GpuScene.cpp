@@ -77,10 +77,10 @@ gpu::MaterialTextures convertMaterialTextures(const Material& m)
 }
 
 /// The textures' buffers, never empty (the uber kernel binds them for any scene).
-TextureBuffers packTextures(const Scene& scene, uint64_t maxBytes)
+TextureBuffers packTextures(const Scene& scene, const TextureChunking& chunking)
 {
     TextureBuffers buffers;
-    if (scene.textures) buffers = scene.textures->pack(maxBytes);
+    if (scene.textures) buffers = scene.textures->pack(chunking);
     if (buffers.texels.empty()) buffers.texels.push_back(0u);
     if (buffers.records.empty()) buffers.records.push_back(gpu::TextureRecord{});
     return buffers;
@@ -645,7 +645,7 @@ void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features, GpuS
     }
 }
 
-GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
+GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes, const TextureChunking& textureChunking)
 {
     GpuSceneStatic fixed;
     prepareMaterialTables(scene, fixed);
@@ -654,7 +654,7 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes)
     for (const Material& m : scene.materials)
         fixed.materialAlpha.push_back(gpu::MaterialAlpha{uint32_t(m.alphaMode), float(m.alphaCutoff), float(m.alpha)});
     if (fixed.materialAlpha.empty()) fixed.materialAlpha.push_back(gpu::MaterialAlpha{});
-    fixed.textures = packTextures(scene, maxBytes);
+    fixed.textures = packTextures(scene, textureChunking);
     fixed.emitters = emitterTableOf(scene);
     checkBufferSize(fixed.emitters.pdf.size() * sizeof(gpu::Emitter), maxBytes, "emitters", scene);
     if (scene.meshes.empty()) return fixed;

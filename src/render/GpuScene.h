@@ -64,8 +64,8 @@ struct GpuSceneStatic {
     std::vector<gpu::MeshTangents> meshTangents{gpu::MeshTangents{}};
     std::vector<uint32_t> meshMaterials{0u};
     std::vector<gpu::MeshColors> meshColors{gpu::MeshColors{}};
-    /// Every texture's texels and records (one zero record and word without
-    /// textures), and per material its texture slots.
+    /// Every texture's texels (in one or more buffers) and records (one zero
+    /// record and word without textures), and per material its texture slots.
     TextureBuffers textures;
     std::vector<gpu::MaterialTextures> materialTextures;
     /// Per material its coverage (glTF alphaMode; read by variants with alpha only).
@@ -90,8 +90,11 @@ struct RecordBoxes {
 std::vector<RecordBoxes> recordBoxes(const Scene& scene);
 
 /// Fails (InputError naming the mesh and the limit) if a mesh buffer would
-/// exceed `maxBytes` (the device's maxStorageBufferRange).
-GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes = ~0ull);
+/// exceed `maxBytes` (the device's maxStorageBufferRange). The texels are
+/// split as `textureChunking` says (TextureAtlas::chunking checked it
+/// against the device).
+GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes = ~0ull,
+                                  const TextureChunking& textureChunking = {});
 
 struct GpuSceneData {
     gpu::SceneUniforms uniforms{};

@@ -133,9 +133,20 @@ std::vector<std::pair<std::string, std::string>> KernelVariant::defines() const
         if (features.has(type)) result.emplace_back("VKRT_MATERIAL_" + upper(materialTypeName(type)), "1");
     if (uniformScene) result.emplace_back("VKRT_UNIFORM_SCENE", "1");
     if (groupLoopCount) result.emplace_back("VKRT_GROUP_LOOP_COUNT", "1");
+    if (multiChunkTextures()) {
+        result.emplace_back("VKRT_TEXTURE_CHUNKS", std::to_string(textureChunks));
+        result.emplace_back("VKRT_TEXTURE_CHUNK_SHIFT", std::to_string(textureChunkShift));
+    }
     // Variance under the Sobol' sampler comes from independently scrambled batches.
     if (variance && sobolSampler) result.emplace_back("VKRT_SOBOL_BATCHES", std::to_string(gpu::VARIANCE_BATCHES));
     return result;
+}
+
+bool KernelVariant::multiChunkTextures() const { return features.textures && textureChunks > 1; }
+
+uint32_t KernelVariant::descriptorCount(uint32_t binding) const
+{
+    return binding == gpu::BINDING_TEXTURE_TEXELS && multiChunkTextures() ? textureChunks : 1;
 }
 
 std::vector<uint32_t> KernelVariant::bindings() const
@@ -153,6 +164,7 @@ std::string KernelVariant::describe() const
     std::string text = integratorName(features.integrator) + ";";
     for (const auto& feature : optionalFeatures(*this))
         if (feature.on && !feature.name.empty()) text += " " + feature.name;
+    if (multiChunkTextures()) text += " texture-buffers=" + std::to_string(textureChunks);
     text += ";";
     for (MaterialType type : kAllMaterialTypes)
         if (features.has(type)) text += " " + materialTypeName(type);

@@ -38,6 +38,12 @@ struct KernelVariant {
     /// instead of vkrt's own BVH walk: a different kernel, so part of the
     /// defines and the SPIR-V cache key.
     bool driverAccel = false;
+    /// Storage buffers the texel words are split into (texture/TextureAtlas.h:
+    /// TextureChunking). 1 (every scene whose texels fit one buffer) adds
+    /// nothing, so those kernels are what they were; more adds
+    /// VKRT_TEXTURE_CHUNKS and VKRT_TEXTURE_CHUNK_SHIFT (lib/texture_bindings.glsl).
+    uint32_t textureChunks = 1;
+    uint32_t textureChunkShift = 0; ///< log2 of the words of each chunk, with several
 
     /// Preprocessor defines selecting this variant, in a stable order.
     std::vector<std::pair<std::string, std::string>> defines() const;
@@ -45,6 +51,10 @@ struct KernelVariant {
     std::vector<uint32_t> bindings() const;
     /// Whether this variant declares `binding` as a uniform buffer.
     bool isUniformBinding(uint32_t binding) const;
+    /// Whether the texels are an array of several buffers (textureChunks > 1 in a textured variant).
+    bool multiChunkTextures() const;
+    /// Descriptors `binding` holds: textureChunks for the texels' array, else 1.
+    uint32_t descriptorCount(uint32_t binding) const;
     /// One line for people, e.g. "whitted; spheres planes point-lights; lambert; uniform-scene".
     std::string describe() const;
 

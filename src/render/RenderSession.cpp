@@ -104,6 +104,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     options.aov = config.aov;
     options.extraDefines = config.extraDefines;
     options.maxBandBytes = config.maxBandBytes;
+    options.maxTextureChunkBytes = config.maxTextureChunkBytes;
     options.cacheDirectory = config.cacheDirectory;
     uint64_t pixels = uint64_t(scene.camera.width) * scene.camera.height;
     uint64_t range = context.physicalDevice().getProperties().limits.maxStorageBufferRange;

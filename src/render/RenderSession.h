@@ -71,6 +71,7 @@ struct SessionConfig {
     AccelChoice accel = AccelChoice::Auto; ///< the traversal backend (resolveAccel decides Auto)
     std::vector<Define> extraDefines;      ///< test hooks
     uint64_t maxBandBytes = 0;             ///< RenderOptions::maxBandBytes (a test hook; 0: the device's limit)
+    uint64_t maxTextureChunkBytes = 0;     ///< RenderOptions::maxTextureChunkBytes (a test hook; 0: the device's)
     std::filesystem::path cacheDirectory = SpirvCache::defaultDirectory();
     StopRules stop; ///< of run(); its interrupt is usually &interruptFlag() (InterruptGuard)
 };

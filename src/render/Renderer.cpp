@@ -49,6 +49,63 @@ FeatureSet uberFeatures(const Scene& scene)
     return features;
 }
 
+/// The largest device-local memory heap (where the per-pixel buffers go).
+uint64_t deviceLocalHeapBytes(const VulkanContext& context)
+{
+    const vk::PhysicalDeviceMemoryProperties memory = context.physicalDevice().getMemoryProperties();
+    uint64_t largest = 0;
+    for (uint32_t i = 0; i < memory.memoryHeapCount; ++i)
+        if (memory.memoryHeaps[i].flags & vk::MemoryHeapFlagBits::eDeviceLocal)
+            largest = std::max<uint64_t>(largest, memory.memoryHeaps[i].size);
+    return largest;
+}
+
+/// What the device leaves a variant's texel buffers: each within one storage
+/// buffer's range and one allocation, as many as the storage-buffer
+/// descriptors its other bindings leave, and device memory.
+TextureStorageLimits textureStorageLimits(const VulkanContext& context, const KernelVariant& variant,
+                                          const RenderOptions& options)
+{
+    const auto properties =
+        context.physicalDevice()
+            .getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceMaintenance3Properties>();
+    const vk::PhysicalDeviceLimits& limits = properties.get<vk::PhysicalDeviceProperties2>().properties.limits;
+    TextureStorageLimits storage;
+    storage.maxBufferBytes =
+        std::min<uint64_t>(limits.maxStorageBufferRange,
+                           properties.get<vk::PhysicalDeviceMaintenance3Properties>().maxMemoryAllocationSize);
+    if (options.maxTextureChunkBytes > 0)
+        storage.maxBufferBytes = std::min(storage.maxBufferBytes, options.maxTextureChunkBytes);
+    const std::vector<uint32_t> bindings = variant.bindings();
+    const auto others = uint32_t(std::count_if(bindings.begin(), bindings.end(), [&](uint32_t binding) {
+        return binding != gpu::BINDING_TEXTURE_TEXELS && !variant.isUniformBinding(binding) &&
+               descriptorTypeOf(binding) == vk::DescriptorType::eStorageBuffer;
+    }));
+    const uint32_t descriptors =
+        std::min(limits.maxPerStageDescriptorStorageBuffers, limits.maxDescriptorSetStorageBuffers);
+    storage.maxBuffers = descriptors > others ? descriptors - others : 0;
+    if (const uint64_t heap = deviceLocalHeapBytes(context)) storage.memoryBytes = heap;
+    return storage;
+}
+
+/// Splits the variant's texels as the device needs (TextureAtlas::chunking);
+/// several buffers need the device to index arrays of them.
+void chooseTextureChunks(const VulkanContext& context, const Scene& scene, const RenderOptions& options,
+                         KernelVariant& variant)
+{
+    if (!variant.features.textures || !scene.textures) return;
+    const TextureStorageLimits limits = textureStorageLimits(context, variant, options);
+    const TextureChunking chunks = scene.textures->chunking(limits);
+    const DeviceInfo& device = context.deviceInfo();
+    if (chunks.count > 1 && !device.bufferArraysMissing.empty())
+        throw InputError(scene.path + ": the scene's textures need " + formatBytes(scene.textures->texelBytes()) +
+                         ", more than one storage buffer of " + device.name + " holds (" +
+                         formatBytes(limits.maxBufferBytes) + "), and splitting them needs " +
+                         device.bufferArraysMissing + ", which it lacks");
+    variant.textureChunks = chunks.count;
+    variant.textureChunkShift = chunks.shift;
+}
+
 KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
     checkSamplesPerInvocation(context.loopCap(), options.samplesPerInvocation); // before any compilation
@@ -68,6 +125,7 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
                          "(its batch count is VARIANCE_BATCHES)");
     variant.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
     variant.groupLoopCount = context.loopCap().capped() && !scene.meshes.empty();
+    chooseTextureChunks(context, scene, options, variant);
     return variant;
 }
 
@@ -76,20 +134,24 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
 std::vector<KernelBinding> kernelBindingsOf(const KernelVariant& variant)
 {
     std::vector<KernelBinding> bindings = renderKernelBindings(variant.bindings());
-    for (KernelBinding& binding : bindings)
+    for (KernelBinding& binding : bindings) {
         if (variant.isUniformBinding(binding.index)) binding.type = vk::DescriptorType::eUniformBuffer;
+        binding.count = variant.descriptorCount(binding.index);
+    }
     return bindings;
 }
 
 /// Refuses a variant that binds more buffers of a type than the device allows
-/// one shader stage (textures never add to the count: they share one buffer).
+/// one shader stage (textures add one, or their chunks: a few).
 std::vector<KernelBinding> checkedKernelBindings(const VulkanContext& context, const Scene& scene,
                                                  const KernelVariant& variant)
 {
     std::vector<KernelBinding> bindings = kernelBindingsOf(variant);
     const vk::PhysicalDeviceLimits limits = context.physicalDevice().getProperties().limits;
     auto count = [&](vk::DescriptorType type) {
-        return uint32_t(std::count_if(bindings.begin(), bindings.end(), [&](const auto& b) { return b.type == type; }));
+        uint32_t descriptors = 0;
+        for (const KernelBinding& b : bindings) descriptors += b.type == type ? b.count : 0;
+        return descriptors;
     };
     auto check = [&](vk::DescriptorType type, uint32_t limit, const char* what) {
         if (count(type) > limit)
@@ -156,17 +218,6 @@ size_t varianceBytesPerPixel(bool sobol)
 }
 
 namespace {
-
-/// The largest device-local memory heap (where the per-pixel buffers go).
-uint64_t deviceLocalHeapBytes(const VulkanContext& context)
-{
-    const vk::PhysicalDeviceMemoryProperties memory = context.physicalDevice().getMemoryProperties();
-    uint64_t largest = 0;
-    for (uint32_t i = 0; i < memory.memoryHeapCount; ++i)
-        if (memory.memoryHeaps[i].flags & vk::MemoryHeapFlagBits::eDeviceLocal)
-            largest = std::max<uint64_t>(largest, memory.memoryHeaps[i].size);
-    return largest;
-}
 
 /// The image's bands, once it is known that the render's memory is there to have.
 ImageBands checkedImageBands(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
@@ -252,7 +303,8 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
       m_options(std::move(options)),
       m_variant(chooseVariant(context, scene, m_options)),
       m_bands(checkedImageBands(context, scene, m_options)),
-      m_static(prepareStaticScene(scene, context.physicalDevice().getProperties().limits.maxStorageBufferRange)),
+      m_static(prepareStaticScene(scene, context.physicalDevice().getProperties().limits.maxStorageBufferRange,
+                                  TextureChunking{m_variant.textureChunks, m_variant.textureChunkShift})),
       m_data(convertScene(scene, frameSettings(), m_static)),
       m_compiled(compileVariant(m_variant, m_options)),
       m_accumulation(context, m_bands, sizeof(gpu::AccumPixel), scene.path, "the accumulation buffer"),
@@ -311,7 +363,7 @@ void Renderer::uploadMeshBuffers()
         m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage | extra));
         m_kernel.bind(binding, m_meshBuffers.back());
     };
-    m_meshBuffers.reserve(12); // bind() keeps references: no reallocation (one per addBuffer below)
+    m_meshBuffers.reserve(11); // bind() keeps references: no reallocation (one per addBuffer below)
     addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
     // The driver backend builds its triangle structures from this same buffer.
     addBuffer(gpu::BINDING_MESH_TRIANGLES, m_static.meshTriangles,
@@ -324,10 +376,23 @@ void Renderer::uploadMeshBuffers()
     addBuffer(gpu::BINDING_MESH_MATERIALS, m_static.meshMaterials);
     addBuffer(gpu::BINDING_MESH_COLORS, m_static.meshColors);
     // Textures never change with the camera either: uploaded once, here.
-    addBuffer(gpu::BINDING_TEXTURE_TEXELS, m_static.textures.texels);
+    uploadTextureChunks();
     addBuffer(gpu::BINDING_TEXTURE_RECORDS, m_static.textures.records);
     addBuffer(gpu::BINDING_MATERIAL_TEXTURES, m_static.materialTextures);
     addBuffer(gpu::BINDING_MATERIAL_ALPHA, m_static.materialAlpha);
+}
+
+// The texel words, one buffer per chunk: a plain binding for one, an array for several.
+void Renderer::uploadTextureChunks()
+{
+    if (!m_kernel.uses(gpu::BINDING_TEXTURE_TEXELS)) return;
+    const TextureBuffers& textures = m_static.textures;
+    VKRT_CHECK(textures.chunking.count == m_kernel.countOf(gpu::BINDING_TEXTURE_TEXELS));
+    m_textureChunks.reserve(textures.chunking.count); // bind() keeps references: no reallocation
+    for (uint32_t chunk = 0; chunk < textures.chunking.count; ++chunk)
+        m_textureChunks.push_back(makeBufferFrom(m_context, textures.chunk(chunk), kStorage));
+    if (m_textureChunks.size() == 1) m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, m_textureChunks.front());
+    else m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, std::span<const Buffer>(m_textureChunks));
 }
 
 void Renderer::bindEnvironment()

@@ -39,6 +39,10 @@ struct RenderOptions {
     /// the device's maxStorageBufferRange. Tests set it to render small
     /// images in several bands.
     uint64_t maxBandBytes = 0;
+    /// Largest storage buffer of texels (texture/TextureAtlas.h: texels
+    /// beyond it are split into several); 0: the device's limit. A test hook:
+    /// tests set it to split small scenes' textures.
+    uint64_t maxTextureChunkBytes = 0;
     /// Host memory the render may use (RenderMemory.h); nullopt: what this
     /// process can still get. Tests set it to check the refusal.
     std::optional<uint64_t> availableMemory;
@@ -123,6 +127,7 @@ private:
     GpuSceneData m_data;
     CompiledKernel m_compiled;
     std::vector<Buffer> m_meshBuffers;
+    std::vector<Buffer> m_textureChunks; ///< the texel words, one buffer per chunk (TextureChunking)
     std::vector<Buffer> m_sceneBuffers;
     BandedBuffer m_accumulation;
     Buffer m_stats;
@@ -151,6 +156,7 @@ private:
     void bindLatLongMap();
     void uploadSceneBuffers();
     void uploadMeshBuffers();
+    void uploadTextureChunks();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
     void bindPerPixelBuffers();
     void recordFrameRun(vk::CommandBuffer cmd, const gpu::FrameRun& run) const;

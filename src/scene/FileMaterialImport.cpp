@@ -18,8 +18,9 @@ uint32_t addFileTexture(const FileTexture& texture, bool linear, const std::file
         // Embedded bytes go through the same header check and budget as a
         // file, before they are decoded: a small .glb may hold a PNG bomb.
         if (!texture.embedded.empty())
-            return atlas.addEncoded(texture.embedded, texture.name, linear, texture.wrapU, texture.wrapV);
-        return atlas.add(TextureRequest{texture.file, linear, texture.wrapU, texture.wrapV});
+            return atlas.addEncoded(texture.embedded, texture.name, linear, texture.wrapU, texture.wrapV,
+                                    texture.filter);
+        return atlas.add(TextureRequest{texture.file, linear, texture.wrapU, texture.wrapV, texture.filter});
     } catch (const InputError& error) {
         throw SceneError(where, "a texture of the mesh file " + file.string() + ": " + error.what());
     }

@@ -81,6 +81,18 @@ const char* wrapName(uint32_t wrap)
     }
 }
 
+/// A record's filters (gpu::TEXTURE_FILTER_* bits): magnified, minified within a level, between levels.
+Json filterJson(uint32_t bits)
+{
+    auto within = [&](uint32_t nearest) { return bits & nearest ? "nearest" : "linear"; };
+    const char* mip = bits & gpu::TEXTURE_FILTER_MIP_NONE      ? "none"
+                      : bits & gpu::TEXTURE_FILTER_MIP_NEAREST ? "nearest"
+                                                               : "linear";
+    return {{"mag", within(gpu::TEXTURE_FILTER_MAG_NEAREST)},
+            {"min", within(gpu::TEXTURE_FILTER_MIN_NEAREST)},
+            {"mip", mip}};
+}
+
 const char* encodingName(uint32_t format)
 {
     switch (format) {
@@ -101,8 +113,8 @@ struct TextureTable {
 TextureTable textureTable(const Scene& scene)
 {
     TextureTable table{scene.textures.get(), {}};
-    // The atlas keeps each record's size, encoding and wrap modes only in its packed form.
-    if (table.atlas) table.records = table.atlas->pack(std::numeric_limits<uint64_t>::max()).records;
+    // The atlas keeps each record's size, encoding and wrap modes only in its GPU form.
+    if (table.atlas) table.records = table.atlas->records();
     return table;
 }
 
@@ -124,6 +136,7 @@ Json textureRecord(const TextureTable& table, uint32_t record)
     out["levels"] = r.levels;
     out["encoding"] = encodingName(r.format);
     out["wrap"] = Json::array({wrapName(r.wrapU), wrapName(r.wrapV)});
+    out["filter"] = filterJson(r.filters);
     return out;
 }
 

@@ -6,13 +6,17 @@
 namespace vkrt {
 namespace {
 
-constexpr std::array<std::string_view, 4> colorTextureKeys{"texture", "scale", "linear", "wrap"};
-constexpr std::array<std::string_view, 5> scalarTextureKeys{"texture", "scale", "linear", "wrap", "channel"};
-constexpr std::array<std::string_view, 4> normalMapKeys{"texture", "scale", "wrap", "strength"};
+constexpr std::array<std::string_view, 5> colorTextureKeys{"texture", "scale", "linear", "wrap", "filter"};
+constexpr std::array<std::string_view, 6> scalarTextureKeys{"texture", "scale", "linear", "wrap", "filter", "channel"};
+constexpr std::array<std::string_view, 5> normalMapKeys{"texture", "scale", "wrap", "filter", "strength"};
 
 constexpr std::array<EnumName<TextureWrap>, 3> wrapModes{
     {{"repeat", TextureWrap::Repeat}, {"clamp", TextureWrap::Clamp}, {"mirror", TextureWrap::Mirror}}};
 constexpr std::array<EnumName<uint32_t>, 4> channels{{{"r", 0}, {"g", 1}, {"b", 2}, {"a", 3}}};
+// "nearest": no interpolation at all, the nearest texel of the nearest mip
+// level (glTF's NEAREST and NEAREST_MIPMAP_NEAREST); "linear": the default.
+constexpr TextureFilter kNearest{true, true, TextureFilter::Mip::Nearest};
+constexpr std::array<EnumName<TextureFilter>, 2> filters{{{"linear", TextureFilter{}}, {"nearest", kNearest}}};
 
 TextureWrap readWrapMode(const Field& field) { return readChoice(field, "wrap mode", wrapModes).value; }
 
@@ -68,6 +72,8 @@ MaterialTexture readTextureTable(const Field& field, TextureUse use, TextureAtla
     request.linear = use == TextureUse::NormalMap || readOr(table, "linear", false, readBool);
     std::tie(request.wrapU, request.wrapV) =
         readOr(table, "wrap", std::make_pair(TextureWrap::Repeat, TextureWrap::Repeat), readWrap);
+    request.filter =
+        readOr(table, "filter", TextureFilter{}, [](const Field& f) { return readChoice(f, "filter", filters).value; });
     MaterialTexture texture;
     texture.scale = readOr(table, "scale", glm::dvec2(1.0), readUvScale);
     texture.channel = readOr(table, "channel", 0u, [](const Field& f) { return readChoice(f, "channel", channels).value; });

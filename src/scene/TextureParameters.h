@@ -1,6 +1,7 @@
 #pragma once
 // Material parameters given as textures in scene files:
-//   albedo = { texture = "wood.png", scale = [4, 4], linear = false, wrap = "repeat", channel = "r" }
+//   albedo = { texture = "wood.png", scale = [4, 4], linear = false, wrap = "repeat", filter = "linear",
+//              channel = "r" }
 //   normal_map = { texture = "bumps.png", scale = [2, 2], wrap = "clamp", strength = 1 }
 // (docs/scene-format.md, "Textures"). The image is loaded here, at parse time,
 // into the scene's TextureAtlas, so a missing or unreadable file is reported

@@ -5,6 +5,7 @@
 #include <Imath/half.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <sstream>
 
@@ -107,6 +108,9 @@ uint32_t TextureAtlas::addImage(TextureImage image, const std::string& name)
     }
     stored.levels = uint32_t(stored.levelWords.size());
     VKRT_CHECK(stored.levels <= gpu::TEXTURE_MAX_LEVELS);
+    // Half-float images start at an even word, so that no two-word texel
+    // straddles two chunks (each holds an even number of words).
+    if (stored.format == gpu::TEXTURE_FORMAT_RGBA16F) m_words += m_words % 2;
     stored.firstWord = m_words;
     m_words += stored.words.size();
     m_images.push_back(std::move(stored));
@@ -116,31 +120,31 @@ uint32_t TextureAtlas::addImage(TextureImage image, const std::string& name)
 std::array<double, 4> TextureAtlas::meanOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].mean;
+    return m_images[m_records[record].image].mean;
 }
 
 const std::string& TextureAtlas::nameOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].name;
+    return m_images[m_records[record].image].name;
 }
 
 uint32_t TextureAtlas::widthOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].width;
+    return m_images[m_records[record].image].width;
 }
 
 uint32_t TextureAtlas::heightOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].height;
+    return m_images[m_records[record].image].height;
 }
 
 uint32_t TextureAtlas::levelsOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[std::get<0>(m_records[record])].levels;
+    return m_images[m_records[record].image].levels;
 }
 
 namespace {
@@ -199,10 +203,17 @@ std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t lev
 std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, double v, uint32_t level) const
 {
     VKRT_CHECK(record < m_records.size());
-    const auto& [imageIndex, wrapU, wrapV] = m_records[record];
+    const auto& [imageIndex, wrapU, wrapV, filter] = m_records[record];
     const StoredImage& image = m_images[imageIndex];
     VKRT_CHECK(level < image.levels);
     const int64_t w = mipSize(image.width, level), h = mipSize(image.height, level);
+    const uint64_t at = image.levelWords[level];
+    if (filter.magNearest) {
+        // Texel i spans [i, i + 1) of the continuous coordinates.
+        const auto i = int64_t(std::floor(wrapCoordinate(u, wrapU) * double(w)));
+        const auto j = int64_t(std::floor(wrapCoordinate(1.0 - v, wrapV) * double(h)));
+        return fetch(image, at, uint32_t(w), wrapIndex(i, w, wrapU), wrapIndex(j, h, wrapV));
+    }
     // Continuous texel coordinates, texel centres at integers; y down from the top row.
     const double s = wrapCoordinate(u, wrapU) * double(w) - 0.5;
     const double t = wrapCoordinate(1.0 - v, wrapV) * double(h) - 0.5;
@@ -211,7 +222,6 @@ std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, doubl
     const auto i0 = int64_t(bs), j0 = int64_t(bt);
     const uint32_t x0 = wrapIndex(i0, w, wrapU), x1 = wrapIndex(i0 + 1, w, wrapU);
     const uint32_t y0 = wrapIndex(j0, h, wrapV), y1 = wrapIndex(j0 + 1, h, wrapV);
-    const uint64_t at = image.levelWords[level];
     const auto a = fetch(image, at, uint32_t(w), x0, y0), b = fetch(image, at, uint32_t(w), x1, y0);
     const auto c = fetch(image, at, uint32_t(w), x0, y1), d = fetch(image, at, uint32_t(w), x1, y1);
     std::array<double, 4> result{};
@@ -222,12 +232,18 @@ std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, doubl
     return result;
 }
 
-uint32_t TextureAtlas::addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV)
+uint32_t TextureFilter::bits() const
 {
-    const auto record = std::make_tuple(image, wrapU, wrapV);
-    const auto found = std::find(m_records.begin(), m_records.end(), record);
+    return (magNearest ? gpu::TEXTURE_FILTER_MAG_NEAREST : 0u) | (minNearest ? gpu::TEXTURE_FILTER_MIN_NEAREST : 0u) |
+           (mip == Mip::Nearest ? gpu::TEXTURE_FILTER_MIP_NEAREST : 0u) |
+           (mip == Mip::None ? gpu::TEXTURE_FILTER_MIP_NONE : 0u);
+}
+
+uint32_t TextureAtlas::addRecord(const RecordKey& key)
+{
+    const auto found = std::find(m_records.begin(), m_records.end(), key);
     if (found != m_records.end()) return uint32_t(found - m_records.begin());
-    m_records.push_back(record);
+    m_records.push_back(key);
     return uint32_t(m_records.size() - 1);
 }
 
@@ -247,47 +263,93 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
         }
         found = m_imageByFile.emplace(key, image).first;
     }
-    return addRecord(found->second, request.wrapU, request.wrapV);
+    return addRecord({found->second, request.wrapU, request.wrapV, request.filter});
 }
 
 uint32_t TextureAtlas::addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
-                                  TextureWrap wrapU, TextureWrap wrapV)
+                                  TextureWrap wrapU, TextureWrap wrapV, const TextureFilter& filter)
 {
-    return addRecord(addDecoded(bytes, name, linear), wrapU, wrapV);
+    return addRecord({addDecoded(bytes, name, linear), wrapU, wrapV, filter});
 }
 
-uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV)
+uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV,
+                           const TextureFilter& filter)
 {
     VKRT_CHECK(image.pixels.width >= 1 && image.pixels.width <= gpu::TEXTURE_MAX_SIZE);
     VKRT_CHECK(image.pixels.height >= 1 && image.pixels.height <= gpu::TEXTURE_MAX_SIZE);
     reserveTexels({image.pixels.width, image.pixels.height, image.encoding}, name);
-    return addRecord(addImage(image, name), wrapU, wrapV);
+    return addRecord({addImage(image, name), wrapU, wrapV, filter});
 }
 
-TextureBuffers TextureAtlas::pack(uint64_t maxStorageBufferRange) const
+TextureChunking textureChunkingFor(uint64_t words, const TextureStorageLimits& limits)
 {
-    if (texelBytes() > maxStorageBufferRange) {
-        const auto largest = std::max_element(m_images.begin(), m_images.end(), [](const auto& a, const auto& b) {
-            return a.words.size() < b.words.size();
-        });
-        throw InputError("textures need " + mebibytes(texelBytes()) + " of GPU storage (all mip levels), more than " +
-                         "this device's limit of " + mebibytes(maxStorageBufferRange) +
-                         " for one storage buffer (maxStorageBufferRange); the largest is " + largest->name + " (" +
-                         std::to_string(largest->width) + "x" + std::to_string(largest->height) + ", " +
-                         mebibytes(largest->words.size() * 4) + ")");
-    }
-    TextureBuffers buffers;
-    buffers.texels.reserve(m_words);
-    for (const StoredImage& image : m_images)
-        buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
-    for (const auto& [imageIndex, wrapU, wrapV] : m_records) {
+    // One buffer whenever it fits: the kernels of such scenes stay as they were.
+    if (words <= limits.maxBufferBytes / 4) return {};
+    const uint64_t chunkWords = std::min(limits.maxBufferBytes, TextureAtlas::kMaxChunkBytes) / 4;
+    VKRT_CHECK(chunkWords >= 2); // a half-float texel's two words fit one chunk
+    const auto shift = uint32_t(std::bit_width(chunkWords) - 1);
+    return {uint32_t((words + (uint64_t(1) << shift) - 1) >> shift), shift};
+}
+
+std::span<const uint32_t> TextureBuffers::chunk(uint32_t index) const
+{
+    VKRT_CHECK(index < chunking.count);
+    if (chunking.count == 1) return texels;
+    const size_t first = size_t(index) << chunking.shift;
+    VKRT_CHECK(first < texels.size());
+    return std::span(texels).subspan(first, std::min(size_t(1) << chunking.shift, texels.size() - first));
+}
+
+TextureChunking TextureAtlas::chunking(const TextureStorageLimits& limits) const
+{
+    const TextureChunking chunks = textureChunkingFor(m_words, limits);
+    if (chunks.count <= limits.maxBuffers && texelBytes() <= limits.memoryBytes) return chunks;
+    const auto largest = std::max_element(m_images.begin(), m_images.end(),
+                                          [](const auto& a, const auto& b) { return a.words.size() < b.words.size(); });
+    const std::string room = chunks.count > limits.maxBuffers
+                                 ? std::to_string(chunks.count) + " storage buffers of " +
+                                       mebibytes(uint64_t(4) << chunks.shift) +
+                                       " (maxStorageBufferRange), and the kernel can bind " +
+                                       std::to_string(limits.maxBuffers) + " more (maxPerStageDescriptorStorageBuffers)"
+                                 : "the device's " + mebibytes(limits.memoryBytes) + " of memory";
+    throw InputError("textures need " + mebibytes(texelBytes()) + " of GPU storage (all mip levels), more than " +
+                     "this device can hold: " + room + "; the largest is " + largest->name + " (" +
+                     std::to_string(largest->width) + "x" + std::to_string(largest->height) + ", " +
+                     mebibytes(largest->words.size() * 4) + ")");
+}
+
+std::vector<gpu::TextureRecord> TextureAtlas::records() const
+{
+    std::vector<gpu::TextureRecord> records;
+    for (const auto& [imageIndex, wrapU, wrapV, filter] : m_records) {
         const StoredImage& image = m_images[imageIndex];
-        gpu::TextureRecord record{
-            image.width, image.height, image.levels, image.format, uint32_t(wrapU), uint32_t(wrapV), {}};
+        gpu::TextureRecord record{image.width,     image.height,    image.levels,  image.format,
+                                  uint32_t(wrapU), uint32_t(wrapV), filter.bits(), {}};
         for (uint32_t level = 0; level < image.levels; ++level)
             record.levelOffset[level] = uint32_t(image.firstWord + image.levelWords[level]);
-        buffers.records.push_back(record);
+        records.push_back(record);
     }
+    return records;
+}
+
+TextureBuffers TextureAtlas::pack(const TextureChunking& chunking) const
+{
+    // Word addresses are 32-bit (TextureRecord::levelOffset). A level-0
+    // texel takes at most 5 words: 2 (half floats), as many again for its
+    // mip chain (a 1-texel-high image's levels halve one side only), and one
+    // of padding before its image. So the scene's texel budget keeps them
+    // below 2^32; the check stands for an atlas made with a larger budget.
+    static_assert(5 * TextureAtlas::kMaxSceneTexels < (uint64_t(1) << 32));
+    VKRT_CHECK(m_words <= uint64_t(UINT32_MAX));
+    VKRT_CHECK(chunking.count == 1 || ((m_words - 1) >> chunking.shift) + 1 == chunking.count);
+    TextureBuffers buffers;
+    buffers.texels.reserve(m_words);
+    for (const StoredImage& image : m_images) {
+        buffers.texels.resize(image.firstWord, 0u); // the padding before a half-float image
+        buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
+    }
+    buffers.records = records();
+    buffers.chunking = chunking;
     return buffers;
 }
 

@@ -1,8 +1,10 @@
 #pragma once
-// Every texture of a scene, all mip levels, packed into one buffer of 32-bit
-// words plus a table of gpu::TextureRecord (shared/TextureTypes.h) that
-// lib/texture.glsl reads. One buffer means no descriptor-count limit; its size
-// is checked against the device's maxStorageBufferRange instead.
+// Every texture of a scene, all mip levels, packed into one address space of
+// 32-bit words plus a table of gpu::TextureRecord (shared/TextureTypes.h) that
+// lib/texture.glsl reads. The words are one storage buffer when they fit the
+// device's maxStorageBufferRange, else chunks of 2^k words, one buffer each
+// (TextureChunking): a few buffers however many textures, so the texture
+// count never meets a descriptor limit.
 #include "shared/TextureTypes.h"
 #include "texture/TextureImage.h"
 #include "util/Error.h"
@@ -13,7 +15,6 @@
 #include <map>
 #include <span>
 #include <string>
-#include <tuple>
 #include <vector>
 
 namespace vkrt {
@@ -24,18 +25,69 @@ enum class TextureWrap : uint32_t {
     Mirror = gpu::TEXTURE_WRAP_MIRROR,
 };
 
+/// How lookups filter a texture (glTF's sampler magFilter and minFilter;
+/// gpu::TextureRecord::filters). The default is vkrt's own: bilinear when
+/// magnified, trilinear when minified (glTF's LINEAR, LINEAR_MIPMAP_LINEAR).
+struct TextureFilter {
+    enum class Mip : uint8_t {
+        Linear,  ///< two levels blended
+        Nearest, ///< the nearest level
+        None,    ///< level 0 alone
+    };
+    bool magNearest = false; ///< magnified: the nearest texel, not bilinear
+    bool minNearest = false; ///< minified: the nearest texel within a level, not bilinear
+    Mip mip = Mip::Linear;   ///< minified: which levels
+
+    /// The gpu::TEXTURE_FILTER_* bits.
+    uint32_t bits() const;
+    bool operator==(const TextureFilter&) const = default;
+};
+
 /// A texture as a scene names it.
 struct TextureRequest {
     std::filesystem::path file; ///< already resolved against the scene file's folder
     bool linear = false;        ///< 8/16-bit data that is not sRGB (roughness, normal maps)
     TextureWrap wrapU = TextureWrap::Repeat;
     TextureWrap wrapV = TextureWrap::Repeat;
+    TextureFilter filter;
 };
 
-/// What the kernels bind: BINDING_TEXTURE_TEXELS and BINDING_TEXTURE_RECORDS.
+/// How the texel words are split into storage buffers. Word w lives in
+/// chunk w >> shift at index w & (2^shift - 1) (lib/texture_bindings.glsl).
+struct TextureChunking {
+    uint32_t count = 1; ///< buffers; 1: every word in one buffer, whatever its size (shift unused)
+    uint32_t shift = 0; ///< with several: log2 of the words each holds (the last may hold fewer)
+
+    bool operator==(const TextureChunking&) const = default;
+};
+
+/// What the device allows the texel words.
+struct TextureStorageLimits {
+    /// Bytes of one buffer: maxStorageBufferRange and maxMemoryAllocationSize
+    /// (tests ask for less, to split small scenes).
+    uint64_t maxBufferBytes = UINT64_MAX;
+    /// Buffers the kernel can bind for texels (the per-stage storage-buffer
+    /// descriptors its other bindings leave).
+    uint32_t maxBuffers = UINT32_MAX;
+    /// Memory there is for them at all (the largest device-local heap).
+    uint64_t memoryBytes = UINT64_MAX;
+};
+
+/// The chunks for `words` texel words: one buffer when they fit
+/// maxBufferBytes, else the largest even power of two words that fits
+/// maxBufferBytes and TextureAtlas::kMaxChunkBytes. The count may exceed
+/// limits.maxBuffers (TextureAtlas::chunking refuses that).
+TextureChunking textureChunkingFor(uint64_t words, const TextureStorageLimits& limits);
+
+/// What the kernels bind: BINDING_TEXTURE_TEXELS (the words, in chunking.count
+/// buffers) and BINDING_TEXTURE_RECORDS.
 struct TextureBuffers {
-    std::vector<uint32_t> texels;
+    std::vector<uint32_t> texels; ///< every word, in one address space (TextureRecord::levelOffset)
     std::vector<gpu::TextureRecord> records;
+    TextureChunking chunking;
+
+    /// The words of buffer `chunk` (< chunking.count).
+    std::span<const uint32_t> chunk(uint32_t chunk) const;
 };
 
 class TextureAtlas {
@@ -46,12 +98,17 @@ public:
     /// a texel (float RGBA and its mip chain) and the atlas keeps 5.3 (8-bit)
     /// or 10.7 (half) bytes a texel on the GPU. At most 683 MiB of GPU storage.
     static constexpr uint64_t kMaxSceneTexels = uint64_t(64) << 20;
+    /// The largest chunk of several (1 GiB): a shift of at most 28, and
+    /// buffers of a size every driver allocates. A scene's texels (683 MiB at
+    /// most) need more than one chunk only on a device whose buffers are smaller.
+    static constexpr uint64_t kMaxChunkBytes = uint64_t(1) << 30;
 
     /// `maxTexels`: the budget (tests use a small one).
     explicit TextureAtlas(uint64_t maxTexels = kMaxSceneTexels) : m_maxTexels(maxTexels) {}
 
     /// Loads the file (once per (file, linear) pair) and returns the index of
-    /// its record (one per distinct pair and wrap modes). Load errors are
+    /// its record (one per distinct pair, wrap modes and filter: records of
+    /// one image share its texels). Load errors are
     /// InputErrors naming the file; given a location (the scene's `texture`
     /// key), a SceneError starting "file:line:column: ".
     uint32_t add(const TextureRequest& request, const SourceLocation& where = {});
@@ -59,11 +116,12 @@ public:
     /// An image file's bytes already in memory (embedded in a .glb, a data:
     /// URI): its header checked against the budget before it is decoded.
     uint32_t addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
-                        TextureWrap wrapU = TextureWrap::Repeat, TextureWrap wrapV = TextureWrap::Repeat);
+                        TextureWrap wrapU = TextureWrap::Repeat, TextureWrap wrapV = TextureWrap::Repeat,
+                        const TextureFilter& filter = {});
 
     /// An image made in memory (procedural textures, tests); `name` is used in messages.
     uint32_t add(const TextureImage& image, const std::string& name, TextureWrap wrapU = TextureWrap::Repeat,
-                 TextureWrap wrapV = TextureWrap::Repeat);
+                 TextureWrap wrapV = TextureWrap::Repeat, const TextureFilter& filter = {});
 
     size_t recordCount() const { return m_records.size(); }
     /// Distinct images loaded (each with its mip chain).
@@ -81,13 +139,19 @@ public:
     uint32_t levelsOf(uint32_t record) const;
     /// The linear RGBA that lib/texture.glsl's sampleTextureLevel returns for
     /// the record at (u, v) in mip level `level` (< levelsOf): the stored
-    /// (encoded) texels decoded, the record's wrap modes, bilinear weights;
-    /// in double. For host integrals of a texture (emitters' power).
+    /// (encoded) texels decoded, the record's wrap modes, bilinear weights
+    /// (the nearest texel with a nearest magnification filter); in double.
+    /// For host integrals of a texture (emitters' power).
     std::array<double, 4> sampleLevel(uint32_t record, double u, double v, uint32_t level) const;
 
-    /// The buffers to upload. Throws InputError when the texels exceed
-    /// `maxStorageBufferRange` bytes (VkPhysicalDeviceLimits), naming the largest texture.
-    TextureBuffers pack(uint64_t maxStorageBufferRange) const;
+    /// How the texels will be split (textureChunkingFor). Throws InputError,
+    /// naming the largest texture, when they need more buffers or memory
+    /// than `limits` allow.
+    TextureChunking chunking(const TextureStorageLimits& limits) const;
+    /// The buffers to upload, split as `chunking` (from chunking()) says.
+    TextureBuffers pack(const TextureChunking& chunking = {}) const;
+    /// The records alone (what pack returns in TextureBuffers::records).
+    std::vector<gpu::TextureRecord> records() const;
 
 private:
     struct StoredImage {
@@ -103,14 +167,21 @@ private:
     void reserveTexels(const TextureHeader& header, const std::string& name);
     /// Header check, budget, decoding and storing, for a file's bytes.
     uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear);
-    uint32_t addRecord(uint32_t image, TextureWrap wrapU, TextureWrap wrapV);
+    /// What makes a record: its image and how lookups read it.
+    struct RecordKey {
+        uint32_t image = 0;
+        TextureWrap wrapU = TextureWrap::Repeat, wrapV = TextureWrap::Repeat;
+        TextureFilter filter;
+        bool operator==(const RecordKey&) const = default;
+    };
+    uint32_t addRecord(const RecordKey& key);
     /// Texel (x, y) of a level of width `width` starting at word `levelWord`, decoded to linear RGBA.
     std::array<double, 4> fetch(const StoredImage& image, uint64_t levelWord, uint32_t width, uint32_t x,
                                 uint32_t y) const;
 
     std::vector<StoredImage> m_images;
-    std::vector<std::tuple<uint32_t, TextureWrap, TextureWrap>> m_records; ///< image, wrap u, wrap v
-    std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile;        ///< (canonical path, linear)
+    std::vector<RecordKey> m_records;
+    std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile; ///< (canonical path, linear)
     uint64_t m_words = 0;
     uint64_t m_maxTexels = kMaxSceneTexels;
     uint64_t m_texels = 0; ///< level 0, of every image added

@@ -4,6 +4,7 @@
 #include "io/ExrFile.h"
 #include "mesh/Procedural.h"
 #include "support/TestSupport.h"
+#include "texture/TextureTestFiles.h"
 
 #include <nlohmann/json.hpp>
 
@@ -296,6 +297,40 @@ TEST_F(Json, InfoCountsWhatTheSceneHolds)
         << r.output;
     EXPECT_NE(r.output.find("3 instances of 2 files; 98 triangles (178 rendered)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("variant:        " + doc["kernel"]["cacheKey"].get<std::string>()), std::string::npos);
+}
+
+// Texture memory: its bytes and the storage buffers they take, one unless
+// they exceed a buffer (here forced by the hidden --max-texture-chunk-bytes).
+TEST_F(Json, InfoReportsTextureMemoryAndItsBuffers)
+{
+    write8BitPng(m_dir / "grey.png", 16, 16, 3, std::vector<uint8_t>(16 * 16 * 3, 128));
+    const fs::path scene = m_dir / "textured.toml";
+    std::ofstream(scene) << "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov = 45\nwidth = 16\nheight = 16\n"
+                            "[materials.m]\ntype = \"lambert\"\nalbedo = { texture = \"grey.png\" }\n"
+                            "[[objects]]\nshape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n"
+                            "[[lights]]\ntype = \"point\"\nposition = [0, 3, 3]\nintensity = [5, 5, 5]\n";
+    auto info = [&](const std::vector<std::string>& extra) {
+        const fs::path file = m_dir / "info.json";
+        std::vector<std::string> args = {"info", scene.string(), "--json", file.string()};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const ProcessResult r = runVkrt(withDevice(args));
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+        return std::make_pair(parseJson(readText(file)), r.output);
+    };
+    const auto [one, oneText] = info({});
+    const uint64_t bytes = 4 * (256 + 64 + 16 + 4 + 1); // 8-bit sRGB, every mip level
+    EXPECT_EQ(one["textures"]["texelBytes"], bytes);
+    EXPECT_EQ(one["textures"]["buffers"], 1);
+    EXPECT_EQ(one["textures"]["bufferBytes"], bytes);
+    EXPECT_FALSE(one["kernel"]["defines"].contains("VKRT_TEXTURE_CHUNKS"));
+    EXPECT_NE(oneText.find("in 1 buffer\n"), std::string::npos) << oneText;
+    const auto [split, splitText] = info({"--max-texture-chunk-bytes", "256"});
+    EXPECT_EQ(split["textures"]["texelBytes"], bytes);
+    EXPECT_EQ(split["textures"]["buffers"], 6); // 341 words in chunks of 64
+    EXPECT_EQ(split["textures"]["bufferBytes"], 256);
+    EXPECT_EQ(split["kernel"]["defines"]["VKRT_TEXTURE_CHUNKS"], "6");
+    EXPECT_EQ(split["kernel"]["defines"]["VKRT_TEXTURE_CHUNK_SHIFT"], "6");
+    EXPECT_NE(splitText.find("in 6 buffers\n"), std::string::npos) << splitText;
 }
 
 TEST_F(Json, InfoToStandardOutputMovesTheLinesForPeopleToStderr)

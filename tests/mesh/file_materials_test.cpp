@@ -191,6 +191,57 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     EXPECT_EQ(m.unsupported.size(), 1u) << joined(m.unsupported);
 }
 
+// The samplers' magFilter and minFilter (glTF 2.0, 5.26), one file per case.
+TEST(MeshFileMaterials, SamplerFiltersAreRead)
+{
+    using Mip = TextureFilter::Mip;
+    const std::vector<std::pair<std::string, TextureFilter>> cases{
+        {R"({"magFilter": 9728, "minFilter": 9728})", {true, true, Mip::None}},    // NEAREST, NEAREST
+        {R"({"magFilter": 9729, "minFilter": 9729})", {false, false, Mip::None}},  // LINEAR, LINEAR
+        {R"({"minFilter": 9984})", {false, true, Mip::Nearest}},                   // NEAREST_MIPMAP_NEAREST
+        {R"({"minFilter": 9985})", {false, false, Mip::Nearest}},                  // LINEAR_MIPMAP_NEAREST
+        {R"({"minFilter": 9986})", {false, true, Mip::Linear}},                    // NEAREST_MIPMAP_LINEAR
+        {R"({"magFilter": 9728, "minFilter": 9987})", {true, false, Mip::Linear}}, // NEAREST, LINEAR_MIPMAP_LINEAR
+        {R"({"wrapS": 33071})", {}},                                               // undefined: vkrt's default
+    };
+    for (size_t i = 0; i < cases.size(); ++i) {
+        SCOPED_TRACE(cases[i].first);
+        const std::string rest = R"("materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0, "sampler": 0}], "samplers": [)" +
+                                 cases[i].first + R"(], "images": [{"uri": "grey.png"}])";
+        const MeshData mesh =
+            loadMeshFile(writeFile(testDir() / ("filters-" + std::to_string(i) + ".gltf"), triangleGltf(rest)));
+        ASSERT_EQ(mesh.materials.size(), 1u);
+        ASSERT_TRUE(mesh.materials[0].baseColorTexture);
+        EXPECT_EQ(mesh.materials[0].baseColorTexture->filter, cases[i].second);
+        EXPECT_TRUE(mesh.materials[0].unsupported.empty()) << joined(mesh.materials[0].unsupported);
+    }
+}
+
+// A filter glTF does not define is an error naming the file, the material and the sampler.
+TEST(MeshFileMaterials, InvalidSamplerFiltersAreErrorsNamingTheFileAndSampler)
+{
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {R"({"magFilter": 9984})", "sampler 1: magFilter is 9984; glTF allows 9728 (NEAREST) and 9729 (LINEAR)"},
+        {R"({"minFilter": 9730})", "sampler 1: minFilter is 9730; glTF allows 9728 (NEAREST), 9729 (LINEAR) and "
+                                   "9984 to 9987 (the MIPMAP filters)"},
+        {R"({"minFilter": "LINEAR"})", "sampler 1: minFilter is \"LINEAR\";"},
+        {R"({"magFilter": -9728})", "sampler 1: magFilter is -9728;"},
+    };
+    for (const auto& [sampler, expected] : cases) {
+        SCOPED_TRACE(sampler);
+        const std::string rest =
+            R"("materials": [{"name": "Pixel", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+               "textures": [{"source": 0, "sampler": 1}], "samplers": [{}, )" +
+            sampler + R"(], "images": [{"uri": "grey.png"}])";
+        const fs::path file = writeFile(testDir() / "bad-filter.gltf", triangleGltf(rest));
+        const std::string message = loadError(file);
+        EXPECT_EQ(message.rfind(file.string() + ": material 0 'Pixel': baseColorTexture's sampler 1: ", 0), 0u)
+            << message;
+        EXPECT_NE(message.find(expected), std::string::npos) << message;
+    }
+}
+
 TEST(MeshFileMaterials, MaskAndBlendAreReadAndNotListedAsUnsupported)
 {
     const std::string mask = R"("materials": [{"alphaMode": "MASK", "alphaCutoff": 0.25}])";

@@ -17,6 +17,7 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -166,6 +167,40 @@ TEST_F(TextureRender, DistantCheckerIsFilteredToItsLinearMeanNearOneKeepsItsCont
     EXPECT_GT(nearMax, 0.95) << "the near checker lost its white texels: blurred although magnified";
 }
 
+// ------------------------------------------------------------ filters
+
+// A 2 x 2 checker (black and white texels) filling the view, magnified about
+// 16 times: with `filter = "nearest"` every pixel shows a texel exactly, 0 or
+// 1, the edges between them sharp; bilinear (the default) blends the texels
+// between their centres.
+TEST_F(TextureRender, NearestMagnificationShowsTheTexelsBilinearBlendsThem)
+{
+    const auto dir = freshTempDir("texture-nearest");
+    write8BitPng(dir / "checker.png", 2, 2, 1, {0, 255, 255, 0});
+    auto render = [&](const std::string& filter) {
+        std::string text = frontCamera();
+        const std::string quadrants = "texture = \"quadrants.png\"";
+        text.replace(text.find(quadrants), quadrants.size(), "texture = \"checker.png\"" + filter);
+        text +=
+            "[[objects]]\nshape = \"plane\"\npoint = [-0.5, -0.5, 0]\nnormal = [0, 0, 1]\nmaterial = \"textured\"\n";
+        return renderCentres(parseSceneString(text, (dir / "scene.toml").string()));
+    };
+    const Image nearest = render(", filter = \"nearest\""), linear = render("");
+    size_t blended = 0, off = 0;
+    for (uint32_t y = 0; y < kSide; ++y)
+        for (uint32_t x = 0; x < kSide; ++x) {
+            // The pixel's centre in texels: the texel it lies in is black where x and y are on the same side.
+            const bool left = x < kSide / 2, top = y < kSide / 2;
+            if (x == kSide / 2 || y == kSide / 2) continue; // the centre row and column look at the edge itself
+            const float expected = left == top ? 0.0f : 1.0f;
+            for (int c = 0; c < 3; ++c) off += std::abs(nearest.at(x, y)[c] - expected) > 1e-5f;
+            const float l = linear.at(x, y)[0];
+            blended += l > 0.01f && l < 0.99f;
+        }
+    EXPECT_EQ(off, 0u) << "nearest: every pixel is its texel, 0 or 1 (up to float rounding)";
+    EXPECT_GT(blended, kSide * kSide / 2) << "bilinear blends between the texel centres";
+}
+
 // ------------------------------------------------------------ normal maps
 
 /// A 4 x 4 linear normal map of one tangent-space normal, given as 8-bit codes.
@@ -310,6 +345,120 @@ intensity = [30, 30, 30]
     }
     EXPECT_EQ(differing, 0u);
     EXPECT_GT(lit, a.rgb.size() / 2) << "most of the image should be lit";
+}
+
+// ------------------------------------------------- texels in several buffers
+
+/// Words a texel of `format` takes.
+uint32_t wordsPerTexel(uint32_t format) { return format == gpu::TEXTURE_FORMAT_RGBA16F ? 2u : 1u; }
+
+/// Levels of `format` (among `records`) whose words straddle a boundary of chunks of 2^shift words.
+int straddlingLevels(const std::vector<gpu::TextureRecord>& records, uint32_t shift, uint32_t format)
+{
+    int count = 0;
+    for (const gpu::TextureRecord& r : records) {
+        if (r.format != format) continue;
+        for (uint32_t level = 0; level < r.levels; ++level) {
+            const uint64_t words =
+                uint64_t(std::max(1u, r.width >> level)) * std::max(1u, r.height >> level) * wordsPerTexel(r.format);
+            const uint64_t first = r.levelOffset[level], last = first + words - 1;
+            count += (first >> shift) != (last >> shift);
+        }
+    }
+    return count;
+}
+
+// Texels split into many small buffers (RenderOptions::maxTextureChunkBytes,
+// as a scene beyond maxStorageBufferRange is) render exactly as in one: the
+// same words read, the same arithmetic. Levels of 8-bit sRGB, 8-bit linear
+// and half-float textures straddle the chunks' boundaries.
+TEST_F(TextureRender, TexelsInSmallChunksRenderBitForBitAsInOneBuffer)
+{
+    const auto dir = freshTempDir("texture-chunks");
+    writeChecker(dir, 64);
+    writeQuadrantTexture(dir);
+    std::vector<uint16_t> wide;
+    for (uint32_t y = 0; y < 10; ++y)
+        for (uint32_t x = 0; x < 12; ++x)
+            wide.insert(wide.end(), {uint16_t(x * 5000), uint16_t(y * 6000), uint16_t(30000 + x * y * 300), 65535});
+    writePng(dir / "wide.png", 12, 10, 16, 6, wide); // 16-bit: half floats
+    std::vector<uint8_t> rough;
+    for (uint32_t i = 0; i < 7 * 5; ++i) rough.push_back(uint8_t(40 + 5 * i));
+    write8BitPng(dir / "rough.png", 7, 5, 1, rough);
+    const std::string text = R"([render]
+integrator = "path"
+max_depth = 2
+[camera]
+eye = [0, 1.5, 4]
+target = [0, 0.5, 0]
+fov = 40
+width = 40
+height = 30
+[background]
+color = [0.8, 0.9, 1.0]
+[materials.floor]
+type = "lambert"
+albedo = { texture = "checker.png", scale = 3 }
+[materials.ball]
+type = "lambert"
+albedo = { texture = "quadrants.png", wrap = "mirror" }
+[materials.wide]
+type = "lambert"
+albedo = { texture = "wide.png", scale = [2, 1] }
+[materials.metal]
+type = "conductor"
+metal = "Au"
+roughness = { texture = "rough.png", linear = true }
+[[objects]]
+shape = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = "floor"
+[[objects]]
+shape = "sphere"
+center = [-0.8, 0.6, 0]
+radius = 0.6
+material = "ball"
+[[objects]]
+shape = "box"
+min = [0.2, 0, -0.5]
+max = [1.2, 1, 0.5]
+material = "wide"
+[[objects]]
+shape = "sphere"
+center = [0.2, 0.3, 1.2]
+radius = 0.3
+material = "metal"
+[[lights]]
+type = "point"
+position = [2, 4, 3]
+intensity = [30, 30, 30]
+)";
+    const Scene scene = parseSceneString(text, (dir / "scene.toml").string());
+    RenderOptions oneOptions = pixelCentreOptions(), splitOptions = pixelCentreOptions();
+    splitOptions.maxTextureChunkBytes = 1024; // 256 words a buffer
+    Renderer one(gpu(), scene, oneOptions), split(gpu(), scene, splitOptions);
+    EXPECT_EQ(one.variant().textureChunks, 1u);
+    const TextureBuffers& textures = split.meshData().textures;
+    ASSERT_EQ(split.variant().textureChunks, textures.chunking.count);
+    EXPECT_EQ(textures.chunking.shift, 8u);
+    EXPECT_EQ(textures.chunking.count, (textures.texels.size() + 255) / 256);
+    EXPECT_GT(textures.chunking.count, 20u);
+    for (uint32_t format :
+         {gpu::TEXTURE_FORMAT_RGBA8_SRGB, gpu::TEXTURE_FORMAT_RGBA8_UNORM, gpu::TEXTURE_FORMAT_RGBA16F})
+        EXPECT_GT(straddlingLevels(textures.records, 8, format), 0) << "format " << format;
+    one.renderFrames(2);
+    split.renderFrames(2);
+    const Image a = one.mean(), b = split.mean();
+    size_t differing = 0;
+    std::vector<float> values;
+    for (size_t i = 0; i < a.rgb.size(); ++i) {
+        differing += a.rgb[i] != b.rgb[i];
+        values.push_back(a.rgb[i]);
+    }
+    EXPECT_EQ(differing, 0u);
+    std::sort(values.begin(), values.end());
+    EXPECT_GT(std::unique(values.begin(), values.end()) - values.begin(), 500) << "the textures should show";
 }
 
 // --------------------------------------------------------- glTF file materials

@@ -69,7 +69,7 @@ roughness = 0.2
 type = "pbr"
 base_color = [0.5, 0.4, 0.3]
 metallic = 0.25
-normal_map = { texture = "grey.png", strength = 0.5 }
+normal_map = { texture = "grey.png", strength = 0.5, filter = "nearest" }
 [[objects]]
 shape = "sphere"
 material = "glass"
@@ -277,6 +277,7 @@ TEST_F(SceneExport, MaterialsHaveEveryParameterOfTheirKind)
     EXPECT_EQ(albedo["channel"], "r");
     const Json& record = j["textures"][albedo["record"].get<size_t>()];
     EXPECT_EQ(record["wrap"], Json::parse(R"(["clamp", "clamp"])"));
+    EXPECT_EQ(record["filter"], Json::parse(R"({"mag": "linear", "min": "linear", "mip": "linear"})"));
     EXPECT_EQ(record["encoding"], "rgba8_srgb");
     EXPECT_EQ(record["width"], 2);
 
@@ -289,6 +290,8 @@ TEST_F(SceneExport, MaterialsHaveEveryParameterOfTheirKind)
     expectSameDouble(wood["roughness"], 1.0, "wood.roughness");
     expectSameVector(wood["emission"], glm::dvec3(0.0), "wood.emission");
     EXPECT_EQ(wood["textures"]["normal_map"]["strength"], 0.5);
+    EXPECT_EQ(j["textures"][wood["textures"]["normal_map"]["record"].get<size_t>()]["filter"],
+              Json::parse(R"({"mag": "nearest", "min": "nearest", "mip": "nearest"})"));
     EXPECT_NE(wood["where"].get<std::string>().find("scene.toml:"), std::string::npos);
 }
 

@@ -61,7 +61,7 @@ TEST_F(SceneParserTextures, ATextureTableSetsTheSlotAndReplacesTheConstant)
     EXPECT_EQ(m.diffuse, Color(1.0)) << "the texel is the albedo: the constant it multiplies is 1";
     EXPECT_EQ(m.texture(TextureSlot::Color)->scale, glm::dvec2(4, 2));
     ASSERT_TRUE(scene.textures);
-    const TextureBuffers buffers = scene.textures->pack(~0ull);
+    const TextureBuffers buffers = scene.textures->pack();
     ASSERT_EQ(buffers.records.size(), 1u);
     EXPECT_EQ(buffers.records[0].wrapU, gpu::TEXTURE_WRAP_CLAMP);
     EXPECT_EQ(buffers.records[0].wrapV, gpu::TEXTURE_WRAP_MIRROR);
@@ -182,6 +182,51 @@ TEST_F(SceneParserTextures, MissingGltfTextureIsAnErrorAtTheMaterialKey)
     EXPECT_NE(error.find("nowhere.png"), std::string::npos) << error;
 }
 
+// glTF samplers' filters reach the texture records (TextureRecord::filters):
+// the base colour's NEAREST_MIPMAP_NEAREST, the metallic-roughness map's
+// LINEAR (no mip maps); the emissive texture reads the base colour's image
+// without a sampler, so it is a record of its own over the same texels.
+TEST_F(SceneParserTextures, GltfSamplerFiltersReachTheTextureRecords)
+{
+    std::ofstream(m_dir / "filtered.gltf") << triangleGltf(
+        R"("materials": [{"emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 2},
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 1}}}],
+          "textures": [{"source": 0, "sampler": 0}, {"source": 0, "sampler": 1}, {"source": 0}],
+          "samplers": [{"magFilter": 9728, "minFilter": 9984}, {"magFilter": 9729, "minFilter": 9729}],
+          "images": [{"uri": "grey.png"}])");
+    const Scene scene = parse("[[objects]]\nshape = \"mesh\"\nfile = \"filtered.gltf\"\nmaterial = \"file\"\n");
+    ASSERT_EQ(scene.materials.size(), 1u);
+    const Material& m = scene.materials[0];
+    ASSERT_TRUE(m.texture(TextureSlot::Color) && m.texture(TextureSlot::Roughness) && m.texture(TextureSlot::Emission));
+    ASSERT_TRUE(scene.textures);
+    const std::vector<gpu::TextureRecord> records = scene.textures->records();
+    const gpu::TextureRecord& color = records.at(m.texture(TextureSlot::Color)->record);
+    const gpu::TextureRecord& roughness = records.at(m.texture(TextureSlot::Roughness)->record);
+    const gpu::TextureRecord& emission = records.at(m.texture(TextureSlot::Emission)->record);
+    EXPECT_EQ(color.filters,
+              gpu::TEXTURE_FILTER_MAG_NEAREST | gpu::TEXTURE_FILTER_MIN_NEAREST | gpu::TEXTURE_FILTER_MIP_NEAREST);
+    EXPECT_EQ(roughness.filters, gpu::TEXTURE_FILTER_MIP_NONE);
+    EXPECT_EQ(emission.filters, 0u);
+    EXPECT_NE(m.texture(TextureSlot::Emission)->record, m.texture(TextureSlot::Color)->record);
+    EXPECT_EQ(emission.levelOffset[0], color.levelOffset[0]);
+    EXPECT_EQ(scene.textures->imageCount(), 2u); // grey.png as sRGB and as linear data
+}
+
+TEST_F(SceneParserTextures, FilterNearestTurnsOffEveryInterpolation)
+{
+    const Scene scene = parse("[materials.m]\ntype = \"lambert\"\n"
+                              "albedo = { texture = \"grey.png\", filter = \"nearest\" }\n" +
+                              kSphere);
+    const std::vector<gpu::TextureRecord> records = scene.textures->records();
+    ASSERT_EQ(records.size(), 1u);
+    EXPECT_EQ(records[0].filters,
+              gpu::TEXTURE_FILTER_MAG_NEAREST | gpu::TEXTURE_FILTER_MIN_NEAREST | gpu::TEXTURE_FILTER_MIP_NEAREST);
+    const Scene linear = parse("[materials.m]\ntype = \"lambert\"\n"
+                               "albedo = { texture = \"grey.png\", filter = \"linear\" }\n" +
+                               kSphere);
+    EXPECT_EQ(linear.textures->records()[0].filters, 0u);
+}
+
 // ---------------------------------------------------------------------------
 // Images embedded in a glTF (data: URIs, .glb) meet the texture budget from
 // their header, before they are decoded, as image files do (issue 26).
@@ -284,6 +329,8 @@ const BadTexture kBadTextures[] = {
      "unknown channel 'x'"},
     {"UnknownWrapMode", kLambert + "albedo = { texture = \"grey.png\", wrap = \"repet\" }\n" + kSphere, "7:41",
      "unknown wrap mode 'repet'; did you mean 'repeat'?"},
+    {"UnknownFilter", kLambert + "albedo = { texture = \"grey.png\", filter = \"nearst\" }\n" + kSphere, "7:43",
+     "unknown filter 'nearst'; did you mean 'nearest'?"},
     {"ZeroScale", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 0] }\n" + kSphere, "7:46",
      "must not be zero"},
     {"ScaleTriple", kLambert + "albedo = { texture = \"grey.png\", scale = [1, 2, 3] }\n" + kSphere, "7:42",

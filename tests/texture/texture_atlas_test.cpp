@@ -1,5 +1,6 @@
-// Packing textures into one buffer (src/texture/TextureAtlas.h): records,
-// level offsets, encodings, de-duplication, located errors and the device limit.
+// Packing textures (src/texture/TextureAtlas.h): records, level offsets,
+// encodings, de-duplication, located errors, the chunks of texels beyond one
+// buffer and the device's limits.
 #include "texture/MipPyramid.h"
 #include "texture/TextureAtlas.h"
 #include "texture/TextureTestFiles.h"
@@ -27,7 +28,7 @@ TEST(TextureAtlas, RecordsPointAtEveryLevel)
     TextureAtlas atlas;
     EXPECT_EQ(atlas.add(solid(5, 3, TexelEncoding::Srgb8), "a", TextureWrap::Clamp, TextureWrap::Mirror), 0u);
     EXPECT_EQ(atlas.add(solid(4, 4, TexelEncoding::Half), "b"), 1u);
-    const TextureBuffers buffers = atlas.pack(1u << 20);
+    const TextureBuffers buffers = atlas.pack();
     ASSERT_EQ(buffers.records.size(), 2u);
     const gpu::TextureRecord& a = buffers.records[0];
     EXPECT_EQ(a.width, 5u);
@@ -58,7 +59,7 @@ TEST(TextureAtlas, EightBitSrgbKeepsTheFileCodes)
     const fs::path file = write8BitPng(textureTestDir() / "codes.png", 256, 1, 4, samples);
     TextureAtlas atlas;
     atlas.add(TextureRequest{file});
-    const TextureBuffers buffers = atlas.pack(1u << 20);
+    const TextureBuffers buffers = atlas.pack();
     for (uint32_t x = 0; x < 256; ++x) {
         const uint32_t word = buffers.texels[x];
         for (int c = 0; c < 4; ++c) EXPECT_EQ((word >> (8 * c)) & 0xffu, samples[x * 4 + c]) << x << " " << c;
@@ -100,7 +101,7 @@ TEST(TextureAtlas, SameFileIsLoadedOnce)
     EXPECT_NE(linear, first);
     EXPECT_EQ(atlas.imageCount(), 2u); // (file, sRGB) and (file, linear)
     EXPECT_EQ(atlas.recordCount(), 3u);
-    const TextureBuffers buffers = atlas.pack(1u << 20);
+    const TextureBuffers buffers = atlas.pack();
     EXPECT_EQ(buffers.records[clamped].levelOffset[0], buffers.records[first].levelOffset[0]);
     EXPECT_NE(buffers.records[linear].levelOffset[0], buffers.records[first].levelOffset[0]);
     EXPECT_EQ(buffers.records[linear].format, gpu::TEXTURE_FORMAT_RGBA8_UNORM);
@@ -121,21 +122,145 @@ TEST(TextureAtlas, LoadErrorCarriesTheSceneLocation)
     EXPECT_EQ(atlas.imageCount(), 0u);
 }
 
-TEST(TextureAtlas, OverTheBufferLimitIsRefusedNamingTheLargest)
+/// Three textures of 341, 2 x 2731 and 2 x 85 words (a word of padding
+/// before the first half-float one, which starts at an even word).
+TextureAtlas threeTextures()
 {
     TextureAtlas atlas;
     atlas.add(solid(16, 16, TexelEncoding::Srgb8), "small.png");
     atlas.add(solid(64, 32, TexelEncoding::Half), "big.exr");
     atlas.add(solid(8, 8, TexelEncoding::Half), "tiny.exr");
+    return atlas;
+}
+
+TEST(TextureChunks, TexelsThatFitOneBufferStayInOne)
+{
+    const TextureAtlas atlas = threeTextures();
     const uint64_t bytes = atlas.texelBytes();
-    EXPECT_NO_THROW(atlas.pack(bytes)); // exactly at the limit fits
+    EXPECT_EQ(atlas.chunking({bytes, 1, bytes}), TextureChunking{}); // exactly at the limit fits
+    const TextureBuffers buffers = atlas.pack(atlas.chunking({bytes, 1, bytes}));
+    ASSERT_EQ(buffers.chunking.count, 1u);
+    EXPECT_EQ(buffers.chunk(0).size(), buffers.texels.size());
+    EXPECT_EQ(buffers.chunk(0).data(), buffers.texels.data());
+}
+
+// Beyond one buffer the words keep their one address space (the records are
+// the same) and are cut into chunks of the largest power of two that fits.
+TEST(TextureChunks, TexelsOverOneBufferAreSplitAtPowersOfTwo)
+{
+    const TextureAtlas atlas = threeTextures();
+    const TextureBuffers whole = atlas.pack();
+    const uint64_t words = whole.texels.size();
+    ASSERT_EQ(words * 4, atlas.texelBytes());
+    const TextureChunking chunks = atlas.chunking({words * 4 - 4, UINT32_MAX, UINT64_MAX});
+    // 5974 words (one of them padding): chunks of 4096 words, the largest
+    // power of two up to the 5973 that fit.
+    ASSERT_EQ(words, 341u + 1u + 2u * 2731u + 2u * 85u);
+    EXPECT_EQ(chunks.shift, 12u);
+    EXPECT_EQ(chunks.count, 2u);
+    const TextureChunking small = atlas.chunking({1000, UINT32_MAX, UINT64_MAX}); // 250 words: chunks of 128
+    EXPECT_EQ(small.shift, 7u);
+    EXPECT_EQ(small.count, (words + 127) / 128);
+    const TextureBuffers split = atlas.pack(small);
+    ASSERT_EQ(split.records.size(), whole.records.size());
+    for (size_t r = 0; r < whole.records.size(); ++r)
+        for (uint32_t level = 0; level < gpu::TEXTURE_MAX_LEVELS; ++level)
+            EXPECT_EQ(split.records[r].levelOffset[level], whole.records[r].levelOffset[level]) << r << " " << level;
+    size_t seen = 0;
+    for (uint32_t c = 0; c < small.count; ++c) {
+        const std::span<const uint32_t> chunk = split.chunk(c);
+        EXPECT_EQ(chunk.size(), c + 1 < small.count ? 128u : words - 128u * (small.count - 1)) << c;
+        for (size_t i = 0; i < chunk.size(); ++i) ASSERT_EQ(chunk[i], whole.texels[(size_t(c) << 7) + i]) << c;
+        seen += chunk.size();
+    }
+    EXPECT_EQ(seen, words);
+}
+
+TEST(TextureChunks, HalfFloatTexelsNeverStraddleTwoChunks)
+{
+    TextureAtlas atlas;
+    atlas.add(solid(7, 1, TexelEncoding::Srgb8), "odd.png"); // 7 + 3 + 1 = 11 words
+    atlas.add(solid(3, 3, TexelEncoding::Half), "half.exr");
+    const TextureBuffers buffers = atlas.pack();
+    const gpu::TextureRecord& half = buffers.records[1];
+    EXPECT_EQ(half.levelOffset[0], 12u) << "a half-float image starts at an even word";
+    for (uint32_t level = 0; level < half.levels; ++level) EXPECT_EQ(half.levelOffset[level] % 2, 0u) << level;
+    EXPECT_EQ(buffers.texels[11], 0u); // the padding
+    // Chunks of two words (8 bytes, the smallest) hold whole texels.
+    EXPECT_EQ(atlas.chunking({8, UINT32_MAX, UINT64_MAX}).shift, 1u);
+    EXPECT_EQ(atlas.chunking({15, UINT32_MAX, UINT64_MAX}).shift, 1u);
+}
+
+// The arithmetic at real sizes, without the texels: lavapipe's 128 MiB
+// buffers and the scene that one buffer refused (224 MiB of texels), and a
+// discrete GPU's 4 GiB - 1, where chunks stop at kMaxChunkBytes.
+TEST(TextureChunks, ChunkingAtDeviceSizes)
+{
+    const uint64_t lavapipe = uint64_t(128) << 20, discrete = UINT32_MAX;
+    const uint64_t words = (uint64_t(224) << 20) / 4;
+    EXPECT_EQ(textureChunkingFor(words, {lavapipe, 8, UINT64_MAX}), (TextureChunking{2, 25}));
+    EXPECT_EQ(textureChunkingFor(words + 1, {lavapipe, 8, UINT64_MAX}), (TextureChunking{2, 25}));
+    EXPECT_EQ(textureChunkingFor(uint64_t(3) << 25, {lavapipe, 8, UINT64_MAX}), (TextureChunking{3, 25}));
+    EXPECT_EQ(textureChunkingFor(words, {discrete, 8, UINT64_MAX}), TextureChunking{});
+    EXPECT_EQ(textureChunkingFor(uint64_t(1) << 31, {discrete, 8, UINT64_MAX}), (TextureChunking{8, 28}));
+    // The largest scene the texel budget lets in: 64 Mi half-float texels with their mip levels.
+    const uint64_t largest = 2 * (TextureAtlas::kMaxSceneTexels * 4 - 1) / 3;
+    EXPECT_EQ(textureChunkingFor(largest, {lavapipe, 8, UINT64_MAX}), (TextureChunking{6, 25}));
+}
+
+// A scene over one buffer of lavapipe's (128 MiB), which pack refused before:
+// three 2048 x 2048 half-float textures with their mip levels fill it but for
+// two words, and a fourth, 16 x 16, starts there and straddles the chunks.
+TEST(TextureChunks, SceneOverOneLavapipeBufferIsSplitNotRefused)
+{
+    TextureAtlas atlas;
+    for (int i = 0; i < 3; ++i) atlas.add(solid(2048, 2048, TexelEncoding::Half, 0.25f * float(i + 1)), "big.exr");
+    const uint64_t lavapipe = uint64_t(128) << 20;
+    EXPECT_EQ(atlas.chunking({lavapipe, 8, UINT64_MAX}), TextureChunking{});
+    atlas.add(solid(16, 16, TexelEncoding::Srgb8), "small.png");
+    ASSERT_GT(atlas.texelBytes(), lavapipe);
+    const TextureChunking chunks = atlas.chunking({lavapipe, 8, UINT64_MAX});
+    EXPECT_EQ(chunks, (TextureChunking{2, 25}));
+    const TextureBuffers buffers = atlas.pack(chunks);
+    EXPECT_EQ(buffers.records[3].levelOffset[0], (1u << 25) - 2);
+    EXPECT_EQ(buffers.chunk(0).size(), size_t(1) << 25);
+    EXPECT_EQ(buffers.chunk(1).size(), 341u - 2u);
+    const float grey[4] = {0.5f, 0.5f, 0.5f, 0.5f};
+    EXPECT_EQ(buffers.chunk(0).back(), encodeRgba8(grey, true));
+    EXPECT_EQ(buffers.chunk(1).front(), encodeRgba8(grey, true));
+    EXPECT_EQ(buffers.chunk(0)[buffers.records[2].levelOffset[0]], 0x3a003a00u); // the third's half 0.75, twice
+}
+
+TEST(TextureChunks, MoreChunksThanTheKernelCanBindAreRefusedNamingTheLargest)
+{
+    const TextureAtlas atlas = threeTextures();
+    const uint64_t bytes = atlas.texelBytes();
+    EXPECT_NO_THROW(atlas.chunking({bytes - 4, 2, UINT64_MAX}));
     try {
-        atlas.pack(bytes - 4);
+        atlas.chunking({bytes - 4, 1, UINT64_MAX});
         FAIL() << "no error";
     } catch (const InputError& error) {
         const std::string message = error.what();
-        EXPECT_NE(message.find("more than this device's limit"), std::string::npos) << message;
-        EXPECT_NE(message.find("maxStorageBufferRange"), std::string::npos) << message;
+        EXPECT_NE(message.find("2 storage buffers of 0.02 MiB (maxStorageBufferRange), and the kernel can bind 1 "
+                               "more (maxPerStageDescriptorStorageBuffers)"),
+                  std::string::npos)
+            << message;
+        EXPECT_NE(message.find("the largest is big.exr (64x32, "), std::string::npos) << message;
+    }
+}
+
+TEST(TextureChunks, TexelsBeyondTheDeviceMemoryAreRefusedNamingTheLargest)
+{
+    const TextureAtlas atlas = threeTextures();
+    const uint64_t bytes = atlas.texelBytes();
+    EXPECT_NO_THROW(atlas.chunking({UINT64_MAX, 1, bytes}));
+    try {
+        atlas.chunking({UINT64_MAX, 1, bytes - 1});
+        FAIL() << "no error";
+    } catch (const InputError& error) {
+        const std::string message = error.what();
+        EXPECT_NE(message.find("more than this device can hold: the device's 0.02 MiB of memory"), std::string::npos)
+            << message;
         EXPECT_NE(message.find("the largest is big.exr (64x32, "), std::string::npos) << message;
     }
 }
@@ -235,6 +360,52 @@ TEST(TextureAtlas, HostLookupIsBilinearBetweenTexelCentresWithTheWrapModes)
     EXPECT_EQ(atlas.widthOf(clamp), 4u);
     EXPECT_EQ(atlas.heightOf(clamp), 2u);
     EXPECT_EQ(atlas.levelsOf(clamp), 3u);
+}
+
+// TextureRecord::filters: glTF's filters as bits, vkrt's trilinear default 0.
+TEST(TextureFilters, RecordBitsSayWhatIsNearest)
+{
+    using Mip = TextureFilter::Mip;
+    EXPECT_EQ(TextureFilter{}.bits(), 0u);
+    EXPECT_EQ((TextureFilter{true, false, Mip::Linear}.bits()), gpu::TEXTURE_FILTER_MAG_NEAREST);
+    EXPECT_EQ((TextureFilter{false, true, Mip::Linear}.bits()), gpu::TEXTURE_FILTER_MIN_NEAREST);
+    EXPECT_EQ((TextureFilter{false, false, Mip::Nearest}.bits()), gpu::TEXTURE_FILTER_MIP_NEAREST);
+    EXPECT_EQ((TextureFilter{true, true, Mip::None}.bits()),
+              gpu::TEXTURE_FILTER_MAG_NEAREST | gpu::TEXTURE_FILTER_MIN_NEAREST | gpu::TEXTURE_FILTER_MIP_NONE);
+}
+
+// One image under two filters: two records over the same texels; the same
+// filter again: the same record.
+TEST(TextureFilters, OtherFiltersGetTheirOwnRecordOverTheSameTexels)
+{
+    const fs::path file = write8BitPng(textureTestDir() / "grey.png", 4, 4, 3, std::vector<uint8_t>(48, 100));
+    TextureAtlas atlas;
+    const TextureFilter nearest{true, true, TextureFilter::Mip::Nearest};
+    const uint32_t plain = atlas.add(TextureRequest{file});
+    const uint32_t sharp = atlas.add(TextureRequest{file, false, TextureWrap::Repeat, TextureWrap::Repeat, nearest});
+    EXPECT_NE(sharp, plain);
+    EXPECT_EQ(atlas.add(TextureRequest{file, false, TextureWrap::Repeat, TextureWrap::Repeat, nearest}), sharp);
+    EXPECT_EQ(atlas.imageCount(), 1u);
+    const TextureBuffers buffers = atlas.pack();
+    EXPECT_EQ(buffers.records[plain].filters, 0u);
+    EXPECT_EQ(buffers.records[sharp].filters, nearest.bits());
+    EXPECT_EQ(buffers.records[sharp].levelOffset[0], buffers.records[plain].levelOffset[0]);
+}
+
+// The host's level lookup follows the magnification filter, as
+// lib/texture.glsl's sampleTextureLevel does: nearest, the texel whose square holds the point.
+TEST(TextureFilters, HostLookupWithNearestMagnificationTakesTheTexelUnderThePoint)
+{
+    TextureImage image{RgbaImage(4, 2), TexelEncoding::Half};
+    for (uint32_t y = 0; y < 2; ++y)
+        for (uint32_t x = 0; x < 4; ++x)
+            for (int c = 0; c < 4; ++c) image.pixels.at(x, y)[c] = float(x + 4 * y);
+    TextureAtlas atlas;
+    const uint32_t nearest = atlas.add(image, "grid", TextureWrap::Repeat, TextureWrap::Repeat, {true, false});
+    EXPECT_EQ(atlas.sampleLevel(nearest, 0.49, 0.9, 0)[0], 1.0);  // x = 1.96, row 0
+    EXPECT_EQ(atlas.sampleLevel(nearest, 0.51, 0.9, 0)[0], 2.0);  // x = 2.04
+    EXPECT_EQ(atlas.sampleLevel(nearest, 0.51, 0.1, 0)[0], 6.0);  // row 1
+    EXPECT_EQ(atlas.sampleLevel(nearest, -0.01, 0.9, 0)[0], 3.0); // repeat: the last column
 }
 
 } // namespace

@@ -23,6 +23,7 @@ TEST(TextureLayout, RecordOffsetsMatchGlslangReflection)
         {"textureRecords[0].format", offsetof(gpu::TextureRecord, format)},
         {"textureRecords[0].wrapU", offsetof(gpu::TextureRecord, wrapU)},
         {"textureRecords[0].wrapV", offsetof(gpu::TextureRecord, wrapV)},
+        {"textureRecords[0].filters", offsetof(gpu::TextureRecord, filters)},
         {"textureRecords[0].levelOffset", offsetof(gpu::TextureRecord, levelOffset)},
     };
     std::string names;

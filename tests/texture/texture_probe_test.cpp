@@ -1,7 +1,8 @@
 // lib/texture.glsl on the test GPU (tests/gpu/kernels/texture_probe.comp)
 // against a double-precision CPU reference of the same rules, written here
 // independently: uv convention, wrap modes on texel indices, bilinear within a
-// level, linear between levels, sRGB decoding per texel before filtering.
+// level, linear between levels, sRGB decoding per texel before filtering,
+// and the records' filters (nearest texels, the nearest level, level 0 alone).
 #include "support/ProbeBuffers.h"
 #include "support/TestSupport.h"
 #include "texture/TextureAtlas.h"
@@ -29,15 +30,21 @@ class ReferenceSampler {
 public:
     explicit ReferenceSampler(const TextureBuffers& buffers, bool flipV = true) : m_buffers(buffers), m_flipV(flipV) {}
 
-    Rgba sample(uint32_t texture, double u, double v, double lod) const
+    /// `lod` is a float, as the kernel's: the levels it picks are rounded as the kernel rounds.
+    Rgba sample(uint32_t texture, double u, double v, float lod) const
     {
         const gpu::TextureRecord& record = m_buffers.records[texture];
-        const double top = record.levels - 1.0;
-        lod = std::isnan(lod) ? 0.0 : std::clamp(lod, 0.0, top);
+        const uint32_t filters = record.filters;
+        if (!(lod > 0.0f)) return filtered(record, 0, u, v, filters & gpu::TEXTURE_FILTER_MAG_NEAREST);
+        const bool nearest = filters & gpu::TEXTURE_FILTER_MIN_NEAREST;
+        if (filters & gpu::TEXTURE_FILTER_MIP_NONE) return filtered(record, 0, u, v, nearest);
+        lod = std::min(lod, float(record.levels - 1));
+        if (filters & gpu::TEXTURE_FILTER_MIP_NEAREST)
+            return filtered(record, uint32_t(std::floor(lod + 0.5f)), u, v, nearest);
         const double level = std::floor(lod), t = lod - level;
-        const Rgba fine = bilinear(record, uint32_t(level), u, v);
+        const Rgba fine = filtered(record, uint32_t(level), u, v, nearest);
         if (t == 0.0) return fine;
-        const Rgba coarse = bilinear(record, uint32_t(level) + 1, u, v);
+        const Rgba coarse = filtered(record, uint32_t(level) + 1, u, v, nearest);
         Rgba out;
         for (int c = 0; c < 4; ++c) out[c] = fine[c] * (1.0 - t) + coarse[c] * t;
         return out;
@@ -72,6 +79,27 @@ private:
             out[c] = record.format == gpu::TEXTURE_FORMAT_RGBA8_SRGB && c < 3 ? srgbReference(value) : value;
         }
         return out;
+    }
+
+    Rgba filtered(const gpu::TextureRecord& record, uint32_t level, double u, double v, bool nearest) const
+    {
+        return nearest ? nearestTexel(record, level, u, v) : bilinear(record, level, u, v);
+    }
+
+    /// The texel whose square holds (u, v). In float, as the kernel computes
+    /// it: the nearest texel jumps at texel edges, where double arithmetic
+    /// could round to the other side.
+    Rgba nearestTexel(const gpu::TextureRecord& record, uint32_t level, double u, double v) const
+    {
+        const int64_t w = std::max(1u, record.width >> level), h = std::max(1u, record.height >> level);
+        auto whole = [](float s, uint32_t mode) { // whole periods off, as wrapTextureCoordinate
+            if (mode == gpu::TEXTURE_WRAP_REPEAT) return s - std::floor(s);
+            if (mode == gpu::TEXTURE_WRAP_MIRROR) return s - 2.0f * std::floor(0.5f * s);
+            return std::clamp(s, -1.0f, 2.0f);
+        };
+        const float s = whole(float(u), record.wrapU), t = whole(1.0f - float(v), record.wrapV);
+        const auto x = int64_t(std::floor(s * float(w))), y = int64_t(std::floor(t * float(h)));
+        return texel(record, level, wrap(x, w, record.wrapU), wrap(y, h, record.wrapV));
     }
 
     Rgba bilinear(const gpu::TextureRecord& record, uint32_t level, double u, double v) const
@@ -137,7 +165,21 @@ protected:
         m_atlas.add(randomImage(13, 1, TexelEncoding::Srgb8, random, 0, 1), "d", W::Mirror, W::Mirror);
         m_atlas.add(randomImage(1, 1, TexelEncoding::Half, random, 0, 1), "e", W::Repeat, W::Repeat);
         m_atlas.add(randomImage(16, 16, TexelEncoding::Srgb8, random, 0, 1), "f", W::Repeat, W::Repeat);
-        m_buffers = m_atlas.pack(1u << 30);
+        // Every filter of glTF's (records 6 to 11): nearest magnification,
+        // nearest within levels, the nearest level, level 0 alone.
+        using M = TextureFilter::Mip;
+        m_atlas.add(randomImage(16, 16, TexelEncoding::Srgb8, random, 0, 1), "g", W::Repeat, W::Mirror, {true});
+        m_atlas.add(randomImage(7, 4, TexelEncoding::Half, random, -1, 4), "h", W::Mirror, W::Repeat,
+                    {false, true, M::Linear});
+        m_atlas.add(randomImage(8, 6, TexelEncoding::Unorm8, random, 0, 1), "i", W::Clamp, W::Mirror,
+                    {false, false, M::Nearest});
+        m_atlas.add(randomImage(13, 3, TexelEncoding::Srgb8, random, 0, 1), "j", W::Mirror, W::Clamp,
+                    {true, true, M::Nearest});
+        m_atlas.add(randomImage(5, 9, TexelEncoding::Srgb8, random, 0, 1), "k", W::Repeat, W::Repeat,
+                    {false, true, M::None});
+        m_atlas.add(randomImage(12, 12, TexelEncoding::Half, random, 0, 1), "l", W::Clamp, W::Clamp,
+                    {true, false, M::None});
+        m_buffers = m_atlas.pack();
     }
 
     /// Random uv over several periods, lod over and beyond [0, levels - 1].
@@ -211,6 +253,10 @@ TEST_F(TextureProbe, RandomLookupsMatchTheReference)
     EXPECT_LT(error, kTolerance) << where;
     // The comparison is sharp enough to see a wrong v convention.
     EXPECT_GT(maxError(lookups, results, ReferenceSampler(m_buffers, false), where), 0.05);
+    // And to see a filter ignored: the same lookups without the filters.
+    TextureBuffers unfiltered = m_buffers;
+    for (gpu::TextureRecord& record : unfiltered.records) record.filters = 0;
+    EXPECT_GT(maxError(lookups, results, ReferenceSampler(unfiltered), where), 0.05);
 }
 
 TEST_F(TextureProbe, TexelCentresEdgesAndWrapModesMatchTheReference)
@@ -250,7 +296,7 @@ TEST_F(TextureProbe, ShaderDecodesEverySrgbCode)
     }
     TextureAtlas atlas;
     atlas.add(ramp, "ramp", TextureWrap::Clamp, TextureWrap::Clamp);
-    const TextureBuffers buffers = atlas.pack(1u << 20);
+    const TextureBuffers buffers = atlas.pack();
     for (uint32_t code = 0; code < 256; ++code) ASSERT_EQ(buffers.texels[code] & 0xffu, code);
     std::vector<Lookup> lookups;
     for (uint32_t code = 0; code < 256; ++code) lookups.push_back({0, (code + 0.5f) / 256.0f, 0.5f, 0.0f});
@@ -275,10 +321,36 @@ TEST_F(TextureProbe, FiltersDecodedValues)
     std::fill(pair.pixels.rgba.begin() + 4, pair.pixels.rgba.end(), 1.0f);
     TextureAtlas atlas;
     atlas.add(pair, "pair", TextureWrap::Clamp, TextureWrap::Clamp);
-    const std::vector<Rgba> results = sampleOnGpu(atlas.pack(1u << 20), {{0, 0.5f, 0.5f, 0.0f}, {0, 0.5f, 0.5f, 1.0f}});
+    const std::vector<Rgba> results = sampleOnGpu(atlas.pack(), {{0, 0.5f, 0.5f, 0.0f}, {0, 0.5f, 0.5f, 1.0f}});
     EXPECT_NEAR(results[0][0], 0.5, 1e-6);
     // The 1x1 level: the linear mean 0.5, stored as sRGB code 188.
     EXPECT_NEAR(results[1][0], srgbReference(188 / 255.0), 1e-6);
+}
+
+// Closed forms: a 4 x 4 image whose left half is 1 and right half 0 (half
+// floats, exact). Level 1 is the same halves at 2 x 2, level 2 their mean 0.5;
+// at u = 0.3 level 0's texel is 1 and level 1's bilinear value 0.9.
+TEST_F(TextureProbe, MinificationFiltersReadTheLevelsTheyName)
+{
+    TextureImage halves{RgbaImage(4, 4), TexelEncoding::Half};
+    for (uint32_t y = 0; y < 4; ++y)
+        for (uint32_t x = 0; x < 4; ++x) std::fill_n(halves.pixels.at(x, y), 4, x < 2 ? 1.0f : 0.0f);
+    using W = TextureWrap;
+    using M = TextureFilter::Mip;
+    TextureAtlas atlas;
+    atlas.add(halves, "trilinear", W::Clamp, W::Clamp);
+    atlas.add(halves, "nearest level", W::Clamp, W::Clamp, {false, false, M::Nearest});
+    atlas.add(halves, "level 0 nearest", W::Clamp, W::Clamp, {false, true, M::None});
+    const std::vector<Rgba> r = sampleOnGpu(atlas.pack(), {{0, 0.3f, 0.5f, 1.5f},
+                                                           {1, 0.3f, 0.5f, 1.4f},
+                                                           {1, 0.3f, 0.5f, 1.6f},
+                                                           {2, 0.3f, 0.5f, 2.0f},
+                                                           {2, 0.6f, 0.5f, 2.0f}});
+    EXPECT_NEAR(r[0][0], 0.5 * 0.9 + 0.5 * 0.5, 1e-6) << "trilinear: levels 1 and 2 blended";
+    EXPECT_NEAR(r[1][0], 0.9, 1e-6) << "lod 1.4: level 1 alone";
+    EXPECT_EQ(r[2][0], 0.5) << "lod 1.6: level 2 alone";
+    EXPECT_EQ(r[3][0], 1.0) << "no mip maps: level 0's nearest texel";
+    EXPECT_EQ(r[4][0], 0.0) << "no mip maps: level 0's nearest texel";
 }
 
 TEST_F(TextureProbe, RayConeLodFollowsTheFormula)
