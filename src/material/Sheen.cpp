@@ -1,14 +1,13 @@
 #include "material/Sheen.h"
 
-#include "shared/SceneTypes.h"
-
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <numbers>
 
 namespace vkrt {
 
-double sheenAlpha(double roughness) { return std::max(roughness * roughness, double(gpu::MIN_SHEEN_ALPHA)); }
+double sheenAlpha(double roughness) { return std::max(roughness * roughness, kMinSheenAlpha); }
 
 double charlieDistribution(double cosH, double alpha)
 {
@@ -67,7 +66,7 @@ double sheenDirectionalAlbedo(double mu, double roughness)
 const std::vector<float>& sheenAlbedoTable()
 {
     static const std::vector<float> table = [] {
-        constexpr uint32_t side = gpu::SHEEN_TABLE_SIDE;
+        constexpr uint32_t side = kSheenTableSide;
         std::vector<float> entries(size_t(side) * side);
         for (uint32_t j = 0; j < side; ++j)
             for (uint32_t i = 0; i < side; ++i) {

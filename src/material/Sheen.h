@@ -7,7 +7,12 @@
 
 namespace vkrt {
 
-/// alpha_g = roughness^2, kept at or above gpu::MIN_SHEEN_ALPHA (the distribution divides by it).
+/// The table's side and the narrowest sheen, as shared/SceneTypes.h has them (SHEEN_TABLE_SIDE,
+/// MIN_SHEEN_ALPHA; src/render/GpuScene.cpp asserts that they agree: src/material includes nothing of vkrt).
+inline constexpr unsigned kSheenTableSide = 64;
+inline constexpr double kMinSheenAlpha = 1e-3;
+
+/// alpha_g = roughness^2, kept at or above kMinSheenAlpha (the distribution divides by it).
 double sheenAlpha(double roughness);
 
 /// The Charlie distribution D(h) at cos(theta_h) = cosH.
@@ -25,7 +30,7 @@ double sheenBrdf(double cosO, double cosI, double cosH, double alpha);
 /// table, once per process).
 double sheenDirectionalAlbedo(double mu, double roughness);
 
-/// The SHEEN_TABLE_SIDE^2 entries of the sheen table: E at roughness j / (side - 1) and
+/// The kSheenTableSide^2 entries of the sheen table: E at roughness j / (side - 1) and
 /// cosine (i / (side - 1))^2 (cosine 0 taken as 1e-4), entry j * side + i. Computed once, then cached.
 const std::vector<float>& sheenAlbedoTable();
 

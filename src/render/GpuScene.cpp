@@ -139,6 +139,9 @@ uint32_t appendCoatingTable(const Material& m, std::vector<float>& tables)
 }
 
 /// The plastics' coating data, once per scene (tens of milliseconds each).
+static_assert(kSheenTableSide == gpu::SHEEN_TABLE_SIDE && float(kMinSheenAlpha) == gpu::MIN_SHEEN_ALPHA,
+              "src/material/Sheen.h and shared/SceneTypes.h describe one sheen table");
+
 void prepareMaterialTables(const Scene& scene, GpuSceneStatic& fixed)
 {
     uint32_t sheenTable = gpu::NO_MATERIAL_TABLE; // one for every material with sheen
