@@ -603,20 +603,6 @@ void readHonouredExtensions(const fs::path& file, const json& material, FileMate
     readTextureTransform(file, member(material, "emissiveTexture"), "emissiveTexture", out.emissiveTexture);
     const json* extensions = member(material, "extensions");
     if (!extensions) return;
-    // The layers' textures (read in MaterialConverter::readLayers) take their transforms the same way.
-    const std::pair<const char*, std::vector<std::pair<const char*, std::optional<FileTexture>*>>> layers[] = {
-        {"KHR_materials_specular",
-         {{"specularTexture", &out.specularTexture}, {"specularColorTexture", &out.specularColorTexture}}},
-        {"KHR_materials_sheen",
-         {{"sheenColorTexture", &out.sheenColorTexture}, {"sheenRoughnessTexture", &out.sheenRoughnessTexture}}},
-        {"KHR_materials_clearcoat",
-         {{"clearcoatTexture", &out.clearcoatTexture},
-          {"clearcoatRoughnessTexture", &out.clearcoatRoughnessTexture},
-          {"clearcoatNormalTexture", &out.clearcoatNormalTexture}}},
-    };
-    for (const auto& [name, textures] : layers)
-        if (const json* e = member(*extensions, name))
-            for (const auto& [key, texture] : textures) readTextureTransform(file, member(*e, key), key, *texture);
     out.unlit = member(*extensions, "KHR_materials_unlit") != nullptr;
     if (const json* e = member(*extensions, "KHR_materials_emissive_strength"))
         out.emissiveFactor *= extensionNumber(file, *e, "KHR_materials_emissive_strength", "emissiveStrength", 1.0f,
@@ -807,20 +793,28 @@ struct MaterialReader {
         return out;
     }
 
-    /// KHR_materials_specular, _sheen and _clearcoat: their factors and textures.
+    /// The texture `key` of extension object `e`, with its KHR_texture_transform.
+    std::optional<FileTexture> layerTexture(const json& e, const char* key) const
+    {
+        std::optional<FileTexture> t = texture(member(e, key), key);
+        readTextureTransform(file, member(e, key), key, t);
+        return t;
+    }
+
+    /// KHR_materials_specular, _sheen, _volume and _clearcoat: their factors and textures.
     void readLayers(const json& extensions, FileMaterial& out) const
     {
         if (const json* e = member(extensions, "KHR_materials_specular")) {
             out.specularFactor = unitFactor(e, "specularFactor", out.specularFactor);
-            out.specularTexture = texture(member(*e, "specularTexture"), "specularTexture");
+            out.specularTexture = layerTexture(*e, "specularTexture");
             out.specularColorFactor = glm::vec3(colour(e, "specularColorFactor", glm::vec4(1.0f), 3, true));
-            out.specularColorTexture = texture(member(*e, "specularColorTexture"), "specularColorTexture");
+            out.specularColorTexture = layerTexture(*e, "specularColorTexture");
         }
         if (const json* e = member(extensions, "KHR_materials_sheen")) {
             out.sheenColorFactor = glm::vec3(colour(e, "sheenColorFactor", glm::vec4(0.0f), 3, false));
-            out.sheenColorTexture = texture(member(*e, "sheenColorTexture"), "sheenColorTexture");
+            out.sheenColorTexture = layerTexture(*e, "sheenColorTexture");
             out.sheenRoughnessFactor = unitFactor(e, "sheenRoughnessFactor", out.sheenRoughnessFactor);
-            out.sheenRoughnessTexture = texture(member(*e, "sheenRoughnessTexture"), "sheenRoughnessTexture");
+            out.sheenRoughnessTexture = layerTexture(*e, "sheenRoughnessTexture");
         }
         if (const json* e = member(extensions, "KHR_materials_volume")) {
             if (const json* t = member(*e, "thicknessFactor")) {
@@ -837,11 +831,11 @@ struct MaterialReader {
         }
         if (const json* e = member(extensions, "KHR_materials_clearcoat")) {
             out.clearcoatFactor = unitFactor(e, "clearcoatFactor", out.clearcoatFactor);
-            out.clearcoatTexture = texture(member(*e, "clearcoatTexture"), "clearcoatTexture");
+            out.clearcoatTexture = layerTexture(*e, "clearcoatTexture");
             out.clearcoatRoughnessFactor = unitFactor(e, "clearcoatRoughnessFactor", out.clearcoatRoughnessFactor);
             out.clearcoatRoughnessTexture =
-                texture(member(*e, "clearcoatRoughnessTexture"), "clearcoatRoughnessTexture");
-            out.clearcoatNormalTexture = texture(member(*e, "clearcoatNormalTexture"), "clearcoatNormalTexture");
+                layerTexture(*e, "clearcoatRoughnessTexture");
+            out.clearcoatNormalTexture = layerTexture(*e, "clearcoatNormalTexture");
         }
     }
 };
@@ -860,14 +854,6 @@ std::vector<const std::optional<FileTexture>*> FileMaterial::textureSlots() cons
             &emissiveTexture,       &specularTexture,          &specularColorTexture,
             &sheenColorTexture,     &sheenRoughnessTexture,    &clearcoatTexture,
             &clearcoatRoughnessTexture, &clearcoatNormalTexture};
-}
-
-std::vector<std::optional<FileTexture>*> FileMaterial::textureSlots()
-{
-    std::vector<std::optional<FileTexture>*> slots;
-    for (const std::optional<FileTexture>* slot : std::as_const(*this).textureSlots())
-        slots.push_back(const_cast<std::optional<FileTexture>*>(slot));
-    return slots;
 }
 
 std::vector<uint8_t> decodeBase64(std::string_view text)

@@ -100,7 +100,6 @@ struct FileMaterial {
     glm::vec3 attenuationColor{1.0f};
     /// Every texture slot above, in one list (for what reads every texture: uv sets, transforms).
     std::vector<const std::optional<FileTexture>*> textureSlots() const;
-    std::vector<std::optional<FileTexture>*> textureSlots();
     std::vector<std::string> unsupported; ///< what vkrt will not honour, one readable phrase each
 };
 

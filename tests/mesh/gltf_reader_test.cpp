@@ -250,7 +250,8 @@ TEST(GltfReader, PbrExtensionLayersAreReadWithTheirTextures)
           "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [2, 1, 0.5],
                                      "specularTexture": {"index": 0}, "specularColorTexture": {"index": 0}},
           "KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.4, 0.2], "sheenRoughnessFactor": 0.6,
-                                  "sheenColorTexture": {"index": 0, "texCoord": 1}},
+                                  "sheenColorTexture": {"index": 0, "texCoord": 1, "extensions":
+                                      {"KHR_texture_transform": {"scale": [2, 3]}}}},
           "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.1,
                                       "clearcoatRoughnessTexture": {"index": 0},
                                       "clearcoatNormalTexture": {"index": 0}}}}])");
@@ -270,6 +271,7 @@ TEST(GltfReader, PbrExtensionLayersAreReadWithTheirTextures)
     EXPECT_EQ(m.sheenRoughnessFactor, 0.6f);
     ASSERT_TRUE(m.sheenColorTexture);
     EXPECT_EQ(m.sheenColorTexture->texCoord, 1u);
+    EXPECT_EQ(m.sheenColorTexture->scale, glm::dvec2(2.0, 3.0)) << "a layer texture's KHR_texture_transform";
     EXPECT_FALSE(model.meshes.at(0).uvs1.empty()) << "the sheen texture reads TEXCOORD_1";
     EXPECT_EQ(m.clearcoatFactor, 1.0f);
     EXPECT_EQ(m.clearcoatRoughnessFactor, 0.1f);
