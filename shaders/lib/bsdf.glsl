@@ -51,6 +51,29 @@ bool scattersIntoDeltasOnly(Material m)
 
 BsdfSample noScatter() { return BsdfSample(vec3(0.0, 0.0, 1.0), vec3(0.0), false, false); }
 
+// The materials whose surfaces bound a medium (lib/media.glsl): a sample
+// they transmit enters or leaves it. A thin-walled pbr surface transmits
+// into no medium.
+bool boundsMedium(Material m)
+{
+#ifdef VKRT_PBR_TRANSMISSION
+    if (m.type == MATERIAL_PBR)
+        return (m.pbrFlags & PBR_FLAG_VOLUME) != 0u;
+#endif
+    return true;
+}
+
+// The rough interfaces' eval and pdf need the crossing's eta = n_i / n_t,
+// which only the integrator knows: it stores it in m.exponent.
+#if defined(VKRT_MATERIAL_ROUGH_DIELECTRIC) || defined(VKRT_PBR_TRANSMISSION)
+Material withInterfaceEta(Material m, float eta)
+{
+    if (m.type == MATERIAL_ROUGH_DIELECTRIC || m.type == MATERIAL_PBR)
+        m.exponent = eta;
+    return m;
+}
+#endif
+
 #define VKRT_ABSENT_MATERIAL(Type)                                                                  \
     vec3 eval##Type(Material m, vec3 n, vec3 wo, vec3 wi) { return vec3(0.0); }                     \
     float pdf##Type(Material m, vec3 n, vec3 wo, vec3 wi, float cosI) { return 0.0; }              \
@@ -272,13 +295,6 @@ VKRT_ABSENT_MATERIAL(Conductor)
 // integrator knows: it stores it in m.exponent (withInterfaceEta).
 
 #ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
-Material withInterfaceEta(Material m, float eta)
-{
-    if (m.type == MATERIAL_ROUGH_DIELECTRIC)
-        m.exponent = eta;
-    return m;
-}
-
 vec3 evalRoughDielectric(Material m, vec3 n, vec3 wo, vec3 wi)
 {
     LocalFrame f = frameAround(n);
@@ -439,12 +455,37 @@ VKRT_ABSENT_MATERIAL(Plastic)
 
 float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
-// The dielectric's Fresnel (KHR_materials_specular with KHR_materials_ior) at cosine c.
+#ifdef VKRT_PBR_TRANSMISSION
+bool pbrVolumetric(Material m) { return (m.pbrFlags & PBR_FLAG_VOLUME) != 0u; }
+// n_i / n_t across the surface: the integrator's at a volume's boundary
+// (withInterfaceEta), from air into the material's index otherwise.
+float pbrEta(Material m) { return pbrVolumetric(m) ? m.exponent : 1.0 / m.ior; }
+float pbrTransmission(Material m) { return m.transmission; }
+#else
+float pbrEta(Material m) { return 1.0 / m.ior; }
+float pbrTransmission(Material m) { return 0.0; }
+#endif
+
+// The dielectric's Fresnel (KHR_materials_specular with KHR_materials_ior) at
+// cosine c between wo and the microfacet normal, crossing from index n_i to
+// n_t (eta = n_i / n_t; from air, 1 / ior). The specification writes it from
+// outside, with F0 of ((ior - 1) / (ior + 1))^2; a ray inside a volume meets
+// the same interface, so Schlick's form takes the cosine on the side of the
+// lower index (the same pair of angles seen from either side), and past the
+// critical angle all is reflected.
 vec3 pbrDielectricFresnel(Material m, float c)
 {
-    float r = (m.ior - 1.0) / (m.ior + 1.0);
+    float eta = pbrEta(m);
+    c = clamp(c, 0.0, 1.0);
+    if (eta > 1.0) {
+        float sin2t = eta * eta * (1.0 - c * c);
+        if (sin2t >= 1.0)
+            return vec3(1.0);
+        c = sqrt(1.0 - sin2t);
+    }
+    float r = (1.0 - eta) / (1.0 + eta);
     vec3 f0 = min(r * r * m.specular, vec3(1.0)) * m.specularFactor;
-    return f0 + (vec3(m.specularFactor) - f0) * pow5(1.0 - clamp(c, 0.0, 1.0));
+    return f0 + (vec3(m.specularFactor) - f0) * pow5(1.0 - c);
 }
 
 // The Charlie sheen (Estevez and Kulla 2017, the form KHR_materials_sheen
@@ -500,6 +541,22 @@ float pbrCoatWeight(Material m, float cosO)
     return m.clearcoat * (0.04 + 0.96 * pow5(1.0 - clamp(cosO, 0.0, 1.0)));
 }
 
+// What the sheen leaves of the layers below it between cosines cosO and cosI
+// (both of the sheen's side). The extension's visibility fit puts E above 1
+// for smooth sheen near grazing (roughness <= 0.25, cosines below ~0.05): the
+// base then keeps nothing there, never a negative share.
+float sheenScaling(Material m, float cosO, float cosI)
+{
+    if (!(max3(m.sheenColor) > 0.0))
+        return 1.0;
+    float strength = max3(m.sheenColor);
+    return max(min(1.0 - strength * sheenAlbedo(m, cosO), 1.0 - strength * sheenAlbedo(m, cosI)), 0.0);
+}
+
+// f(wo, wi) of the reflection lobes. Transmission (KHR_materials_transmission)
+// takes its share of the dielectric's diffuse lobe: the specification's
+// mix(diffuse, baseColor x the specular BTDF, transmission) below the
+// dielectric's Fresnel; its BTDF is only ever sampled (samplePbr).
 vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
 {
     LocalFrame f = frameAround(n);
@@ -507,17 +564,11 @@ vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
     vec3 h = normalize(lo + li);
     float s = ggxSpecularCorrelated(lo, li, h, ggxAlpha(m));
     vec3 fd = pbrDielectricFresnel(m, dot(lo, h));
-    vec3 dielectric = fd * s + (1.0 - max3(fd)) * m.diffuse * INV_PI;
+    vec3 dielectric = fd * s + (1.0 - max3(fd)) * (1.0 - pbrTransmission(m)) * m.diffuse * INV_PI;
     vec3 fm = m.diffuse + (vec3(1.0) - m.diffuse) * pow5(1.0 - clamp(dot(lo, h), 0.0, 1.0));
     vec3 value = mix(dielectric, fm * s, m.metallic);
-    if (max3(m.sheenColor) > 0.0) {
-        float strength = max3(m.sheenColor);
-        // The extension's visibility fit puts E above 1 for smooth sheen near
-        // grazing (roughness <= 0.25, cosines below ~0.05): the base then
-        // keeps nothing there, never a negative share.
-        float scaling = min(1.0 - strength * sheenAlbedo(m, lo.z), 1.0 - strength * sheenAlbedo(m, li.z));
-        value = m.sheenColor * sheenBrdf(lo, li, h, sheenAlpha(m)) + value * max(scaling, 0.0);
-    }
+    if (max3(m.sheenColor) > 0.0)
+        value = m.sheenColor * sheenBrdf(lo, li, h, sheenAlpha(m)) + value * sheenScaling(m, lo.z, li.z);
     if (m.clearcoat > 0.0) {
         float coat = pbrCoatWeight(m, lo.z);
         value = (1.0 - coat) * value + coat * ggxSpecularCorrelated(lo, li, h, vec2(m.clearcoatAlpha));
@@ -525,24 +576,28 @@ vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
     return value;
 }
 
-// The lobe probabilities seen from cosO: (coat, base GGX, cosine), summing to 1.
-vec3 pbrLobeProbabilities(Material m, float cosO)
+// The lobe probabilities seen from cosO, summing to 1: x the coat, y the
+// base's GGX reflection, z the cosine lobe (diffuse and sheen), w transmission.
+vec4 pbrLobeProbabilities(Material m, float cosO)
 {
     float coat = m.clearcoat > 0.0 ? pbrCoatWeight(m, cosO) : 0.0;
     float fd = max3(pbrDielectricFresnel(m, cosO));
     float specular = m.metallic + (1.0 - m.metallic) * fd;
-    float diffuse = (1.0 - m.metallic) * (1.0 - fd) * luminance(m.diffuse);
+    float below = (1.0 - m.metallic) * (1.0 - fd) * luminance(m.diffuse);
+    float transmitted = below * pbrTransmission(m);
     float sheen = max3(m.sheenColor) > 0.0 ? max3(m.sheenColor) * sheenAlbedo(m, cosO) : 0.0;
-    float base = specular + diffuse + sheen;
-    float ps = base > 0.0 ? specular / base : 1.0;
-    return vec3(coat, (1.0 - coat) * ps, (1.0 - coat) * (1.0 - ps));
+    float cosine = below - transmitted + sheen;
+    float base = specular + cosine + transmitted;
+    if (!(base > 0.0))
+        return vec4(coat, 1.0 - coat, 0.0, 0.0);
+    return vec4(coat, (1.0 - coat) / base * vec3(specular, cosine, transmitted));
 }
 
 float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
 {
     LocalFrame f = frameAround(n);
     vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
-    vec3 p = pbrLobeProbabilities(m, lo.z);
+    vec4 p = pbrLobeProbabilities(m, lo.z);
     vec3 h = normalize(lo + li);
     float pdf = p.y * ggxReflectionPdf(lo, h, ggxAlpha(m)) + p.z * li.z * INV_PI;
     if (p.x > 0.0)
@@ -550,18 +605,49 @@ float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
     return pdf;
 }
 
+#ifdef VKRT_PBR_TRANSMISSION
+// The transmission lobe, sampled with probability `chosen` from the base's
+// visible normals: baseColor x (1 - max3(Fd(wo.h))) x the GGX BTDF, under the
+// sheen's scaling and the coat's (1 - clearcoat Fc). Its weight f |cosI| / pdf
+// is that product times G2(wo, wi) / G1(wo) (height-correlated, as the
+// reflection's). Across a volume's boundary wi refracts about h by eta (the
+// integrator scales radiance by eta^2 and tracks the medium); a thin-walled
+// surface passes the reflected direction mirrored through its plane, the
+// specification's unrefracted thin-walled BTDF. Marked specular, as a rough
+// dielectric's refraction: no light sample competes for it.
+BsdfSample samplePbrTransmission(Material m, LocalFrame f, vec3 lo, float eta, float chosen, vec2 u)
+{
+    vec2 alpha = ggxAlpha(m);
+    vec3 h = sampleGgxVisibleNormal(lo, alpha, u);
+    // Refraction's zero vector (total internal reflection) and a reflection
+    // below the surface both fail the test.
+    vec3 li = pbrVolumetric(m) ? refractDirection(lo, h, eta) : reflect(-lo, h) * vec3(1.0, 1.0, -1.0);
+    if (!(li.z < 0.0))
+        return noScatter();
+    float lambdaO = ggxLambdaOf(lo, alpha);
+    float shadowing = (1.0 + lambdaO) / (1.0 + lambdaO + ggxLambdaOf(-li, alpha));
+    float layers = (1.0 - m.metallic) * m.transmission * (1.0 - max3(pbrDielectricFresnel(m, dot(lo, h))));
+    layers *= sheenScaling(m, lo.z, -li.z) * (1.0 - (m.clearcoat > 0.0 ? pbrCoatWeight(m, lo.z) : 0.0));
+    return BsdfSample(fromFrame(f, li), m.diffuse * (layers * shadowing / chosen), true, true);
+}
+#endif
+
 BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
     LocalFrame f = frameAround(n);
     vec3 lo = toFrame(f, wo);
     if (lo.z <= 0.0)
         return noScatter();
-    vec3 p = pbrLobeProbabilities(m, lo.z);
+    vec4 p = pbrLobeProbabilities(m, lo.z);
     vec3 li;
     if (u.z < p.x)
         li = reflect(-lo, sampleGgxVisibleNormal(lo, vec2(m.clearcoatAlpha), u.xy));
     else if (u.z < p.x + p.y)
         li = reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy));
+#ifdef VKRT_PBR_TRANSMISSION
+    else if (u.z >= p.x + p.y + p.z && p.w > 0.0)
+        return samplePbrTransmission(m, f, lo, eta, p.w, u.xy);
+#endif
     else
         li = toFrame(f, sampleCosineHemisphere(n, u.xy));
     if (li.z <= 0.0)

@@ -161,6 +161,12 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
         } else if (k == TEXTURE_SLOT_CLEARCOAT_ROUGHNESS) {
             float r = channelOf(texel, slot.channel);
             m.clearcoatAlpha = max(m.clearcoatAlpha * r * r, MIN_GGX_ALPHA);
+        } else if (k == TEXTURE_SLOT_TRANSMISSION) {
+            m.transmission *= channelOf(texel, slot.channel);
+        } else if (k == TEXTURE_SLOT_IRIDESCENCE) {
+            m.iridescence *= channelOf(texel, slot.channel);
+        } else if (k == TEXTURE_SLOT_IRIDESCENCE_THICKNESS) {
+            m.iridescenceThickness = mix(m.iridescenceThicknessMin, m.iridescenceThickness, channelOf(texel, slot.channel));
         }
 #endif
 #ifdef VKRT_HAS_NORMAL_MAPS

@@ -25,7 +25,7 @@ MediumStack cameraMedia()
     return MediumStack(min(u.cameraMediumCount, MEDIUM_STACK_DEPTH), u.cameraMedia, vec2(1.0));
 }
 
-#if defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_MATERIAL_ROUGH_DIELECTRIC)
+#if defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_MATERIAL_ROUGH_DIELECTRIC) || defined(VKRT_PBR_TRANSMISSION)
 float mediumIor(MediumStack s) { return s.count == 0u ? 1.0 : materials[s.materials[s.count - 1u]].ior; }
 
 vec3 mediumAbsorption(MediumStack s)
@@ -132,7 +132,7 @@ float radianceScale(MediumStack s)
     return ratio * ratio;
 }
 #else
-// Without dielectrics a ray is always in air.
+// Without dielectrics or volumetric pbr materials a ray is always in air.
 vec3 mediumAbsorption(MediumStack s) { return vec3(0.0); }
 MediumStack crossInterface(MediumStack s, uint material, bool entering) { return s; }
 MediumStack mediaAtSurface(MediumStack s, SurfaceHit hit) { return s; }

@@ -108,7 +108,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     vec3 n = hit.front ? hit.normal : -hit.normal;
     vec3 ns = shadingSide(hit, n);
     vec3 wo = -p.ray.dir;
-#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
+#if defined(VKRT_MATERIAL_ROUGH_DIELECTRIC) || defined(VKRT_PBR_TRANSMISSION)
     m = withInterfaceEta(m, surfaceEta(p.path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
     aovScatter(m, ns);
@@ -124,7 +124,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     p.path.throughput *= s.weight;
     p.path.specular = s.specular;
     p.path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
-    if (s.transmitted)
+    if (s.transmitted && boundsMedium(m))
         p.path.media = refractThrough(p.path.media, hit);
     if (!survivesRoulette(p.path, p.depth, u4.w))
         return false;

@@ -81,7 +81,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         vec3 n = hit.front ? hit.normal : -hit.normal;
         vec3 ns = shadingSide(hit, n);
         vec3 wo = -ray.dir;
-#ifdef VKRT_MATERIAL_ROUGH_DIELECTRIC
+#if defined(VKRT_MATERIAL_ROUGH_DIELECTRIC) || defined(VKRT_PBR_TRANSMISSION)
         m = withInterfaceEta(m, surfaceEta(path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
         aovScatter(m, ns);
@@ -105,7 +105,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         path.specular = s.specular;
         path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
 #endif
-        if (s.transmitted)
+        if (s.transmitted && boundsMedium(m))
             path.media = crossInterface(path.media, hit.material, hit.front);
         ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);
 #endif

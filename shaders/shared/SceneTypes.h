@@ -45,7 +45,9 @@ VKRT_CONSTANT(float, MIN_SHEEN_ALPHA, 1e-3)
 //   pbr: diffuse (base colour), metallic, alphaX = alphaY; with the glTF
 //        extension layers (variants with VKRT_PBR_LAYERS) also specular
 //        (KHR_materials_specular's colour), specularFactor, ior, sheenColor,
-//        sheenRoughness, clearcoat, clearcoatAlpha, table (the sheen table).
+//        sheenRoughness, clearcoat, clearcoatAlpha, table (the sheen table),
+//        transmission, pbrFlags, absorption (inside a volumetric one) and the
+//        iridescence members.
 // alpha is the GGX width (perceptual roughness squared), never below
 // MIN_GGX_ALPHA where it is used.
 struct Material {
@@ -69,7 +71,21 @@ struct Material {
     float specularFactor;      // pbr: KHR_materials_specular's strength (dielectric F90; scales F0)
     float clearcoat;           // pbr: KHR_materials_clearcoat's factor (0: no coat)
     float clearcoatAlpha;      // pbr: the coat's GGX alpha, clearcoatRoughness^2 (>= MIN_GGX_ALPHA)
+    float transmission;        // pbr: KHR_materials_transmission's factor (0: opaque; variants with VKRT_PBR_TRANSMISSION)
+    uint pbrFlags;             // pbr: PBR_FLAG_* below
+    float iridescence;         // pbr: KHR_materials_iridescence's factor (0: none; variants with VKRT_PBR_IRIDESCENCE)
+    float iridescenceIor;      // pbr: the thin film's index
+    float iridescenceThicknessMin; // pbr: the film's thickness in nm where its thickness texture reads 0
+    float iridescenceThickness;    // pbr: ... where it reads 1, and the thickness without a texture
 };
+
+// Material::pbrFlags
+// A transmitting pbr material whose mesh bounds a volume (KHR_materials_volume
+// of thickness > 0): transmitted light refracts by `ior` into a medium that
+// absorbs by `absorption`, as a rough dielectric's does. Without the flag
+// transmission is thin-walled: light passes unrefracted (the reflection lobe
+// mirrored through the surface) and enters no medium.
+VKRT_CONSTANT(uint, PBR_FLAG_VOLUME, 1)
 
 // The narrowest GGX lobe a rough material gets: narrower ones lose float
 // precision in D and the visible-normal sampler (roughness 0 selects the
@@ -287,7 +303,7 @@ VKRT_CONSTANT(uint, RENDER_FLAG_ORTHOGRAPHIC, 2)
 // maxUniformBufferRange Vulkan allows; src/gpu/SharedTypes.cpp checks the
 // sizes. Bigger scenes use the storage-buffer variant. The shape and light
 // arrays' capacities (UNIFORM_SPHERES, ...) are in the registry, shared/Kinds.h.
-VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 128) // 16384 / 128
+VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 107) // 16384 / 152
 
 // One record count per shape and light array, in registry order:
 // sphereCount, boxCount, triangleCount, planeCount, pointLightCount, ...

@@ -93,10 +93,14 @@ VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_COLOR, 5)         // KHR_materials_sheen 
 VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_ROUGHNESS, 6)     // sheenRoughnessTexture (A)
 VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT, 7)           // KHR_materials_clearcoat clearcoatTexture (R)
 VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, 8) // clearcoatRoughnessTexture (G): alpha scales by texel^2
-VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 9)    // tangent-space normal map (rgb = (n + 1) / 2)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 10) // emitted radiance (glTF emissiveTexture, sRGB): read by the
+VKRT_CONSTANT(uint, TEXTURE_SLOT_TRANSMISSION, 9)        // KHR_materials_transmission transmissionTexture (R)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE, 10)         // KHR_materials_iridescence iridescenceTexture (R)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE_THICKNESS, 11) // iridescenceThicknessTexture (G): mixes the
+                                                            // thickness from its minimum (0) to its maximum (1)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 12)   // tangent-space normal map (rgb = (n + 1) / 2)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 13) // emitted radiance (glTF emissiveTexture, sRGB): read by the
                                                // emitters (lib/emitters.glsl), not by texturedMaterial
-VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 11)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 14)
 
 /// The textures of one material (one per Material, same index).
 struct MaterialTextures {

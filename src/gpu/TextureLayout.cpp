@@ -20,6 +20,6 @@ static_assert(sizeof(MaterialTextures) == 36 * TEXTURE_SLOT_COUNT + 4);
 static_assert(TEXTURE_SLOT_EMISSION == TEXTURE_SLOT_NORMAL + 1 && TEXTURE_SLOT_COUNT == TEXTURE_SLOT_EMISSION + 1);
 // ... and the pbr layers' slots in one run between the base's and the normal map's.
 static_assert(TEXTURE_SLOT_SPECULAR_FACTOR == TEXTURE_SLOT_METALLIC + 1 &&
-              TEXTURE_SLOT_CLEARCOAT_ROUGHNESS + 1 == TEXTURE_SLOT_NORMAL);
+              TEXTURE_SLOT_IRIDESCENCE_THICKNESS + 1 == TEXTURE_SLOT_NORMAL);
 
 } // namespace vkrt::gpu

@@ -167,10 +167,6 @@ void listTextureProblems(const json& material, std::vector<std::string>& out)
 std::vector<std::string> materialProblems(const json& material)
 {
     std::vector<std::string> out;
-    if (const json* extensions = member(material, "extensions"))
-        if (const json* transmission = member(*extensions, "KHR_materials_transmission"))
-            if (member(*transmission, "transmissionTexture"))
-                out.push_back("KHR_materials_transmission's transmissionTexture: not applied (its factor is)");
     listTextureProblems(material, out);
     return out;
 }
@@ -653,6 +649,17 @@ struct MaterialReader {
         return float(value->get<double>());
     }
 
+    /// A number of `owner` at least `low`, finite in 32-bit floats (`name` names it in messages).
+    float numberAtLeast(const json& owner, const char* key, const char* name, float low, float fallback) const
+    {
+        const json* value = member(owner, key);
+        if (!value) return fallback;
+        if (!value->is_number() || !(value->get<double>() >= low) ||
+            !(value->get<double>() <= std::numeric_limits<float>::max()))
+            malformed(std::string(name) + "." + key + " must be a finite number >= " + std::to_string(low));
+        return float(value->get<double>());
+    }
+
     glm::vec4 colour(const json* owner, const char* key, glm::vec4 fallback, size_t size, bool unbounded) const
     {
         const json* value = owner ? member(*owner, key) : nullptr;
@@ -829,6 +836,19 @@ struct MaterialReader {
             }
             out.attenuationColor = glm::vec3(colour(e, "attenuationColor", glm::vec4(1.0f), 3, false));
         }
+        if (const json* e = member(extensions, "KHR_materials_transmission"))
+            out.transmissionTexture = layerTexture(*e, "transmissionTexture");
+        if (const json* e = member(extensions, "KHR_materials_iridescence")) {
+            out.iridescenceFactor = unitFactor(e, "iridescenceFactor", out.iridescenceFactor);
+            out.iridescenceTexture = layerTexture(*e, "iridescenceTexture");
+            const char* name = "KHR_materials_iridescence";
+            out.iridescenceIor = numberAtLeast(*e, "iridescenceIor", name, 1.0f, out.iridescenceIor);
+            out.iridescenceThicknessMinimum =
+                numberAtLeast(*e, "iridescenceThicknessMinimum", name, 0.0f, out.iridescenceThicknessMinimum);
+            out.iridescenceThicknessMaximum =
+                numberAtLeast(*e, "iridescenceThicknessMaximum", name, 0.0f, out.iridescenceThicknessMaximum);
+            out.iridescenceThicknessTexture = layerTexture(*e, "iridescenceThicknessTexture");
+        }
         if (const json* e = member(extensions, "KHR_materials_clearcoat")) {
             out.clearcoatFactor = unitFactor(e, "clearcoatFactor", out.clearcoatFactor);
             out.clearcoatTexture = layerTexture(*e, "clearcoatTexture");
@@ -853,7 +873,8 @@ std::vector<const std::optional<FileTexture>*> FileMaterial::textureSlots() cons
     return {&baseColorTexture,      &metallicRoughnessTexture, &normalTexture,
             &emissiveTexture,       &specularTexture,          &specularColorTexture,
             &sheenColorTexture,     &sheenRoughnessTexture,    &clearcoatTexture,
-            &clearcoatRoughnessTexture, &clearcoatNormalTexture};
+            &clearcoatRoughnessTexture, &clearcoatNormalTexture, &transmissionTexture,
+            &iridescenceTexture,    &iridescenceThicknessTexture};
 }
 
 std::vector<uint8_t> decodeBase64(std::string_view text)

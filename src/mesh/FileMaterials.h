@@ -11,13 +11,11 @@
 // its scale, emissiveFactor/Texture, doubleSided, the samplers' wrap modes and
 // filters (an undefined filter is vkrt's default: bilinear magnification,
 // trilinear minification over vkrt's own mip maps),
-// KHR_materials_emissive_strength, KHR_materials_transmission's factor,
-// KHR_materials_ior (scene/FileMaterialImport.cpp makes glass of them) and
-// KHR_texture_transform on TEXCOORD_0 (a normal map's tangent frame is not
-// turned with its uvs).
-// Listed in `unsupported`: every extension the material or its textures use
-// (KHR_texture_transform, KHR_materials_*, ...), extensions the file uses
-// outside its materials, textures read through a TEXCOORD other than 0.
+// KHR_materials_emissive_strength, _ior, _specular, _sheen, _clearcoat,
+// _transmission, _volume and _iridescence (the pbr material's layers:
+// scene/FileMaterialImport.cpp), and KHR_texture_transform on every texture
+// (a normal map's tangent frame is not turned with its uvs).
+// Listed in `unsupported`: extensions on a texture other than KHR_texture_transform.
 // alphaMode and alphaCutoff are read (MASK and BLEND are honoured: alpha is
 // baseColorFactor.a times the base colour texture's A). Not listed, documented here:
 // occlusionTexture, which a path tracer has no use for (it computes the
@@ -72,9 +70,10 @@ struct FileMaterial {
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f; ///< for MASK
     bool doubleSided = false;
-    /// KHR_materials_transmission's transmissionFactor and KHR_materials_ior's
-    /// ior (glTF's defaults 0 and 1.5): a transmitting material is glass.
+    /// KHR_materials_transmission's transmissionFactor (R of its texture) and
+    /// KHR_materials_ior's ior (glTF's defaults 0 and 1.5).
     float transmission = 0.0f;
+    std::optional<FileTexture> transmissionTexture;
     float ior = 1.5f;
     /// KHR_materials_unlit: the base colour is what the camera sees, no lighting.
     bool unlit = false;
@@ -94,6 +93,14 @@ struct FileMaterial {
     float clearcoatRoughnessFactor = 0.0f;
     std::optional<FileTexture> clearcoatRoughnessTexture;
     std::optional<FileTexture> clearcoatNormalTexture;
+    /// KHR_materials_iridescence: strength (R of its texture), the film's index and its thickness in nm
+    /// (the maximum, or mixed from the minimum by G of its texture).
+    float iridescenceFactor = 0.0f;
+    std::optional<FileTexture> iridescenceTexture;
+    float iridescenceIor = 1.3f;
+    float iridescenceThicknessMinimum = 100.0f;
+    float iridescenceThicknessMaximum = 400.0f;
+    std::optional<FileTexture> iridescenceThicknessTexture;
     /// KHR_materials_volume: thickness (0: thin-walled) and Beer-Lambert attenuation (world units).
     float thicknessFactor = 0.0f;
     float attenuationDistance = std::numeric_limits<float>::infinity();

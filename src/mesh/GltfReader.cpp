@@ -896,9 +896,9 @@ const std::vector<std::string>& implementedGltfExtensions()
         "KHR_lights_punctual",        "KHR_texture_transform", "KHR_materials_emissive_strength",
         "KHR_materials_ior",          "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
         "KHR_materials_unlit",        "KHR_materials_variants",
-        "KHR_materials_transmission", // read as glass or not, each approximation warned (docs/scene-format.md)
-        "KHR_materials_specular",     "KHR_materials_sheen",   "KHR_materials_clearcoat",
-        "KHR_materials_volume", // its attenuation, inside glass (the thickness only decides thin or not)
+        "KHR_materials_transmission", "KHR_materials_specular", "KHR_materials_sheen",
+        "KHR_materials_clearcoat",    "KHR_materials_iridescence",
+        "KHR_materials_volume", // its attenuation (the thickness only decides thin-walled or not)
     };
     return names;
 }

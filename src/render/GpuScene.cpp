@@ -124,6 +124,13 @@ gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t
         g.clearcoat = float(m.layers.clearcoat);
         g.clearcoatAlpha =
             float(std::max(m.layers.clearcoatRoughness * m.layers.clearcoatRoughness, double(gpu::MIN_GGX_ALPHA)));
+        g.transmission = float(m.layers.transmission);
+        g.pbrFlags = m.layers.volumetric() ? gpu::PBR_FLAG_VOLUME : 0u;
+        if (!m.layers.volumetric()) g.absorption = glm::vec3(0.0f); // only a volume absorbs
+        g.iridescence = float(m.layers.iridescence);
+        g.iridescenceIor = float(m.layers.iridescenceIor);
+        g.iridescenceThicknessMin = float(m.layers.iridescenceThicknessMin);
+        g.iridescenceThickness = float(m.layers.iridescenceThicknessMax);
     }
     return g;
 }

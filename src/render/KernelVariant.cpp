@@ -67,7 +67,10 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({meshes && f.alpha, "VKRT_HAS_ALPHA", int(gpu::BINDING_MATERIAL_ALPHA), "alpha"});
     // The rough plastics' coating tables come with the plastic kind.
     // The glTF extension layers of pbr materials (their sheen table is a material table too).
-    list.push_back({f.has(MaterialType::Pbr) && f.pbrLayers, "VKRT_PBR_LAYERS", -1, "pbr-layers"});
+    const bool pbrLayers = f.has(MaterialType::Pbr) && f.pbrLayers;
+    list.push_back({pbrLayers, "VKRT_PBR_LAYERS", -1, "pbr-layers"});
+    list.push_back({pbrLayers && f.pbrTransmission, "VKRT_PBR_TRANSMISSION", -1, "pbr-transmission"});
+    list.push_back({pbrLayers && f.pbrIridescence, "VKRT_PBR_IRIDESCENCE", -1, "pbr-iridescence"});
     list.push_back({f.has(MaterialType::Plastic) || (f.has(MaterialType::Pbr) && f.pbrLayers),
                     "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});

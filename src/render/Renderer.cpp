@@ -33,7 +33,7 @@ void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation
 }
 
 /// The uber kernel's features: every feature, except that the glTF alpha
-/// test, emission textures, second uv set and pbr layers come only with a scene that uses them. Measured
+/// test, emission textures, second uv set and pbr layers (transmission, iridescence) come only with a scene that uses them. Measured
 /// on Mesa 26.1's lavapipe (LLVM 19.1): an uber kernel with either, rendering
 /// a scene without them, crashed the driver (SIGSEGV in the dispatch; Mesa
 /// 25.0 ran it), while their own variants render right on both. Until the
@@ -46,6 +46,8 @@ FeatureSet uberFeatures(const Scene& scene)
     features.emissionTextures = own.emissionTextures;
     features.secondUvs = own.secondUvs;
     features.pbrLayers = own.pbrLayers;
+    features.pbrTransmission = own.pbrTransmission;
+    features.pbrIridescence = own.pbrIridescence;
     return features;
 }
 

@@ -43,6 +43,8 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.vertexColors = true;
     all.secondUvs = true;
     all.pbrLayers = true;
+    all.pbrTransmission = true;
+    all.pbrIridescence = true;
     all.thinLens = true;
     all.orthographic = true;
     all.alpha = true;
@@ -63,6 +65,8 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
         set.normalMaps = set.normalMaps || material.hasNormalMap();
         set.secondUvs = set.secondUvs || material.readsUvSet(1);
         set.pbrLayers = set.pbrLayers || material.hasPbrLayers();
+        set.pbrTransmission = set.pbrTransmission || material.pbrTransmits();
+        set.pbrIridescence = set.pbrIridescence || material.pbrIridescent();
     };
 #define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     for (const auto& shape : scene.array) markUsed(shape.material);

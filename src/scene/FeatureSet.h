@@ -25,6 +25,8 @@ struct FeatureSet {
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     bool vertexColors = false;        ///< ... and its file's vertex colours (glTF COLOR_0)
     bool pbrLayers = false;           ///< some pbr material has a glTF extension layer (Material::hasPbrLayers)
+    bool pbrTransmission = false;     ///< ... transmission (Material::pbrTransmits)
+    bool pbrIridescence = false;      ///< ... iridescence (Material::pbrIridescent)
     bool secondUvs = false;           ///< some material in use reads a mesh's second uv set (glTF TEXCOORD_1)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
     bool orthographic = false;        ///< the camera projects orthographically (parallel rays)

@@ -44,7 +44,19 @@ std::string displayName(const FileMaterial& f, size_t index)
     return f.fileIndex < 0 ? "default material" : "material " + std::to_string(index);
 }
 
-/// KHR_materials_ior, _specular, _sheen and _clearcoat as the pbr material's
+/// KHR_materials_volume's Beer-Lambert coefficient per world unit, -ln(attenuationColor) /
+/// attenuationDistance, inside a volumetric (thickness > 0) material; 0 for a thin-walled one or
+/// without attenuation. A colour component of 0 absorbs as one of 1e-9 does (opaque within a few
+/// attenuation distances) rather than infinitely.
+Color volumeAbsorption(const FileMaterial& f)
+{
+    if (!(f.thicknessFactor > 0.0f) || !std::isfinite(f.attenuationDistance)) return Color(0.0);
+    Color sigma;
+    for (int c = 0; c < 3; ++c) sigma[c] = -std::log(std::max(double(f.attenuationColor[c]), 1e-9)) / f.attenuationDistance;
+    return sigma;
+}
+
+/// KHR_materials_ior, _specular, _sheen, _clearcoat, _transmission, _volume and _iridescence as the pbr material's
 /// layers: factors as constants, each texture's channel as the extension says
 /// (sRGB colours, strengths in A, the coat in R and its roughness in G).
 void addLayers(const FileMaterial& f, const std::filesystem::path& file, const SourceLocation& where,
@@ -57,6 +69,15 @@ void addLayers(const FileMaterial& f, const std::filesystem::path& file, const S
     m.layers.sheenRoughness = f.sheenRoughnessFactor;
     m.layers.clearcoat = f.clearcoatFactor;
     m.layers.clearcoatRoughness = f.clearcoatRoughnessFactor;
+    m.layers.transmission = f.transmission;
+    // A path tracer has the mesh itself: thicknessFactor (and its texture, for
+    // rasterizers) only says whether the surface bounds a volume.
+    m.layers.thinWalled = !(f.thicknessFactor > 0.0f);
+    if (m.layers.volumetric()) m.absorption = volumeAbsorption(f);
+    m.layers.iridescence = f.iridescenceFactor;
+    m.layers.iridescenceIor = f.iridescenceIor;
+    m.layers.iridescenceThicknessMin = f.iridescenceThicknessMinimum;
+    m.layers.iridescenceThicknessMax = f.iridescenceThicknessMaximum;
     auto add = [&](const std::optional<FileTexture>& texture, bool linear, TextureSlot which, uint32_t channel) {
         if (texture) m.textures[size_t(which)] = slot(addFileTexture(*texture, linear, file, where, atlas), *texture, channel);
     };
@@ -66,6 +87,9 @@ void addLayers(const FileMaterial& f, const std::filesystem::path& file, const S
     add(f.sheenRoughnessTexture, true, TextureSlot::SheenRoughness, 3);
     add(f.clearcoatTexture, true, TextureSlot::Clearcoat, 0);
     add(f.clearcoatRoughnessTexture, true, TextureSlot::ClearcoatRoughness, 1);
+    add(f.transmissionTexture, true, TextureSlot::Transmission, 0);
+    add(f.iridescenceTexture, true, TextureSlot::Iridescence, 0);
+    add(f.iridescenceThicknessTexture, true, TextureSlot::IridescenceThickness, 1);
 }
 
 /// glTF 2.0 metallic-roughness as vkrt's pbr kind: the factors are the
@@ -108,43 +132,6 @@ Material toPbr(const FileMaterial& f, size_t index, const std::filesystem::path&
     return m;
 }
 
-/// Glass when KHR_materials_transmission says the surface transmits: a
-/// dielectric of KHR_materials_ior's index, rough (GGX, the material's
-/// roughness) unless the roughness is 0. Only its normal map carries over.
-bool transmits(const FileMaterial& f) { return f.transmission >= 0.5f; }
-
-/// KHR_materials_volume's Beer-Lambert coefficient per world unit, -ln(attenuationColor) /
-/// attenuationDistance, inside a volumetric (thickness > 0) material; 0 for a thin-walled one or
-/// without attenuation. A colour component of 0 absorbs as one of 1e-9 does (opaque within a few
-/// attenuation distances) rather than infinitely.
-Color volumeAbsorption(const FileMaterial& f)
-{
-    if (!(f.thicknessFactor > 0.0f) || !std::isfinite(f.attenuationDistance)) return Color(0.0);
-    Color sigma;
-    for (int c = 0; c < 3; ++c) sigma[c] = -std::log(std::max(double(f.attenuationColor[c]), 1e-9)) / f.attenuationDistance;
-    return sigma;
-}
-
-Material toGlass(const FileMaterial& f, Material pbr)
-{
-    Material m;
-    m.type = pbr.roughness > 0.0 ? MaterialType::RoughDielectric : MaterialType::Dielectric;
-    m.name = pbr.name;
-    m.where = pbr.where;
-    m.ior = f.ior;
-    m.roughness = pbr.roughness;
-    m.absorption = volumeAbsorption(f);
-    m.textures[size_t(TextureSlot::Normal)] = pbr.texture(TextureSlot::Normal);
-    m.normalStrength = pbr.normalStrength;
-    // Glass keeps its coverage: the alpha test reads the colour slot, so it
-    // carries over with the alpha mode.
-    m.alphaMode = pbr.alphaMode;
-    m.alphaCutoff = pbr.alphaCutoff;
-    m.alpha = pbr.alpha;
-    if (pbr.alphaTested()) m.textures[size_t(TextureSlot::Color)] = pbr.texture(TextureSlot::Color);
-    return m;
-}
-
 /// KHR_materials_unlit: the base colour (factor x texture, sRGB) reaches the
 /// camera as it is. An emitter of that radiance with a black Lambert surface:
 /// seen directly it is exactly its colour, and no light it receives changes
@@ -159,11 +146,10 @@ Material toUnlit(Material pbr)
     m.emission = pbr.diffuse;
     m.textures[size_t(TextureSlot::Emission)] = pbr.texture(TextureSlot::Color);
     m.diffuse = Color(0.0);
-    for (TextureSlot slot : {TextureSlot::Specular, TextureSlot::Roughness, TextureSlot::Metallic, TextureSlot::Normal,
-                             TextureSlot::SpecularFactor, TextureSlot::SheenColor, TextureSlot::SheenRoughness,
-                             TextureSlot::Clearcoat, TextureSlot::ClearcoatRoughness})
-        m.textures[size_t(slot)].reset();
+    for (size_t slot = 0; slot < kTextureSlotCount; ++slot)
+        if (slot != size_t(TextureSlot::Color) && slot != size_t(TextureSlot::Emission)) m.textures[slot].reset();
     m.layers = PbrLayers{};
+    m.absorption = Color(0.0);
     m.metallic = 0.0;
     m.roughness = 0.0;
     return m;
@@ -178,20 +164,6 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
     if (f.normalTexture && f.normalTexture->rotation != 0.0)
         warnings.push_back(prefix + "normalTexture's KHR_texture_transform rotation turns its uvs, not its tangent "
                                     "frame: the normals are tilted the wrong way");
-    if (f.transmission > 0.0f && f.transmission < 1.0f)
-        warnings.push_back(prefix + "transmissionFactor " + std::to_string(f.transmission) + " rendered as " +
-                           (transmits(f) ? "1 (glass)" : "0 (opaque)") +
-                           ": vkrt does not mix transmission with the base material");
-    if (transmits(f)) {
-        if (!(f.thicknessFactor > 0.0f))
-            warnings.push_back(prefix + "thin-walled transmission (no KHR_materials_volume thickness) is rendered "
-                                        "as refracting glass, its volume without attenuation");
-        const glm::vec3 base(f.baseColorFactor);
-        if (base != glm::vec3(1.0f) || f.baseColorTexture)
-            warnings.push_back(prefix + "the base colour does not tint transmitted light (vkrt's glass is clear)");
-        if (f.metallicRoughnessTexture)
-            warnings.push_back(prefix + "metallicRoughnessTexture is not applied to glass (its roughness factor is)");
-    }
     if (f.clearcoatNormalTexture && m.type == MaterialType::Pbr)
         warnings.push_back(prefix + "clearcoatNormalTexture is not applied: the coat takes the base's shading normal");
     else if (f.clearcoatFactor > 0.0f && f.normalTexture && m.type == MaterialType::Pbr)
@@ -214,7 +186,6 @@ std::vector<uint32_t> importFileMaterials(const std::vector<FileMaterial>& fileM
     for (size_t i = 0; i < fileMaterials.size(); ++i) {
         Material m = toPbr(fileMaterials[i], i, file, where, atlas);
         if (fileMaterials[i].unlit) m = toUnlit(std::move(m));
-        else if (transmits(fileMaterials[i])) m = toGlass(fileMaterials[i], std::move(m));
         warnAbout(fileMaterials[i], m, where, warnings);
         indices.push_back(uint32_t(materials.size()));
         materials.push_back(std::move(m));

@@ -180,6 +180,9 @@ enum class TextureSlot : uint32_t {
     SheenRoughness = gpu::TEXTURE_SLOT_SHEEN_ROUGHNESS,         ///< pbr sheen_roughness (A)
     Clearcoat = gpu::TEXTURE_SLOT_CLEARCOAT,                    ///< pbr clearcoat (R)
     ClearcoatRoughness = gpu::TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, ///< pbr clearcoat_roughness (G)
+    Transmission = gpu::TEXTURE_SLOT_TRANSMISSION,              ///< pbr transmission (R)
+    Iridescence = gpu::TEXTURE_SLOT_IRIDESCENCE,                ///< pbr iridescence (R)
+    IridescenceThickness = gpu::TEXTURE_SLOT_IRIDESCENCE_THICKNESS, ///< pbr iridescence_thickness (G: min to max)
     Normal = gpu::TEXTURE_SLOT_NORMAL,       ///< tangent-space normal map
     Emission = gpu::TEXTURE_SLOT_EMISSION,   ///< emitted radiance (glTF emissiveTexture; meshes only)
 };
@@ -195,8 +198,21 @@ struct PbrLayers {
     double sheenRoughness = 0.0; ///< sheenRoughnessFactor
     double clearcoat = 0.0;      ///< KHR_materials_clearcoat clearcoatFactor
     double clearcoatRoughness = 0.0; ///< clearcoatRoughnessFactor (perceptual; alpha = roughness^2)
+    double transmission = 0.0;       ///< KHR_materials_transmission transmissionFactor
+    /// KHR_materials_volume absent or of thickness 0: transmitted light passes
+    /// unrefracted and enters no medium. Otherwise the mesh bounds a volume of
+    /// index `ior` absorbing by Material::absorption (attenuationColor and _Distance).
+    bool thinWalled = true;
+    double iridescence = 0.0;            ///< KHR_materials_iridescence iridescenceFactor
+    double iridescenceIor = 1.3;         ///< iridescenceIor: the thin film's index
+    double iridescenceThicknessMin = 100.0; ///< iridescenceThicknessMinimum (nm): where its texture reads 0
+    double iridescenceThicknessMax = 400.0; ///< iridescenceThicknessMaximum (nm): where it reads 1; without one
 
     bool sheen() const { return sheenColor != Color(0.0); }
+    /// Light crosses the surface (the kernel's VKRT_PBR_TRANSMISSION).
+    bool transmits() const { return transmission > 0.0; }
+    /// The surface bounds a refracting, absorbing volume.
+    bool volumetric() const { return transmits() && !thinWalled; }
     bool operator==(const PbrLayers&) const = default;
 };
 
@@ -207,7 +223,7 @@ struct Material {
     Color specular{0.0};   ///< phong `specular`; mirror/glossy `reflectance`
     double exponent = 0.0; ///< phong `shininess`, glossy `exponent`
     double ior = 1.5;      ///< dielectric IOR; also Schlick's R0 for mirror/glossy
-    Color absorption{0.0}; ///< dielectric Beer–Lambert κ per unit length
+    Color absorption{0.0}; ///< dielectric, volumetric pbr: Beer–Lambert κ per unit length
     FresnelMode fresnel = FresnelMode::Default;
     /// conductor, rough_dielectric, plastic, pbr: perceptual roughness in [0, 1]; GGX alpha = roughness²
     double roughness = 0.0;
@@ -239,6 +255,8 @@ struct Material {
     bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
     /// A pbr material with a glTF extension layer (or a KHR_materials_ior index other than 1.5).
     bool hasPbrLayers() const;
+    bool pbrTransmits() const { return type == MaterialType::Pbr && layers.transmits(); }
+    bool pbrIridescent() const { return type == MaterialType::Pbr && layers.iridescence > 0.0; }
     bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
 

@@ -278,6 +278,13 @@ void parameters(MaterialKindTag<MaterialType::Pbr>, MaterialWriter& w, Integrato
     w.textured("sheen_roughness", layers.sheenRoughness, TextureSlot::SheenRoughness);
     w.textured("clearcoat", layers.clearcoat, TextureSlot::Clearcoat);
     w.textured("clearcoat_roughness", layers.clearcoatRoughness, TextureSlot::ClearcoatRoughness);
+    w.textured("transmission", layers.transmission, TextureSlot::Transmission);
+    w.value("thin_walled", layers.thinWalled);
+    w.value("absorption", vec(w.material().absorption));
+    w.textured("iridescence", layers.iridescence, TextureSlot::Iridescence);
+    w.value("iridescence_ior", layers.iridescenceIor);
+    w.textured("iridescence_thickness", layers.iridescenceThicknessMax, TextureSlot::IridescenceThickness);
+    w.value("iridescence_thickness_range", Json::array({layers.iridescenceThicknessMin, layers.iridescenceThicknessMax}));
 }
 
 /// Every kind's parameters; a kind added to shared/Kinds.h without an overload above does not compile.

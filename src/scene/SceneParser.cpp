@@ -138,10 +138,12 @@ constexpr std::array<std::string_view, 8> conductorKeys{"type", "roughness", "an
 constexpr std::array<std::string_view, 6> rough_dielectricKeys{"type",       "roughness", "ior",
                                                                "absorption", "fresnel",   "normal_map"};
 constexpr std::array<std::string_view, 5> plasticKeys{"type", "diffuse", "roughness", "ior", "normal_map"};
-constexpr std::array<std::string_view, 13> pbrKeys{
+constexpr std::array<std::string_view, 22> pbrKeys{
     "type",           "base_color",      "metallic",  "roughness",           "emission",
     "normal_map",     "ior",             "specular",  "specular_color",      "sheen_color",
-    "sheen_roughness", "clearcoat",      "clearcoat_roughness"};
+    "sheen_roughness", "clearcoat",      "clearcoat_roughness", "transmission", "thin_walled",
+    "attenuation_color", "attenuation_distance", "iridescence", "iridescence_ior", "iridescence_thickness",
+    "iridescence_thickness_range", "absorption"};
 
 /// A colour parameter: a value, or a texture table whose texel is the colour
 /// (the constant becomes 1, which the texel multiplies on the GPU).
@@ -304,6 +306,68 @@ void readPlastic(const TableField& table, Material& material, ParseContext& cont
     if (material.ior == 1.0) table.find("ior")->fail("must differ from 1 (a coating of index 1 is no coating)");
 }
 
+/// KHR_materials_transmission and _volume: `transmission` (or its texture's R),
+/// `thin_walled` (glTF's default without a volume: true), and inside a volume
+/// the absorption as glTF writes it (attenuation_color reached after
+/// attenuation_distance) or as vkrt's glass does (`absorption`, per unit).
+void readPbrTransmission(const TableField& table, Material& material, ParseContext& context)
+{
+    PbrLayers& layers = material.layers;
+    layers.transmission =
+        readUnitParameter(table, "transmission", 0.0, material, TextureSlot::Transmission, context.textures);
+    const std::optional<Field> thin = table.find("thin_walled");
+    const std::optional<Field> color = table.find("attenuation_color");
+    const std::optional<Field> distance = table.find("attenuation_distance");
+    const std::optional<Field> absorption = table.find("absorption");
+    if (thin && !layers.transmits())
+        thin->fail("applies to a transmitting material: set transmission above 0");
+    layers.thinWalled = thin ? readBool(*thin) : true;
+    for (const std::optional<Field>& inside : {color, distance, absorption})
+        if (inside && !layers.volumetric())
+            inside->fail("absorbs inside a volume: needs transmission above 0 and thin_walled = false");
+    if (absorption && (color || distance))
+        absorption->fail("give the absorption either as `absorption` or as attenuation_color and "
+                         "attenuation_distance, not both");
+    if (absorption) material.absorption = readOr(table, "absorption", Color(0.0), readRadiance);
+    if (color || distance) {
+        const Color reached = color ? readUnitColor(*color) : Color(1.0);
+        const double length = distance ? readPositive(*distance) : std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 3; ++c)
+            material.absorption[c] = std::isinf(length) ? 0.0 : -std::log(std::max(reached[c], 1e-9)) / length;
+    }
+}
+
+/// KHR_materials_iridescence: `iridescence` (or its texture's R), the film's
+/// `iridescence_ior` and `iridescence_thickness` in nanometres: a number, or a
+/// texture whose texel (its `channel`; glTF's is G) mixes across
+/// `iridescence_thickness_range` ([100, 400], glTF's defaults).
+void readPbrIridescence(const TableField& table, Material& material, ParseContext& context)
+{
+    PbrLayers& layers = material.layers;
+    layers.iridescence =
+        readUnitParameter(table, "iridescence", 0.0, material, TextureSlot::Iridescence, context.textures);
+    layers.iridescenceIor = readOr(table, "iridescence_ior", 1.3, readIor);
+    const std::optional<Field> thickness = table.find("iridescence_thickness");
+    const std::optional<Field> range = table.find("iridescence_thickness_range");
+    if (thickness && isTextureTable(*thickness)) {
+        material.textures[size_t(TextureSlot::IridescenceThickness)] =
+            readTextureTable(*thickness, TextureUse::Scalar, context.textures);
+        if (range) {
+            const toml::array* bounds = range->node().as_array();
+            const auto bound = [&](size_t i) { return readNonNegative(range->element(i, *bounds->get(i))); };
+            if (!bounds || bounds->size() != 2)
+                range->fail("expected [minimum, maximum] in nanometres, got " + describeType(range->node()));
+            layers.iridescenceThicknessMin = bound(0);
+            layers.iridescenceThicknessMax = bound(1);
+            if (layers.iridescenceThicknessMax < layers.iridescenceThicknessMin)
+                range->fail("the minimum exceeds the maximum");
+        }
+    } else {
+        if (range) range->fail("applies to a textured iridescence_thickness (a number is the thickness itself)");
+        if (thickness) layers.iridescenceThicknessMax = readNonNegative(*thickness);
+    }
+}
+
 /// The glTF extension layers (KHR_materials_ior, _specular, _sheen, _clearcoat; their defaults).
 /// specular_color may exceed 1, as specularColorFactor may (the F0 it scales stays at most 1).
 void readPbrLayers(const TableField& table, Material& material, ParseContext& context)
@@ -326,6 +390,8 @@ void readPbrLayers(const TableField& table, Material& material, ParseContext& co
     layers.clearcoat = readUnitParameter(table, "clearcoat", 0.0, material, TextureSlot::Clearcoat, context.textures);
     layers.clearcoatRoughness = readUnitParameter(table, "clearcoat_roughness", 0.0, material,
                                                   TextureSlot::ClearcoatRoughness, context.textures);
+    readPbrTransmission(table, material, context);
+    readPbrIridescence(table, material, context);
 }
 
 /// glTF 2.0's defaults: base colour 1, metallic 1, roughness 1.

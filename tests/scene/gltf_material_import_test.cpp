@@ -1,7 +1,8 @@
 // glTF materials as vkrt materials (scene/FileMaterialImport.cpp), through
 // parseGltfScene on files written here: the PBR extension layers with their
 // factors and each texture in the slot and channel its extension names, and
-// transmitting materials as glass with KHR_materials_volume's attenuation.
+// transmission with KHR_materials_volume's attenuation inside a volume.
+#include "scene/FeatureSet.h"
 #include "scene/GltfScene.h"
 #include "support/GltfTestFiles.h"
 #include "support/TestSupport.h"
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vkrt::test {
@@ -69,29 +71,55 @@ TEST(GltfMaterialImport, PbrLayersTakeTheirFactorsAndTexturesInTheirChannels)
 
 TEST(GltfMaterialImport, TransmittingVolumesAbsorbAsTheirAttenuationSays)
 {
-    // sigma = -ln(attenuationColor) / attenuationDistance per channel, inside glass of the file's index.
+    // sigma = -ln(attenuationColor) / attenuationDistance per channel, inside a volume of the file's index.
     const std::string volume = R"({"pbrMetallicRoughness": {"roughnessFactor": 0}, "extensions": {
-        "KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.4},
+        "KHR_materials_transmission": {"transmissionFactor": 0.75}, "KHR_materials_ior": {"ior": 1.4},
         "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 2,
                                  "attenuationColor": [0.5, 1, 0.25]}}})";
     const std::string used = R"(["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"])";
     const Scene scene = importOne("volume", volume, used);
     ASSERT_EQ(scene.materials.size(), 1u);
     const Material& glass = scene.materials[0];
-    EXPECT_EQ(glass.type, MaterialType::Dielectric);
+    EXPECT_EQ(glass.type, MaterialType::Pbr);
+    EXPECT_EQ(glass.layers.transmission, 0.75) << "a partial transmission is kept, not rounded";
+    EXPECT_TRUE(glass.layers.volumetric());
     EXPECT_NEAR(glass.ior, 1.4, 1e-6);
     EXPECT_NEAR(glass.absorption.r, std::log(2.0) / 2.0, 1e-7);
     EXPECT_EQ(glass.absorption.g, 0.0);
     EXPECT_NEAR(glass.absorption.b, std::log(4.0) / 2.0, 1e-7);
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
 
-    // Thin-walled (thickness 0): no volume to absorb in, and vkrt says that its glass refracts anyway.
+    // Thin-walled (thickness 0): no volume to refract into or absorb in.
     std::string thin = volume;
     thin.replace(thin.find("\"thicknessFactor\": 1"), 20, "\"thicknessFactor\": 0");
     const Scene thinScene = importOne("thin", thin, used);
+    EXPECT_TRUE(thinScene.materials.at(0).layers.thinWalled);
+    EXPECT_FALSE(thinScene.materials.at(0).layers.volumetric());
     EXPECT_EQ(thinScene.materials.at(0).absorption, Color(0.0));
-    std::string all;
-    for (const std::string& w : thinScene.warnings) all += w + "\n";
-    EXPECT_NE(all.find("thin-walled"), std::string::npos) << all;
+}
+
+TEST(GltfMaterialImport, TransmissionAndIridescenceTakeTheirFactorsAndTextures)
+{
+    const std::string json = R"({"extensions": {
+        "KHR_materials_transmission": {"transmissionFactor": 0.5, "transmissionTexture": {"index": 0}},
+        "KHR_materials_iridescence": {"iridescenceFactor": 0.8, "iridescenceTexture": {"index": 0},
+            "iridescenceIor": 1.6, "iridescenceThicknessMinimum": 50, "iridescenceThicknessMaximum": 700,
+            "iridescenceThicknessTexture": {"index": 0}}}})";
+    const Scene scene = importOne("layers", json, R"(["KHR_materials_transmission", "KHR_materials_iridescence"])");
+    const Material& m = scene.materials.at(0);
+    EXPECT_EQ(m.layers.transmission, 0.5);
+    EXPECT_EQ(m.layers.iridescence, float(0.8));
+    EXPECT_EQ(m.layers.iridescenceIor, float(1.6));
+    EXPECT_EQ(m.layers.iridescenceThicknessMin, 50.0);
+    EXPECT_EQ(m.layers.iridescenceThicknessMax, 700.0);
+    // The channels the extensions name: transmission and iridescence in R, the thickness in G.
+    for (const auto& [slot, channel] : std::vector<std::pair<TextureSlot, uint32_t>>{
+             {TextureSlot::Transmission, 0}, {TextureSlot::Iridescence, 0}, {TextureSlot::IridescenceThickness, 1}}) {
+        ASSERT_TRUE(m.texture(slot).has_value()) << int(slot);
+        EXPECT_EQ(m.texture(slot)->channel, channel) << int(slot);
+    }
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.pbrTransmission && features.pbrIridescence);
 }
 
 } // namespace
