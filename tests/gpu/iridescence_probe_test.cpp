@@ -25,7 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
+#include <iterator>
 #include <vector>
 
 namespace vkrt::test {
@@ -94,19 +94,24 @@ std::vector<FilmCase> referenceGrid()
     return cases;
 }
 
-// Measured on lavapipe (Mesa 25.0.7) over referenceGrid()'s 5040 cases, the
-// largest channel's |GLSL - reference| (reference white-balanced, as the
-// specification's m = 0 term assumes a grey spectrum is grey):
-//   all cases                     max 1.10   mean 0.080
-//   cos >= 0.7                    max 0.14   mean 0.021
-//   cos >= 0.7, base F0 <= 0.3    max 0.13   mean 0.019
-// The large errors are the specification's: at grazing angles Schlick's
-// R12 with outside IOR = film IOR is (1 - cos)^5 (0.77 at cos 0.05), not 0; and
-// over a dense base (F0 0.6) the Airy sum cut after m = 2 misses much of a
-// geometric series of ratio sqrt(R12 R23) ~ 0.7. Against the unbalanced
-// reference (plain XYZ -> Rec.709, where a grey spectrum is (1.20, 0.95,
-// 0.91)) the mean is 0.15. The bounds leave about 25 % over the measurement:
-// a wrong phase, matrix or sensitivity constant moves the mean by more.
+// Measured on lavapipe (Mesa 25.0.7) over referenceGrid()'s 4950 cases, the
+// largest channel's |GLSL - reference| (the reference white-balanced, as the
+// specification's m = 0 term takes a grey spectrum to be grey):
+//   all cases                     max 1.098  mean 0.070
+//   cos >= 0.7                    max 0.139  mean 0.0109
+//   cos >= 0.7, base F0 <= 0.3    max 0.096  mean 0.0104
+//   d = 0 / 0 < d <= 50 / 50 < d <= 400 / d > 400 nm:
+//                                 max 0.93 / 0.93 / 1.01 / 1.10,
+//                                 mean 0.118 / 0.077 / 0.062 / 0.062
+// (a double-precision port of the same formulas gave the same figures, so
+// this is the approximation's error, not float's). The large errors are the
+// specification's, at grazing angles: Schlick's R12 = (1 - cos)^5 is 0.77 at
+// cos 0.05 even where the film or base matches the outside IOR and the exact
+// reflectance is 0; over a dense base (F0 0.6) the Airy sum cut after m = 2
+// misses much of a geometric series of ratio sqrt(R12 R23) ~ 0.7. Thickness
+// barely matters. Against the unbalanced reference (plain XYZ -> Rec.709,
+// where a grey spectrum is (1.20, 0.95, 0.91)) the mean is 0.129. The bounds
+// leave 15-25 % over the measurement.
 TEST_F(IridescenceProbe, StaysWithinTheMeasuredDeviationFromTheSpectralReference)
 {
     const std::vector<FilmCase> cases = referenceGrid();
@@ -135,12 +140,12 @@ TEST_F(IridescenceProbe, StaysWithinTheMeasuredDeviationFromTheSpectralReference
     report("50 < d <= 400 nm", byThickness[2]);
     report("d > 400 nm", byThickness[3]);
     report("all, unbalanced reference", unbalanced);
-    EXPECT_LT(all.max, 1.4);
-    EXPECT_LT(all.mean(), 0.10);
-    EXPECT_LT(nearNormal.max, 0.18);
-    EXPECT_LT(nearNormal.mean(), 0.027);
-    EXPECT_LT(nearNormalDielectric.max, 0.17);
-    EXPECT_LT(nearNormalDielectric.mean(), 0.025);
+    EXPECT_LT(all.max, 1.25);
+    EXPECT_LT(all.mean(), 0.085);
+    EXPECT_LT(nearNormal.max, 0.165);
+    EXPECT_LT(nearNormal.mean(), 0.0135);
+    EXPECT_LT(nearNormalDielectric.max, 0.115);
+    EXPECT_LT(nearNormalDielectric.mean(), 0.0125);
 }
 
 TEST_F(IridescenceProbe, IsFiniteAndNonNegativeEverywhere)
@@ -179,12 +184,14 @@ TEST_F(IridescenceProbe, AFilmOfThicknessZeroHasVanished)
             double r = (nb - c.outsideIor) / (nb + c.outsideIor);
             for (int k = 0; k < 3; ++k) EXPECT_NEAR(gpu[i][k], r * r, 2e-6) << c.outsideIor << " F0 " << c.baseF0.r;
         }
-        // ... and elsewhere the bare interface within the (Schlick) error measured above, where the base is
-        // denser than the outside (Schlick knows no total internal reflection into a rarer base).
+        // ... and elsewhere the bare interface within Schlick's error (measured: 0.045 at cos 0.7, 0.926 at
+        // cos 0.05 over an invisible base, F0 0 under air, where R12 = 0.95^5), where the base is denser than
+        // the outside (Schlick knows no total internal reflection into a rarer base).
         double exact = dielectricFresnel(c.outsideIor, baseIorFromF0(c.baseF0.r), c.cosTheta);
-        if (baseIorFromF0(c.baseF0.r) >= c.outsideIor)
-            EXPECT_LT(maxAbs(gpu[i] - glm::dvec3(exact)), c.cosTheta >= 0.7 ? 0.02 : 0.8)
-            << c.outsideIor << " cos " << c.cosTheta << " F0 " << c.baseF0.r;
+        if (baseIorFromF0(c.baseF0.r) >= c.outsideIor) {
+            EXPECT_LT(maxAbs(gpu[i] - glm::dvec3(exact)), c.cosTheta >= 0.7 ? 0.055 : 0.95)
+                << c.outsideIor << " cos " << c.cosTheta << " F0 " << c.baseF0.r;
+        }
     }
     // A film 1 nm thick is there: its IOR changes the result.
     const std::vector<glm::dvec3> thin = evaluateOnGpu({{1.0, 1.2, 0.7, 1.0, glm::dvec3(0.04)},

@@ -130,7 +130,7 @@ TEST(ThinFilmReference, ConstantReflectanceIntegratesToItsValue)
     glm::dvec3 plain = thinFilmRgb(mirror, 0.6, RgbWhite::EqualEnergy);
     EXPECT_NEAR(plain.r, equalEnergyRgb().r, 1e-12);
     // A coloured film is not grey.
-    glm::dvec3 film = thinFilmRgb({1.0, 1.5, 300.0, 0.04}, 1.0);
+    glm::dvec3 film = thinFilmRgb({1.0, 2.0, 300.0, 0.04}, 1.0);
     EXPECT_GT(std::abs(film.r - film.b), 0.01);
 }
 

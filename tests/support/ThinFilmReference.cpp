@@ -34,6 +34,7 @@ struct Amplitudes {
 
 Amplitudes interfaceAmplitudes(double na, Complex ca, double nb, Complex cb)
 {
+    if (na == nb) return {}; // no interface (the formulas are 0 / 0 at grazing incidence)
     return {(na * ca - nb * cb) / (na * ca + nb * cb), (nb * ca - na * cb) / (nb * ca + na * cb)};
 }
 
