@@ -65,11 +65,12 @@ What both renderers are given
   BRDF is single-scatter), view transform Standard, 32-bit float EXR.
 
 Material extensions that differ by design (BY_DESIGN below: iridescence,
-volume) are stripped from the temporary copy for *both* renderers, so the
-rest of such a model is still compared; the row's notes say what was
-stripped. --keep-extensions turns that off. Transmission (vkrt: untinted
-glass for transmissionFactor >= 0.5, Cycles: tinted, mixed) and spot lights
-exclude the model from the verdict instead, as does --exclude NAME=WHY.
+which Blender's importer does not read) are stripped from the temporary copy
+for *both* renderers, so the rest of such a model is still compared; the
+row's notes say what was stripped. --keep-extensions turns that off.
+Thin-walled transmission (vkrt: unrefracted, as the extension says; Cycles:
+refracted) and spot lights exclude the model from the verdict instead, as
+does --exclude NAME=WHY.
 
 Metrics (luminance Y = 0.2126 R + 0.7152 G + 0.0722 B of the linear images)
 -------------------------------------------------------------------------
@@ -150,14 +151,24 @@ CYCLES_BOUNCES = VKRT_MAX_DEPTH - 1
 # they are compared: Principled's sheen is a different lobe, its coat a true
 # layer, yet the Khronos test models agree within the tool's rule.)
 BY_DESIGN = {
-    "KHR_materials_iridescence": "iridescence: vkrt ignores it; Principled's thin film differs",
-    "KHR_materials_volume": "volume: vkrt's glass absorbs as it says, untinted at its surface; Blender's volume differs",
+    "KHR_materials_iridescence": "iridescence: Blender's glTF importer does not read it (Cycles would render "
+                                 "the material without its film)",
 }
 # Features that exclude a model from the verdict (the model is rendered as it is).
-EXCLUDING = {
-    "KHR_materials_transmission": "transmission: vkrt makes untinted glass for a factor >= 0.5, "
-                                  "Cycles mixes tinted transmission",
-}
+EXCLUDING = {}
+THIN_WALLED = ("thin-walled transmission: vkrt passes light unrefracted, as KHR_materials_transmission says "
+               "without KHR_materials_volume; Cycles' Principled BSDF always refracts")
+
+
+def has_thin_walled_transmission(gltf: dict) -> bool:
+    """Whether some material transmits without a volume (KHR_materials_volume
+    absent or of thicknessFactor 0): thin-walled, unrefracted in vkrt."""
+    for m in gltf.get("materials", []):
+        ext = m.get("extensions", {})
+        if ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0) > 0.0 and \
+                not ext.get("KHR_materials_volume", {}).get("thicknessFactor", 0.0) > 0.0:
+            return True
+    return False
 
 # ----------------------------------------------------------------------------
 # Metrics (pure NumPy: tests/tools/test_compare_cycles.py)
@@ -688,6 +699,8 @@ def compare_model(name: str, source: Path, args, vkrt: Path, work: Path) -> dict
         row["notes"].append("glTF's default material made explicit for Blender")
     used = set(gltf.get("extensionsUsed", []))
     exclusions = [why for ext, why in EXCLUDING.items() if ext in used]
+    if has_thin_walled_transmission(gltf):
+        exclusions.append(THIN_WALLED)
     camera, origin = choose_camera(gltf, folder)
     row["camera"] = dict(camera, origin=origin)
     lights = punctual_lights(gltf, folder)

@@ -11,6 +11,10 @@
 #ifndef VKRT_BSDF_GLSL
 #define VKRT_BSDF_GLSL
 
+#ifdef VKRT_PBR_IRIDESCENCE
+#include "lib/iridescence.glsl"
+#endif
+
 struct BsdfSample {
     vec3 dir;
     vec3 weight;      // f * cos / pdf (or the specular reflectance / transmittance)
@@ -466,6 +470,21 @@ float pbrEta(Material m) { return 1.0 / m.ior; }
 float pbrTransmission(Material m) { return 0.0; }
 #endif
 
+// KHR_materials_iridescence: a thin film over the layer whose Fresnel is
+// `fresnel` (normal-incidence reflectance f0) mixes in the film's
+// reflectance (lib/iridescence.glsl) by the iridescence factor, at cosine c.
+vec3 withIridescence(Material m, vec3 fresnel, float c, vec3 f0)
+{
+#ifdef VKRT_PBR_IRIDESCENCE
+    if (m.iridescence > 0.0)
+        // The film's reflectance is clamped to 1: its spectral fit can overshoot,
+        // and the dielectric's diffuse takes 1 - F.
+        return mix(fresnel, min(iridescenceFresnel(1.0, m.iridescenceIor, c, m.iridescenceThickness, f0), vec3(1.0)),
+                   m.iridescence);
+#endif
+    return fresnel;
+}
+
 // The dielectric's Fresnel (KHR_materials_specular with KHR_materials_ior) at
 // cosine c between wo and the microfacet normal, crossing from index n_i to
 // n_t (eta = n_i / n_t; from air, 1 / ior). The specification writes it from
@@ -485,7 +504,15 @@ vec3 pbrDielectricFresnel(Material m, float c)
     }
     float r = (1.0 - eta) / (1.0 + eta);
     vec3 f0 = min(r * r * m.specular, vec3(1.0)) * m.specularFactor;
-    return f0 + (vec3(m.specularFactor) - f0) * pow5(1.0 - c);
+    vec3 fresnel = f0 + (vec3(m.specularFactor) - f0) * pow5(1.0 - c);
+    return withIridescence(m, fresnel, c, f0);
+}
+
+// The metal's Fresnel at cosine c: Schlick's with the base colour as F0.
+vec3 pbrMetalFresnel(Material m, float c)
+{
+    c = clamp(c, 0.0, 1.0);
+    return withIridescence(m, m.diffuse + (vec3(1.0) - m.diffuse) * pow5(1.0 - c), c, m.diffuse);
 }
 
 // The Charlie sheen (Estevez and Kulla 2017, the form KHR_materials_sheen
@@ -565,8 +592,7 @@ vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
     float s = ggxSpecularCorrelated(lo, li, h, ggxAlpha(m));
     vec3 fd = pbrDielectricFresnel(m, dot(lo, h));
     vec3 dielectric = fd * s + (1.0 - max3(fd)) * (1.0 - pbrTransmission(m)) * m.diffuse * INV_PI;
-    vec3 fm = m.diffuse + (vec3(1.0) - m.diffuse) * pow5(1.0 - clamp(dot(lo, h), 0.0, 1.0));
-    vec3 value = mix(dielectric, fm * s, m.metallic);
+    vec3 value = mix(dielectric, pbrMetalFresnel(m, dot(lo, h)) * s, m.metallic);
     if (max3(m.sheenColor) > 0.0)
         value = m.sheenColor * sheenBrdf(lo, li, h, sheenAlpha(m)) + value * sheenScaling(m, lo.z, li.z);
     if (m.clearcoat > 0.0) {

@@ -258,6 +258,17 @@ def test_strip_by_design_removes_only_the_listed_extensions():
     assert gltf["extensionsUsed"] == ["KHR_materials_sheen", "KHR_materials_emissive_strength"]
 
 
+def test_only_transmission_without_a_volume_is_thin_walled():
+    gltf = box_gltf()
+    assert not cc.has_thin_walled_transmission(gltf)
+    gltf["materials"][0]["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": 0.5}}
+    assert cc.has_thin_walled_transmission(gltf)
+    gltf["materials"][0]["extensions"]["KHR_materials_volume"] = {"thicknessFactor": 0.0}
+    assert cc.has_thin_walled_transmission(gltf)
+    gltf["materials"][0]["extensions"]["KHR_materials_volume"] = {"thicknessFactor": 0.01}
+    assert not cc.has_thin_walled_transmission(gltf)
+
+
 def test_default_material_is_made_explicit():
     gltf = box_gltf()
     assert not cc.make_default_material_explicit(copy.deepcopy(gltf))
