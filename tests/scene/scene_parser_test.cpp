@@ -258,6 +258,59 @@ material = "layered"
     EXPECT_TRUE(featuresOf(scene).pbrLayers);
 }
 
+TEST(SceneParserValid, PbrTransmissionAndIridescenceAreRead)
+{
+    const Scene scene = parseSceneString(kCamera + R"([materials.window]
+type = "pbr"
+transmission = 0.5
+[materials.water]
+type = "pbr"
+transmission = 1
+thin_walled = false
+ior = 1.33
+attenuation_color = [0.5, 1, 0.25]
+attenuation_distance = 2
+[materials.bubble]
+type = "pbr"
+iridescence = 1
+iridescence_ior = 1.4
+iridescence_thickness = 550
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "window"
+[[objects]]
+shape = "sphere"
+center = [3, 0, 0]
+radius = 1
+material = "water"
+[[objects]]
+shape = "sphere"
+center = [6, 0, 0]
+radius = 1
+material = "bubble"
+)",
+                                         "transmission.toml");
+    const Material& window = scene.materials.at(0);
+    EXPECT_DOUBLE_EQ(window.layers.transmission, 0.5);
+    EXPECT_TRUE(window.layers.thinWalled) << "glTF's default without a volume";
+    EXPECT_FALSE(window.layers.volumetric());
+    const Material& water = scene.materials.at(1);
+    EXPECT_TRUE(water.layers.volumetric());
+    EXPECT_DOUBLE_EQ(water.ior, 1.33);
+    // attenuation_color reached after attenuation_distance: sigma = -ln(c) / d.
+    EXPECT_NEAR(water.absorption.r, std::log(2.0) / 2.0, 1e-12);
+    EXPECT_EQ(water.absorption.g, 0.0);
+    EXPECT_NEAR(water.absorption.b, std::log(4.0) / 2.0, 1e-12);
+    const Material& bubble = scene.materials.at(2);
+    EXPECT_DOUBLE_EQ(bubble.layers.iridescence, 1.0);
+    EXPECT_DOUBLE_EQ(bubble.layers.iridescenceIor, 1.4);
+    EXPECT_DOUBLE_EQ(bubble.layers.iridescenceThicknessMax, 550.0);
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.pbrLayers && features.pbrTransmission && features.pbrIridescence);
+}
+
 TEST(SceneParserValid, ShapesReferToMaterialIndices)
 {
     const Scene scene = parseSceneString(kEverything);
@@ -721,6 +774,18 @@ const std::vector<BadScene> kBadScenes = {
     {"EnvironmentRotateWithoutAxis",
      kCamera + "[background.environment]\nfile = \"a.exr\"\nrotate = { angle = 30 }\n", 7, 10,
      "background.environment.rotate: missing required key 'axis'"},
+    {"PbrThinWalledWithoutTransmission", kCamera + "[materials.g]\ntype = \"pbr\"\nthin_walled = false\n", 7, 15,
+     "materials.g.thin_walled: applies to a transmitting material"},
+    {"PbrAttenuationOnAThinWall",
+     kCamera + "[materials.g]\ntype = \"pbr\"\ntransmission = 1\nattenuation_distance = 2\n", 8, 24,
+     "materials.g.attenuation_distance: absorbs inside a volume: needs transmission above 0 and thin_walled = false"},
+    {"PbrAbsorptionTwice",
+     kCamera + "[materials.g]\ntype = \"pbr\"\ntransmission = 1\nthin_walled = false\nabsorption = 1\n"
+               "attenuation_color = 0.5\n",
+     9, 14, "materials.g.absorption: give the absorption either as `absorption` or as attenuation_color"},
+    {"PbrIridescenceRangeWithoutTexture",
+     kCamera + "[materials.g]\ntype = \"pbr\"\niridescence_thickness = 300\niridescence_thickness_range = [1, 2]\n",
+     8, 31, "materials.g.iridescence_thickness_range: applies to a textured iridescence_thickness"},
     {"DeepTomlNesting", kCamera + "[" + repeatedParts(20000) + "]\n", 5, 257,
      "invalid TOML: tables and arrays nest more than 128 levels deep here"},
 };
