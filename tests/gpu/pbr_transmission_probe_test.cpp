@@ -15,6 +15,8 @@
 //    (chi-square with Walter's Jacobian, Sidak-corrected);
 //  - partial transmission takes its share of the diffuse only: evalBsdf equals
 //    the reference's specular part plus (1 - transmission) x its diffuse part.
+// Two tests fail on purpose, each marked KNOWN FAILURE: they found faults of
+// lib/bsdf.glsl leaving a volume past the critical angle, reported to be fixed there.
 #include "material/Ggx.h"
 #include "material/Sheen.h"
 #include "shared/SceneTypes.h"
@@ -27,6 +29,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -237,6 +240,13 @@ double overVisibleNormals(const Ggx& ggx, const glm::dvec3& wo, const Value& val
     return sum / (double(n) * n);
 }
 
+/// A figure for the test's XML report (gtest attribute names: no spaces).
+void property(std::string key, double value)
+{
+    std::replace_if(key.begin(), key.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '.'; }, '_');
+    ::testing::Test::RecordProperty(key, std::to_string(value));
+}
+
 /// Upper quantile of the standard normal: z with P(Z > z) = tail (bisection).
 double normalQuantile(double tail)
 {
@@ -291,7 +301,7 @@ class PbrTransmissionProbe : public GpuTest {};
 
 TEST_F(PbrTransmissionProbe, ThinWalledWhiteDielectricKeepsTheWhiteMetalsAlbedo)
 {
-    constexpr uint32_t kSamples = 1u << 17;
+    constexpr uint32_t kSamples = 1u << 16;
     const std::vector<double> roughnesses{0.3, 0.6, 1.0}, cosines{0.9, 0.5, 0.15};
     const double z = normalQuantile(0.5 * sidakCorrectedAlpha(0.01, int(roughnesses.size() * cosines.size())));
     for (const double roughness : roughnesses)
@@ -300,64 +310,78 @@ TEST_F(PbrTransmissionProbe, ThinWalledWhiteDielectricKeepsTheWhiteMetalsAlbedo)
             SCOPED_TRACE(name);
             const glm::dvec3 wo = direction(cosO, 0.0);
             const double expected = whiteMetalAlbedo(roughness, wo);
-            // The same albedo the other way: E[G2(wo, wi) / G1(wo)] over visible normals.
+            // The same albedo the other way: E[G2(wo, wi) / G1(wo)] over visible normals. At
+            // roughness 0.3 this midpoint rule converges slowly (measured: 384^2 nodes 1.9e-4
+            // from the adaptive Simpson's 0.98942360 at cosO 0.9; 2048^2 nodes 1.5e-5), which
+            // agreed with itself to 1e-9 at 8x the panels and 1e-3 of the tolerance.
             const Ggx ggx{ggxAlpha(roughness), ggxAlpha(roughness)};
             const double check = overVisibleNormals(ggx, wo, [&](const glm::dvec3& h) {
                 const glm::dvec3 wi = reflect(wo, h);
                 return wi.z > 0.0 ? ggx.gCorrelated(wo, wi, h) / ggx.g1(wo, h) : 0.0;
             });
-            ASSERT_NEAR(expected, check, 1e-4) << "the two quadratures of the white metal's albedo";
+            ASSERT_NEAR(expected, check, 3e-4) << "the two quadratures of the white metal's albedo";
             const TransmissionCase c = whiteDielectric("thin", roughness, false, 1.0 / 1.5);
             const MeanWeight w = meanWeight(sampleOnGpu(c, wo, kSamples, 11.0f));
             const double score = (w.mean.x - expected) / w.standardError.x;
             EXPECT_LT(std::abs(score), z) << "mean " << w.mean.x << " +- " << w.standardError.x << ", expected "
                                           << expected << ", Z " << score << " (bound " << z << ")";
-            RecordProperty("z " + name, std::to_string(score));
+            property("z " + name, score);
         }
+}
+
+/// A volumetric white dielectric of transmission 1 (roughness 0.5) keeps the
+/// single-scattering albedo of its interface: E over visible normals h of
+/// Fd G2(wo, r) / G1(wo) for the reflection r plus (1 - Fd) G2(wo, t) / G1(wo)
+/// for the refraction t (Z test, Sidak-corrected over the cosines).
+void expectVolumetricAlbedo(const std::string& sideName, double eta, const std::vector<double>& cosines)
+{
+    constexpr uint32_t kSamples = 1u << 16;
+    const double roughness = 0.5;
+    const double z = normalQuantile(0.5 * sidakCorrectedAlpha(0.01, int(cosines.size())));
+    for (const double cosO : cosines) {
+        const std::string name = sideName + " cosO " + std::to_string(cosO);
+        SCOPED_TRACE(name);
+        const TransmissionCase c = whiteDielectric(sideName, roughness, true, eta);
+        const glm::dvec3 wo = direction(cosO, 0.0);
+        const Ggx ggx{ggxAlpha(roughness), ggxAlpha(roughness)};
+        const double lambdaO = ggx.lambda(wo);
+        auto shadowing = [&](const glm::dvec3& wi) { return (1.0 + lambdaO) / (1.0 + lambdaO + ggx.lambda(wi)); };
+        const double expected = overVisibleNormals(ggx, wo, [&](const glm::dvec3& h) {
+            const double cosOH = glm::dot(wo, h), f = dielectricFresnel(c, cosOH).x;
+            const glm::dvec3 r = reflect(wo, h);
+            double value = r.z > 0.0 ? f * shadowing(r) : 0.0;
+            const double cos2t = 1.0 - eta * eta * (1.0 - cosOH * cosOH);
+            if (cos2t > 0.0) {
+                const glm::dvec3 t = -eta * wo + (eta * cosOH - std::sqrt(cos2t)) * h;
+                if (t.z < 0.0) value += (1.0 - f) * shadowing(t);
+            }
+            return value;
+        });
+        const MeanWeight w = meanWeight(sampleOnGpu(c, wo, kSamples, 13.0f));
+        const double score = (w.mean.x - expected) / w.standardError.x;
+        EXPECT_LE(expected, 1.0);
+        EXPECT_LT(std::abs(score), z) << "mean " << w.mean.x << " +- " << w.standardError.x << ", expected "
+                                      << expected << ", Z " << score << " (bound " << z << ")";
+        property("z " + name, score);
+    }
 }
 
 TEST_F(PbrTransmissionProbe, VolumetricWhiteDielectricKeepsItsSingleScatteringAlbedo)
 {
-    // Past the critical angle leaving (cosO 0.3 at eta 1.5) the macro-surface's
-    // Fresnel is 1, so pbrLobeProbabilities gives transmission probability 0,
-    // yet microfacets tilted towards wo still transmit; expected here is the
-    // lobe's full single-scattering albedo (reflection plus transmission).
-    constexpr uint32_t kSamples = 1u << 17;
-    struct Side {
-        std::string name;
-        double eta;
-    };
-    const std::vector<Side> sides{{"entering", 1.0 / 1.5}, {"leaving", 1.5}};
-    const std::vector<double> cosines{0.9, 0.5, 0.3};
-    const double roughness = 0.5;
-    const double z = normalQuantile(0.5 * sidakCorrectedAlpha(0.01, int(sides.size() * cosines.size())));
-    for (const Side& side : sides)
-        for (const double cosO : cosines) {
-            const std::string name = side.name + " cosO " + std::to_string(cosO);
-            SCOPED_TRACE(name);
-            const TransmissionCase c = whiteDielectric(side.name, roughness, true, side.eta);
-            const glm::dvec3 wo = direction(cosO, 0.0);
-            const Ggx ggx{ggxAlpha(roughness), ggxAlpha(roughness)};
-            const double lambdaO = ggx.lambda(wo);
-            auto shadowing = [&](const glm::dvec3& wi) { return (1.0 + lambdaO) / (1.0 + lambdaO + ggx.lambda(wi)); };
-            const double expected = overVisibleNormals(ggx, wo, [&](const glm::dvec3& h) {
-                const double cosOH = glm::dot(wo, h), f = dielectricFresnel(c, cosOH).x;
-                const glm::dvec3 r = reflect(wo, h);
-                double value = r.z > 0.0 ? f * shadowing(r) : 0.0;
-                const double cos2t = 1.0 - side.eta * side.eta * (1.0 - cosOH * cosOH);
-                if (cos2t > 0.0) {
-                    const glm::dvec3 t = -side.eta * wo + (side.eta * cosOH - std::sqrt(cos2t)) * h;
-                    if (t.z < 0.0) value += (1.0 - f) * shadowing(t);
-                }
-                return value;
-            });
-            const MeanWeight w = meanWeight(sampleOnGpu(c, wo, kSamples, 13.0f));
-            const double score = (w.mean.x - expected) / w.standardError.x;
-            EXPECT_LE(expected, 1.0);
-            EXPECT_LT(std::abs(score), z) << "mean " << w.mean.x << " +- " << w.standardError.x << ", expected "
-                                          << expected << ", Z " << score << " (bound " << z << ")";
-            RecordProperty("z " + name, std::to_string(score));
-        }
+    expectVolumetricAlbedo("entering", 1.0 / 1.5, {0.9, 0.78, 0.3});
+    expectVolumetricAlbedo("leaving", 1.5, {0.9, 0.78}); // below the critical angle (cosine 0.745)
+}
+
+// KNOWN FAILURE, a bug of lib/bsdf.glsl (reported, not fixed here): leaving the
+// volume past the critical angle (cosO < 0.745 at eta 1.5), pbrLobeProbabilities
+// takes the Fresnel at the macro-surface's cosine, which is 1 there, so the
+// transmission lobe gets probability 0; yet microfacets tilted towards wo do not
+// reflect totally and should transmit. Measured (2^16 samples): cosO 0.5 mean
+// 0.7245 +- 0.0015, expected 0.8271, Z -70; cosO 0.3 mean 0.7473 +- 0.0014,
+// expected 0.7972, Z -36 (the means are the reflection's share alone).
+TEST_F(PbrTransmissionProbe, VolumetricWhiteDielectricLeavingPastTheCriticalAngleStillTransmits)
+{
+    expectVolumetricAlbedo("leaving", 1.5, {0.5, 0.3});
 }
 
 /// Layer sets on a white base that could gain energy if a share were counted twice.
@@ -402,27 +426,53 @@ std::vector<TransmissionCase> energyCases()
     return cases;
 }
 
-TEST_F(PbrTransmissionProbe, NoLayerCombinationGainsEnergyOrGivesABadWeight)
+/// The mean weight of each case at each cosine is at most 1 (one-sided Z test,
+/// Sidak-corrected over cases, cosines and channels); no weight is negative or
+/// not finite.
+void expectNoGain(const std::vector<TransmissionCase>& cases, const std::vector<double>& cosines)
 {
     constexpr uint32_t kSamples = 1u << 15;
-    const std::vector<TransmissionCase> cases = energyCases();
-    const std::vector<double> cosines{0.8, 0.3}; // leaving at ior 1.5: below and past the critical angle (0.745)
     const double z = normalQuantile(sidakCorrectedAlpha(0.01, int(3 * cases.size() * cosines.size())));
-    double highest = 0.0;
     for (const TransmissionCase& c : cases)
         for (const double cosO : cosines) {
             SCOPED_TRACE(c.name + " cosO " + std::to_string(cosO));
             const MeanWeight w = meanWeight(sampleOnGpu(c, direction(cosO, 0.7), kSamples, 17.0f));
             EXPECT_EQ(w.nonFinite, 0);
             EXPECT_EQ(w.negative, 0);
-            for (int k = 0; k < 3; ++k) {
+            for (int k = 0; k < 3; ++k)
                 EXPECT_LE(w.mean[k], 1.0 + z * w.standardError[k] + 1e-6)
                     << "gains energy: channel " << k << " mean " << describe(w.mean) << " +- "
                     << describe(w.standardError);
-                highest = std::max(highest, w.mean[k]);
-            }
+            property("mean " + c.name + " cosO " + std::to_string(cosO), max3(w.mean));
         }
-    RecordProperty("highest mean", std::to_string(highest));
+}
+
+std::vector<TransmissionCase> energyCasesOn(bool leaving)
+{
+    std::vector<TransmissionCase> cases;
+    for (const TransmissionCase& c : energyCases())
+        if (c.volume && c.eta > 1.0 ? leaving : !leaving) cases.push_back(c);
+    return cases;
+}
+
+TEST_F(PbrTransmissionProbe, NoLayerCombinationGainsEnergyOrGivesABadWeight)
+{
+    expectNoGain(energyCasesOn(false), {0.3}); // grazing: the largest Fresnel
+    expectNoGain(energyCasesOn(true), {0.8}); // below the critical angle (cosine 0.745)
+}
+
+// KNOWN FAILURE (reported, not fixed here): leaving past the critical angle with
+// transmission 0.5, the reflection side's own f integrates to more than 1: the
+// specification's fresnel_mix gives the diffuse 1 - Fd(wo.h) per direction (the
+// gain GltfPbrReference.h notes for a white dielectric at grazing view), and
+// inside the volume Fd's total internal reflection makes the specular keep much
+// (0.746) while the diffuse half keeps 0.266 (quadrature, roughness 0.5, cosO
+// 0.3: 1.012). Measured: mean 1.016 +- 0.004. The sampler is not at fault
+// there; transmission, which that sampler then never picks (see above), would
+// add 0.025 more.
+TEST_F(PbrTransmissionProbe, NoLayerCombinationGainsEnergyLeavingPastTheCriticalAngle)
+{
+    expectNoGain(energyCasesOn(true), {0.3});
 }
 
 /// Geometry and sampling cases without sheen (its table is the GPU's alone).
@@ -480,7 +530,7 @@ TEST_F(PbrTransmissionProbe, TransmittedSamplesAreMirrorsOrRefractionsWithTheirW
         EXPECT_GT(transmitted, kSamples / 10);
         EXPECT_EQ(wrongGeometry, 0) << firstWrong;
         EXPECT_EQ(wrongWeight, 0) << "worst relative error " << worstWeight << "; first: " << firstWrong;
-        RecordProperty("worst weight error " + c.name, std::to_string(worstWeight));
+        property("worst weight error " + c.name, worstWeight);
     }
 }
 
@@ -506,7 +556,7 @@ TEST_F(PbrTransmissionProbe, DirectionsFollowTheirDensityChiSquare)
         const ChiSquareResult result = chiSquareTest(
             directions, none, [&](const glm::dvec3& w) { return samplerPdf(c, wo, w); }, options);
         EXPECT_TRUE(result.passes(alpha)) << "p = " << result.pValue << " (alpha " << alpha << ")\n" << result.table;
-        RecordProperty("p " + c.name, std::to_string(result.pValue));
+        property("p " + c.name, result.pValue);
     }
 }
 
