@@ -13,6 +13,11 @@
 // layers at inputs[31 .. 37] (sheenColor, sheenRoughness, specularFactor,
 // clearcoat, clearcoatAlpha), the sheen table at inputs[128 ..] (Material::table
 // = 128) and mode 1's directions after it, at inputs[kDirectionsAt ..].
+// With VKRT_PBR_TRANSMISSION also (tests/gpu/pbr_transmission_probe_test.cpp):
+// m.transmission at inputs[38], m.pbrFlags at inputs[39] (PBR_FLAG_VOLUME for
+// a volume's boundary). A volume's interface eta, m.exponent, is inputs[28]:
+// withInterfaceEta puts it there as the integrators do (lib/path.glsl), and
+// sampleBsdf gets the same eta.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "probe.glsl"
@@ -58,6 +63,10 @@ Material probeMaterial()
     m.specularFactor = inputs[35];
     m.clearcoat = inputs[36];
     m.clearcoatAlpha = inputs[37];
+#endif
+#ifdef VKRT_PBR_TRANSMISSION
+    m.transmission = inputs[38];
+    m.pbrFlags = uint(inputs[39]);
 #endif
     return m;
 }
