@@ -15,8 +15,8 @@
 //    (chi-square with Walter's Jacobian, Sidak-corrected);
 //  - partial transmission takes its share of the diffuse only: evalBsdf equals
 //    the reference's specular part plus (1 - transmission) x its diffuse part.
-// Two tests fail on purpose, each marked KNOWN FAILURE: they found faults of
-// lib/bsdf.glsl leaving a volume past the critical angle, reported to be fixed there.
+// The two tests past the critical angle found faults of lib/bsdf.glsl, since
+// fixed (their comments say what they measured before).
 #include "material/Ggx.h"
 #include "material/Sheen.h"
 #include "shared/SceneTypes.h"
@@ -156,12 +156,14 @@ glm::dvec4 lobeProbabilities(const TransmissionCase& tc, double cosO)
     const double coat = coatWeight(p, cosO);
     const double fd = max3(dielectricFresnel(tc, cosO));
     const double specular = p.metallic + (1.0 - p.metallic) * fd;
-    const double below = (1.0 - p.metallic) * (1.0 - fd) * luminance(p.baseColor);
-    const double transmitted = below * tc.transmission;
-    const double total = specular + below;
+    const double below = (1.0 - p.metallic) * luminance(p.baseColor);
+    // Transmission keeps a tenth of its share where Fd(cosO) reaches 1 (past
+    // the critical angle, leaving a volume), where tilted microfacets still transmit.
+    const double transmitted = below * tc.transmission * std::max(1.0 - fd, 0.1);
+    const double cosine = below * (1.0 - fd) * (1.0 - tc.transmission);
+    const double total = specular + cosine + transmitted;
     if (!(total > 0.0)) return {coat, 1.0 - coat, 0.0, 0.0};
-    return {coat, (1.0 - coat) * specular / total, (1.0 - coat) * (below - transmitted) / total,
-            (1.0 - coat) * transmitted / total};
+    return {coat, (1.0 - coat) * specular / total, (1.0 - coat) * cosine / total, (1.0 - coat) * transmitted / total};
 }
 
 /// The microfacet normal a transmitted direction came from: the mirrored
@@ -372,8 +374,8 @@ TEST_F(PbrTransmissionProbe, VolumetricWhiteDielectricKeepsItsSingleScatteringAl
     expectVolumetricAlbedo("leaving", 1.5, {0.9, 0.78}); // below the critical angle (cosine 0.745)
 }
 
-// KNOWN FAILURE, a bug of lib/bsdf.glsl (reported, not fixed here): leaving the
-// volume past the critical angle (cosO < 0.745 at eta 1.5), pbrLobeProbabilities
+// Found a bug of lib/bsdf.glsl, fixed (transmission now keeps a tenth of its
+// sampling share there): leaving the volume past the critical angle (cosO < 0.745 at eta 1.5), pbrLobeProbabilities
 // takes the Fresnel at the macro-surface's cosine, which is 1 there, so the
 // transmission lobe gets probability 0; yet microfacets tilted towards wo do not
 // reflect totally and should transmit. Measured (2^16 samples): cosO 0.5 mean
@@ -461,7 +463,8 @@ TEST_F(PbrTransmissionProbe, NoLayerCombinationGainsEnergyOrGivesABadWeight)
     expectNoGain(energyCasesOn(true), {0.8}); // below the critical angle (cosine 0.745)
 }
 
-// KNOWN FAILURE (reported, not fixed here): leaving past the critical angle with
+// Found a gain, fixed (inside a volume the diffuse also loses Fd(cosO):
+// lib/bsdf.glsl pbrDiffuseFresnel): leaving past the critical angle with
 // transmission 0.5, the reflection side's own f integrates to more than 1: the
 // specification's fresnel_mix gives the diffuse 1 - Fd(wo.h) per direction (the
 // gain GltfPbrReference.h notes for a white dielectric at grazing view), and
