@@ -204,8 +204,10 @@ double samplerPdf(const TransmissionCase& tc, const glm::dvec3& wo, const glm::d
     return p.w * base.visibleNormalPdf(wo, h) * std::abs(cosIH) / (denominator * denominator);
 }
 
-/// A transmitted sample's weight: baseColor (1 - metallic) transmission
-/// (1 - max3 Fd(wo.h)) (1 - coat) G2(wo, wi) / G1(wo) / p.w (cases without sheen).
+/// A transmitted sample's weight: tint (1 - metallic) transmission
+/// (1 - max3 Fd(wo.h)) (1 - coat) G2(wo, wi) / G1(wo) / p.w (cases without sheen);
+/// the tint is baseColor through a thin wall and sqrt(baseColor) at each of a
+/// volume's two crossings, so that a closed object tints by baseColor once.
 glm::dvec3 transmissionWeight(const TransmissionCase& tc, const glm::dvec3& wo, const glm::dvec3& wi,
                               const glm::dvec3& h)
 {
@@ -214,7 +216,8 @@ glm::dvec3 transmissionWeight(const TransmissionCase& tc, const glm::dvec3& wo, 
     const double shadowing = (1.0 + lambdaO) / (1.0 + lambdaO + lambdaI);
     const double layers = (1.0 - tc.p.metallic) * tc.transmission *
                           (1.0 - max3(dielectricFresnel(tc, glm::dot(wo, h)))) * (1.0 - coatWeight(tc.p, wo.z));
-    return tc.p.baseColor * (layers * shadowing / lobeProbabilities(tc, wo.z).w);
+    const glm::dvec3 tint = tc.volume ? glm::sqrt(tc.p.baseColor) : tc.p.baseColor;
+    return tint * (layers * shadowing / lobeProbabilities(tc, wo.z).w);
 }
 
 /// The white metal's (baseColor 1, metallic 1: F = 1) directional albedo from
