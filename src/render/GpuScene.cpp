@@ -565,7 +565,7 @@ uint32_t tileStrideFor(uint32_t tileCount)
     return 1;
 }
 
-/// The dielectric objects the eye is inside (spheres, boxes, the back side of
+/// The dielectric (and volumetric pbr) objects the eye is inside (spheres, boxes, the back side of
 /// planes), outermost first, at most MEDIUM_STACK_DEPTH of the innermost.
 /// Decided in double on the world coordinates. Nesting order comes from the
 /// distance between the eye and each boundary: for A inside B, the eye is
@@ -575,9 +575,11 @@ uint32_t tileStrideFor(uint32_t tileCount)
 std::vector<uint32_t> mediaAroundCamera(const Scene& scene)
 {
     std::vector<std::pair<double, uint32_t>> around; // (distance to the boundary, material)
+    // A volumetric pbr material bounds a medium as the dielectrics do (lib/media.glsl).
     auto dielectric = [&](uint32_t m) {
-        return scene.materials[m].type == MaterialType::Dielectric ||
-               scene.materials[m].type == MaterialType::RoughDielectric;
+        const Material& material = scene.materials[m];
+        return material.type == MaterialType::Dielectric || material.type == MaterialType::RoughDielectric ||
+               (material.type == MaterialType::Pbr && material.layers.volumetric());
     };
     const glm::dvec3 eye = scene.camera.eye;
     for (size_t i = 0; i < scene.spheres.size(); ++i) {

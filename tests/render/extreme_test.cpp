@@ -913,6 +913,43 @@ std::string mediaNames(const Scene& scene, const std::vector<uint32_t>& media)
     return names + "]";
 }
 
+// A volumetric pbr material (transmission with thin_walled = false) bounds a
+// medium as glass does, so a camera inside it starts in it; a thin-walled or
+// opaque pbr sphere around the camera bounds none.
+TEST(MediaAroundCamera, VolumetricPbrSpheresCountThinWalledOnesDoNot)
+{
+    const Scene scene = parseSceneString(R"([camera]
+eye = [0, 0, 0]
+target = [0, 0, -1]
+fov = 45
+[materials.volume]
+type = "pbr"
+transmission = 1
+thin_walled = false
+[materials.thin]
+type = "pbr"
+transmission = 1
+[materials.opaque]
+type = "pbr"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 3
+material = "volume"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 2
+material = "thin"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "opaque"
+)");
+    EXPECT_EQ(mediaAroundCamera(scene), (std::vector<uint32_t>{0u}));
+}
+
 // The camera inside an absorbing sphere nested in a sphere of another
 // absorption: the camera ray must start in the inner medium (host), switch to
 // the outer one at the inner interface (stack pop) without bending (eta =
