@@ -71,10 +71,10 @@ struct Material {
     float specularFactor;      // pbr: KHR_materials_specular's strength (dielectric F90; scales F0)
     float clearcoat;           // pbr: KHR_materials_clearcoat's factor (0: no coat)
     float clearcoatAlpha;      // pbr: the coat's GGX alpha, clearcoatRoughness^2 (>= MIN_GGX_ALPHA)
-    float transmission;        // pbr: KHR_materials_transmission's factor (0: opaque; variants with VKRT_PBR_TRANSMISSION)
-    uint pbrFlags;             // pbr: PBR_FLAG_* below
-    float iridescence;         // pbr: KHR_materials_iridescence's factor (0: none; variants with VKRT_PBR_IRIDESCENCE)
-    float iridescenceIor;      // pbr: the thin film's index
+    float transmission;   // pbr: KHR_materials_transmission's factor (0: opaque; variants with VKRT_PBR_TRANSMISSION)
+    uint pbrFlags;        // pbr: PBR_FLAG_* below
+    float iridescence;    // pbr: KHR_materials_iridescence's factor (0: none; variants with VKRT_PBR_IRIDESCENCE)
+    float iridescenceIor; // pbr: the thin film's index
     float iridescenceThicknessMin; // pbr: the film's thickness in nm where its thickness texture reads 0
     float iridescenceThickness;    // pbr: ... where it reads 1, and the thickness without a texture
 };
@@ -118,9 +118,9 @@ struct Plane {
 };
 
 // Mesh::flags
-VKRT_CONSTANT(uint, MESH_FLAG_NORMALS, 1)   // meshNormals holds shading normals for its triangles
-VKRT_CONSTANT(uint, MESH_FLAG_EMISSIVE, 2)  // its triangles are emitters firstEmitter, ...
-VKRT_CONSTANT(uint, MESH_FLAG_TWO_SIDED, 4) // they emit on both sides
+VKRT_CONSTANT(uint, MESH_FLAG_NORMALS, 1)    // meshNormals holds shading normals for its triangles
+VKRT_CONSTANT(uint, MESH_FLAG_EMISSIVE, 2)   // its triangles are emitters firstEmitter, ...
+VKRT_CONSTANT(uint, MESH_FLAG_TWO_SIDED, 4)  // they emit on both sides
 VKRT_CONSTANT(uint, MESH_FLAG_UVS, 8)        // meshUvs holds its triangles' texture coordinates
 VKRT_CONSTANT(uint, MESH_FLAG_TANGENTS, 16)  // meshTangents holds its triangles' tangents
 VKRT_CONSTANT(uint, MESH_FLAG_MATERIALS, 32) // meshMaterials holds each triangle's material (file materials)
@@ -144,7 +144,7 @@ struct Mesh {
     uint firstTriangle; // its geometry's first MeshTriangle in meshTriangles
     uint firstNormals;  // its geometry's first MeshNormals in meshNormals (MESH_FLAG_NORMALS)
     uint flags;
-    uint firstEmitter;  // its first triangle's Emitter (MESH_FLAG_EMISSIVE)
+    uint firstEmitter; // its first triangle's Emitter (MESH_FLAG_EMISSIVE)
 };
 
 /// Shading normals at a mesh triangle's three vertices (object space; a zero
@@ -320,15 +320,15 @@ struct SceneUniforms {
     uint maxDepth;
     VKRT_SHAPE_KINDS(VKRT_COUNT_MEMBER)
     VKRT_LIGHT_KINDS(VKRT_COUNT_MEMBER)
-    uint tileCount;         // workgroup tiles in the image
-    uint tileStride;        // coprime to tileCount: scatters tiles over the image
-    uint environmentSize;   // cubemap face width N (0 without a cubemap)
-    uint cameraMediumCount; // dielectrics containing the eye (lib/media.glsl)
-    uvec4 cameraMedia;      // their materials, innermost last
-    uint emitterCount;      // Emitter records (triangle lights, then emissive mesh triangles)
-    uint topNodeCount;      // nodes of the top-level BVH (0: none; the kernel loops over the arrays)
-    float apertureRadius;   // thin lens (VKRT_THIN_LENS): the lens's radius, scene units
-    float focusDistance;    // ... and the plane in focus's distance along cameraForward
+    uint tileCount;          // workgroup tiles in the image
+    uint tileStride;         // coprime to tileCount: scatters tiles over the image
+    uint environmentSize;    // cubemap face width N (0 without a cubemap)
+    uint cameraMediumCount;  // dielectrics containing the eye (lib/media.glsl)
+    uvec4 cameraMedia;       // their materials, innermost last
+    uint emitterCount;       // Emitter records (triangle lights, then emissive mesh triangles)
+    uint topNodeCount;       // nodes of the top-level BVH (0: none; the kernel loops over the arrays)
+    float apertureRadius;    // thin lens (VKRT_THIN_LENS): the lens's radius, scene units
+    float focusDistance;     // ... and the plane in focus's distance along cameraForward
     uvec2 environmentExtent; // lat-long map (VKRT_HAS_LATLONG): width W, height H in texels
     uvec2 environmentGrid;   // its sampling grid: columns, rows (render/EnvironmentSampling.h)
     uint environmentBlock;   // bilinear cells a side per grid cell

@@ -88,16 +88,16 @@ VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR, 1)  // specular / reflectance / tint 
 VKRT_CONSTANT(uint, TEXTURE_SLOT_ROUGHNESS, 2) // perceptual roughness: alpha scales by texel^2
 VKRT_CONSTANT(uint, TEXTURE_SLOT_METALLIC, 3)  // pbr metallic
 // The pbr material's glTF extension layers (variants with VKRT_PBR_LAYERS):
-VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR_FACTOR, 4)     // KHR_materials_specular specularTexture (A)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_COLOR, 5)         // KHR_materials_sheen sheenColorTexture (sRGB)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_ROUGHNESS, 6)     // sheenRoughnessTexture (A)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT, 7)           // KHR_materials_clearcoat clearcoatTexture (R)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, 8) // clearcoatRoughnessTexture (G): alpha scales by texel^2
-VKRT_CONSTANT(uint, TEXTURE_SLOT_TRANSMISSION, 9)        // KHR_materials_transmission transmissionTexture (R)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE, 10)         // KHR_materials_iridescence iridescenceTexture (R)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SPECULAR_FACTOR, 4)        // KHR_materials_specular specularTexture (A)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_COLOR, 5)            // KHR_materials_sheen sheenColorTexture (sRGB)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_SHEEN_ROUGHNESS, 6)        // sheenRoughnessTexture (A)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT, 7)              // KHR_materials_clearcoat clearcoatTexture (R)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, 8)    // clearcoatRoughnessTexture (G): alpha scales by texel^2
+VKRT_CONSTANT(uint, TEXTURE_SLOT_TRANSMISSION, 9)           // KHR_materials_transmission transmissionTexture (R)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE, 10)           // KHR_materials_iridescence iridescenceTexture (R)
 VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE_THICKNESS, 11) // iridescenceThicknessTexture (G): mixes the
                                                             // thickness from its minimum (0) to its maximum (1)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 12)   // tangent-space normal map (rgb = (n + 1) / 2)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 12)                // tangent-space normal map (rgb = (n + 1) / 2)
 VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 13) // emitted radiance (glTF emissiveTexture, sRGB): read by the
                                                // emitters (lib/emitters.glsl), not by texturedMaterial
 VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 14)

@@ -171,7 +171,6 @@ std::vector<std::string> materialProblems(const json& material)
     return out;
 }
 
-
 } // namespace
 
 std::string readGltfJson(const fs::path& file)
@@ -340,7 +339,6 @@ uint64_t saturatingMultiply(uint64_t a, uint64_t b)
     return __builtin_mul_overflow(a, b, &product) ? UINT64_MAX : product;
 }
 
-
 /// An accessor's `count` (clamped far above any bound), or 0 when `index` names none.
 uint64_t accessorCount(const json* accessors, std::optional<uint32_t> index)
 {
@@ -379,7 +377,8 @@ std::vector<uint64_t> meshTriangles(const json& doc)
 
 /// How many times the reader reaches each node: once per listing of it or
 /// of an ancestor among the roots of the default scene (`scene`, or 0;
-/// another scene chosen with --scene is bounded by the reader's own walk). Parents come before children in a walk down from the forest's roots.
+/// another scene chosen with --scene is bounded by the reader's own walk). Parents come before children in a walk down
+/// from the forest's roots.
 std::vector<uint64_t> importsPerNode(const json& doc, const json& nodes, const std::vector<uint32_t>& parent)
 {
     std::vector<uint64_t> times(nodes.size(), 0);
@@ -711,7 +710,8 @@ struct MaterialReader {
     void readImage(uint32_t index, FileTexture& texture) const
     {
         const json* image = element(arrayMember(doc, "images"), index);
-        if (!image || !image->is_object()) malformed("names image " + std::to_string(index) + ", which the file does not have");
+        if (!image || !image->is_object())
+            malformed("names image " + std::to_string(index) + ", which the file does not have");
         const json* uri = member(*image, "uri");
         if (uri && uri->is_string() && uri->get<std::string>().rfind("data:", 0) != 0) {
             const std::string text = uri->get<std::string>();
@@ -785,8 +785,8 @@ struct MaterialReader {
         }
         out.emissiveFactor = glm::vec3(colour(&m, "emissiveFactor", glm::vec4(0.0f), 3, true));
         out.emissiveTexture = texture(member(m, "emissiveTexture"), "emissiveTexture");
-        const std::string mode = member(m, "alphaMode") && m["alphaMode"].is_string() ? m["alphaMode"].get<std::string>()
-                                                                                     : "OPAQUE";
+        const std::string mode =
+            member(m, "alphaMode") && m["alphaMode"].is_string() ? m["alphaMode"].get<std::string>() : "OPAQUE";
         if (mode == "MASK") out.alphaMode = AlphaMode::Mask;
         else if (mode == "BLEND") out.alphaMode = AlphaMode::Blend;
         else if (mode != "OPAQUE") malformed("alphaMode must be OPAQUE, MASK or BLEND, not '" + mode + "'");
@@ -853,8 +853,7 @@ struct MaterialReader {
             out.clearcoatFactor = unitFactor(e, "clearcoatFactor", out.clearcoatFactor);
             out.clearcoatTexture = layerTexture(*e, "clearcoatTexture");
             out.clearcoatRoughnessFactor = unitFactor(e, "clearcoatRoughnessFactor", out.clearcoatRoughnessFactor);
-            out.clearcoatRoughnessTexture =
-                layerTexture(*e, "clearcoatRoughnessTexture");
+            out.clearcoatRoughnessTexture = layerTexture(*e, "clearcoatRoughnessTexture");
             out.clearcoatNormalTexture = layerTexture(*e, "clearcoatNormalTexture");
         }
     }
@@ -870,11 +869,10 @@ std::string describeMaterial(size_t index, const json& material)
 
 std::vector<const std::optional<FileTexture>*> FileMaterial::textureSlots() const
 {
-    return {&baseColorTexture,      &metallicRoughnessTexture, &normalTexture,
-            &emissiveTexture,       &specularTexture,          &specularColorTexture,
-            &sheenColorTexture,     &sheenRoughnessTexture,    &clearcoatTexture,
-            &clearcoatRoughnessTexture, &clearcoatNormalTexture, &transmissionTexture,
-            &iridescenceTexture,    &iridescenceThicknessTexture};
+    return {&baseColorTexture,   &metallicRoughnessTexture,   &normalTexture,          &emissiveTexture,
+            &specularTexture,    &specularColorTexture,       &sheenColorTexture,      &sheenRoughnessTexture,
+            &clearcoatTexture,   &clearcoatRoughnessTexture,  &clearcoatNormalTexture, &transmissionTexture,
+            &iridescenceTexture, &iridescenceThicknessTexture};
 }
 
 std::vector<uint8_t> decodeBase64(std::string_view text)
@@ -928,6 +926,5 @@ std::vector<FileMaterial> readGltfMaterials(const json& doc, const fs::path& fil
     materials.emplace_back(); // glTF's default material, for primitives without one
     return materials;
 }
-
 
 } // namespace vkrt

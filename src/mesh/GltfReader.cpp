@@ -33,7 +33,10 @@ using namespace gltf_json;
 
 [[noreturn]] void fail(const fs::path& file, const std::string& what) { throw InputError(file.string() + ": " + what); }
 
-std::string indexed(const char* array, uint64_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
+std::string indexed(const char* array, uint64_t index)
+{
+    return std::string(array) + "[" + std::to_string(index) + "]";
+}
 
 // ------------------------------------------------------------------ buffers
 
@@ -260,7 +263,7 @@ uint32_t componentsOf(const std::string& type)
 /// Accessor `index`, of one of the `allowed` element sizes, sparse substitution applied.
 template <class T = float>
 Accessor<T> readAccessor(const Document& d, uint64_t index, std::initializer_list<uint32_t> allowed,
-                      const std::string& where)
+                         const std::string& where)
 {
     const std::string name = indexed("accessors", index);
     const json& a = d.element("accessors", index, where);
@@ -330,8 +333,7 @@ std::vector<glm::uvec3> assembleTriangles(const std::vector<uint32_t>& v, uint32
     if (mode == kTriangles)
         for (size_t i = 0; i + 2 < v.size(); i += 3) triangles.push_back({v[i], v[i + 1], v[i + 2]});
     if (mode == kStrip)
-        for (size_t i = 0; i + 2 < v.size(); ++i)
-            triangles.push_back({v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]});
+        for (size_t i = 0; i + 2 < v.size(); ++i) triangles.push_back({v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]});
     if (mode == kFan)
         for (size_t i = 1; i + 1 < v.size(); ++i) triangles.push_back({v[i], v[i + 1], v[0]});
     return triangles;
@@ -419,13 +421,16 @@ struct MeshBuilder {
         if (!material.normalTexture) return;
         const uint32_t set = material.normalTexture->texCoord;
         if (normalMapSet && *normalMapSet != set)
-            warnOnce(where + ": the mesh's normal maps read both TEXCOORD_0 and TEXCOORD_1; its tangents follow "
-                             "TEXCOORD_" + std::to_string(*normalMapSet));
+            warnOnce(where +
+                     ": the mesh's normal maps read both TEXCOORD_0 and TEXCOORD_1; its tangents follow "
+                     "TEXCOORD_" +
+                     std::to_string(*normalMapSet));
         if (!normalMapSet) normalMapSet = set;
     }
 
     /// Appends one vertex's uv of `uvs` (zero without), v turned up (MeshData.h).
-    void appendUv(std::vector<glm::vec2>& to, const std::optional<Accessor<>>& uvs, uint64_t i, const std::string& where)
+    void appendUv(std::vector<glm::vec2>& to, const std::optional<Accessor<>>& uvs, uint64_t i,
+                  const std::string& where)
     {
         glm::vec2 uv(0.0f);
         if (uvs) {
@@ -480,9 +485,8 @@ struct MeshBuilder {
             sequence.resize(a.count);
             for (uint64_t i = 0; i < a.count; ++i) {
                 if (a.values[i] >= count)
-                    fail(d.file, where + ".indices[" + std::to_string(i) + "] is " +
-                                     std::to_string(a.values[i]) + ", beyond the " + std::to_string(count) +
-                                     " vertices");
+                    fail(d.file, where + ".indices[" + std::to_string(i) + "] is " + std::to_string(a.values[i]) +
+                                     ", beyond the " + std::to_string(count) + " vertices");
                 sequence[i] = a.values[i];
             }
         } else {
@@ -610,8 +614,8 @@ glm::dmat4 localTransform(const fs::path& file, const json& node, const std::str
         if (!r->is_array() || r->size() != 4) fail(file, where + ".rotation: expected a quaternion of 4 numbers");
         for (int i = 0; i < 4; ++i) q[i] = finiteNumber(file, (*r)[size_t(i)], where + ".rotation");
     }
-    return trs(numbers3(file, node, "translation", glm::dvec3(0.0), where), unitQuaternion(file, q, where + ".rotation"),
-               numbers3(file, node, "scale", glm::dvec3(1.0), where));
+    return trs(numbers3(file, node, "translation", glm::dvec3(0.0), where),
+               unitQuaternion(file, q, where + ".rotation"), numbers3(file, node, "scale", glm::dvec3(1.0), where));
 }
 
 /// EXT_mesh_gpu_instancing's per-instance transforms (TRS), or one identity.
@@ -647,11 +651,13 @@ std::vector<glm::dmat4> instanceTransforms(const Document& d, const json& node, 
     out.reserve(count);
     for (uint64_t i = 0; i < count; ++i) {
         const glm::dvec3 translation = t ? glm::dvec3(t->at(i, 0), t->at(i, 1), t->at(i, 2)) : glm::dvec3(0.0);
-        const glm::dvec4 q = r ? glm::dvec4(r->at(i, 0), r->at(i, 1), r->at(i, 2), r->at(i, 3)) : glm::dvec4(0, 0, 0, 1);
+        const glm::dvec4 q =
+            r ? glm::dvec4(r->at(i, 0), r->at(i, 1), r->at(i, 2), r->at(i, 3)) : glm::dvec4(0, 0, 0, 1);
         const glm::dvec3 scale = s ? glm::dvec3(s->at(i, 0), s->at(i, 1), s->at(i, 2)) : glm::dvec3(1.0);
         if (!std::isfinite(glm::dot(translation, translation) + glm::dot(scale, scale)))
             fail(d.file, name + ": instance " + std::to_string(i) + " has a non-finite transform");
-        out.push_back(trs(translation, unitQuaternion(d.file, q, name + ".ROTATION[" + std::to_string(i) + "]"), scale));
+        out.push_back(
+            trs(translation, unitQuaternion(d.file, q, name + ".ROTATION[" + std::to_string(i) + "]"), scale));
     }
     return out;
 }
@@ -774,11 +780,11 @@ void walkNodes(const Document& d, GltfModel& model, std::optional<uint32_t> scen
                     model.lights.push_back({*index, visit.node, name, world});
         if (const json* children = arrayMember(node, "children"))
             for (size_t c = children->size(); c-- > 0;)
-                if (const json& child = (*children)[c]; child.is_number_unsigned() && child.get<uint64_t>() < nodes->size())
+                if (const json& child = (*children)[c];
+                    child.is_number_unsigned() && child.get<uint64_t>() < nodes->size())
                     stack.push_back({uint32_t(child.get<uint64_t>()), world});
     }
-    if (singular)
-        model.warnings.push_back("nodes with a zero scale (a singular transform) are not drawn");
+    if (singular) model.warnings.push_back("nodes with a zero scale (a singular transform) are not drawn");
 }
 
 // --------------------------------------------------- cameras and lights
@@ -893,11 +899,11 @@ void checkExtensions(const Document& d, GltfModel& model)
 const std::vector<std::string>& implementedGltfExtensions()
 {
     static const std::vector<std::string> names{
-        "KHR_lights_punctual",        "KHR_texture_transform", "KHR_materials_emissive_strength",
-        "KHR_materials_ior",          "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
-        "KHR_materials_unlit",        "KHR_materials_variants",
-        "KHR_materials_transmission", "KHR_materials_specular", "KHR_materials_sheen",
-        "KHR_materials_clearcoat",    "KHR_materials_iridescence",
+        "KHR_lights_punctual",       "KHR_texture_transform",  "KHR_materials_emissive_strength",
+        "KHR_materials_ior",         "KHR_mesh_quantization",  "EXT_mesh_gpu_instancing",
+        "KHR_materials_unlit",       "KHR_materials_variants", "KHR_materials_transmission",
+        "KHR_materials_specular",    "KHR_materials_sheen",    "KHR_materials_clearcoat",
+        "KHR_materials_iridescence",
         "KHR_materials_volume", // its attenuation (the thickness only decides thin-walled or not)
     };
     return names;
@@ -941,7 +947,8 @@ GltfModel readGltfModel(const fs::path& file, const GltfReadOptions& options)
 namespace {
 
 /// Appends one instance of `mesh` transformed by `world`, its materials renumbered through `materialMap`.
-void appendInstance(MeshData& out, const MeshData& mesh, const glm::dmat4& world, const std::vector<uint32_t>& materialMap)
+void appendInstance(MeshData& out, const MeshData& mesh, const glm::dmat4& world,
+                    const std::vector<uint32_t>& materialMap)
 {
     const auto base = uint32_t(out.positions.size());
     const glm::dmat3 linear(world);
@@ -982,7 +989,8 @@ MeshData flattenGltfModel(GltfModel model)
         triangles += model.meshes[i.mesh].triangles.size();
         vertices += model.meshes[i.mesh].positions.size();
     }
-    if (triangles == 0) fail(model.file, "no triangles in " + model.file.string() + " (its scene places no triangle mesh)");
+    if (triangles == 0)
+        fail(model.file, "no triangles in " + model.file.string() + " (its scene places no triangle mesh)");
     if (triangles > kMaxGltfTriangles)
         fail(model.file, "the node hierarchy instances meshes " + withThousands(model.instances.size()) + " times, " +
                              withThousands(triangles) + " triangles in all; vkrt reads at most " +

@@ -514,7 +514,7 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
             e.twoSided = mesh.twoSided ? 1u : 0u;
             e.radiance = toFloat(triangleEmission(scene, mesh, slot));
             e.textures = triangleEmissionTextured(scene, mesh, slot) ? triangleMaterialIndex(mesh, slot)
-                                                                    : gpu::NO_EMISSION_TEXTURE;
+                                                                     : gpu::NO_EMISSION_TEXTURE;
             e.uvs = at.firstTriangle + slot;
             data.emitters.push_back(withAliasEntry(e, fixed.emitters, firstEmitter));
         }
@@ -527,7 +527,8 @@ void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
     glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
     glm::dvec3 up = glm::cross(right, forward);
     // Perspective: scaled to the plane one unit ahead; orthographic: the view's half extents.
-    double halfHeight = camera.orthographic() ? camera.orthographicHeight / 2.0 : std::tan(glm::radians(camera.fovY) / 2.0);
+    double halfHeight =
+        camera.orthographic() ? camera.orthographicHeight / 2.0 : std::tan(glm::radians(camera.fovY) / 2.0);
     double halfWidth = halfHeight * double(camera.width) / double(camera.height);
     u.cameraRight = toFloat(right * halfWidth);
     u.cameraUp = toFloat(up * halfHeight);

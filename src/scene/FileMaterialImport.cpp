@@ -52,7 +52,8 @@ Color volumeAbsorption(const FileMaterial& f)
 {
     if (!(f.thicknessFactor > 0.0f) || !std::isfinite(f.attenuationDistance)) return Color(0.0);
     Color sigma;
-    for (int c = 0; c < 3; ++c) sigma[c] = -std::log(std::max(double(f.attenuationColor[c]), 1e-9)) / f.attenuationDistance;
+    for (int c = 0; c < 3; ++c)
+        sigma[c] = -std::log(std::max(double(f.attenuationColor[c]), 1e-9)) / f.attenuationDistance;
     return sigma;
 }
 
@@ -79,7 +80,8 @@ void addLayers(const FileMaterial& f, const std::filesystem::path& file, const S
     m.layers.iridescenceThicknessMin = f.iridescenceThicknessMinimum;
     m.layers.iridescenceThicknessMax = f.iridescenceThicknessMaximum;
     auto add = [&](const std::optional<FileTexture>& texture, bool linear, TextureSlot which, uint32_t channel) {
-        if (texture) m.textures[size_t(which)] = slot(addFileTexture(*texture, linear, file, where, atlas), *texture, channel);
+        if (texture)
+            m.textures[size_t(which)] = slot(addFileTexture(*texture, linear, file, where, atlas), *texture, channel);
     };
     add(f.specularTexture, true, TextureSlot::SpecularFactor, 3);
     add(f.specularColorTexture, false, TextureSlot::Specular, 0);

@@ -171,20 +171,20 @@ struct MaterialTexture {
 
 /// Which parameter a texture drives (gpu::TEXTURE_SLOT_*).
 enum class TextureSlot : uint32_t {
-    Color = gpu::TEXTURE_SLOT_COLOR,         ///< diffuse / albedo / base_color
-    Specular = gpu::TEXTURE_SLOT_SPECULAR,   ///< specular / reflectance / tint
-    Roughness = gpu::TEXTURE_SLOT_ROUGHNESS, ///< perceptual roughness
-    Metallic = gpu::TEXTURE_SLOT_METALLIC,   ///< pbr metallic
-    SpecularFactor = gpu::TEXTURE_SLOT_SPECULAR_FACTOR,         ///< pbr specular (A)
-    SheenColor = gpu::TEXTURE_SLOT_SHEEN_COLOR,                 ///< pbr sheen_color
-    SheenRoughness = gpu::TEXTURE_SLOT_SHEEN_ROUGHNESS,         ///< pbr sheen_roughness (A)
-    Clearcoat = gpu::TEXTURE_SLOT_CLEARCOAT,                    ///< pbr clearcoat (R)
-    ClearcoatRoughness = gpu::TEXTURE_SLOT_CLEARCOAT_ROUGHNESS, ///< pbr clearcoat_roughness (G)
-    Transmission = gpu::TEXTURE_SLOT_TRANSMISSION,              ///< pbr transmission (R)
-    Iridescence = gpu::TEXTURE_SLOT_IRIDESCENCE,                ///< pbr iridescence (R)
+    Color = gpu::TEXTURE_SLOT_COLOR,                                ///< diffuse / albedo / base_color
+    Specular = gpu::TEXTURE_SLOT_SPECULAR,                          ///< specular / reflectance / tint
+    Roughness = gpu::TEXTURE_SLOT_ROUGHNESS,                        ///< perceptual roughness
+    Metallic = gpu::TEXTURE_SLOT_METALLIC,                          ///< pbr metallic
+    SpecularFactor = gpu::TEXTURE_SLOT_SPECULAR_FACTOR,             ///< pbr specular (A)
+    SheenColor = gpu::TEXTURE_SLOT_SHEEN_COLOR,                     ///< pbr sheen_color
+    SheenRoughness = gpu::TEXTURE_SLOT_SHEEN_ROUGHNESS,             ///< pbr sheen_roughness (A)
+    Clearcoat = gpu::TEXTURE_SLOT_CLEARCOAT,                        ///< pbr clearcoat (R)
+    ClearcoatRoughness = gpu::TEXTURE_SLOT_CLEARCOAT_ROUGHNESS,     ///< pbr clearcoat_roughness (G)
+    Transmission = gpu::TEXTURE_SLOT_TRANSMISSION,                  ///< pbr transmission (R)
+    Iridescence = gpu::TEXTURE_SLOT_IRIDESCENCE,                    ///< pbr iridescence (R)
     IridescenceThickness = gpu::TEXTURE_SLOT_IRIDESCENCE_THICKNESS, ///< pbr iridescence_thickness (G: min to max)
-    Normal = gpu::TEXTURE_SLOT_NORMAL,       ///< tangent-space normal map
-    Emission = gpu::TEXTURE_SLOT_EMISSION,   ///< emitted radiance (glTF emissiveTexture; meshes only)
+    Normal = gpu::TEXTURE_SLOT_NORMAL,                              ///< tangent-space normal map
+    Emission = gpu::TEXTURE_SLOT_EMISSION, ///< emitted radiance (glTF emissiveTexture; meshes only)
 };
 inline constexpr size_t kTextureSlotCount = gpu::TEXTURE_SLOT_COUNT;
 
@@ -192,19 +192,19 @@ inline constexpr size_t kTextureSlotCount = gpu::TEXTURE_SLOT_COUNT;
 /// names and defaults; lib/bsdf.glsl evaluates them). The defaults leave the
 /// plain metallic-roughness material, and its kernel (FeatureSet::pbrLayers).
 struct PbrLayers {
-    double specular = 1.0;       ///< KHR_materials_specular specularFactor: dielectric F90, scales F0
-    Color specularColor{1.0};    ///< specularColorFactor: scales the dielectric F0 (may exceed 1)
-    Color sheenColor{0.0};       ///< KHR_materials_sheen sheenColorFactor
-    double sheenRoughness = 0.0; ///< sheenRoughnessFactor
-    double clearcoat = 0.0;      ///< KHR_materials_clearcoat clearcoatFactor
+    double specular = 1.0;           ///< KHR_materials_specular specularFactor: dielectric F90, scales F0
+    Color specularColor{1.0};        ///< specularColorFactor: scales the dielectric F0 (may exceed 1)
+    Color sheenColor{0.0};           ///< KHR_materials_sheen sheenColorFactor
+    double sheenRoughness = 0.0;     ///< sheenRoughnessFactor
+    double clearcoat = 0.0;          ///< KHR_materials_clearcoat clearcoatFactor
     double clearcoatRoughness = 0.0; ///< clearcoatRoughnessFactor (perceptual; alpha = roughness^2)
     double transmission = 0.0;       ///< KHR_materials_transmission transmissionFactor
     /// KHR_materials_volume absent or of thickness 0: transmitted light passes
     /// unrefracted and enters no medium. Otherwise the mesh bounds a volume of
     /// index `ior` absorbing by Material::absorption (attenuationColor and _Distance).
     bool thinWalled = true;
-    double iridescence = 0.0;            ///< KHR_materials_iridescence iridescenceFactor
-    double iridescenceIor = 1.3;         ///< iridescenceIor: the thin film's index
+    double iridescence = 0.0;               ///< KHR_materials_iridescence iridescenceFactor
+    double iridescenceIor = 1.3;            ///< iridescenceIor: the thin film's index
     double iridescenceThicknessMin = 100.0; ///< iridescenceThicknessMinimum (nm): where its texture reads 0
     double iridescenceThicknessMax = 400.0; ///< iridescenceThicknessMaximum (nm): where it reads 1; without one
 
@@ -260,10 +260,7 @@ struct Material {
     bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
 
-inline double Camera::resolvedFocusDistance() const
-{
-    return focusDistance.value_or(glm::length(target - eye));
-}
+inline double Camera::resolvedFocusDistance() const { return focusDistance.value_or(glm::length(target - eye)); }
 
 inline bool Material::hasTextures() const
 {
@@ -381,8 +378,8 @@ struct EnvironmentMap {
 };
 
 struct Background {
-    Color color{0.0};               ///< constant radiance when there is no map
-    std::optional<Cubemap> cubemap; ///< environment radiance from six faces
+    Color color{0.0};                          ///< constant radiance when there is no map
+    std::optional<Cubemap> cubemap;            ///< environment radiance from six faces
     std::optional<EnvironmentMap> environment; ///< ... or from a lat-long map
 };
 

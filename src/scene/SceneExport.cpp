@@ -284,7 +284,8 @@ void parameters(MaterialKindTag<MaterialType::Pbr>, MaterialWriter& w, Integrato
     w.textured("iridescence", layers.iridescence, TextureSlot::Iridescence);
     w.value("iridescence_ior", layers.iridescenceIor);
     w.textured("iridescence_thickness", layers.iridescenceThicknessMax, TextureSlot::IridescenceThickness);
-    w.value("iridescence_thickness_range", Json::array({layers.iridescenceThicknessMin, layers.iridescenceThicknessMax}));
+    w.value("iridescence_thickness_range",
+            Json::array({layers.iridescenceThicknessMin, layers.iridescenceThicknessMax}));
 }
 
 /// Every kind's parameters; a kind added to shared/Kinds.h without an overload above does not compile.
@@ -343,9 +344,12 @@ Aabb worldBounds(const Mesh& mesh)
 
 Json geometry(const MeshGeometry& g)
 {
-    return {{"vertices", g.data.positions.size()},      {"triangles", g.data.triangles.size()},
-            {"has_normals", !g.data.normals.empty()},   {"has_uvs", !g.data.uvs.empty()},
-            {"has_uvs1", !g.data.uvs1.empty()},         {"has_tangents", !g.data.tangents.empty()},
+    return {{"vertices", g.data.positions.size()},
+            {"triangles", g.data.triangles.size()},
+            {"has_normals", !g.data.normals.empty()},
+            {"has_uvs", !g.data.uvs.empty()},
+            {"has_uvs1", !g.data.uvs1.empty()},
+            {"has_tangents", !g.data.tangents.empty()},
             {"bounds", bounds(g.bounds)}};
 }
 

@@ -138,12 +138,28 @@ constexpr std::array<std::string_view, 8> conductorKeys{"type", "roughness", "an
 constexpr std::array<std::string_view, 6> rough_dielectricKeys{"type",       "roughness", "ior",
                                                                "absorption", "fresnel",   "normal_map"};
 constexpr std::array<std::string_view, 5> plasticKeys{"type", "diffuse", "roughness", "ior", "normal_map"};
-constexpr std::array<std::string_view, 22> pbrKeys{
-    "type",           "base_color",      "metallic",  "roughness",           "emission",
-    "normal_map",     "ior",             "specular",  "specular_color",      "sheen_color",
-    "sheen_roughness", "clearcoat",      "clearcoat_roughness", "transmission", "thin_walled",
-    "attenuation_color", "attenuation_distance", "iridescence", "iridescence_ior", "iridescence_thickness",
-    "iridescence_thickness_range", "absorption"};
+constexpr std::array<std::string_view, 22> pbrKeys{"type",
+                                                   "base_color",
+                                                   "metallic",
+                                                   "roughness",
+                                                   "emission",
+                                                   "normal_map",
+                                                   "ior",
+                                                   "specular",
+                                                   "specular_color",
+                                                   "sheen_color",
+                                                   "sheen_roughness",
+                                                   "clearcoat",
+                                                   "clearcoat_roughness",
+                                                   "transmission",
+                                                   "thin_walled",
+                                                   "attenuation_color",
+                                                   "attenuation_distance",
+                                                   "iridescence",
+                                                   "iridescence_ior",
+                                                   "iridescence_thickness",
+                                                   "iridescence_thickness_range",
+                                                   "absorption"};
 
 /// A colour parameter: a value, or a texture table whose texel is the colour
 /// (the constant becomes 1, which the texel multiplies on the GPU).
@@ -319,8 +335,7 @@ void readPbrTransmission(const TableField& table, Material& material, ParseConte
     const std::optional<Field> color = table.find("attenuation_color");
     const std::optional<Field> distance = table.find("attenuation_distance");
     const std::optional<Field> absorption = table.find("absorption");
-    if (thin && !layers.transmits())
-        thin->fail("applies to a transmitting material: set transmission above 0");
+    if (thin && !layers.transmits()) thin->fail("applies to a transmitting material: set transmission above 0");
     layers.thinWalled = thin ? readBool(*thin) : true;
     for (const std::optional<Field>& inside : {color, distance, absorption})
         if (inside && !layers.volumetric())
@@ -374,7 +389,8 @@ void readPbrLayers(const TableField& table, Material& material, ParseContext& co
 {
     material.ior = readOr(table, "ior", 1.5, readIor);
     PbrLayers& layers = material.layers;
-    layers.specular = readUnitParameter(table, "specular", 1.0, material, TextureSlot::SpecularFactor, context.textures);
+    layers.specular =
+        readUnitParameter(table, "specular", 1.0, material, TextureSlot::SpecularFactor, context.textures);
     if (const std::optional<Field> color = table.find("specular_color")) {
         if (isTextureTable(*color)) {
             material.textures[size_t(TextureSlot::Specular)] =

@@ -88,9 +88,10 @@ std::vector<FilmCase> referenceGrid()
         for (double film : {1.2, 1.35, 1.5, 1.7, 2.0})
             for (double c : {0.05, 0.2, 0.45, 0.7, 0.9, 1.0})
                 for (double f0 : {0.04, 0.1, 0.3, 0.6, 1.0})
-                    for (double d : {0.0, 0.001, 0.01, 0.5, 5.0, 20.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0,
-                                     500.0, 600.0, 700.0, 800.0, 1000.0, 1200.0})
-                        if (!totalInternalReflection(outside, film, c)) cases.push_back({outside, film, c, d, glm::dvec3(f0)});
+                    for (double d : {0.0, 0.001, 0.01, 0.5, 5.0, 20.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0,
+                                     600.0, 700.0, 800.0, 1000.0, 1200.0})
+                        if (!totalInternalReflection(outside, film, c))
+                            cases.push_back({outside, film, c, d, glm::dvec3(f0)});
     return cases;
 }
 
@@ -194,8 +195,8 @@ TEST_F(IridescenceProbe, AFilmOfThicknessZeroHasVanished)
         }
     }
     // A film 1 nm thick is there: its IOR changes the result.
-    const std::vector<glm::dvec3> thin = evaluateOnGpu({{1.0, 1.2, 0.7, 1.0, glm::dvec3(0.04)},
-                                                        {1.0, 2.0, 0.7, 1.0, glm::dvec3(0.04)}});
+    const std::vector<glm::dvec3> thin =
+        evaluateOnGpu({{1.0, 1.2, 0.7, 1.0, glm::dvec3(0.04)}, {1.0, 2.0, 0.7, 1.0, glm::dvec3(0.04)}});
     EXPECT_GT(maxAbs(thin[0] - thin[1]), 0.01);
 }
 

@@ -39,7 +39,7 @@
 namespace vkrt::test {
 namespace {
 
-constexpr size_t kSheenTableAt = 128; // bsdf_probe.comp's layout with VKRT_PBR_LAYERS
+constexpr size_t kSheenTableAt = 128;  // bsdf_probe.comp's layout with VKRT_PBR_LAYERS
 constexpr size_t kTransmissionAt = 38; // ... and with VKRT_PBR_TRANSMISSION: transmission, pbrFlags
 
 const std::vector<Define> kTransmission{{"VKRT_PBR_LAYERS", "1"}, {"VKRT_PBR_TRANSMISSION", "1"}};
@@ -49,8 +49,8 @@ struct TransmissionCase {
     std::string name;
     GltfPbrParams p;
     double transmission = 1.0;
-    bool volume = false;     ///< bounds a volume (PBR_FLAG_VOLUME): refracts; else thin-walled
-    double eta = 1.0 / 1.5;  ///< n_i / n_t of the crossing (a volume's; thin-walled: 1 / ior)
+    bool volume = false;    ///< bounds a volume (PBR_FLAG_VOLUME): refracts; else thin-walled
+    double eta = 1.0 / 1.5; ///< n_i / n_t of the crossing (a volume's; thin-walled: 1 / ior)
 };
 
 glm::dvec3 direction(double cosTheta, double phi)
@@ -70,13 +70,26 @@ std::vector<float> probeInput(const TransmissionCase& c, const glm::dvec3& wo, f
 {
     const GltfPbrParams& p = c.p;
     std::vector<float> in(kSheenTableAt, 0.0f);
-    const float material[] = {float(p.baseColor.x),     float(p.baseColor.y),     float(p.baseColor.z),
-                              float(gpu::MATERIAL_PBR), float(p.specularColor.x), float(p.specularColor.y),
-                              float(p.specularColor.z), 0.0f,                     0.0f,
-                              0.0f,                     0.0f,                     float(p.ior),
-                              0.0f,                     float(ggxAlpha(p.roughness)), float(ggxAlpha(p.roughness)),
-                              float(kSheenTableAt),     0.0f,                     0.0f,
-                              0.0f,                     float(p.metallic)};
+    const float material[] = {float(p.baseColor.x),
+                              float(p.baseColor.y),
+                              float(p.baseColor.z),
+                              float(gpu::MATERIAL_PBR),
+                              float(p.specularColor.x),
+                              float(p.specularColor.y),
+                              float(p.specularColor.z),
+                              0.0f,
+                              0.0f,
+                              0.0f,
+                              0.0f,
+                              float(p.ior),
+                              0.0f,
+                              float(ggxAlpha(p.roughness)),
+                              float(ggxAlpha(p.roughness)),
+                              float(kSheenTableAt),
+                              0.0f,
+                              0.0f,
+                              0.0f,
+                              float(p.metallic)};
     std::copy(std::begin(material), std::end(material), in.begin());
     in[25] = float(wo.x);
     in[26] = float(wo.y);
@@ -84,9 +97,14 @@ std::vector<float> probeInput(const TransmissionCase& c, const glm::dvec3& wo, f
     in[28] = float(c.eta);
     in[29] = mode;
     in[30] = seed;
-    const float layers[] = {float(p.sheenColor.x),   float(p.sheenColor.y), float(p.sheenColor.z),
-                            float(p.sheenRoughness), float(p.specular),     float(p.clearcoat),
-                            float(ggxAlpha(p.clearcoatRoughness)), float(c.transmission),
+    const float layers[] = {float(p.sheenColor.x),
+                            float(p.sheenColor.y),
+                            float(p.sheenColor.z),
+                            float(p.sheenRoughness),
+                            float(p.specular),
+                            float(p.clearcoat),
+                            float(ggxAlpha(p.clearcoatRoughness)),
+                            float(c.transmission),
                             float(c.volume ? gpu::PBR_FLAG_VOLUME : 0u)};
     std::copy(std::begin(layers), std::end(layers), in.begin() + 31);
     static_assert(31 + 7 == kTransmissionAt);
@@ -248,7 +266,8 @@ double overVisibleNormals(const Ggx& ggx, const glm::dvec3& wo, const Value& val
 /// A figure for the test's XML report (gtest attribute names: no spaces).
 void property(std::string key, double value)
 {
-    std::replace_if(key.begin(), key.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '.'; }, '_');
+    std::replace_if(
+        key.begin(), key.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '.'; }, '_');
     ::testing::Test::RecordProperty(key, std::to_string(value));
 }
 
@@ -365,8 +384,8 @@ void expectVolumetricAlbedo(const std::string& sideName, double eta, const std::
         const MeanWeight w = meanWeight(sampleOnGpu(c, wo, kSamples, 13.0f));
         const double score = (w.mean.x - expected) / w.standardError.x;
         EXPECT_LE(expected, 1.0);
-        EXPECT_LT(std::abs(score), z) << "mean " << w.mean.x << " +- " << w.standardError.x << ", expected "
-                                      << expected << ", Z " << score << " (bound " << z << ")";
+        EXPECT_LT(std::abs(score), z) << "mean " << w.mean.x << " +- " << w.standardError.x << ", expected " << expected
+                                      << ", Z " << score << " (bound " << z << ")";
         property("z " + name, score);
     }
 }
@@ -463,7 +482,7 @@ std::vector<TransmissionCase> energyCasesOn(bool leaving)
 TEST_F(PbrTransmissionProbe, NoLayerCombinationGainsEnergyOrGivesABadWeight)
 {
     expectNoGain(energyCasesOn(false), {0.3}); // grazing: the largest Fresnel
-    expectNoGain(energyCasesOn(true), {0.8}); // below the critical angle (cosine 0.745)
+    expectNoGain(energyCasesOn(true), {0.8});  // below the critical angle (cosine 0.745)
 }
 
 // Found a gain, fixed (inside a volume the diffuse also loses Fd(cosO):
@@ -484,8 +503,8 @@ TEST_F(PbrTransmissionProbe, NoLayerCombinationGainsEnergyLeavingPastTheCritical
 /// Geometry and sampling cases without sheen (its table is the GPU's alone).
 std::vector<std::pair<TransmissionCase, double>> directionCases()
 {
-    TransmissionCase layered{"grey, coat, specular colour, metallic 0.2, transmission 0.6, entering", {}, 0.6,
-                             true, 1.0 / 1.4};
+    TransmissionCase layered{
+        "grey, coat, specular colour, metallic 0.2, transmission 0.6, entering", {}, 0.6, true, 1.0 / 1.4};
     layered.p.baseColor = {0.8, 0.5, 0.2};
     layered.p.metallic = 0.2;
     layered.p.roughness = 0.7;
@@ -521,8 +540,8 @@ TEST_F(PbrTransmissionProbe, TransmittedSamplesAreMirrorsOrRefractionsWithTheirW
             // Volume: the generalized half vector points to +z entering, -z leaving (before
             // transmissionNormal turns it), and wo, wi lie on either side of it.
             const double orientation = c.volume ? -(c.eta * wo + wi).z * (c.eta < 1.0 ? 1.0 : -1.0) : 1.0;
-            const bool geometry = s.flags == 3u && std::abs(glm::length(wi) - 1.0) < 1e-5 && wi.z < 0.0 &&
-                                  h.z > 0.0 && glm::dot(wo, h) > 0.0 && orientation > 0.0 &&
+            const bool geometry = s.flags == 3u && std::abs(glm::length(wi) - 1.0) < 1e-5 && wi.z < 0.0 && h.z > 0.0 &&
+                                  glm::dot(wo, h) > 0.0 && orientation > 0.0 &&
                                   (c.volume ? glm::dot(wi, h) < 0.0 : glm::dot(mirrored(wi), h) > 0.0);
             const glm::dvec3 expected = transmissionWeight(c, wo, wi, h);
             const double error = glm::length(s.weight - expected) / glm::length(expected);

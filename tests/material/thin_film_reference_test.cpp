@@ -44,8 +44,8 @@ TEST(ThinFilmReference, AFilmMatchingTheOutsideIsInvisible)
             for (double c : kCosines)
                 for (double nm : kWavelengths) {
                     ThinFilm film{outside, outside, thickness, 0.2};
-                    EXPECT_NEAR(thinFilmReflectance(film, c, nm),
-                                dielectricFresnel(outside, baseIorFromF0(0.2), c), 1e-12);
+                    EXPECT_NEAR(thinFilmReflectance(film, c, nm), dielectricFresnel(outside, baseIorFromF0(0.2), c),
+                                1e-12);
                 }
 }
 
@@ -69,8 +69,8 @@ TEST(ThinFilmReference, ReflectanceStaysWithinZeroAndOne)
                     for (double c : {1.0, 0.7, 0.3, 0.1, 0.0})
                         for (double nm : kWavelengths) {
                             double r = thinFilmReflectance({outside, filmIor, thickness, f0}, c, nm);
-                            ASSERT_TRUE(r >= 0.0 && r <= 1.0 + 1e-12)
-                                << r << " at " << outside << " " << filmIor << " " << f0 << " " << thickness << " " << c;
+                            ASSERT_TRUE(r >= 0.0 && r <= 1.0 + 1e-12) << r << " at " << outside << " " << filmIor << " "
+                                                                      << f0 << " " << thickness << " " << c;
                         }
 }
 
@@ -96,10 +96,8 @@ TEST(ThinFilmReference, AQuarterWaveFilmGivesTheTextbookExtremum)
         EXPECT_NEAR(atLambda, expected, 1e-12) << n2;
         for (double offset : {-30.0, 30.0}) {
             double beside = thinFilmReflectance(film, 1.0, lambda + offset);
-            if (n2 < n3)
-                EXPECT_GT(beside, atLambda) << n2; // a minimum
-            else
-                EXPECT_LT(beside, atLambda) << n2; // a maximum
+            if (n2 < n3) EXPECT_GT(beside, atLambda) << n2; // a minimum
+            else EXPECT_LT(beside, atLambda) << n2;         // a maximum
         }
     }
     EXPECT_LT(std::pow((n1 * n3 - 1.38 * 1.38) / (n1 * n3 + 1.38 * 1.38), 2.0), f0OfIor(n3)); // it does coat

@@ -67,7 +67,8 @@ std::string loadError(const fs::path& file)
 
 bool mentions(const std::vector<std::string>& list, const std::string& word)
 {
-    return std::any_of(list.begin(), list.end(), [&](const std::string& s) { return s.find(word) != std::string::npos; });
+    return std::any_of(list.begin(), list.end(),
+                       [&](const std::string& s) { return s.find(word) != std::string::npos; });
 }
 
 std::string joined(const std::vector<std::string>& list)
@@ -152,7 +153,8 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1.0}}}],
   "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
   "samplers": [{"wrapS": 33071, "wrapT": 33648}],
-  "images": [{"uri": "base%20color.png"}, {"uri": ")" + dataUri("image/png", png) + R"("}])";
+  "images": [{"uri": "base%20color.png"}, {"uri": ")" +
+                             dataUri("image/png", png) + R"("}])";
     const MeshData mesh = loadMeshFile(writeFile(dir / "coated.gltf", triangleGltf(rest)));
     ASSERT_EQ(mesh.materials.size(), 1u);
     const FileMaterial& m = mesh.materials[0];
@@ -289,7 +291,8 @@ TEST(MeshFileMaterials, TrianglesKeepTheirMaterialsWhenAssimpRenumbersThem)
   "materials": [{"name": "A", "pbrMetallicRoughness": {"roughnessFactor": 0.125}}, {"name": "B"},
                 {"pbrMetallicRoughness": {"roughnessFactor": 0.875}, "extensions": {"KHR_materials_anisotropy": {}}}],
   "extensionsUsed": ["KHR_materials_anisotropy"],
-  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) + R"(", "byteLength": 108}],
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) +
+                             R"(", "byteLength": 108}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 108}],
   "accessors": [
     {"bufferView": 0, "byteOffset": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
@@ -329,10 +332,12 @@ TEST(MeshFileMaterials, EmbeddedImageInAGlb)
   "meshes": [{"primitives": [{"material": 0, "attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 3}]}],
   "materials": [{"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}}}],
   "textures": [{"source": 0}], "images": [{"bufferView": 4, "mimeType": "image/png"}],
-  "buffers": [{"byteLength": )" + std::to_string(bin.size()) + R"(}],
+  "buffers": [{"byteLength": )" +
+                       std::to_string(bin.size()) + R"(}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24},
                   {"buffer": 0, "byteOffset": 60, "byteLength": 24}, {"buffer": 0, "byteOffset": 84, "byteLength": 6},
-                  {"buffer": 0, "byteOffset": 92, "byteLength": )" + std::to_string(png.size()) + R"(}],
+                  {"buffer": 0, "byteOffset": 92, "byteLength": )" +
+                       std::to_string(png.size()) + R"(}],
   "accessors": [
     {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
     {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
@@ -443,7 +448,8 @@ TEST(MeshFileMaterials, AccessorBeyondItsBufferViewIsAnErrorNotAnOverflow)
     std::string buffer(108, '\0');
     const std::string json = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) + R"(", "byteLength": 108}],
+  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) +
+                             R"(", "byteLength": 108}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 108}],
   "accessors": [{"bufferView": 0, "byteOffset": 72, "componentType": 5126, "count": 6, "type": "VEC3"}]})";
     const fs::path file = writeFile(testDir() / "overflow.gltf", json);

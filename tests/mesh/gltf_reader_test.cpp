@@ -36,8 +36,11 @@ class GltfBuilder {
 public:
     GltfBuilder()
     {
-        m_doc = {{"asset", {{"version", "2.0"}}}, {"bufferViews", json::array()}, {"accessors", json::array()},
-                 {"meshes", json::array()}, {"nodes", json::array()}};
+        m_doc = {{"asset", {{"version", "2.0"}}},
+                 {"bufferViews", json::array()},
+                 {"accessors", json::array()},
+                 {"meshes", json::array()},
+                 {"nodes", json::array()}};
     }
 
     /// An accessor over tightly packed values of one component type.
@@ -48,7 +51,8 @@ public:
         align();
         const size_t offset = m_bin.size();
         for (T v : values) put(m_bin, v);
-        m_doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
+        m_doc["bufferViews"].push_back(
+            {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
         json a = {{"bufferView", m_doc["bufferViews"].size() - 1},
                   {"componentType", componentType},
                   {"count", values.size() / components},
@@ -82,7 +86,8 @@ public:
     fs::path write(const std::string& name)
     {
         json doc = m_doc;
-        doc["buffers"] = json::array({{{"byteLength", m_bin.size()}, {"uri", dataUri("application/octet-stream", m_bin)}}});
+        doc["buffers"] =
+            json::array({{{"byteLength", m_bin.size()}, {"uri", dataUri("application/octet-stream", m_bin)}}});
         const fs::path path = testDir() / name;
         std::ofstream(path) << doc.dump();
         return path;
@@ -367,7 +372,8 @@ TEST(GltfReader, ANegativeScaleKeepsTheFrontSide)
     b.node({{"mesh", b.mesh({{"POSITION", positions}, {"NORMAL", normals}})}, {"scale", {-1.0, 1.0, 1.0}}});
     const MeshData flat = loadMeshFile(b.write("mirror.gltf"));
     const glm::uvec3 t = flat.triangles[0];
-    const glm::vec3 winding = glm::cross(flat.positions[t.y] - flat.positions[t.x], flat.positions[t.z] - flat.positions[t.x]);
+    const glm::vec3 winding =
+        glm::cross(flat.positions[t.y] - flat.positions[t.x], flat.positions[t.z] - flat.positions[t.x]);
     EXPECT_GT(glm::dot(winding, flat.normals[t.x]), 0.0f);
     EXPECT_EQ(flat.normals[t.x], glm::vec3(0, 0, 1));
 }

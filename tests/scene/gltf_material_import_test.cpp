@@ -27,9 +27,9 @@ Scene importOne(const std::string& name, const std::string& material, const std:
 {
     const fs::path dir = freshTempDir("gltf-material-import");
     write8BitPng(dir / "grey.png", 2, 2, 4, std::vector<uint8_t>(16, 128));
-    writeText(dir / (name + ".gltf"),
-              triangleGltf(R"("materials": [)" + material + R"(], "textures": [{"source": 0}],
-                             "images": [{"uri": "grey.png"}], "extensionsUsed": )" + used));
+    writeText(dir / (name + ".gltf"), triangleGltf(R"("materials": [)" + material + R"(], "textures": [{"source": 0}],
+                             "images": [{"uri": "grey.png"}], "extensionsUsed": )" +
+                                                   used));
     return parseGltfScene((dir / (name + ".gltf")).string());
 }
 
@@ -43,7 +43,7 @@ TEST(GltfMaterialImport, PbrLayersTakeTheirFactorsAndTexturesInTheirChannels)
                                 "sheenRoughnessTexture": {"index": 0}},
         "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.1,
                                     "clearcoatTexture": {"index": 0}, "clearcoatRoughnessTexture": {"index": 0}}}})",
-                                   R"(["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_sheen",
+                                  R"(["KHR_materials_ior", "KHR_materials_specular", "KHR_materials_sheen",
                                        "KHR_materials_clearcoat"])");
     ASSERT_EQ(scene.materials.size(), 1u);
     const Material& m = scene.materials[0];

@@ -91,7 +91,8 @@ double thinFilmReflectance(const ThinFilm& film, double cosTheta, double wavelen
     double sin2 = 1.0 - c1 * c1;
     Complex c2 = layerCosine(n1, n2, sin2);
     Amplitudes top = interfaceAmplitudes(n1, Complex(c1), n2, c2);
-    Amplitudes bottom = std::isinf(n3) ? mirrorAmplitudes() : interfaceAmplitudes(n2, c2, n3, layerCosine(n1, n3, sin2));
+    Amplitudes bottom =
+        std::isinf(n3) ? mirrorAmplitudes() : interfaceAmplitudes(n2, c2, n3, layerCosine(n1, n3, sin2));
     // Phase of one round trip through the film (complex, i.e. decaying, when the film's wave is evanescent).
     Complex phase = 4.0 * kPi * n2 * film.thicknessNm * c2 / wavelengthNm;
     return 0.5 * (airyReflectance(top.s, bottom.s, phase) + airyReflectance(top.p, bottom.p, phase));
@@ -99,11 +100,13 @@ double thinFilmReflectance(const ThinFilm& film, double cosTheta, double wavelen
 
 glm::dvec3 cieXyzMatching(double nm)
 {
-    double x = 0.362 * piecewiseGaussian(nm, 442.0, 0.0624, 0.0374)
-             + 1.056 * piecewiseGaussian(nm, 599.8, 0.0264, 0.0323)
-             - 0.065 * piecewiseGaussian(nm, 501.1, 0.0490, 0.0382);
-    double y = 0.821 * piecewiseGaussian(nm, 568.8, 0.0213, 0.0247) + 0.286 * piecewiseGaussian(nm, 530.9, 0.0613, 0.0322);
-    double z = 1.217 * piecewiseGaussian(nm, 437.0, 0.0845, 0.0278) + 0.681 * piecewiseGaussian(nm, 459.0, 0.0385, 0.0725);
+    double x = 0.362 * piecewiseGaussian(nm, 442.0, 0.0624, 0.0374) +
+               1.056 * piecewiseGaussian(nm, 599.8, 0.0264, 0.0323) -
+               0.065 * piecewiseGaussian(nm, 501.1, 0.0490, 0.0382);
+    double y =
+        0.821 * piecewiseGaussian(nm, 568.8, 0.0213, 0.0247) + 0.286 * piecewiseGaussian(nm, 530.9, 0.0613, 0.0322);
+    double z =
+        1.217 * piecewiseGaussian(nm, 437.0, 0.0845, 0.0278) + 0.681 * piecewiseGaussian(nm, 459.0, 0.0385, 0.0725);
     return {x, y, z};
 }
 
