@@ -81,7 +81,11 @@ The conversion follows the semantics of vkrt's path integrator
   or the temporary folder of --print-dict and convert()). Only meshes with
   texture coordinates on every face corner can carry textured materials.
 
-What has no Mitsuba equivalent (phong, glossy, pbr, anisotropic conductors, Schlick Fresnel, the Whitted
+* pbr glass (transmission = 1, thin_walled = false, metallic = 0, every other glTF layer at its default)
+  -> roughdielectric of its ior and roughness, with its absorbing medium (glTF's Schlick Fresnel and
+  height-correlated G against Mitsuba's exact Fresnel and separable G: a note says so).
+
+What has no Mitsuba equivalent (phong, glossy, other pbr materials, anisotropic conductors, Schlick Fresnel, the Whitted
 integrator, directional lights with an angle (sun discs), spot lights with a soft edge (glTF's falloff
 between the inner and outer cone; Mitsuba's is linear in the angle), normal maps, plastic roughness
 textures, different wrap modes for u and v, textured materials on spheres, boxes, planes and triangles,
@@ -623,6 +627,27 @@ def _used_materials(shapes: dict) -> dict[int, str]:
     return used
 
 
+# A pbr material Mitsuba can render: glass that transmits everything into a
+# volume, every other layer at its default (glTF's values).
+PBR_GLASS = {"transmission": 1.0, "thin_walled": False, "metallic": 0.0, "base_color": [1.0, 1.0, 1.0],
+             "emission": [0.0, 0.0, 0.0], "specular": 1.0, "specular_color": [1.0, 1.0, 1.0],
+             "sheen_color": [0.0, 0.0, 0.0], "clearcoat": 0.0, "iridescence": 0.0}
+
+
+def pbr_glass_refusal(m: dict):
+    """None when the exported pbr material `m` converts to Mitsuba's rough
+    dielectric, else (key, why) for the first key that keeps it from it."""
+    why = ("pbr converts only as volumetric glass (transmission = 1, thin_walled = false, metallic = 0, "
+           "base_color = 1, no emission, sheen, clearcoat, iridescence or specular change): Mitsuba's principled "
+           "BSDF is Disney's model, not glTF's, and its other BSDFs have no fresnel_mix, sheen or thin film")
+    for key, value in PBR_GLASS.items():
+        if key in m.get("textures", {}):
+            return key, f"{key} is a texture; {why}"
+        if m.get(key, value) != value:
+            return key, f"{key} = {json.dumps(m.get(key))}; {why}"
+    return None
+
+
 def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF_SIZE,
             envmap_width: int | None = None, allow_whitted: bool = False, spp: int = 64,
             vkrt: str | None = None) -> dict:
@@ -675,6 +700,28 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
     def is_rough(roughness):
         return isinstance(roughness, _Texture) or roughness > 0
 
+    def glass(index, m, roughness):
+        """Mitsuba's (rough) dielectric of m's ior, with a purely absorbing
+        interior medium where m absorbs."""
+        nonlocal needs_volpath
+        bsdf = {"type": "dielectric", "int_ior": m["ior"], "ext_ior": 1.0}
+        if is_rough(roughness):
+            bsdf.update({"type": "roughdielectric", **ggx(roughness)})
+        absorption = m["absorption"]
+        if any(k > 0 for k in absorption):
+            media_ids[index] = f"medium{index}"
+            # volpath turns a channel with sigma_t = 0 and albedo 0 into NaN
+            # (0/0 in its albedo ratio); a floor of 1e-7 per unit length
+            # changes the transmittance by less than 1e-6 over 10 units.
+            # An RGB sigma_t is read as a reflectance (each channel <= 1),
+            # so pass κ / max(κ) and scale = max(κ).
+            sigma_t = [max(k, ABSORPTION_FLOOR) for k in absorption]
+            scale = max(sigma_t)
+            scene[media_ids[index]] = {"type": "homogeneous", "id": media_ids[index], "albedo": 0.0,
+                                       "sigma_t": _rgb([k / scale for k in sigma_t]), "scale": scale}
+            needs_volpath = True
+        return bsdf
+
     def fresnel_of(m):
         """The Fresnel term; under --allow-whitted, one the scene did not set is the path integrator's."""
         if allow_whitted and not m["fresnel_explicit"] and m["type"] in ("dielectric", "rough_dielectric"):
@@ -710,23 +757,16 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
                 _fail(path, f"{where}.fresnel", f"dielectric with fresnel = \"{fresnel}\" has no Mitsuba equivalent "
                                                 "(Mitsuba's dielectric uses the exact Fresnel equations; "
                                                 "use fresnel = \"exact\" or omit the key)")
-            absorption = m["absorption"]
-            bsdf = {"type": "dielectric", "int_ior": m["ior"], "ext_ior": 1.0}
             roughness = roughness_param(m, where, index) if mtype == "rough_dielectric" else 0.0
-            if is_rough(roughness):
-                bsdf.update({"type": "roughdielectric", **ggx(roughness)})
-            if any(k > 0 for k in absorption):
-                media_ids[index] = f"medium{index}"
-                # volpath turns a channel with sigma_t = 0 and albedo 0 into NaN
-                # (0/0 in its albedo ratio); a floor of 1e-7 per unit length
-                # changes the transmittance by less than 1e-6 over 10 units.
-                # An RGB sigma_t is read as a reflectance (each channel <= 1),
-                # so pass κ / max(κ) and scale = max(κ).
-                sigma_t = [max(k, ABSORPTION_FLOOR) for k in absorption]
-                scale = max(sigma_t)
-                scene[media_ids[index]] = {"type": "homogeneous", "id": media_ids[index], "albedo": 0.0,
-                                           "sigma_t": _rgb([k / scale for k in sigma_t]), "scale": scale}
-                needs_volpath = True
+            bsdf = glass(index, m, roughness)
+        elif mtype == "pbr":
+            refusal = pbr_glass_refusal(m)
+            if refusal:
+                _fail(path, f"{where}.{refusal[0]}", refusal[1])
+            _note(f"{path}: {where}: pbr glass (transmission 1 into a volume) converted to Mitsuba's rough "
+                  "dielectric, whose exact Fresnel differs from glTF's Schlick form by less than 0.01 away from "
+                  "grazing, and whose Smith G is separable where glTF's is height-correlated")
+            bsdf = glass(index, m, roughness_param(m, where, index))
         elif mtype == "conductor":
             roughness = roughness_param(m, where, index)
             if m["anisotropy"] != 0.0:
@@ -745,9 +785,6 @@ def convert(path, *, files_dir=None, plane_half_size: float = DEFAULT_PLANE_HALF
             if roughness > 0:
                 inner.update({"type": "roughplastic", **ggx(roughness)})
             bsdf = {"type": "twosided", "bsdf": inner}
-        elif mtype == "pbr":
-            _fail(path, f"{where}.type", "material type 'pbr' (glTF metallic-roughness) has no Mitsuba equivalent: "
-                                         "Mitsuba's principled BSDF is another model")
         elif mtype in ("phong", "glossy"):
             _fail(path, f"{where}.type", f"material type '{mtype}' has no Mitsuba equivalent "
                                          f"(used by {used[index]}); only lambert, mirror (fresnel = \"none\") and "

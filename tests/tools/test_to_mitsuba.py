@@ -108,6 +108,41 @@ def test_refuses_schlick():
     _refusal('type = "dielectric"\nfresnel = "schlick"', 'materials."odd one".fresnel')
 
 
+def test_refuses_pbr_other_than_volumetric_glass():
+    # glTF's default pbr is an opaque metal: no Mitsuba BSDF is glTF's model.
+    message = _refusal('type = "pbr"', 'materials."odd one".transmission')
+    assert "Disney" in message, message
+    glass = 'type = "pbr"\ntransmission = 1\nmetallic = 0\nthin_walled = false\n'
+    _refusal(glass.replace("thin_walled = false\n", ""), 'materials."odd one".thin_walled')
+    _refusal(glass + "clearcoat = 0.5", 'materials."odd one".clearcoat')
+    _refusal(glass + "base_color = [1, 0.5, 0.5]", 'materials."odd one".base_color')
+    _refusal(glass + "iridescence = 1", 'materials."odd one".iridescence')
+
+
+def test_pbr_glass_is_a_rough_dielectric_with_its_medium():
+    _need(mi, "mitsuba")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = _write(Path(tmp), HEADER + textwrap.dedent("""
+            [materials.water]
+            type = "pbr"
+            transmission = 1
+            metallic = 0
+            thin_walled = false
+            ior = 1.33
+            roughness = 0.5
+            absorption = [0.1, 0.4, 0.8]
+            [[objects]]
+            shape = "sphere"
+            material = "water"
+            center = [0.0, 0.0, 0.0]
+            radius = 1
+            """))
+        d = to_mitsuba.convert(path)
+    bsdf = d["mat0"]
+    assert bsdf["type"] == "roughdielectric" and bsdf["int_ior"] == 1.33 and bsdf["alpha"] == 0.25, bsdf
+    assert d["medium0"]["scale"] == 0.8, d["medium0"]
+
+
 def test_refuses_whitted():
     header = HEADER.replace('integrator = "path"', 'integrator = "whitted"')
     _refusal('type = "lambert"', "render.integrator", header=header)
