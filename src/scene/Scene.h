@@ -213,6 +213,14 @@ struct PbrLayers {
     bool transmits() const { return transmission > 0.0; }
     /// The surface bounds a refracting, absorbing volume.
     bool volumetric() const { return transmits() && !thinWalled; }
+    /// Some layer changes the material: the parameters of a layer whose
+    /// factor is 0 (a glTF file's iridescenceIor, say) change nothing and keep
+    /// the plain kernel.
+    bool active() const
+    {
+        return specular != 1.0 || specularColor != Color(1.0) || sheen() || clearcoat > 0.0 || transmits() ||
+               iridescence > 0.0;
+    }
     bool operator==(const PbrLayers&) const = default;
 };
 
@@ -271,7 +279,7 @@ inline bool Material::hasTextures() const
 
 inline bool Material::hasPbrLayers() const
 {
-    return type == MaterialType::Pbr && (layers != PbrLayers{} || ior != 1.5);
+    return type == MaterialType::Pbr && (layers.active() || ior != 1.5);
 }
 
 inline bool Material::readsUvSet(uint32_t set) const

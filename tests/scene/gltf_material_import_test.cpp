@@ -69,6 +69,17 @@ TEST(GltfMaterialImport, PbrLayersTakeTheirFactorsAndTexturesInTheirChannels)
     EXPECT_FALSE(m.texture(TextureSlot::SheenColor).has_value());
 }
 
+TEST(GltfMaterialImport, AMaterialWithoutExtensionsKeepsThePlainPbrKernel)
+{
+    // The file's defaults (iridescenceIor 1.3f, a float) must not count as layers.
+    const Scene scene = importOne("plain", R"({"pbrMetallicRoughness": {"roughnessFactor": 0.5}})", "[]");
+    EXPECT_FALSE(scene.materials.at(0).hasPbrLayers());
+    EXPECT_FALSE(featuresOf(scene).pbrLayers);
+    const Scene film = importOne("film", R"({"extensions": {"KHR_materials_iridescence": {"iridescenceIor": 1.8}}})",
+                                 R"(["KHR_materials_iridescence"])");
+    EXPECT_FALSE(film.materials.at(0).hasPbrLayers()) << "an iridescence factor of 0 is no film";
+}
+
 TEST(GltfMaterialImport, TransmittingVolumesAbsorbAsTheirAttenuationSays)
 {
     // sigma = -ln(attenuationColor) / attenuationDistance per channel, inside a volume of the file's index.
