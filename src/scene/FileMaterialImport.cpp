@@ -46,15 +46,11 @@ std::string displayName(const FileMaterial& f, size_t index)
 
 /// KHR_materials_volume's Beer-Lambert coefficient per world unit, -ln(attenuationColor) /
 /// attenuationDistance, inside a volumetric (thickness > 0) material; 0 for a thin-walled one or
-/// without attenuation. A colour component of 0 absorbs as one of 1e-9 does (opaque within a few
-/// attenuation distances) rather than infinitely.
+/// without attenuation.
 Color volumeAbsorption(const FileMaterial& f)
 {
-    if (!(f.thicknessFactor > 0.0f) || !std::isfinite(f.attenuationDistance)) return Color(0.0);
-    Color sigma;
-    for (int c = 0; c < 3; ++c)
-        sigma[c] = -std::log(std::max(double(f.attenuationColor[c]), 1e-9)) / f.attenuationDistance;
-    return sigma;
+    if (!(f.thicknessFactor > 0.0f)) return Color(0.0);
+    return absorptionOfAttenuation(Color(f.attenuationColor), f.attenuationDistance);
 }
 
 /// KHR_materials_ior, _specular, _sheen, _clearcoat, _transmission, _volume and _iridescence as the pbr material's
@@ -178,6 +174,14 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
 }
 
 } // namespace
+
+Color absorptionOfAttenuation(const Color& color, double distance)
+{
+    if (!std::isfinite(distance)) return Color(0.0);
+    Color sigma;
+    for (int c = 0; c < 3; ++c) sigma[c] = -std::log(std::max(color[c], 1e-9)) / distance;
+    return sigma;
+}
 
 std::vector<uint32_t> importFileMaterials(const std::vector<FileMaterial>& fileMaterials,
                                           const std::filesystem::path& file, const SourceLocation& where,

@@ -4,8 +4,8 @@
 // textures enter the scene's TextureAtlas, and whatever vkrt cannot honour
 // (extensions, alpha modes, emissive textures, ...) becomes a warning that
 // names it, located at the mesh's `material` key.
-#include "scene/Scene.h"
 #include "mesh/FileMaterials.h"
+#include "scene/Scene.h"
 #include "texture/TextureAtlas.h"
 
 #include <filesystem>
@@ -14,6 +14,13 @@
 #include <vector>
 
 namespace vkrt {
+
+/// Beer-Lambert absorption per unit length of a volume whose white light turns
+/// `color` after `distance` (KHR_materials_volume's attenuationColor and
+/// attenuationDistance; TOML's attenuation_color and attenuation_distance):
+/// -ln(color) / distance per channel, 0 for an infinite distance. A channel of
+/// 0 absorbs as one of 1e-9 does (opaque within a few distances), not infinitely.
+Color absorptionOfAttenuation(const Color& color, double distance);
 
 /// Appends one Material per material of the geometry's file to `materials`
 /// and returns their indices, in the order of the file's materials (the

@@ -347,8 +347,7 @@ void readPbrTransmission(const TableField& table, Material& material, ParseConte
     if (color || distance) {
         const Color reached = color ? readUnitColor(*color) : Color(1.0);
         const double length = distance ? readPositive(*distance) : std::numeric_limits<double>::infinity();
-        for (int c = 0; c < 3; ++c)
-            material.absorption[c] = std::isinf(length) ? 0.0 : -std::log(std::max(reached[c], 1e-9)) / length;
+        material.absorption = absorptionOfAttenuation(reached, length);
     }
 }
 
