@@ -452,7 +452,12 @@ VKRT_ABSENT_MATERIAL(Plastic)
 //     Charlie lobe's directional albedo (the sheen table);
 //   clearcoat (KHR_materials_clearcoat): (1 - c Fc) below + c Fc Scoat, with
 //     Fc = 0.04 + 0.96 (1 - cosO)^5 at the normal, not at h, as the
-//     specification says (so the coat is not reciprocal; it never adds energy).
+//     specification says (so the coat is not reciprocal; it never adds energy);
+//     the coat has its own shading normal (clearcoatNormalTexture): its Fc and
+//     lobe are taken about it;
+//   anisotropy (KHR_materials_anisotropy): the base's GGX lobes (metal,
+//     dielectric, transmission) stretch their alpha to mix(alpha, 1,
+//     strength^2) along a direction in the tangent plane.
 // S is the GGX lobe with the height-correlated G. Sampled as a mixture: the
 // coat's and the base's visible-normal lobes and the cosine lobe (diffuse and
 // sheen), each chosen in proportion to its reflectance seen from wo.
@@ -562,10 +567,12 @@ float sheenAlbedo(Material m, float mu)
 #endif
 }
 
-// The coat's Fresnel weight seen from cosine cosO: clearcoat x Fc.
+// The coat's Fresnel weight seen from cosine cosO: clearcoat x Fc, with the
+// specification's |N.V| (wo can be below a coat's own normal: its lobe is then
+// 0, and the layers below keep 1 - clearcoat Fc).
 float pbrCoatWeight(Material m, float cosO)
 {
-    return m.clearcoat * (0.04 + 0.96 * pow5(1.0 - clamp(cosO, 0.0, 1.0)));
+    return m.clearcoat * (0.04 + 0.96 * pow5(1.0 - min(abs(cosO), 1.0)));
 }
 
 // The Fresnel weight the dielectric's diffuse loses: max3(Fd(wo.h)) as the
@@ -597,13 +604,54 @@ float sheenScaling(Material m, float cosO, float cosI)
     return max(min(1.0 - strength * sheenAlbedo(m, cosO), 1.0 - strength * sheenAlbedo(m, cosI)), 0.0);
 }
 
+// The base's frame about n: its x axis the direction the anisotropy stretches
+// (KHR_materials_anisotropy, resolved at the hit by withAnisotropy), any
+// frame where the lobe is isotropic.
+LocalFrame pbrFrame(Material m, vec3 n)
+{
+#ifdef VKRT_PBR_ANISOTROPY
+    vec3 t = m.anisotropy - n * dot(n, m.anisotropy);
+    float len = length(t);
+    if (len > 1e-6) {
+        LocalFrame f;
+        f.n = n;
+        f.t = t / len;
+        f.b = cross(n, f.t);
+        return f;
+    }
+#endif
+    return frameAround(n);
+}
+
+// The clear coat's frame: about its own shading normal (clearcoatNormalTexture,
+// or the normal a base normal map leaves untilted), turned to n's side, or
+// about n. Its lobe is isotropic: any frame around it.
+LocalFrame pbrCoatFrame(Material m, vec3 n)
+{
+    vec3 c = m.clearcoatNormal;
+    if (c == vec3(0.0))
+        return frameAround(n);
+    return frameAround(dot(c, n) < 0.0 ? -c : c);
+}
+
+// The coat's lobe as a term of f (which the integrator weighs by the base's
+// cosine li.z): S(co, ci) ci.z / li.z, the coat's GGX with its own cosine, as
+// the Khronos sample viewer lights the coat with its clearcoat N.L. Zero where
+// either direction is below the coat's normal.
+float pbrCoatLobe(Material m, vec3 co, vec3 ci, float baseCosI)
+{
+    if (!(co.z > 0.0) || !(ci.z > 0.0))
+        return 0.0;
+    return ggxSpecularCorrelated(co, ci, normalize(co + ci), vec2(m.clearcoatAlpha)) * (ci.z / baseCosI);
+}
+
 // f(wo, wi) of the reflection lobes. Transmission (KHR_materials_transmission)
 // takes its share of the dielectric's diffuse lobe: the specification's
 // mix(diffuse, baseColor x the specular BTDF, transmission) below the
 // dielectric's Fresnel; its BTDF is only ever sampled (samplePbr).
 vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
 {
-    LocalFrame f = frameAround(n);
+    LocalFrame f = pbrFrame(m, n);
     vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
     vec3 h = normalize(lo + li);
     float s = ggxSpecularCorrelated(lo, li, h, ggxAlpha(m));
@@ -613,17 +661,26 @@ vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
     if (max3(m.sheenColor) > 0.0)
         value = m.sheenColor * sheenBrdf(lo, li, h, sheenAlpha(m)) + value * sheenScaling(m, lo.z, li.z);
     if (m.clearcoat > 0.0) {
-        float coat = pbrCoatWeight(m, lo.z);
-        value = (1.0 - coat) * value + coat * ggxSpecularCorrelated(lo, li, h, vec2(m.clearcoatAlpha));
+        LocalFrame fc = pbrCoatFrame(m, n);
+        vec3 co = toFrame(fc, wo);
+        float coat = pbrCoatWeight(m, co.z);
+        value = (1.0 - coat) * value + coat * pbrCoatLobe(m, co, toFrame(fc, wi), li.z);
     }
     return value;
 }
 
-// The lobe probabilities seen from cosO, summing to 1: x the coat, y the
-// base's GGX reflection, z the cosine lobe (diffuse and sheen), w transmission.
-vec4 pbrLobeProbabilities(Material m, float cosO)
+// wo's cosine about the coat's normal; 0 without a coat.
+float pbrCoatCosine(Material m, vec3 n, vec3 wo)
 {
-    float coat = m.clearcoat > 0.0 ? pbrCoatWeight(m, cosO) : 0.0;
+    return m.clearcoat > 0.0 ? toFrame(pbrCoatFrame(m, n), wo).z : 0.0;
+}
+
+// The lobe probabilities seen from cosO (the coat's lobe from coatCosO, wo's
+// cosine about the coat's normal), summing to 1: x the coat, y the base's GGX
+// reflection, z the cosine lobe (diffuse and sheen), w transmission.
+vec4 pbrLobeProbabilities(Material m, float cosO, float coatCosO)
+{
+    float coat = m.clearcoat > 0.0 && coatCosO > 0.0 ? pbrCoatWeight(m, coatCosO) : 0.0;
     float fd = max3(pbrDielectricFresnel(m, cosO));
     float specular = m.metallic + (1.0 - m.metallic) * fd;
     float below = (1.0 - m.metallic) * luminance(m.diffuse);
@@ -640,13 +697,16 @@ vec4 pbrLobeProbabilities(Material m, float cosO)
 
 float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
 {
-    LocalFrame f = frameAround(n);
+    LocalFrame f = pbrFrame(m, n);
     vec3 lo = toFrame(f, wo), li = toFrame(f, wi);
-    vec4 p = pbrLobeProbabilities(m, lo.z);
+    vec4 p = pbrLobeProbabilities(m, lo.z, pbrCoatCosine(m, n, wo));
     vec3 h = normalize(lo + li);
     float pdf = p.y * ggxReflectionPdf(lo, h, ggxAlpha(m)) + p.z * li.z * INV_PI;
-    if (p.x > 0.0)
-        pdf += p.x * ggxReflectionPdf(lo, h, vec2(m.clearcoatAlpha));
+    if (p.x > 0.0) {
+        LocalFrame fc = pbrCoatFrame(m, n);
+        vec3 co = toFrame(fc, wo);
+        pdf += p.x * ggxReflectionPdf(co, normalize(co + toFrame(fc, wi)), vec2(m.clearcoatAlpha));
+    }
     return pdf;
 }
 
@@ -666,7 +726,7 @@ float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
 // coloured, transparent foil") and Cycles' Principled BSDF renders; baseColor
 // at each crossing made TransmissionRoughnessTest's glass samples (base
 // colour (0.5, 0.7, 0.9)) darker than Cycles by that colour again.
-BsdfSample samplePbrTransmission(Material m, LocalFrame f, vec3 lo, float eta, float chosen, vec2 u)
+BsdfSample samplePbrTransmission(Material m, LocalFrame f, vec3 lo, float coatCosO, float eta, float chosen, vec2 u)
 {
     vec2 alpha = ggxAlpha(m);
     vec3 h = sampleGgxVisibleNormal(lo, alpha, u);
@@ -678,7 +738,7 @@ BsdfSample samplePbrTransmission(Material m, LocalFrame f, vec3 lo, float eta, f
     float lambdaO = ggxLambdaOf(lo, alpha);
     float shadowing = (1.0 + lambdaO) / (1.0 + lambdaO + ggxLambdaOf(-li, alpha));
     float layers = (1.0 - m.metallic) * m.transmission * (1.0 - max3(pbrDielectricFresnel(m, dot(lo, h))));
-    layers *= sheenScaling(m, lo.z, -li.z) * (1.0 - (m.clearcoat > 0.0 ? pbrCoatWeight(m, lo.z) : 0.0));
+    layers *= sheenScaling(m, lo.z, -li.z) * (1.0 - (m.clearcoat > 0.0 ? pbrCoatWeight(m, coatCosO) : 0.0));
     vec3 tint = pbrVolumetric(m) ? sqrt(m.diffuse) : m.diffuse;
     return BsdfSample(fromFrame(f, li), tint * (layers * shadowing / chosen), true, true);
 }
@@ -686,19 +746,22 @@ BsdfSample samplePbrTransmission(Material m, LocalFrame f, vec3 lo, float eta, f
 
 BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
-    LocalFrame f = frameAround(n);
+    LocalFrame f = pbrFrame(m, n);
     vec3 lo = toFrame(f, wo);
     if (lo.z <= 0.0)
         return noScatter();
-    vec4 p = pbrLobeProbabilities(m, lo.z);
+    float coatCosO = pbrCoatCosine(m, n, wo);
+    vec4 p = pbrLobeProbabilities(m, lo.z, coatCosO);
     vec3 li;
-    if (u.z < p.x)
-        li = reflect(-lo, sampleGgxVisibleNormal(lo, vec2(m.clearcoatAlpha), u.xy));
-    else if (u.z < p.x + p.y)
+    if (u.z < p.x) {
+        LocalFrame fc = pbrCoatFrame(m, n);
+        vec3 co = toFrame(fc, wo);
+        li = toFrame(f, fromFrame(fc, reflect(-co, sampleGgxVisibleNormal(co, vec2(m.clearcoatAlpha), u.xy))));
+    } else if (u.z < p.x + p.y)
         li = reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy));
 #ifdef VKRT_PBR_TRANSMISSION
     else if (u.z >= p.x + p.y + p.z && p.w > 0.0)
-        return samplePbrTransmission(m, f, lo, eta, p.w, u.xy);
+        return samplePbrTransmission(m, f, lo, coatCosO, eta, p.w, u.xy);
 #endif
     else
         li = toFrame(f, sampleCosineHemisphere(n, u.xy));

@@ -99,6 +99,36 @@ vec3 normalMapped(SurfaceHit hit, vec3 texel, float strength)
 }
 #endif
 
+#ifdef VKRT_PBR_ANISOTROPY
+// KHR_materials_anisotropy at a hit: the direction `texel` encodes in the
+// tangent frame (rg = (d + 1) / 2; b scales the strength), turned by the
+// material's rotation and scaled by its strength (m.anisotropy.xy = strength x
+// (cos, sin) of the rotation: a complex product), taken to world space in the
+// frame of the hit's tangent about the unmapped shading normal n, as the
+// specification's TBN. The base's alpha along it becomes mix(alpha, 1,
+// strength^2) (alphaY keeps alpha); m.anisotropy becomes the world direction,
+// or zero where the lobe stays isotropic.
+Material withAnisotropy(Material m, SurfaceHit hit, vec3 n, vec3 texel)
+{
+    vec2 d = 2.0 * texel.xy - 1.0;
+    float dLength = length(d);
+    d = dLength > 0.0 ? d / dLength : vec2(1.0, 0.0);
+    vec2 r = m.anisotropy.xy * clamp(texel.z, 0.0, 1.0);
+    vec2 turned = vec2(r.x * d.x - r.y * d.y, r.x * d.y + r.y * d.x);
+    float strength = min(length(turned), 1.0);
+    vec3 t = hit.tangent.xyz - n * dot(n, hit.tangent.xyz);
+    float tLength = length(t);
+    m.anisotropy = vec3(0.0);
+    if (!(strength > 0.0) || !(tLength > 1e-6))
+        return m;
+    t /= tLength;
+    vec3 b = hit.tangent.w * cross(n, t);
+    m.anisotropy = normalize(turned.x * t + turned.y * b);
+    m.alphaX = mix(m.alphaY, 1.0, strength * strength);
+    return m;
+}
+#endif
+
 // The material at this hit: `m` with its textured parameters applied, and the
 // hit's shading normal normal-mapped. `pathLength` is the distance travelled
 // from the camera to this hit.
@@ -127,6 +157,12 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
     const uint slots = TEXTURE_SLOT_SPECULAR_FACTOR + layerSlots + 1u;
 #else
     const uint slots = TEXTURE_SLOT_SPECULAR_FACTOR + layerSlots;
+#endif
+#ifdef VKRT_PBR_LAYERS
+    vec3 anisotropyTexel = vec3(1.0, 0.5, 1.0); // without a texture: along the tangent, the full strength
+#endif
+#ifdef VKRT_PBR_ANISOTROPY
+    vec3 unmapped = hit.shading;
 #endif
     [[dont_unroll]] for (uint i = 0u; i < slots; ++i) {
         ++g_loopIterations;
@@ -167,14 +203,31 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
             m.iridescence *= channelOf(texel, slot.channel);
         } else if (k == TEXTURE_SLOT_IRIDESCENCE_THICKNESS) {
             m.iridescenceThickness = mix(m.iridescenceThicknessMin, m.iridescenceThickness, channelOf(texel, slot.channel));
+        } else if (k == TEXTURE_SLOT_ANISOTROPY) {
+            anisotropyTexel = texel.rgb;
         }
+#ifdef VKRT_HAS_NORMAL_MAPS
+        else if (k == TEXTURE_SLOT_CLEARCOAT_NORMAL) {
+            // Before the base's normal map (a later slot) has tilted hit.shading.
+            m.clearcoatNormal = normalMapped(hit, texel.rgb, materialTextures[hit.material].clearcoatNormalStrength);
+        }
+#endif
 #endif
 #ifdef VKRT_HAS_NORMAL_MAPS
         else {
+#ifdef VKRT_PBR_LAYERS
+            // KHR_materials_clearcoat: a coat without a normal map of its own
+            // keeps the normal the base's map does not tilt.
+            if (m.clearcoat > 0.0 && m.clearcoatNormal == vec3(0.0))
+                m.clearcoatNormal = hit.shading;
+#endif
             hit.shading = normalMapped(hit, texel.rgb, materialTextures[hit.material].normalStrength);
         }
 #endif
     }
+#ifdef VKRT_PBR_ANISOTROPY
+    m = withAnisotropy(m, hit, unmapped, anisotropyTexel);
+#endif
     return m;
 }
 

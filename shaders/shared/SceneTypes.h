@@ -77,6 +77,16 @@ struct Material {
     float iridescenceIor; // pbr: the thin film's index
     float iridescenceThicknessMin; // pbr: the film's thickness in nm where its thickness texture reads 0
     float iridescenceThickness;    // pbr: ... where it reads 1, and the thickness without a texture
+    // pbr: KHR_materials_anisotropy (variants with VKRT_PBR_ANISOTROPY). In the
+    // buffer: strength x (cos, sin) of its rotation, in the surface's tangent
+    // frame (z 0). texturedMaterial resolves it at a hit: then it is the world
+    // direction of the stretched GGX axis (unit), alphaX the stretched alpha,
+    // or zero where the lobe is isotropic.
+    vec3 anisotropy;
+    // pbr: the clear coat's shading normal at a hit (world; texturedMaterial
+    // sets it from clearcoatNormalTexture, or keeps the normal a base normal
+    // map tilts); zero: the coat shares the base's shading normal.
+    vec3 clearcoatNormal;
 };
 
 // Material::pbrFlags
@@ -303,7 +313,7 @@ VKRT_CONSTANT(uint, RENDER_FLAG_ORTHOGRAPHIC, 2)
 // maxUniformBufferRange Vulkan allows; src/gpu/SharedTypes.cpp checks the
 // sizes. Bigger scenes use the storage-buffer variant. The shape and light
 // arrays' capacities (UNIFORM_SPHERES, ...) are in the registry, shared/Kinds.h.
-VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 107) // 16384 / 152
+VKRT_CONSTANT(uint, UNIFORM_MATERIALS, 93) // 16384 / 176
 
 // One record count per shape and light array, in registry order:
 // sphereCount, boxCount, triangleCount, planeCount, pointLightCount, ...

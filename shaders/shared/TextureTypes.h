@@ -97,15 +97,19 @@ VKRT_CONSTANT(uint, TEXTURE_SLOT_TRANSMISSION, 9)           // KHR_materials_tra
 VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE, 10)           // KHR_materials_iridescence iridescenceTexture (R)
 VKRT_CONSTANT(uint, TEXTURE_SLOT_IRIDESCENCE_THICKNESS, 11) // iridescenceThicknessTexture (G): mixes the
                                                             // thickness from its minimum (0) to its maximum (1)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 12)                // tangent-space normal map (rgb = (n + 1) / 2)
-VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 13) // emitted radiance (glTF emissiveTexture, sRGB): read by the
+VKRT_CONSTANT(uint, TEXTURE_SLOT_ANISOTROPY, 12)       // KHR_materials_anisotropy anisotropyTexture: RG the
+                                                       // direction in the tangent frame ((d + 1) / 2), B strength
+VKRT_CONSTANT(uint, TEXTURE_SLOT_CLEARCOAT_NORMAL, 13) // clearcoatNormalTexture: the coat's own normal map
+VKRT_CONSTANT(uint, TEXTURE_SLOT_NORMAL, 14)           // tangent-space normal map (rgb = (n + 1) / 2)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_EMISSION, 15) // emitted radiance (glTF emissiveTexture, sRGB): read by the
                                                // emitters (lib/emitters.glsl), not by texturedMaterial
-VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 14)
+VKRT_CONSTANT(uint, TEXTURE_SLOT_COUNT, 16)
 
 /// The textures of one material (one per Material, same index).
 struct MaterialTextures {
     TextureSlot slots[TEXTURE_SLOT_COUNT];
     float normalStrength; // a normal map's tangent-plane components scale by this (glTF normalTexture.scale)
+    float clearcoatNormalStrength; // ... the coat's normal map's (clearcoatNormalTexture.scale)
 };
 
 VKRT_END_NAMESPACE

@@ -11,7 +11,7 @@
 namespace vkrt::gpu {
 
 static_assert(alignof(vec3) == 4 && sizeof(vec3) == 12, "GLM vec3 must be three packed floats");
-static_assert(sizeof(Material) == 152);
+static_assert(sizeof(Material) == 176);
 // The shape and light records' sizes are pinned by their registry capacities
 // below: 16384 / (capacity + 1) < size <= 16384 / capacity admits one size.
 // Each uniform scene array fills at most the 16 KiB every Vulkan device allows.

@@ -659,6 +659,16 @@ struct MaterialReader {
         return float(value->get<double>());
     }
 
+    /// A finite number of `owner` (`name` names it in messages).
+    float finiteNumber(const json& owner, const char* key, const char* name, float fallback) const
+    {
+        const json* value = member(owner, key);
+        if (!value) return fallback;
+        if (!value->is_number() || !(std::abs(value->get<double>()) <= std::numeric_limits<float>::max()))
+            malformed(std::string(name) + "." + key + " must be a finite number");
+        return float(value->get<double>());
+    }
+
     glm::vec4 colour(const json* owner, const char* key, glm::vec4 fallback, size_t size, bool unbounded) const
     {
         const json* value = owner ? member(*owner, key) : nullptr;
@@ -855,6 +865,13 @@ struct MaterialReader {
             out.clearcoatRoughnessFactor = unitFactor(e, "clearcoatRoughnessFactor", out.clearcoatRoughnessFactor);
             out.clearcoatRoughnessTexture = layerTexture(*e, "clearcoatRoughnessTexture");
             out.clearcoatNormalTexture = layerTexture(*e, "clearcoatNormalTexture");
+            if (const json* normal = member(*e, "clearcoatNormalTexture"))
+                out.clearcoatNormalScale = finiteNumber(*normal, "scale", "clearcoatNormalTexture", 1.0f);
+        }
+        if (const json* e = member(extensions, "KHR_materials_anisotropy")) {
+            out.anisotropyStrength = unitFactor(e, "anisotropyStrength", out.anisotropyStrength);
+            out.anisotropyRotation = finiteNumber(*e, "anisotropyRotation", "KHR_materials_anisotropy", 0.0f);
+            out.anisotropyTexture = layerTexture(*e, "anisotropyTexture");
         }
     }
 };
@@ -872,7 +889,7 @@ std::vector<const std::optional<FileTexture>*> FileMaterial::textureSlots() cons
     return {&baseColorTexture,   &metallicRoughnessTexture,   &normalTexture,          &emissiveTexture,
             &specularTexture,    &specularColorTexture,       &sheenColorTexture,      &sheenRoughnessTexture,
             &clearcoatTexture,   &clearcoatRoughnessTexture,  &clearcoatNormalTexture, &transmissionTexture,
-            &iridescenceTexture, &iridescenceThicknessTexture};
+            &iridescenceTexture, &iridescenceThicknessTexture, &anisotropyTexture};
 }
 
 std::vector<uint8_t> decodeBase64(std::string_view text)

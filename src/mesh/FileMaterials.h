@@ -93,6 +93,12 @@ struct FileMaterial {
     float clearcoatRoughnessFactor = 0.0f;
     std::optional<FileTexture> clearcoatRoughnessTexture;
     std::optional<FileTexture> clearcoatNormalTexture;
+    float clearcoatNormalScale = 1.0f; ///< scales the coat's normal map's X and Y
+    /// KHR_materials_anisotropy: strength (times B of its texture), rotation in radians from the tangent (the
+    /// texture's RG: the direction in the tangent frame, which the rotation turns).
+    float anisotropyStrength = 0.0f;
+    float anisotropyRotation = 0.0f;
+    std::optional<FileTexture> anisotropyTexture;
     /// KHR_materials_iridescence: strength (R of its texture), the film's index and its thickness in nm
     /// (the maximum, or mixed from the minimum by G of its texture).
     float iridescenceFactor = 0.0f;

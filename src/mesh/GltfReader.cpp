@@ -903,7 +903,7 @@ const std::vector<std::string>& implementedGltfExtensions()
         "KHR_materials_ior",         "KHR_mesh_quantization",  "EXT_mesh_gpu_instancing",
         "KHR_materials_unlit",       "KHR_materials_variants", "KHR_materials_transmission",
         "KHR_materials_specular",    "KHR_materials_sheen",    "KHR_materials_clearcoat",
-        "KHR_materials_iridescence",
+        "KHR_materials_iridescence", "KHR_materials_anisotropy",
         "KHR_materials_volume", // its attenuation (the thickness only decides thin-walled or not)
     };
     return names;

@@ -73,6 +73,7 @@ gpu::MaterialTextures convertMaterialTextures(const Material& m)
                                              texture->texCoord};
     }
     g.normalStrength = float(m.normalStrength);
+    g.clearcoatNormalStrength = float(m.clearcoatNormalStrength);
     return g;
 }
 
@@ -131,6 +132,9 @@ gpu::Material convertMaterial(const Material& m, Integrator integrator, uint32_t
         g.iridescenceIor = float(m.layers.iridescenceIor);
         g.iridescenceThicknessMin = float(m.layers.iridescenceThicknessMin);
         g.iridescenceThickness = float(m.layers.iridescenceThicknessMax);
+        // KHR_materials_anisotropy, in the tangent frame until a hit resolves it (lib/material_textures.glsl).
+        const double strength = m.layers.anisotropy, rotation = m.layers.anisotropyRotation;
+        g.anisotropy = glm::vec3(float(strength * std::cos(rotation)), float(strength * std::sin(rotation)), 0.0f);
     }
     return g;
 }
@@ -638,7 +642,7 @@ void appendTriangleAttributes(const Mesh& mesh, const FeatureSet& features, GpuS
     };
     if (features.textures) appendUvs(d.uvs, fixed.meshUvs);
     if (features.textures && features.secondUvs) appendUvs(d.uvs1, fixed.meshUvs1);
-    if (features.normalMaps) {
+    if (features.tangentFrames()) {
         for (const glm::uvec3& t : d.triangles) {
             fixed.meshTangents.push_back(d.tangents.empty()
                                              ? gpu::MeshTangents{}
@@ -675,7 +679,7 @@ GpuSceneStatic prepareStaticScene(const Scene& scene, uint64_t maxBytes, const T
     // The per-triangle attributes start at index 0 beside meshTriangles: drop the placeholders.
     if (features.textures) fixed.meshUvs.clear();
     if (features.textures && features.secondUvs) fixed.meshUvs1.clear();
-    if (features.normalMaps) fixed.meshTangents.clear();
+    if (features.tangentFrames()) fixed.meshTangents.clear();
     if (features.fileMaterials) fixed.meshMaterials.clear();
     if (features.vertexColors) fixed.meshColors.clear();
     for (const Mesh& mesh : scene.meshes) {

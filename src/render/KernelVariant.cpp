@@ -55,7 +55,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({meshes && f.textures, "VKRT_HAS_MESH_UVS", int(gpu::BINDING_MESH_UVS), ""});
     list.push_back({meshes && f.textures && f.secondUvs, "VKRT_HAS_MESH_UVS1", int(gpu::BINDING_MESH_UVS1), "uv1"});
     list.push_back(
-        {meshes && f.textures && f.normalMaps, "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS), ""});
+        {meshes && f.textures && f.tangentFrames(), "VKRT_HAS_MESH_TANGENTS", int(gpu::BINDING_MESH_TANGENTS), ""});
     // An emission texture is read by the emitters at the mesh triangle's uvs.
     list.push_back({meshes && f.emitters && f.textures && f.emissionTextures, "VKRT_HAS_EMISSION_TEXTURES", -1,
                     "emission-textures"});
@@ -71,6 +71,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({pbrLayers, "VKRT_PBR_LAYERS", -1, "pbr-layers"});
     list.push_back({pbrLayers && f.pbrTransmission, "VKRT_PBR_TRANSMISSION", -1, "pbr-transmission"});
     list.push_back({pbrLayers && f.pbrIridescence, "VKRT_PBR_IRIDESCENCE", -1, "pbr-iridescence"});
+    list.push_back({pbrLayers && f.textures && f.pbrAnisotropy, "VKRT_PBR_ANISOTROPY", -1, "pbr-anisotropy"});
     list.push_back({f.has(MaterialType::Plastic) || (f.has(MaterialType::Pbr) && f.pbrLayers),
                     "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});

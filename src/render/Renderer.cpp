@@ -33,7 +33,7 @@ void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation
 }
 
 /// The uber kernel's features: every feature, except that the glTF alpha
-/// test, emission textures, second uv set and pbr layers (transmission, iridescence) come only with a scene that uses
+/// test, emission textures, second uv set and pbr layers (transmission, iridescence, anisotropy) come only with a scene that uses
 /// them. Measured on Mesa 26.1's lavapipe (LLVM 19.1): an uber kernel with either, rendering a scene without them,
 /// crashed the driver (SIGSEGV in the dispatch; Mesa 25.0 ran it), while their own variants render right on both. Until
 /// the cause is found the uber kernel does not carry code for data the scene lacks.
@@ -47,6 +47,7 @@ FeatureSet uberFeatures(const Scene& scene)
     features.pbrLayers = own.pbrLayers;
     features.pbrTransmission = own.pbrTransmission;
     features.pbrIridescence = own.pbrIridescence;
+    features.pbrAnisotropy = own.pbrAnisotropy;
     return features;
 }
 

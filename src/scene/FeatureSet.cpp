@@ -45,6 +45,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.pbrLayers = true;
     all.pbrTransmission = true;
     all.pbrIridescence = true;
+    all.pbrAnisotropy = true;
     all.thinLens = true;
     all.orthographic = true;
     all.alpha = true;
@@ -61,12 +62,14 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
     auto markUsed = [&](uint32_t index) {
         const Material& material = scene.materials[index];
         set.materialTypes[size_t(material.type)] = true;
-        set.textures = set.textures || material.hasTextures();
+        // An anisotropic lobe turns with the tangent frame, which the textured variants compute.
+        set.textures = set.textures || material.hasTextures() || material.pbrAnisotropic();
         set.normalMaps = set.normalMaps || material.hasNormalMap();
         set.secondUvs = set.secondUvs || material.readsUvSet(1);
         set.pbrLayers = set.pbrLayers || material.hasPbrLayers();
         set.pbrTransmission = set.pbrTransmission || material.pbrTransmits();
         set.pbrIridescence = set.pbrIridescence || material.pbrIridescent();
+        set.pbrAnisotropy = set.pbrAnisotropy || material.pbrAnisotropic();
     };
 #define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     for (const auto& shape : scene.array) markUsed(shape.material);

@@ -27,6 +27,7 @@ struct FeatureSet {
     bool pbrLayers = false;           ///< some pbr material has a glTF extension layer (Material::hasPbrLayers)
     bool pbrTransmission = false;     ///< ... transmission (Material::pbrTransmits)
     bool pbrIridescence = false;      ///< ... iridescence (Material::pbrIridescent)
+    bool pbrAnisotropy = false;       ///< ... anisotropy (Material::pbrAnisotropic: needs the hit's tangent frame)
     bool secondUvs = false;           ///< some material in use reads a mesh's second uv set (glTF TEXCOORD_1)
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
     bool orthographic = false;        ///< the camera projects orthographically (parallel rays)
@@ -37,6 +38,8 @@ struct FeatureSet {
     static FeatureSet everything(Integrator integrator);
 
     bool anyPrimitive() const;
+    /// Some material needs the surfaces' tangent frames: a normal map, or a pbr anisotropy.
+    bool tangentFrames() const { return normalMaps || pbrAnisotropy; }
     bool has(ShapeKind kind) const { return shapes[size_t(kind)]; }
     bool has(LightKind kind) const { return lights[size_t(kind)]; }
     bool has(MaterialType type) const { return materialTypes[size_t(type)]; }

@@ -53,9 +53,11 @@ Color volumeAbsorption(const FileMaterial& f)
     return absorptionOfAttenuation(Color(f.attenuationColor), f.attenuationDistance);
 }
 
-/// KHR_materials_ior, _specular, _sheen, _clearcoat, _transmission, _volume and _iridescence as the pbr material's
-/// layers: factors as constants, each texture's channel as the extension says
-/// (sRGB colours, strengths in A, the coat in R and its roughness in G).
+/// KHR_materials_ior, _specular, _sheen, _clearcoat, _transmission, _volume,
+/// _iridescence and _anisotropy as the pbr material's layers: factors as
+/// constants, each texture's channel as the extension says (sRGB colours,
+/// strengths in A, the coat in R and its roughness in G; normal and direction
+/// textures linear, read whole).
 void addLayers(const FileMaterial& f, const std::filesystem::path& file, const SourceLocation& where,
                TextureAtlas& atlas, Material& m)
 {
@@ -75,6 +77,8 @@ void addLayers(const FileMaterial& f, const std::filesystem::path& file, const S
     m.layers.iridescenceIor = f.iridescenceIor;
     m.layers.iridescenceThicknessMin = f.iridescenceThicknessMinimum;
     m.layers.iridescenceThicknessMax = f.iridescenceThicknessMaximum;
+    m.layers.anisotropy = f.anisotropyStrength;
+    m.layers.anisotropyRotation = f.anisotropyRotation;
     auto add = [&](const std::optional<FileTexture>& texture, bool linear, TextureSlot which, uint32_t channel) {
         if (texture)
             m.textures[size_t(which)] = slot(addFileTexture(*texture, linear, file, where, atlas), *texture, channel);
@@ -88,6 +92,11 @@ void addLayers(const FileMaterial& f, const std::filesystem::path& file, const S
     add(f.transmissionTexture, true, TextureSlot::Transmission, 0);
     add(f.iridescenceTexture, true, TextureSlot::Iridescence, 0);
     add(f.iridescenceThicknessTexture, true, TextureSlot::IridescenceThickness, 1);
+    if (m.layers.anisotropy > 0.0) add(f.anisotropyTexture, true, TextureSlot::Anisotropy, 0);
+    if (m.layers.clearcoat > 0.0) {
+        add(f.clearcoatNormalTexture, true, TextureSlot::ClearcoatNormal, 0);
+        m.clearcoatNormalStrength = f.clearcoatNormalScale;
+    }
 }
 
 /// glTF 2.0 metallic-roughness as vkrt's pbr kind: the factors are the
@@ -162,11 +171,9 @@ void warnAbout(const FileMaterial& f, const Material& m, const SourceLocation& w
     if (f.normalTexture && f.normalTexture->rotation != 0.0)
         warnings.push_back(prefix + "normalTexture's KHR_texture_transform rotation turns its uvs, not its tangent "
                                     "frame: the normals are tilted the wrong way");
-    if (f.clearcoatNormalTexture && m.type == MaterialType::Pbr)
-        warnings.push_back(prefix + "clearcoatNormalTexture is not applied: the coat takes the base's shading normal");
-    else if (f.clearcoatFactor > 0.0f && f.normalTexture && m.type == MaterialType::Pbr)
-        warnings.push_back(prefix + "the clear coat takes the base's normal map (glTF: a coat without "
-                                    "clearcoatNormalTexture is not normal-mapped)");
+    if (f.clearcoatNormalTexture && f.clearcoatNormalTexture->rotation != 0.0)
+        warnings.push_back(prefix + "clearcoatNormalTexture's KHR_texture_transform rotation turns its uvs, not its "
+                                    "tangent frame: the coat's normals are tilted the wrong way");
     if (f.clearcoatFactor > 0.0f && f.emissiveFactor != glm::vec3(0.0f))
         warnings.push_back(prefix + "the emission is not darkened by the clear coat's Fresnel");
     if (f.baseColorFactor.a < 1.0f && f.alphaMode == AlphaMode::Opaque)

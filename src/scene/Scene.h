@@ -183,6 +183,8 @@ enum class TextureSlot : uint32_t {
     Transmission = gpu::TEXTURE_SLOT_TRANSMISSION,                  ///< pbr transmission (R)
     Iridescence = gpu::TEXTURE_SLOT_IRIDESCENCE,                    ///< pbr iridescence (R)
     IridescenceThickness = gpu::TEXTURE_SLOT_IRIDESCENCE_THICKNESS, ///< pbr iridescence_thickness (G: min to max)
+    Anisotropy = gpu::TEXTURE_SLOT_ANISOTROPY,                      ///< pbr anisotropy_texture (RG direction, B strength)
+    ClearcoatNormal = gpu::TEXTURE_SLOT_CLEARCOAT_NORMAL,           ///< pbr clearcoat_normal_map
     Normal = gpu::TEXTURE_SLOT_NORMAL,                              ///< tangent-space normal map
     Emission = gpu::TEXTURE_SLOT_EMISSION, ///< emitted radiance (glTF emissiveTexture; meshes only)
 };
@@ -207,6 +209,11 @@ struct PbrLayers {
     double iridescenceIor = 1.3;            ///< iridescenceIor: the thin film's index
     double iridescenceThicknessMin = 100.0; ///< iridescenceThicknessMinimum (nm): where its texture reads 0
     double iridescenceThicknessMax = 400.0; ///< iridescenceThicknessMaximum (nm): where it reads 1; without one
+    /// KHR_materials_anisotropy: anisotropyStrength stretches the base's GGX
+    /// alpha along a direction anisotropyRotation (radians) counter-clockwise
+    /// from the surface's tangent: alpha_t = mix(alpha, 1, strength^2).
+    double anisotropy = 0.0;
+    double anisotropyRotation = 0.0;
 
     bool sheen() const { return sheenColor != Color(0.0); }
     /// Light crosses the surface (the kernel's VKRT_PBR_TRANSMISSION).
@@ -219,7 +226,7 @@ struct PbrLayers {
     bool active() const
     {
         return specular != 1.0 || specularColor != Color(1.0) || sheen() || clearcoat > 0.0 || transmits() ||
-               iridescence > 0.0;
+               iridescence > 0.0 || anisotropy > 0.0;
     }
     bool operator==(const PbrLayers&) const = default;
 };
@@ -246,6 +253,7 @@ struct Material {
     /// (1 for the scene's textures, a glTF file's factor for its own).
     std::array<std::optional<MaterialTexture>, kTextureSlotCount> textures{};
     double normalStrength = 1.0; ///< scales a normal map's tangent-plane components (glTF normalTexture.scale)
+    double clearcoatNormalStrength = 1.0; ///< ... the clear coat's (glTF clearcoatNormalTexture.scale)
     /// Coverage (glTF alphaMode; meshes only): alpha = `alpha` times the colour
     /// texture's A channel; MASK keeps the surface where alpha >= alphaCutoff,
     /// BLEND keeps it with probability alpha (lib/alpha.glsl).
@@ -260,11 +268,17 @@ struct Material {
     bool hasTextures() const;
     /// Whether a texture of it reads uv set `set` (MaterialTexture::texCoord).
     bool readsUvSet(uint32_t set) const;
-    bool hasNormalMap() const { return texture(TextureSlot::Normal).has_value(); }
+    /// A normal map of the base or of the coat (both tilt a normal in the hit's tangent frame).
+    bool hasNormalMap() const
+    {
+        return texture(TextureSlot::Normal).has_value() || texture(TextureSlot::ClearcoatNormal).has_value();
+    }
     /// A pbr material with a glTF extension layer (or a KHR_materials_ior index other than 1.5).
     bool hasPbrLayers() const;
     bool pbrTransmits() const { return type == MaterialType::Pbr && layers.transmits(); }
     bool pbrIridescent() const { return type == MaterialType::Pbr && layers.iridescence > 0.0; }
+    /// Its base's GGX lobe is anisotropic along the hit's tangent frame.
+    bool pbrAnisotropic() const { return type == MaterialType::Pbr && layers.anisotropy > 0.0; }
     bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
 

@@ -4,6 +4,7 @@
 #include "scene/FeatureSet.h"
 #include "texture/TextureAtlas.h"
 
+#include <numbers>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -286,6 +287,10 @@ void parameters(MaterialKindTag<MaterialType::Pbr>, MaterialWriter& w, Integrato
     w.textured("iridescence_thickness", layers.iridescenceThicknessMax, TextureSlot::IridescenceThickness);
     w.value("iridescence_thickness_range",
             Json::array({layers.iridescenceThicknessMin, layers.iridescenceThicknessMax}));
+    w.value("anisotropy", layers.anisotropy);
+    w.value("anisotropy_rotation", layers.anisotropyRotation * 180.0 / std::numbers::pi);
+    w.texture("anisotropy_texture", TextureSlot::Anisotropy);
+    w.texture("clearcoat_normal_map", TextureSlot::ClearcoatNormal);
 }
 
 /// Every kind's parameters; a kind added to shared/Kinds.h without an overload above does not compile.
@@ -305,7 +310,9 @@ Json material(const Material& m, const TextureTable& textures, Integrator integr
     MaterialWriter writer(m, textures, out);
     kindParameters(writer, integrator);
     writer.texture("normal_map", TextureSlot::Normal);
-    if (m.hasNormalMap()) out["textures"]["normal_map"]["strength"] = m.normalStrength;
+    if (m.texture(TextureSlot::Normal)) out["textures"]["normal_map"]["strength"] = m.normalStrength;
+    if (m.texture(TextureSlot::ClearcoatNormal))
+        out["textures"]["clearcoat_normal_map"]["strength"] = m.clearcoatNormalStrength;
     if (!out.contains("textures")) out["textures"] = Json::object();
     // glTF alphaMode (file materials only); absent for opaque materials.
     if (m.alphaTested())

@@ -29,6 +29,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <utility>
@@ -138,7 +139,7 @@ constexpr std::array<std::string_view, 8> conductorKeys{"type", "roughness", "an
 constexpr std::array<std::string_view, 6> rough_dielectricKeys{"type",       "roughness", "ior",
                                                                "absorption", "fresnel",   "normal_map"};
 constexpr std::array<std::string_view, 5> plasticKeys{"type", "diffuse", "roughness", "ior", "normal_map"};
-constexpr std::array<std::string_view, 22> pbrKeys{"type",
+constexpr std::array<std::string_view, 26> pbrKeys{"type",
                                                    "base_color",
                                                    "metallic",
                                                    "roughness",
@@ -159,7 +160,11 @@ constexpr std::array<std::string_view, 22> pbrKeys{"type",
                                                    "iridescence_ior",
                                                    "iridescence_thickness",
                                                    "iridescence_thickness_range",
-                                                   "absorption"};
+                                                   "absorption",
+                                                   "anisotropy",
+                                                   "anisotropy_rotation",
+                                                   "anisotropy_texture",
+                                                   "clearcoat_normal_map"};
 
 /// A colour parameter: a value, or a texture table whose texel is the colour
 /// (the constant becomes 1, which the texel multiplies on the GPU).
@@ -382,6 +387,41 @@ void readPbrIridescence(const TableField& table, Material& material, ParseContex
     }
 }
 
+/// KHR_materials_anisotropy: `anisotropy` (the strength, in [0, 1]),
+/// `anisotropy_rotation` (degrees counter-clockwise from the surface's
+/// tangent) and `anisotropy_texture` (glTF's encoding: RG the direction in
+/// the tangent frame as (d + 1) / 2, which the rotation turns; B scales the
+/// strength).
+void readPbrAnisotropy(const TableField& table, Material& material, ParseContext& context)
+{
+    PbrLayers& layers = material.layers;
+    layers.anisotropy = readOr(table, "anisotropy", 0.0, readUnitInterval);
+    layers.anisotropyRotation = readOr(table, "anisotropy_rotation", 0.0, readNumber) * std::numbers::pi / 180.0;
+    if (const std::optional<Field> texture = table.find("anisotropy_texture")) {
+        if (!(layers.anisotropy > 0.0)) texture->fail("applies to an anisotropic material: set anisotropy above 0");
+        if (!isTextureTable(*texture))
+            texture->fail("expected a texture table ({ texture = \"directions.png\" }), got " +
+                          describeType(texture->node()));
+        material.textures[size_t(TextureSlot::Anisotropy)] =
+            readTextureTable(*texture, TextureUse::Vector, context.textures);
+    }
+}
+
+/// KHR_materials_clearcoat's clearcoatNormalTexture: the coat's own normal map
+/// (a texture table with `strength`, as `normal_map`). Without it the coat is
+/// not normal-mapped, whatever the base's `normal_map` does.
+void readClearcoatNormalMap(const TableField& table, Material& material, ParseContext& context)
+{
+    const std::optional<Field> field = table.find("clearcoat_normal_map");
+    if (!field) return;
+    if (!(material.layers.clearcoat > 0.0)) field->fail("applies to a coated material: set clearcoat above 0");
+    if (!isTextureTable(*field))
+        field->fail("expected a texture table ({ texture = \"normals.png\", ... }), got " +
+                    describeType(field->node()));
+    material.textures[size_t(TextureSlot::ClearcoatNormal)] =
+        readTextureTable(*field, TextureUse::NormalMap, context.textures, &material.clearcoatNormalStrength);
+}
+
 /// The glTF extension layers (KHR_materials_ior, _specular, _sheen, _clearcoat; their defaults).
 /// specular_color may exceed 1, as specularColorFactor may (the F0 it scales stays at most 1).
 void readPbrLayers(const TableField& table, Material& material, ParseContext& context)
@@ -405,8 +445,10 @@ void readPbrLayers(const TableField& table, Material& material, ParseContext& co
     layers.clearcoat = readUnitParameter(table, "clearcoat", 0.0, material, TextureSlot::Clearcoat, context.textures);
     layers.clearcoatRoughness = readUnitParameter(table, "clearcoat_roughness", 0.0, material,
                                                   TextureSlot::ClearcoatRoughness, context.textures);
+    readClearcoatNormalMap(table, material, context);
     readPbrTransmission(table, material, context);
     readPbrIridescence(table, material, context);
+    readPbrAnisotropy(table, material, context);
 }
 
 /// glTF 2.0's defaults: base colour 1, metallic 1, roughness 1.

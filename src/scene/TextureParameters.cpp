@@ -9,6 +9,7 @@ namespace {
 constexpr std::array<std::string_view, 5> colorTextureKeys{"texture", "scale", "linear", "wrap", "filter"};
 constexpr std::array<std::string_view, 6> scalarTextureKeys{"texture", "scale", "linear", "wrap", "filter", "channel"};
 constexpr std::array<std::string_view, 5> normalMapKeys{"texture", "scale", "wrap", "filter", "strength"};
+constexpr std::array<std::string_view, 4> vectorTextureKeys{"texture", "scale", "wrap", "filter"};
 
 constexpr std::array<EnumName<TextureWrap>, 3> wrapModes{
     {{"repeat", TextureWrap::Repeat}, {"clamp", TextureWrap::Clamp}, {"mirror", TextureWrap::Mirror}}};
@@ -54,6 +55,7 @@ std::span<const std::string_view> keysFor(TextureUse use)
     case TextureUse::Color: return colorTextureKeys;
     case TextureUse::Scalar: return scalarTextureKeys;
     case TextureUse::NormalMap: return normalMapKeys;
+    case TextureUse::Vector: return vectorTextureKeys;
     }
     return colorTextureKeys;
 }
@@ -69,7 +71,8 @@ MaterialTexture readTextureTable(const Field& field, TextureUse use, TextureAtla
     const Field file = table.require("texture");
     TextureRequest request;
     request.file = readPath(file);
-    request.linear = use == TextureUse::NormalMap || readOr(table, "linear", false, readBool);
+    request.linear =
+        use == TextureUse::NormalMap || use == TextureUse::Vector || readOr(table, "linear", false, readBool);
     std::tie(request.wrapU, request.wrapV) =
         readOr(table, "wrap", std::make_pair(TextureWrap::Repeat, TextureWrap::Repeat), readWrap);
     request.filter =

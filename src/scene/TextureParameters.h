@@ -13,7 +13,9 @@
 namespace vkrt {
 
 /// What a texture table may hold for a colour or scalar parameter.
-enum class TextureUse { Color, Scalar, NormalMap };
+/// Color: sRGB unless `linear`; Scalar: one `channel`; NormalMap: linear, with
+/// `strength`; Vector: linear, read whole (pbr anisotropy directions).
+enum class TextureUse { Color, Scalar, NormalMap, Vector };
 
 /// Whether `field` is a texture table (rather than a value).
 bool isTextureTable(const Field& field);

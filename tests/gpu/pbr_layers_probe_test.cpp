@@ -1,5 +1,6 @@
 // The pbr material's glTF extension layers (KHR_materials_specular, _ior,
-// _sheen, _clearcoat; lib/bsdf.glsl under VKRT_PBR_LAYERS) run on the test GPU
+// _sheen, _clearcoat with its own normal, _anisotropy; lib/bsdf.glsl under
+// VKRT_PBR_LAYERS and VKRT_PBR_ANISOTROPY) run on the test GPU
 // through tests/gpu/kernels/bsdf_probe.comp, against the independent
 // double-precision reference of the Khronos formulas (support/GltfPbrReference.h):
 //  - evaluation equals the reference at many direction pairs (the sheen's
@@ -32,7 +33,7 @@ namespace {
 constexpr uint32_t kSamples = 1u << 18;
 constexpr size_t kSheenTableAt = 128; // bsdf_probe.comp's layout with VKRT_PBR_LAYERS
 
-const std::vector<Define> kLayers{{"VKRT_PBR_LAYERS", "1"}};
+const std::vector<Define> kLayers{{"VKRT_PBR_LAYERS", "1"}, {"VKRT_PBR_ANISOTROPY", "1"}};
 
 struct LayerCase {
     std::string name;
@@ -49,13 +50,15 @@ glm::dvec3 direction(double cosTheta, double phi)
 std::vector<float> probeInput(const GltfPbrParams& p, const glm::dvec3& wo, float mode, float seed)
 {
     const double alpha = std::max(p.roughness * p.roughness, double(gpu::MIN_GGX_ALPHA));
+    // KHR_materials_anisotropy as a hit resolves it: alphaX stretched along the direction.
+    const double alphaX = alpha + (1.0 - alpha) * p.anisotropy * p.anisotropy;
     const double coatAlpha = std::max(p.clearcoatRoughness * p.clearcoatRoughness, double(gpu::MIN_GGX_ALPHA));
     std::vector<float> in(kSheenTableAt, 0.0f);
     const float material[] = {float(p.baseColor.x),     float(p.baseColor.y),     float(p.baseColor.z),
                               float(gpu::MATERIAL_PBR), float(p.specularColor.x), float(p.specularColor.y),
                               float(p.specularColor.z), 0.0f,                     0.0f,
                               0.0f,                     0.0f,                     float(p.ior),
-                              0.0f,                     float(alpha),             float(alpha),
+                              0.0f,                     float(alphaX),            float(alpha),
                               float(kSheenTableAt),     0.0f,                     0.0f,
                               0.0f,                     float(p.metallic)};
     std::copy(std::begin(material), std::end(material), in.begin());
@@ -68,6 +71,15 @@ std::vector<float> probeInput(const GltfPbrParams& p, const glm::dvec3& wo, floa
     const float layers[] = {float(p.sheenColor.x), float(p.sheenColor.y), float(p.sheenColor.z),
                             float(p.sheenRoughness), float(p.specular), float(p.clearcoat), float(coatAlpha)};
     std::copy(std::begin(layers), std::end(layers), in.begin() + 31);
+    if (p.anisotropy > 0.0) {
+        in[40] = float(std::cos(p.anisotropyAngle));
+        in[41] = float(std::sin(p.anisotropyAngle));
+    }
+    if (p.clearcoatNormal != glm::dvec3(0.0, 0.0, 1.0)) {
+        in[43] = float(p.clearcoatNormal.x);
+        in[44] = float(p.clearcoatNormal.y);
+        in[45] = float(p.clearcoatNormal.z);
+    }
     const std::vector<float>& table = sheenAlbedoTable();
     in.insert(in.end(), table.begin(), table.end());
     return in;
@@ -131,6 +143,18 @@ std::vector<LayerCase> layerCases()
     cases.back().p.sheenRoughness = 0.9;
     cases.back().p.clearcoat = 1.0;
     cases.back().p.clearcoatRoughness = 0.35;
+    cases.push_back({"anisotropic metal", base});
+    cases.back().p.metallic = 1.0;
+    cases.back().p.roughness = 0.4;
+    cases.back().p.anisotropy = 0.8;
+    cases.back().p.anisotropyAngle = 0.7;
+    cases.push_back({"anisotropic dielectric, coat with its own normal", base});
+    cases.back().p.metallic = 0.0;
+    cases.back().p.anisotropy = 0.5;
+    cases.back().p.anisotropyAngle = -1.2;
+    cases.back().p.clearcoat = 0.9;
+    cases.back().p.clearcoatRoughness = 0.3;
+    cases.back().p.clearcoatNormal = glm::normalize(glm::dvec3(0.3, -0.2, 1.0));
     return cases;
 }
 
@@ -178,7 +202,12 @@ double samplerPdf(const GltfPbrParams& p, const glm::dvec3& wo, const glm::dvec3
 {
     if (wi.z <= 0.0) return 0.0;
     auto pow5 = [](double x) { return x * x * x * x * x; };
-    const double coat = p.clearcoat * (0.04 + 0.96 * pow5(1.0 - wo.z));
+    // The coat's lobe about its own normal (any frame around it: the lobe is isotropic).
+    const glm::dvec3 nc = p.clearcoatNormal;
+    const glm::dvec3 tc = glm::normalize(glm::cross(nc, glm::dvec3(1.0, 0.0, 0.0))), bc = glm::cross(nc, tc);
+    auto coatLocal = [&](const glm::dvec3& w) { return glm::dvec3(glm::dot(w, tc), glm::dot(w, bc), glm::dot(w, nc)); };
+    const glm::dvec3 woCoat = coatLocal(wo), wiCoat = coatLocal(wi);
+    const double coat = woCoat.z > 0.0 ? p.clearcoat * (0.04 + 0.96 * pow5(1.0 - woCoat.z)) : 0.0;
     const double r = (p.ior - 1.0) / (p.ior + 1.0);
     double fd = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -190,13 +219,22 @@ double samplerPdf(const GltfPbrParams& p, const glm::dvec3& wo, const glm::dvec3
     const double sheenStrength = std::max({p.sheenColor.x, p.sheenColor.y, p.sheenColor.z});
     const double sheen = sheenStrength > 0.0 ? sheenStrength * sheenDirectionalAlbedo(wo.z, p.sheenRoughness) : 0.0;
     const double ps = specular / (specular + diffuse + sheen);
-    const glm::dvec3 h = glm::normalize(wo + wi);
-    auto lobe = [&](double roughness) {
-        const double a = std::max(roughness * roughness, double(gpu::MIN_GGX_ALPHA));
-        const Ggx ggx{a, a};
-        return ggx.visibleNormalPdf(wo, h) / (4.0 * glm::dot(wo, h));
+    // The reflection's density about h = normalize(o + i) of the visible normals of Ggx{ax, ay} in the frame
+    // where o and i are given.
+    auto lobe = [&](double ax, double ay, const glm::dvec3& o, const glm::dvec3& i) {
+        const glm::dvec3 h = glm::normalize(o + i);
+        const Ggx ggx{ax, ay};
+        return ggx.visibleNormalPdf(o, h) / (4.0 * glm::dot(o, h));
     };
-    return coat * lobe(p.clearcoatRoughness) + (1.0 - coat) * (ps * lobe(p.roughness) + (1.0 - ps) * wi.z / std::numbers::pi);
+    const double coatAlpha = std::max(p.clearcoatRoughness * p.clearcoatRoughness, double(gpu::MIN_GGX_ALPHA));
+    // The base's lobe in the frame whose x axis is the anisotropy's direction.
+    const double alpha = std::max(p.roughness * p.roughness, double(gpu::MIN_GGX_ALPHA));
+    const double c = std::cos(p.anisotropyAngle), s = std::sin(p.anisotropyAngle);
+    auto turned = [&](const glm::dvec3& w) { return glm::dvec3(c * w.x + s * w.y, -s * w.x + c * w.y, w.z); };
+    const double alphaT = alpha + (1.0 - alpha) * p.anisotropy * p.anisotropy;
+    const double base = lobe(alphaT, alpha, turned(wo), turned(wi));
+    return coat * lobe(coatAlpha, coatAlpha, woCoat, wiCoat) +
+           (1.0 - coat) * (ps * base + (1.0 - ps) * wi.z / std::numbers::pi);
 }
 
 TEST_F(PbrLayersProbe, SamplerMatchesItsDensityChiSquare)
@@ -243,17 +281,25 @@ double referenceAlbedo(const GltfPbrParams& p, const glm::dvec3& wo, int channel
 TEST_F(PbrLayersProbe, WhiteFurnaceMatchesTheReferenceAlbedoAndNeverGains)
 {
     // A white metal under a white sheen and a full coat: each layer takes
-    // energy from the one below, so the whole stays at most 1.
-    GltfPbrParams p;
-    p.baseColor = glm::dvec3(1.0);
-    p.metallic = 1.0;
-    p.roughness = 0.6;
-    p.sheenColor = glm::dvec3(1.0);
-    p.sheenRoughness = 0.6;
-    p.clearcoat = 1.0;
-    p.clearcoatRoughness = 0.3;
+    // energy from the one below, so the whole stays at most 1. Then the same
+    // metal anisotropic under a coat with its own, tilted normal.
+    GltfPbrParams layered;
+    layered.baseColor = glm::dvec3(1.0);
+    layered.metallic = 1.0;
+    layered.roughness = 0.6;
+    layered.sheenColor = glm::dvec3(1.0);
+    layered.sheenRoughness = 0.6;
+    layered.clearcoat = 1.0;
+    layered.clearcoatRoughness = 0.3;
+    GltfPbrParams anisotropic = layered;
+    anisotropic.sheenColor = glm::dvec3(0.0);
+    anisotropic.roughness = 0.3;
+    anisotropic.anisotropy = 0.9;
+    anisotropic.anisotropyAngle = 0.4;
+    anisotropic.clearcoatNormal = glm::normalize(glm::dvec3(-0.25, 0.1, 1.0));
+    for (const GltfPbrParams& p : {layered, anisotropic})
     for (const double cosO : {1.0, 0.5, 0.15}) {
-        SCOPED_TRACE("cosO " + std::to_string(cosO));
+        SCOPED_TRACE("anisotropy " + std::to_string(p.anisotropy) + " cosO " + std::to_string(cosO));
         const glm::dvec3 wo = direction(cosO, 0.0);
         double sum = 0.0, sumSquares = 0.0;
         for (const Sample& s : sampleOnGpu(p, wo, 3.0f)) {
@@ -266,7 +312,7 @@ TEST_F(PbrLayersProbe, WhiteFurnaceMatchesTheReferenceAlbedoAndNeverGains)
         EXPECT_LE(expected, 1.0);
         EXPECT_LE(mean, 1.0 + 4.0 * standardError) << "gains energy";
         EXPECT_NEAR(mean, expected, 4.5 * standardError + 2e-3) << "GPU mean vs quadrature of the reference";
-        RecordProperty("albedo_c" + std::to_string(cosO), std::to_string(expected));
+        RecordProperty("albedo_a" + std::to_string(p.anisotropy) + "_c" + std::to_string(cosO), std::to_string(expected));
     }
 }
 

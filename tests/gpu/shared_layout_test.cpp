@@ -62,6 +62,8 @@ std::vector<Member> expectedMembers()
         ARRAY_MEMBER(materials, Material, iridescenceIor),
         ARRAY_MEMBER(materials, Material, iridescenceThicknessMin),
         ARRAY_MEMBER(materials, Material, iridescenceThickness),
+        ARRAY_MEMBER(materials, Material, anisotropy),
+        ARRAY_MEMBER(materials, Material, clearcoatNormal),
         ARRAY_MEMBER(spheres, Sphere, center),
         ARRAY_MEMBER(spheres, Sphere, radius),
         ARRAY_MEMBER(spheres, Sphere, material),
@@ -180,7 +182,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     // stride is the struct size in the scalar layout, which static_asserts in
     // src/gpu/SharedTypes.cpp pin. Here check the last member ends the struct.
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
-    EXPECT_EQ(offsets.at("materials[0].iridescenceThickness") + 4, int(sizeof(gpu::Material)));
+    EXPECT_EQ(offsets.at("materials[0].clearcoatNormal") + 12, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].v2") + 12, int(sizeof(gpu::TriangleLight)));
     EXPECT_EQ(offsets.at("u.environmentAxisZ") + 12, int(sizeof(gpu::SceneUniforms)));
     EXPECT_EQ(offsets.at("directionalLights[0].sin2Alpha") + 4, int(sizeof(gpu::DirectionalLight)));

@@ -1,6 +1,7 @@
 #pragma once
 // An independent double-precision CPU reference of the glTF 2.0 metallic-roughness material (Appendix B) with
-// KHR_materials_specular, KHR_materials_ior, KHR_materials_sheen and KHR_materials_clearcoat, written from the
+// KHR_materials_specular, KHR_materials_ior, KHR_materials_sheen, KHR_materials_clearcoat (with its own normal) and
+// KHR_materials_anisotropy, written from the
 // Khronos specification texts alone (not from vkrt's shaders or src/material), to check vkrt's GLSL against.
 //
 // Local frame: the normal (also the clearcoat normal) is +z; wo = V points to the viewer, wi = L to the light,
@@ -10,7 +11,9 @@
 //                     F_d = f0 + (f90 - f0) (1 - |V.H|)^5, f90 = specular,
 //                     f0 = min(((ior - 1) / (ior + 1))^2 specularColor, 1) specular   (+ KHR_materials_ior)
 //   metal_brdf      = (baseColor + (1 - baseColor) (1 - |V.H|)^5) * specular_brdf
-//   specular_brdf   = D_GGX(alpha) * V_GGX (height-correlated Smith), alpha = roughness^2
+//   specular_brdf   = D_GGX(alpha) * V_GGX (height-correlated Smith), alpha = roughness^2; with anisotropy the
+//                     spec's D_GGX_anisotropic * V_GGX_anisotropic, at = mix(alpha, 1, anisotropy^2) along T,
+//                     ab = clamp(alpha, 0.001, 1) along B (metal and dielectric lobes; not the coat)
 //   sheen_material  = sheenColor * D_charlie * V_charlie
 //                     + material * min(1 - max3(sheenColor) E(N.V), 1 - max3(sheenColor) E(N.L))
 //   coated          = (1 - clearcoat Fc) sheen_material + clearcoat Fc specular_brdf(clearcoatRoughness^2),
@@ -43,6 +46,15 @@ struct GltfPbrParams {
     double sheenRoughness = 0.0;
     double clearcoat = 0.0;
     double clearcoatRoughness = 0.0;
+    /// KHR_materials_clearcoat's own normal (clearcoatNormalTexture), unit, local frame: the coat's Fresnel and
+    /// lobe are taken about it. The lobe enters f weighed by its own cosine: f cos(N, L) holds the coat's
+    /// clearcoat_brdf cos(Nc, L), as the Khronos sample viewer lights the coat (the spec's formulas leave the
+    /// cosine implicit).
+    glm::dvec3 clearcoatNormal{0.0, 0.0, 1.0};
+    /// KHR_materials_anisotropy: its strength, and the direction it stretches the base's specular lobes along
+    /// (the anisotropicT of the spec's TBN), at angle anisotropyAngle from +x in the tangent plane.
+    double anisotropy = 0.0;
+    double anisotropyAngle = 0.0;
 };
 
 /// The lower bound on the Charlie alpha_g = sheenRoughness^2 (1 / alpha_g is an exponent of the distribution).

@@ -12,7 +12,10 @@
 // With VKRT_PBR_LAYERS defined (tests/gpu/pbr_layers_probe_test.cpp): the pbr
 // layers at inputs[31 .. 37] (sheenColor, sheenRoughness, specularFactor,
 // clearcoat, clearcoatAlpha), the sheen table at inputs[128 ..] (Material::table
-// = 128) and mode 1's directions after it, at inputs[kDirectionsAt ..].
+// = 128) and mode 1's directions after it, at inputs[kDirectionsAt ..]; as a
+// hit resolves them (lib/material_textures.glsl), the anisotropy's direction
+// at inputs[40 .. 42] (VKRT_PBR_ANISOTROPY; alphaX its stretched alpha) and the
+// coat's normal at inputs[43 .. 45] (zero: n).
 // With VKRT_PBR_TRANSMISSION also (tests/gpu/pbr_transmission_probe_test.cpp):
 // m.transmission at inputs[38], m.pbrFlags at inputs[39] (PBR_FLAG_VOLUME for
 // a volume's boundary). A volume's interface eta, m.exponent, is inputs[28]:
@@ -63,6 +66,8 @@ Material probeMaterial()
     m.specularFactor = inputs[35];
     m.clearcoat = inputs[36];
     m.clearcoatAlpha = inputs[37];
+    m.anisotropy = vec3(inputs[40], inputs[41], inputs[42]);
+    m.clearcoatNormal = vec3(inputs[43], inputs[44], inputs[45]);
 #endif
 #ifdef VKRT_PBR_TRANSMISSION
     m.transmission = inputs[38];
