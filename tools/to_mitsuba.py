@@ -631,15 +631,16 @@ def _used_materials(shapes: dict) -> dict[int, str]:
 # volume, every other layer at its default (glTF's values).
 PBR_GLASS = {"transmission": 1.0, "thin_walled": False, "metallic": 0.0, "base_color": [1.0, 1.0, 1.0],
              "emission": [0.0, 0.0, 0.0], "specular": 1.0, "specular_color": [1.0, 1.0, 1.0],
-             "sheen_color": [0.0, 0.0, 0.0], "clearcoat": 0.0, "iridescence": 0.0}
+             "sheen_color": [0.0, 0.0, 0.0], "clearcoat": 0.0, "iridescence": 0.0, "anisotropy": 0.0}
 
 
 def pbr_glass_refusal(m: dict):
     """None when the exported pbr material `m` converts to Mitsuba's rough
     dielectric, else (key, why) for the first key that keeps it from it."""
     why = ("pbr converts only as volumetric glass (transmission = 1, thin_walled = false, metallic = 0, "
-           "base_color = 1, no emission, sheen, clearcoat, iridescence or specular change): Mitsuba's principled "
-           "BSDF is Disney's model, not glTF's, and its other BSDFs have no fresnel_mix, sheen or thin film")
+           "base_color = 1, no emission, sheen, clearcoat, iridescence, anisotropy or specular change): Mitsuba's "
+           "principled BSDF is Disney's model, not glTF's, and its other BSDFs have no fresnel_mix, sheen or thin "
+           "film, nor glTF's anisotropy mapping and tangent frame")
     for key, value in PBR_GLASS.items():
         if key in m.get("textures", {}):
             return key, f"{key} is a texture; {why}"

@@ -144,13 +144,13 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     const fs::path dir = testDir();
     const std::string png = readFile(cubeDir() / "Cube_MetallicRoughness.png");
     const std::string rest = R"(
-  "extensionsUsed": ["KHR_texture_transform", "KHR_materials_anisotropy", "KHR_lights_punctual"],
+  "extensionsUsed": ["KHR_texture_transform", "KHR_materials_diffuse_transmission", "KHR_lights_punctual"],
   "materials": [{"name": "Coated", "alphaMode": "BLEND", "doubleSided": true, "emissiveFactor": [1, 0.5, 0],
     "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 0.75], "metallicFactor": 0.25, "roughnessFactor": 0.5,
       "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 3], "offset": [0.5, 0.25],
                                                                                  "rotation": 0.125}}}},
     "normalTexture": {"index": 1, "scale": 0.5, "texCoord": 1},
-    "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1.0}}}],
+    "extensions": {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0}}}],
   "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
   "samplers": [{"wrapS": 33071, "wrapT": 33648}],
   "images": [{"uri": "base%20color.png"}, {"uri": ")" +
@@ -184,7 +184,7 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     EXPECT_EQ(m.baseColorTexture->rotation, 0.125);
     EXPECT_FALSE(mentions(m.unsupported, "KHR_texture_transform")) << joined(m.unsupported);
     // Each unsupported feature named.
-    EXPECT_TRUE(mentions(m.unsupported, "KHR_materials_anisotropy")) << joined(m.unsupported);
+    EXPECT_TRUE(mentions(m.unsupported, "KHR_materials_diffuse_transmission")) << joined(m.unsupported);
     EXPECT_FALSE(mentions(m.unsupported, "alphaMode")) << joined(m.unsupported); // honoured (lib/alpha.glsl)
     // Each texture reads its own uv set: mixing TEXCOORD_0 and TEXCOORD_1 is nothing to warn about.
     EXPECT_FALSE(mentions(m.unsupported, "TEXCOORD")) << joined(m.unsupported);
@@ -289,8 +289,8 @@ TEST(MeshFileMaterials, TrianglesKeepTheirMaterialsWhenAssimpRenumbersThem)
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 2}, {"attributes": {"POSITION": 1}}]},
              {"primitives": [{"attributes": {"POSITION": 2}, "material": 0}]}],
   "materials": [{"name": "A", "pbrMetallicRoughness": {"roughnessFactor": 0.125}}, {"name": "B"},
-                {"pbrMetallicRoughness": {"roughnessFactor": 0.875}, "extensions": {"KHR_materials_anisotropy": {}}}],
-  "extensionsUsed": ["KHR_materials_anisotropy"],
+                {"pbrMetallicRoughness": {"roughnessFactor": 0.875}, "extensions": {"KHR_materials_diffuse_transmission": {}}}],
+  "extensionsUsed": ["KHR_materials_diffuse_transmission"],
   "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) +
                              R"(", "byteLength": 108}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 108}],
@@ -308,7 +308,7 @@ TEST(MeshFileMaterials, TrianglesKeepTheirMaterialsWhenAssimpRenumbersThem)
         if (x < 5.0f) {
             EXPECT_EQ(m.fileIndex, 2);
             EXPECT_EQ(m.roughnessFactor, 0.875f);
-            EXPECT_TRUE(mentions(m.unsupported, "KHR_materials_anisotropy")) << joined(m.unsupported);
+            EXPECT_TRUE(mentions(m.unsupported, "KHR_materials_diffuse_transmission")) << joined(m.unsupported);
         } else if (x < 15.0f) {
             EXPECT_EQ(m.fileIndex, -1);
             EXPECT_EQ(m.roughnessFactor, 1.0f);

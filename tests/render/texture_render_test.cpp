@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <numbers>
 
 namespace vkrt::test {
 namespace {
@@ -72,7 +73,9 @@ void expectTexel(const Image& image, uint32_t x, uint32_t y, const uint8_t (&srg
 {
     for (int c = 0; c < 3; ++c) {
         const double expected = srgbToLinear(srgb[c] / 255.0);
-        EXPECT_NEAR(image.at(x, y)[c], expected, 2e-4) << what << " got " << image.at(x, y)[0] << " " << image.at(x, y)[1] << " " << image.at(x, y)[2] << ": pixel (" << x << ", " << y << ") channel " << c;
+        EXPECT_NEAR(image.at(x, y)[c], expected, 2e-4)
+            << what << " got " << image.at(x, y)[0] << " " << image.at(x, y)[1] << " " << image.at(x, y)[2]
+            << ": pixel (" << x << ", " << y << ") channel " << c;
     }
 }
 
@@ -223,12 +226,13 @@ std::string normalMapScene(const std::string& integrator, const glm::dvec3& ligh
     auto vec = [](const glm::dvec3& v) {
         return "[" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + "]";
     };
-    return "[render]\nintegrator = \"" + integrator + "\"\nmax_depth = 1\n[camera]\neye = [0, 3, 0]\n"
-           "target = [0, 0, 0]\nup = [0, 0, -1]\nfov = 20\nwidth = " + std::to_string(kSide) + "\nheight = " +
-           std::to_string(kSide) +
+    return "[render]\nintegrator = \"" + integrator +
+           "\"\nmax_depth = 1\n[camera]\neye = [0, 3, 0]\n"
+           "target = [0, 0, 0]\nup = [0, 0, -1]\nfov = 20\nwidth = " +
+           std::to_string(kSide) + "\nheight = " + std::to_string(kSide) +
            "\n[materials.bumpy]\ntype = \"lambert\"\nalbedo = 0.5\n"
-           "normal_map = { texture = \"normals.png\" }\n[[lights]]\ntype = \"point\"\nposition = " + vec(light) +
-           "\nintensity = [10, 10, 10]\n" + floor;
+           "normal_map = { texture = \"normals.png\" }\n[[lights]]\ntype = \"point\"\nposition = " +
+           vec(light) + "\nintensity = [10, 10, 10]\n" + floor;
 }
 
 /// Radiance at the floor's origin: albedo / pi * I * cos(mapped normal, light) / d^2.
@@ -271,13 +275,138 @@ TEST_F(TextureRender, ConstantNormalMapTiltsTheShadingNormalInTheTangentFrame)
         ASSERT_GT(expected, 1.2 * unmapped) << "the case does not tell a tilted normal from a flat one";
         for (const auto& [name, floor] : floors)
             for (const std::string integrator : {"path", "whitted"}) {
-                const Scene scene = parseSceneString(normalMapScene(integrator, light, floor),
-                                                     (dir / "scene.toml").string());
+                const Scene scene =
+                    parseSceneString(normalMapScene(integrator, light, floor), (dir / "scene.toml").string());
                 const Image image = renderCentres(scene);
                 EXPECT_NEAR(image.at(kSide / 2, kSide / 2)[0], expected, 2e-3 * expected)
-                    << name << ", " << integrator << ", normal map code " << int(code[0]) << " " << int(code[1])
-                    << " " << int(code[2]) << " (flat normal would give " << unmapped << ")";
+                    << name << ", " << integrator << ", normal map code " << int(code[0]) << " " << int(code[1]) << " "
+                    << int(code[2]) << " (flat normal would give " << unmapped << ")";
             }
+    }
+}
+
+// ------------------------------------------- pbr anisotropy and coat normals
+
+/// The floor of the normal-map tests (tangent +x, bitangent -z, normal +y),
+/// seen from straight above, under material `surface` and a point light of
+/// intensity 10 at `light`.
+std::string floorScene(const glm::dvec3& light, const std::string& surface, const std::string& shape)
+{
+    auto vec = [](const glm::dvec3& v) {
+        return "[" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + "]";
+    };
+    const std::string floor =
+        shape == "plane"
+            ? "[[objects]]\nshape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\nmaterial = \"surface\"\n"
+            : "[[objects]]\nshape = \"mesh\"\nfile = \"floor.obj\"\nmaterial = \"surface\"\n";
+    return "[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 3, 0]\ntarget = [0, 0, 0]\n"
+           "up = [0, 0, -1]\nfov = 20\nwidth = " +
+           std::to_string(kSide) + "\nheight = " + std::to_string(kSide) + "\n[materials.surface]\ntype = \"pbr\"\n" +
+           surface + "[[lights]]\ntype = \"point\"\nposition = " + vec(light) + "\nintensity = [10, 10, 10]\n" + floor;
+}
+
+/// Smith GGX with the height-correlated G, D G / (4 N.V N.L), for directions
+/// given in a frame whose x axis has alpha ax and y axis alpha ay (written from
+/// KHR_materials_anisotropy's D_GGX_anisotropic and V_GGX_anisotropic).
+double anisotropicGgx(const glm::dvec3& v, const glm::dvec3& l, double ax, double ay)
+{
+    const glm::dvec3 h = glm::normalize(v + l);
+    const double a2 = ax * ay;
+    const glm::dvec3 f(ay * h.x, ax * h.y, a2 * h.z);
+    const double w2 = a2 / glm::dot(f, f);
+    const double d = a2 * w2 * w2 / 3.14159265358979323846;
+    const double visibility = 0.5 / (l.z * glm::length(glm::dvec3(ax * v.x, ay * v.y, v.z)) +
+                                     v.z * glm::length(glm::dvec3(ax * l.x, ay * l.y, l.z)));
+    return d * visibility;
+}
+
+/// Directions in the floor's frame turned by `angle` about its normal: x along
+/// cos(angle) tangent + sin(angle) bitangent.
+glm::dvec3 inTurnedFloorFrame(const glm::dvec3& world, double angle)
+{
+    const glm::dvec3 t(1, 0, 0), b(0, 0, -1), n(0, 1, 0);
+    const glm::dvec3 x = std::cos(angle) * t + std::sin(angle) * b, y = glm::cross(n, x);
+    return {glm::dot(world, x), glm::dot(world, y), glm::dot(world, n)};
+}
+
+TEST_F(TextureRender, PbrAnisotropyStretchesTheHighlightAlongItsDirectionInTheTangentFrame)
+{
+    const auto dir = freshTempDir("texture-anisotropy");
+    std::ofstream(dir / "floor.obj") << "v -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\n"
+                                        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+    // A direction texture along the bitangent: rg = ((0, 1) + 1) / 2, strength (b) 1.
+    writeConstantNormalMap(dir / "directions.png", {128, 255, 255});
+    // A white metal (Fresnel 1 at every angle), roughness 0.3, strength 0.8:
+    // alpha 0.09 across, mix(0.09, 1, 0.64) = 0.6724 along the direction.
+    const double alpha = 0.09, stretched = alpha + (1.0 - alpha) * 0.64;
+    const std::string metal = "base_color = 1\nmetallic = 1\nroughness = 0.3\nanisotropy = 0.8\n";
+    const glm::dvec3 wo(0, 1, 0);
+    struct Case {
+        std::string name, surface;
+        double angle; // of the stretched axis from the tangent, towards the bitangent
+    };
+    const std::vector<Case> cases = {
+        {"rotation 0", metal, 0.0},
+        {"rotation 90", metal + "anisotropy_rotation = 90\n", std::numbers::pi / 2},
+        {"rotation 30", metal + "anisotropy_rotation = 30\n", std::numbers::pi / 6},
+        {"texture along the bitangent", metal + "anisotropy_texture = { texture = \"directions.png\" }\n",
+         std::numbers::pi / 2},
+        {"texture turned by -90",
+         metal + "anisotropy_rotation = -90\nanisotropy_texture = { texture = \"directions.png\" }\n", 0.0},
+    };
+    // Lights off to the side along the tangent and along the bitangent (-z): the
+    // highlight reaches the farther one where the lobe is stretched towards it.
+    for (const glm::dvec3 light : {glm::dvec3(1.2, 2, 0), glm::dvec3(0, 2, -1.2)})
+        for (const Case& c : cases)
+            for (const std::string shape : {"plane", "mesh"}) {
+                const glm::dvec3 wi = glm::normalize(light);
+                const double f =
+                    anisotropicGgx(inTurnedFloorFrame(wo, c.angle), inTurnedFloorFrame(wi, c.angle), stretched, alpha);
+                const double expected = f * 10.0 * wi.y / glm::dot(light, light);
+                const double across =
+                    anisotropicGgx(inTurnedFloorFrame(wo, c.angle + std::numbers::pi / 2),
+                                   inTurnedFloorFrame(wi, c.angle + std::numbers::pi / 2), stretched, alpha) *
+                    10.0 * wi.y / glm::dot(light, light);
+                ASSERT_GT(std::abs(expected - across), 0.2 * expected) << "the case does not tell the two axes apart";
+                const Scene scene =
+                    parseSceneString(floorScene(light, c.surface, shape), (dir / "scene.toml").string());
+                const Image image = renderCentres(scene);
+                EXPECT_NEAR(image.at(kSide / 2, kSide / 2)[0], expected, 3e-3 * expected)
+                    << c.name << ", " << shape << ", light (" << light.x << ", " << light.y << ", " << light.z
+                    << "); stretched across it instead: " << across;
+            }
+}
+
+TEST_F(TextureRender, TheCoatTakesItsOwnNormalMapNotTheBases)
+{
+    const auto dir = freshTempDir("texture-coat-normal");
+    writeConstantNormalMap(dir / "normals.png", {191, 128, 238}); // tilted 30 degrees towards +tangent
+    // Only the coat reflects: a black base with no dielectric specular (KHR_materials_specular 0).
+    const std::string coat = "base_color = 0\nmetallic = 0\nspecular = 0\nclearcoat = 1\nclearcoat_roughness = 0.4\n";
+    const glm::dvec3 light(2, 2, 0), wi = glm::normalize(light), wo(0, 1, 0);
+    const glm::dvec3 tilted = glm::normalize(decodeNormal({191, 128, 238}).x * glm::dvec3(1, 0, 0) +
+                                             decodeNormal({191, 128, 238}).z * glm::dvec3(0, 1, 0));
+    // The coat about normal nc: clearcoat Fc(nc.wo) S(nc) (nc.wi) I / d^2, with
+    // Fc = 0.04 + 0.96 (1 - nc.wo)^5 and S the GGX of alpha 0.16 about nc.
+    auto coatRadiance = [&](const glm::dvec3& nc) {
+        const glm::dvec3 t = glm::normalize(glm::cross(glm::dvec3(0, 0, 1), nc)), b = glm::cross(nc, t);
+        auto local = [&](const glm::dvec3& w) { return glm::dvec3(glm::dot(w, t), glm::dot(w, b), glm::dot(w, nc)); };
+        const double cosO = glm::dot(nc, wo);
+        const double fresnel = 0.04 + 0.96 * std::pow(1.0 - cosO, 5.0);
+        return fresnel * anisotropicGgx(local(wo), local(wi), 0.16, 0.16) * glm::dot(nc, wi) * 10.0 /
+               glm::dot(light, light);
+    };
+    const double flat = coatRadiance(glm::dvec3(0, 1, 0)), mapped = coatRadiance(tilted);
+    ASSERT_GT(mapped, 1.5 * flat) << "the case does not tell a tilted coat from a flat one";
+    const std::vector<std::pair<std::string, double>> cases = {
+        {coat + "clearcoat_normal_map = { texture = \"normals.png\" }\n", mapped},
+        {coat + "normal_map = { texture = \"normals.png\" }\n", flat},
+    };
+    for (const auto& [surface, expected] : cases) {
+        const Scene scene = parseSceneString(floorScene(light, surface, "plane"), (dir / "scene.toml").string());
+        const Image image = renderCentres(scene);
+        EXPECT_NEAR(image.at(kSide / 2, kSide / 2)[0], expected, 3e-3 * expected)
+            << surface << "(flat coat " << flat << ", tilted coat " << mapped << ")";
     }
 }
 
@@ -476,8 +605,10 @@ std::string twoQuadGltf(const std::string& materials)
     return R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0},
                              {"attributes": {"POSITION": 1}, "material": 1}]}],
-  "materials": )" + materials + R"(,
-  "buffers": [{"uri": ")" + dataUri("application/octet-stream", buffer) + R"(", "byteLength": 144}],
+  "materials": )" +
+           materials + R"(,
+  "buffers": [{"uri": ")" +
+           dataUri("application/octet-stream", buffer) + R"(", "byteLength": 144}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 144}],
   "accessors": [
     {"bufferView": 0, "byteOffset": 0, "componentType": 5126, "count": 6, "type": "VEC3", "min": [-1, -0.5, 0], "max": [0, 0.5, 0]},
@@ -494,8 +625,8 @@ TEST_F(TextureRender, GltfMaterialsApplyPerTriangleWithTheirEmission)
         R"([{"name": "Red", "emissiveFactor": [1, 0, 0], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}},
             {"name": "Green", "emissiveFactor": [0, 0.5, 0], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}}])");
     const std::string text = "[render]\nintegrator = \"path\"\nmax_depth = 2\n[camera]\neye = [0, 0, 3]\n"
-                             "target = [0, 0, 0]\nfov = 30\nwidth = " + std::to_string(kSide) + "\nheight = " +
-                             std::to_string(kSide) +
+                             "target = [0, 0, 0]\nfov = 30\nwidth = " +
+                             std::to_string(kSide) + "\nheight = " + std::to_string(kSide) +
                              "\n[[objects]]\nshape = \"mesh\"\nfile = \"quads.gltf\"\nmaterial = \"file\"\n";
     const Scene scene = parseSceneString(text, (dir / "scene.toml").string());
     const Image image = renderCentres(scene);

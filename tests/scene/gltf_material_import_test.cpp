@@ -133,5 +133,47 @@ TEST(GltfMaterialImport, TransmissionAndIridescenceTakeTheirFactorsAndTextures)
     EXPECT_TRUE(features.pbrTransmission && features.pbrIridescence);
 }
 
+TEST(GltfMaterialImport, AnisotropyAndTheCoatsNormalMapTakeTheirFactorsAndTextures)
+{
+    const std::string json = R"({"normalTexture": {"index": 0}, "extensions": {
+        "KHR_materials_anisotropy": {"anisotropyStrength": 0.6, "anisotropyRotation": 1.25,
+                                     "anisotropyTexture": {"index": 0}},
+        "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatNormalTexture": {"index": 0, "scale": 0.5}}}})";
+    const Scene scene = importOne("brushed", json, R"(["KHR_materials_anisotropy", "KHR_materials_clearcoat"])");
+    const Material& m = scene.materials.at(0);
+    EXPECT_EQ(m.layers.anisotropy, float(0.6));
+    EXPECT_EQ(m.layers.anisotropyRotation, float(1.25)) << "radians, as the file writes them";
+    ASSERT_TRUE(m.texture(TextureSlot::Anisotropy).has_value());
+    ASSERT_TRUE(m.texture(TextureSlot::ClearcoatNormal).has_value());
+    EXPECT_TRUE(m.texture(TextureSlot::Normal).has_value()) << "the base keeps its own normal map";
+    EXPECT_EQ(m.clearcoatNormalStrength, 0.5);
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.pbrAnisotropy && features.tangentFrames());
+
+    // Without a strength the direction texture changes nothing: no anisotropic kernel for it.
+    const Scene none = importOne("none", R"({"extensions": {"KHR_materials_anisotropy": {
+        "anisotropyTexture": {"index": 0}}}})",
+                                 R"(["KHR_materials_anisotropy"])");
+    EXPECT_FALSE(none.materials.at(0).pbrAnisotropic());
+    EXPECT_FALSE(featuresOf(none).pbrLayers);
+}
+
+TEST(GltfMaterialImport, AnisotropyRotationMustBeAFiniteNumber)
+{
+    const fs::path dir = freshTempDir("gltf-material-import");
+    writeText(dir / "bad.gltf", triangleGltf(R"("materials": [{"extensions": {"KHR_materials_anisotropy":
+        {"anisotropyStrength": 1, "anisotropyRotation": "left"}}}], "extensionsUsed": ["KHR_materials_anisotropy"])"));
+    try {
+        parseGltfScene((dir / "bad.gltf").string());
+        FAIL() << "accepted a rotation that is no number";
+    } catch (const std::exception& error) {
+        EXPECT_NE(std::string(error.what()).find("KHR_materials_anisotropy.anisotropyRotation must be a finite number"),
+                  std::string::npos)
+            << error.what();
+        EXPECT_NE(std::string(error.what()).find("bad.gltf"), std::string::npos) << error.what();
+    }
+}
+
 } // namespace
 } // namespace vkrt::test

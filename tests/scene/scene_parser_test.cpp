@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -309,6 +310,32 @@ material = "bubble"
     EXPECT_DOUBLE_EQ(bubble.layers.iridescenceThicknessMax, 550.0);
     const FeatureSet features = featuresOf(scene);
     EXPECT_TRUE(features.pbrLayers && features.pbrTransmission && features.pbrIridescence);
+}
+
+TEST(SceneParserValid, PbrAnisotropyIsReadInDegreesAndTurnsOnItsVariant)
+{
+    const Scene scene = parseSceneString(kCamera + R"([materials.brushed]
+type = "pbr"
+roughness = 0.3
+anisotropy = 0.7
+anisotropy_rotation = 90
+[materials.plain]
+type = "pbr"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "brushed"
+)",
+                                         "anisotropy.toml");
+    const Material& brushed = scene.materials.at(0);
+    EXPECT_DOUBLE_EQ(brushed.layers.anisotropy, 0.7);
+    EXPECT_NEAR(brushed.layers.anisotropyRotation, std::numbers::pi / 2.0, 1e-15);
+    EXPECT_TRUE(brushed.pbrAnisotropic() && brushed.hasPbrLayers());
+    EXPECT_FALSE(scene.materials.at(1).hasPbrLayers());
+    // The lobe turns with the hit's tangent frame, which the textured variants compute.
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.pbrAnisotropy && features.textures && features.tangentFrames());
 }
 
 TEST(SceneParserValid, ShapesReferToMaterialIndices)
@@ -784,6 +811,17 @@ const std::vector<BadScene> kBadScenes = {
     {"PbrIridescenceRangeWithoutTexture",
      kCamera + "[materials.g]\ntype = \"pbr\"\niridescence_thickness = 300\niridescence_thickness_range = [1, 2]\n", 8,
      31, "materials.g.iridescence_thickness_range: applies to a textured iridescence_thickness"},
+    {"PbrAnisotropyAboveOne", kCamera + "[materials.g]\ntype = \"pbr\"\nanisotropy = 1.5\n", 7, 14,
+     "materials.g.anisotropy: must be in [0, 1]"},
+    {"PbrAnisotropyTextureWithoutStrength",
+     kCamera + "[materials.g]\ntype = \"pbr\"\nanisotropy_texture = { texture = \"d.png\" }\n", 7, 22,
+     "materials.g.anisotropy_texture: applies to an anisotropic material: set anisotropy above 0"},
+    {"PbrCoatNormalMapWithoutCoat",
+     kCamera + "[materials.g]\ntype = \"pbr\"\nclearcoat_normal_map = { texture = \"n.png\" }\n", 7, 24,
+     "materials.g.clearcoat_normal_map: applies to a coated material: set clearcoat above 0"},
+    {"PbrCoatNormalMapNotATable",
+     kCamera + "[materials.g]\ntype = \"pbr\"\nclearcoat = 1\nclearcoat_normal_map = \"n.png\"\n", 8, 24,
+     "materials.g.clearcoat_normal_map: expected a texture table"},
     {"DeepTomlNesting", kCamera + "[" + repeatedParts(20000) + "]\n", 5, 257,
      "invalid TOML: tables and arrays nest more than 128 levels deep here"},
 };

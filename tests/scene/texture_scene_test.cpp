@@ -143,9 +143,9 @@ TEST_F(SceneParserTextures, UnsupportedGltfFeaturesAreLocatedWarnings)
         R"("materials": [{"name": "Coat", "alphaMode": "BLEND",
                           "pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
                               "extensions": {"KHR_texture_transform": {"scale": [2, 2], "texCoord": 1}}}},
-                          "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1}}}],
+                          "extensions": {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1}}}],
             "textures": [{"source": 0}], "images": [{"uri": "grey.png"}],
-            "extensionsUsed": ["KHR_texture_transform", "KHR_materials_anisotropy"])");
+            "extensionsUsed": ["KHR_texture_transform", "KHR_materials_diffuse_transmission"])");
     std::ofstream(m_dir / "coat.gltf") << gltf;
     const Scene scene = parse("[[objects]]\nshape = \"mesh\"\nfile = \"coat.gltf\"\nmaterial = \"file\"\n");
     ASSERT_EQ(scene.materials.size(), 1u);
@@ -156,7 +156,7 @@ TEST_F(SceneParserTextures, UnsupportedGltfFeaturesAreLocatedWarnings)
         EXPECT_EQ(w.rfind(scenePath() + ":8:12: coat.gltf#Coat: ", 0), 0u) << w;
     }
     // KHR_texture_transform is honoured, its texCoord override too (the primitive's TEXCOORD_1 is the uv set read).
-    for (const char* named : {"KHR_materials_anisotropy"})
+    for (const char* named : {"KHR_materials_diffuse_transmission"})
         EXPECT_NE(all.find(named), std::string::npos) << named << " is not named in:\n" << all;
     EXPECT_EQ(all.find("TEXCOORD"), std::string::npos) << all;
     // alphaMode BLEND is honoured: no warning, and the material keeps it.

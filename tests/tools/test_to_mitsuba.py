@@ -117,6 +117,7 @@ def test_refuses_pbr_other_than_volumetric_glass():
     _refusal(glass + "clearcoat = 0.5", 'materials."odd one".clearcoat')
     _refusal(glass + "base_color = [1, 0.5, 0.5]", 'materials."odd one".base_color')
     _refusal(glass + "iridescence = 1", 'materials."odd one".iridescence')
+    _refusal(glass + "anisotropy = 0.5", 'materials."odd one".anisotropy')
 
 
 def test_pbr_glass_is_a_rough_dielectric_with_its_medium():
