@@ -513,8 +513,12 @@ struct MeshBuilder {
                     fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite tangent");
                 const glm::dvec3 v(tangents->at(i, 0), tangents->at(i, 1), tangents->at(i, 2));
                 const double length = glm::length(v);
-                // glTF's bitangent runs along increasing file v; MeshData's v is 1 - file v (MeshData.h).
-                const float w = tangents->at(i, 3) < 0.0 ? 1.0f : -1.0f;
+                // glTF's bitangent w cross(n, t) runs along decreasing file v (MikkTSpace's
+                // increasing v before the exporter turned v down; the Khronos viewer's
+                // computed b = cross(n, t) runs the same way), which is MeshData's
+                // increasing v = 1 - file v: the sign carries over as it is. Read
+                // inverted, a 45-degree anisotropy and a normal map's green turned the wrong way.
+                const float w = tangents->at(i, 3) < 0.0 ? -1.0f : 1.0f;
                 t = length > 0.0 ? glm::vec4(glm::vec3(v / length), w) : glm::vec4(0.0f);
             }
             out.tangents.push_back(t);
@@ -899,10 +903,10 @@ void checkExtensions(const Document& d, GltfModel& model)
 const std::vector<std::string>& implementedGltfExtensions()
 {
     static const std::vector<std::string> names{
-        "KHR_lights_punctual",       "KHR_texture_transform",  "KHR_materials_emissive_strength",
-        "KHR_materials_ior",         "KHR_mesh_quantization",  "EXT_mesh_gpu_instancing",
-        "KHR_materials_unlit",       "KHR_materials_variants", "KHR_materials_transmission",
-        "KHR_materials_specular",    "KHR_materials_sheen",    "KHR_materials_clearcoat",
+        "KHR_lights_punctual",       "KHR_texture_transform",    "KHR_materials_emissive_strength",
+        "KHR_materials_ior",         "KHR_mesh_quantization",    "EXT_mesh_gpu_instancing",
+        "KHR_materials_unlit",       "KHR_materials_variants",   "KHR_materials_transmission",
+        "KHR_materials_specular",    "KHR_materials_sheen",      "KHR_materials_clearcoat",
         "KHR_materials_iridescence", "KHR_materials_anisotropy",
         "KHR_materials_volume", // its attenuation (the thickness only decides thin-walled or not)
     };

@@ -233,6 +233,38 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
     ASSERT_EQ(geometry->data.tangents.size(), 3u);
     EXPECT_NEAR(geometry->data.tangents[0].x, 1.0f, 1e-6f);
 
+    // A file's TANGENT means what the tangents computed from its uvs mean:
+    // w = +1 on a triangle whose file uvs are laid out as an image seen from
+    // the front (u right, v down) is the computed handedness.
+    GltfBuilder carried;
+    carried.doc()["materials"] = json::parse(R"([{"normalTexture": {"index": 0}}])");
+    carried.doc()["textures"] = b.doc()["textures"];
+    carried.doc()["images"] = b.doc()["images"];
+    auto uvTriangle = [&](GltfBuilder& builder, bool withTangents) {
+        json attributes{{"POSITION", builder.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3")},
+                        {"NORMAL", builder.floats({0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3")},
+                        // Image up (+y here) is file v decreasing.
+                        {"TEXCOORD_0", builder.floats({0, 1, 1, 1, 0, 0}, "VEC2")}};
+        if (withTangents) attributes["TANGENT"] = builder.floats({1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1}, "VEC4");
+        return builder.mesh(attributes, std::nullopt, 4, 0);
+    };
+    carried.node({{"mesh", uvTriangle(carried, true)}});
+    const MeshData fromFile = readGltfModel(carried.write("carried.gltf")).meshes.at(0);
+    GltfBuilder computed;
+    computed.doc()["materials"] = carried.doc()["materials"];
+    computed.doc()["textures"] = b.doc()["textures"];
+    computed.doc()["images"] = b.doc()["images"];
+    computed.node({{"mesh", uvTriangle(computed, false)}});
+    const auto computedGeometry = makeMeshGeometry(readGltfModel(computed.write("computed.gltf")).meshes.at(0),
+                                                   NormalMode::File, "computed.gltf");
+    ASSERT_EQ(fromFile.tangents.size(), 3u);
+    ASSERT_EQ(computedGeometry->data.tangents.size(), 3u);
+    for (size_t v = 0; v < 3; ++v) {
+        EXPECT_EQ(fromFile.tangents[v], glm::vec4(1, 0, 0, 1)) << "vertex " << v;
+        EXPECT_NEAR(computedGeometry->data.tangents[v].x, 1.0f, 1e-6f) << "vertex " << v;
+        EXPECT_EQ(computedGeometry->data.tangents[v].w, fromFile.tangents[v].w) << "vertex " << v;
+    }
+
     // A primitive without the TEXCOORD_1 its material reads is refused, by name.
     GltfBuilder bad;
     bad.doc()["materials"] = b.doc()["materials"];
