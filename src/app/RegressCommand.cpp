@@ -7,7 +7,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <memory>
+#include <string>
 
 namespace vkrt {
 
@@ -38,18 +40,38 @@ struct CommandLineExtras {
     CLI::Option* jobsOption = nullptr;
     double caseTimeout = 0.0;
     CLI::Option* caseTimeoutOption = nullptr;
+    std::string runCase;
+    CLI::Option* runCaseOption = nullptr;
 };
 
 void applyExtras(RegressOptions& o, const CommandLineExtras& extras)
 {
     if (extras.jobsOption->count()) o.jobs = extras.jobs;
     if (extras.caseTimeoutOption->count()) o.caseTimeout = extras.caseTimeout;
+    // Given at all, even empty, it makes this process a child: a child that
+    // took itself for the parent started the suite again, without end.
+    if (extras.runCaseOption->count()) o.runCase = extras.runCase;
+}
+
+/// Seconds a case may run: a positive finite number (nan and inf would switch
+/// the timeout off without a word).
+std::string checkCaseTimeout(const std::string& text)
+{
+    try {
+        size_t used = 0;
+        const double seconds = std::stod(text, &used);
+        if (used == text.size() && std::isfinite(seconds) && seconds > 0.0) return "";
+    } catch (const std::exception&) {
+    }
+    return "must be a positive finite number of seconds, got '" + text.substr(0, 96) + "'";
 }
 
 /// The child process's options (regress/AttemptPool.cpp gives them): hidden from --help.
-void addChildOptions(CLI::App* cmd, RegressOptions& o)
+void addChildOptions(CLI::App* cmd, RegressOptions& o, CommandLineExtras& extras)
 {
-    cmd->add_option("--run-case", o.runCase, "Make one attempt at this case (a child of vkrt regress)")->group("");
+    extras.runCaseOption =
+        cmd->add_option("--run-case", extras.runCase, "Make one attempt at this case (a child of vkrt regress)")
+            ->group("");
     cmd->add_option("--case-result", o.caseResult, "Write the attempt here (JSON)")->group("");
     cmd->add_option("--case-image", o.caseImage, "Write the render here (EXR with its variance)")->group("");
     cmd->add_option("--attempt", o.attempt, "1, or 2 for the re-run")->group("")->check(CLI::Range(1, 2));
@@ -79,7 +101,7 @@ CommandRunner addRegressCommand(CLI::App& app)
     extras->caseTimeoutOption = cmd->add_option("--case-timeout", extras->caseTimeout,
                                                 "Seconds a case's process may run (default: from "
                                                 "its baseline_seconds, docs/regress.md)")
-                                    ->check(CLI::PositiveNumber);
+                                    ->check(CLI::Validator(checkCaseTimeout, "SECONDS"));
     cmd->add_option("--baseline", o->baseline, "Expected failures: 'case-name,Status' lines (deqp-runner's fails.txt)");
     cmd->add_option("--flakes", o->flakes, "Known flaky cases: one regular expression per line");
     cmd->add_option("--skips", o->skips, "Cases not to run: one regular expression per line");
@@ -92,10 +114,10 @@ CommandRunner addRegressCommand(CLI::App& app)
                   "and times");
     addAccelOption(*cmd, o->accel);
     cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");
-    addChildOptions(cmd, *o);
+    addChildOptions(cmd, *o, *extras);
     return [o, defines, extras] {
         applyExtras(*o, *extras);
-        if (o->runCase.empty()) checkRegressFiles(*o);
+        if (!o->runCase) checkRegressFiles(*o);
         o->kernelDefines = parseKernelDefines(*defines);
         return exitCodeFor(runRegression(*o));
     };

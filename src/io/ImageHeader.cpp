@@ -1,6 +1,7 @@
 #include "io/ImageHeader.h"
 
 #include "io/Image.h"
+#include "io/RadianceHdr.h"
 #include "util/Error.h"
 
 #include <ImfChannelList.h>
@@ -15,6 +16,7 @@
 #include <cctype>
 #include <climits>
 #include <cstring>
+#include <fstream>
 #include <iterator>
 #include <stdexcept>
 
@@ -163,6 +165,14 @@ void checkExrLength(const Imf::Header& header, uint64_t headerEnd, uint64_t stre
                        std::to_string(streamBytes) + ": truncated or damaged");
 }
 
+bool fileStartsWithRadianceSignature(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    uint8_t head[2] = {0, 0};
+    in.read(reinterpret_cast<char*>(head), 2);
+    return in.gcount() == 2 && isRadianceHdr(head);
+}
+
 } // namespace
 
 uint64_t exrMaxCompressionRatio(Imf::Compression compression)
@@ -227,6 +237,7 @@ bool MemoryExrStream::read(char c[], int n)
 
 ImageExtent stbImageExtent(std::span<const uint8_t> bytes, const std::string& name)
 {
+    if (isRadianceHdr(bytes)) return radianceHdrExtent(bytes, bytes.size(), name);
     if (bytes.size() > size_t(INT_MAX)) fail(name, "unsupported image: larger than 2 GiB");
     int width = 0, height = 0, channels = 0;
     if (!stbi_info_from_memory(bytes.data(), int(bytes.size()), &width, &height, &channels))
@@ -237,6 +248,7 @@ ImageExtent stbImageExtent(std::span<const uint8_t> bytes, const std::string& na
 
 ImageExtent stbImageFileExtent(const fs::path& file)
 {
+    if (fileStartsWithRadianceSignature(file)) return radianceHdrFileExtent(file);
     int width = 0, height = 0, channels = 0;
     if (!stbi_info(file.c_str(), &width, &height, &channels))
         fail(file.string(), std::string("no image header stb_image can read (stb_image: ") +

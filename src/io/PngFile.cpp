@@ -2,6 +2,7 @@
 
 #include "io/AtomicFile.h"
 #include "io/ExrFile.h"
+#include "io/RadianceHdr.h"
 #include "util/Error.h"
 
 #include <stb/stb_image.h>
@@ -9,8 +10,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace vkrt {
 
@@ -83,14 +88,16 @@ Image readPng(const std::filesystem::path& path)
 
 Image readRadianceHdr(const std::filesystem::path& path)
 {
-    int width = 0, height = 0, channels = 0;
-    std::unique_ptr<float, void (*)(void*)> pixels(stbi_loadf(path.c_str(), &width, &height, &channels, 3),
-                                                   stbi_image_free);
-    if (!pixels || !stbi_is_hdr(path.c_str()))
-        throw InputError(path.string() + ": cannot read Radiance HDR: " +
-                         (pixels ? "not an HDR file" : stbi_failure_reason() ? stbi_failure_reason() : "?"));
-    Image image{uint32_t(width), uint32_t(height)};
-    std::copy_n(pixels.get(), image.rgb.size(), image.rgb.begin());
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error))
+        throw InputError(path.string() +
+                         (std::filesystem::exists(path, error) ? ": is not a regular file" : ": no such file"));
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path.string() + ": cannot be opened");
+    const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const RadianceHdrImage decoded = decodeRadianceHdr(bytes, path.string());
+    Image image{decoded.extent.width, decoded.extent.height};
+    for (size_t i = 0; i < decoded.extent.pixels(); ++i) std::copy_n(&decoded.rgba[4 * i], 3, &image.rgb[3 * i]);
     return image;
 }
 

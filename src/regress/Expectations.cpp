@@ -2,6 +2,8 @@
 
 #include "util/Error.h"
 
+#include <re2/re2.h>
+
 #include <algorithm>
 #include <fstream>
 #include <sstream>
@@ -20,6 +22,15 @@ std::string trimmed(const std::string& text)
     return text.substr(begin, text.find_last_not_of(space) - begin + 1);
 }
 
+/// What a message shows of a value from a file: its first 96 bytes.
+std::string echoed(const std::string& text)
+{
+    constexpr size_t kShown = 96;
+    std::string shown = text.substr(0, kShown);
+    if (text.size() > kShown) shown.append("...");
+    return shown;
+}
+
 /// The file's lines, each with "file:line"; blank lines and `#` comments left out.
 std::vector<std::pair<std::string, std::string>> meaningfulLines(const fs::path& path, const std::string& option)
 {
@@ -29,6 +40,10 @@ std::vector<std::pair<std::string, std::string>> meaningfulLines(const fs::path&
     std::vector<std::pair<std::string, std::string>> lines;
     std::string line;
     for (int number = 1; std::getline(in, line); ++number) {
+        if (line.size() > kMaxExpectationLineBytes)
+            throw InputError(path.string() + ":" + std::to_string(number) + ": a line of " +
+                             std::to_string(line.size()) + " bytes, more than the " +
+                             std::to_string(kMaxExpectationLineBytes) + " vkrt reads ('" + echoed(line) + "')");
         line = trimmed(line);
         if (line.empty() || line[0] == '#') continue;
         lines.emplace_back(path.string() + ":" + std::to_string(number), line);
@@ -72,10 +87,11 @@ std::optional<CaseStatus> Expectations::expectedStatus(const std::string& name) 
 namespace {
 bool anyMatches(const std::vector<NamePattern>& patterns, const std::string& name)
 {
-    return std::any_of(patterns.begin(), patterns.end(),
-                       [&](const NamePattern& p) { return std::regex_search(name, p.regex); });
+    return std::any_of(patterns.begin(), patterns.end(), [&](const NamePattern& p) { return p.foundIn(name); });
 }
 } // namespace
+
+bool NamePattern::foundIn(const std::string& name) const { return re2::RE2::PartialMatch(name, *regex); }
 
 bool Expectations::isKnownFlake(const std::string& name) const { return anyMatches(flakes, name); }
 bool Expectations::isSkipped(const std::string& name) const { return anyMatches(skips, name); }
@@ -86,11 +102,13 @@ std::map<std::string, ExpectedStatus> readBaseline(const fs::path& path)
     for (const auto& [where, line] : meaningfulLines(path, "--baseline")) {
         std::vector<std::string> fields = fieldsOf(line);
         if (fields.size() < 2 || fields.size() > 3 || fields[0].empty() || fields[1].empty())
-            throw InputError(where + ": expected 'case-name,Status' (e.g. 'extreme/tir,Fail'), got '" + line + "'");
+            throw InputError(where + ": expected 'case-name,Status' (e.g. 'extreme/tir,Fail'), got '" + echoed(line) +
+                             "'");
         ExpectedStatus expected{expectableStatus(where, fields[1]), where};
         auto [first, inserted] = baseline.emplace(fields[0], expected);
         if (!inserted)
-            throw InputError(where + ": case " + fields[0] + " is already listed (" + first->second.where + ")");
+            throw InputError(where + ": case " + echoed(fields[0]) + " is already listed (" + first->second.where +
+                             ")");
     }
     return baseline;
 }
@@ -99,11 +117,14 @@ std::vector<NamePattern> readNamePatterns(const fs::path& path, const std::strin
 {
     std::vector<NamePattern> patterns;
     for (const auto& [where, line] : meaningfulLines(path, option)) {
-        try {
-            patterns.push_back({std::regex(line, std::regex::ECMAScript), line, where});
-        } catch (const std::regex_error& e) {
-            throw InputError(where + ": not a regular expression: '" + line + "' (" + e.what() + ")");
-        }
+        re2::RE2::Options options;
+        options.set_log_errors(false);
+        // RE2 bounds its memory; a pattern that needs more is refused, not run.
+        options.set_max_mem(8 << 20);
+        auto regex = std::make_shared<const re2::RE2>(line, options);
+        if (!regex->ok())
+            throw InputError(where + ": not a regular expression: '" + echoed(line) + "' (" + regex->error() + ")");
+        patterns.push_back({std::move(regex), line, where});
     }
     return patterns;
 }
@@ -123,7 +144,7 @@ std::vector<std::string> baselineLinesNamingNoCase(const Expectations& expectati
     std::vector<std::string> warnings;
     for (const auto& [name, expected] : expectations.baseline)
         if (std::find(names.begin(), names.end(), name) == names.end())
-            warnings.push_back(expected.where + ": no case named " + name + " in the suite");
+            warnings.push_back(expected.where + ": no case named " + echoed(name) + " in the suite");
     return warnings;
 }
 

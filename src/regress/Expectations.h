@@ -8,19 +8,29 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
-#include <regex>
 #include <string>
 #include <vector>
 
+namespace re2 {
+class RE2;
+}
+
 namespace vkrt {
 
-/// One line of a --flakes or --skips file.
+/// One line of a --flakes or --skips file: an RE2 expression (the syntax of
+/// deqp-runner's Rust regex), matched in time linear in the name.
 struct NamePattern {
-    std::regex regex;
+    std::shared_ptr<const re2::RE2> regex;
     std::string text;  ///< as written, for messages
     std::string where; ///< "file:line"
+
+    bool foundIn(const std::string& name) const;
 };
+
+/// The longest --flakes/--skips pattern and baseline line vkrt reads (bytes).
+inline constexpr size_t kMaxExpectationLineBytes = 1024;
 
 struct ExpectedStatus {
     CaseStatus status = CaseStatus::Fail; ///< Fail, Crash or Timeout
@@ -44,9 +54,11 @@ struct Expectations {
 /// status, a case listed twice.
 std::map<std::string, ExpectedStatus> readBaseline(const std::filesystem::path& path);
 
-/// Reads one regular expression (ECMAScript) per line, blank lines and `#`
-/// comments skipped; a case matches when the expression is found anywhere in
-/// its name (deqp-runner's rule). A bad expression is an InputError "file:line: ...".
+/// Reads one regular expression (RE2 syntax, as deqp-runner's Rust regex) per
+/// line, blank lines and `#` comments skipped; a case matches when the
+/// expression is found anywhere in its name (deqp-runner's rule). A bad
+/// expression, or a line over kMaxExpectationLineBytes, is an InputError
+/// "file:line: ..." (what it echoes of the line cut at 96 bytes).
 std::vector<NamePattern> readNamePatterns(const std::filesystem::path& path, const std::string& option);
 
 /// The three files of the options (empty paths: none).

@@ -345,9 +345,9 @@ const RegressionCase& caseNamed(const RegressionSuite& suite, const std::string&
 /// error becomes a Fail that says what; only Ctrl-C or death write nothing.
 Outcome runCaseForParent(const RegressOptions& options)
 {
-    if (options.caseResult.empty()) throw InputError("--run-case " + options.runCase + " needs --case-result FILE");
+    if (options.caseResult.empty()) throw InputError("--run-case " + *options.runCase + " needs --case-result FILE");
     const RegressionSuite suite = readRegressionSuite(options.suite);
-    const RegressionCase& c = caseNamed(suite, options.runCase);
+    const RegressionCase& c = caseNamed(suite, *options.runCase);
     const AttemptPlan plan{options.attempt, options.seedOffset, options.reportDir, options.caseImage};
     CaseAttempt attempt;
     attempt.number = plan.number;
@@ -457,7 +457,7 @@ void selectVulkanDriver(const fs::path& icdManifest)
 
 Outcome runRegression(const RegressOptions& options)
 {
-    if (!options.runCase.empty()) return runCaseForParent(options);
+    if (options.runCase) return runCaseForParent(options);
     RegressionSuite suite = readRegressionSuite(options.suite);
     refuseContradictions(options);
     const std::vector<RegressionCase> cases = selectedCases(suite, options.filters);

@@ -38,7 +38,9 @@ struct RegressOptions {
     bool compares() const { return !compareDrivers.empty() || compareAccel; }
 
     // The child process's side (hidden options, given by regress/AttemptPool.cpp):
-    std::string runCase;              ///< --run-case: make one attempt at this case
+    /// --run-case: make one attempt at this case. Set (even to "") only in a
+    /// child: a child never runs the suite itself.
+    std::optional<std::string> runCase;
     std::filesystem::path caseResult; ///< --case-result: write the attempt here (JSON)
     std::filesystem::path caseImage;  ///< --case-image: write the render here (EXR with variance)
     int attempt = 1;                  ///< --attempt: 1, or 2 for the re-run

@@ -7,7 +7,9 @@
 #include "util/Error.h"
 
 #include <array>
+#include <cctype>
 #include <cstdint>
+#include <cstdio>
 #include <map>
 #include <string_view>
 #include <utility>
@@ -20,9 +22,9 @@ namespace {
 
 constexpr std::array<std::string_view, 2> topLevelKeys{"suite", "case"};
 constexpr std::array<std::string_view, 5> suiteKeys{"alpha", "pooled_alpha", "min_pass", "max_slowdown", "seed"};
-constexpr std::array<std::string_view, 11> caseKeys{"name",  "scene",  "reference",        "reference_source",
-                                                    "reference_spp", "spp", "width", "height", "baseline_seconds",
-                                                    "max_rejected",  "shards"};
+constexpr std::array<std::string_view, 11> caseKeys{"name",  "scene", "reference", "reference_source", "reference_spp",
+                                                    "spp",   "width", "height",    "baseline_seconds", "max_rejected",
+                                                    "shards"};
 
 constexpr std::array<EnumName<ReferenceSource>, 2> referenceSources{
     {{"mitsuba", ReferenceSource::Mitsuba}, {"vkrt", ReferenceSource::Vkrt}}};
@@ -60,11 +62,34 @@ void readSuiteSettings(const TableField& table, RegressionSuite& suite)
     suite.seed = readOr(table, "seed", suite.seed, readSeed);
 }
 
+/// A case name: what a child process is started with (--run-case), --filter
+/// matches, and every report (CSV, JUnit XML, the baseline files) writes
+/// unquoted. So it is 1 to kMaxCaseNameBytes letters, digits and `._/+-`
+/// (deqp's case names and paths need no more), never a character a report
+/// would have to escape.
+std::string readCaseName(const Field& field)
+{
+    const std::string name = readString(field);
+    if (name.empty()) field.fail("a case name cannot be empty");
+    if (name.size() > kMaxCaseNameBytes)
+        field.fail("a case name is at most " + std::to_string(kMaxCaseNameBytes) + " bytes, this one " +
+                   std::to_string(name.size()));
+    for (const char c : name) {
+        if (!isCaseNameCharacter(c)) {
+            char code[8];
+            std::snprintf(code, sizeof code, "0x%02X", unsigned(static_cast<unsigned char>(c)));
+            field.fail("a case name holds only letters, digits and . _ / + -, not " +
+                       (std::isprint(static_cast<unsigned char>(c)) ? quote(std::string(1, c)) : std::string(code)));
+        }
+    }
+    return name;
+}
+
 RegressionCase readCase(const TableField& table)
 {
     table.rejectUnknownKeys(caseKeys);
     RegressionCase c;
-    c.name = readString(table.require("name"));
+    c.name = readCaseName(table.require("name"));
     c.scene = readScenePath(table.require("scene"));
     c.referenceDir = readFolder(table.require("reference"));
     c.source = readChoice(table.require("reference_source"), "reference source", referenceSources).value;
@@ -112,6 +137,12 @@ std::vector<RegressionCase> readCases(const TableField& top)
 }
 
 } // namespace
+
+bool isCaseNameCharacter(char c)
+{
+    const auto u = static_cast<unsigned char>(c);
+    return std::isalnum(u) || c == '.' || c == '_' || c == '/' || c == '+' || c == '-';
+}
 
 RegressionSuite readRegressionSuite(const fs::path& path)
 {

@@ -2,6 +2,7 @@
 // A regression suite manifest (TOML, docs/regress.md): cases, each a scene
 // rendered at a fixed size, spp and seed and tested against a reference mean
 // and variance.
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -33,6 +34,11 @@ struct RegressionSuite {
     uint32_t seed = 1;
     std::vector<RegressionCase> cases;
 };
+
+/// A case name's longest (what reports echo of any value is cut there too).
+inline constexpr size_t kMaxCaseNameBytes = 96;
+/// The characters of a case name: letters, digits and `._/+-` (reports write names unescaped).
+bool isCaseNameCharacter(char c);
 
 /// Parses and checks a manifest; paths are resolved against its folder.
 /// Errors are InputError "file:line:column: ...".

@@ -2,6 +2,7 @@
 
 #include "io/ExrFile.h"
 #include "io/ImageHeader.h"
+#include "io/RadianceHdr.h"
 #include "shared/TextureTypes.h"
 #include "util/Error.h"
 
@@ -176,6 +177,18 @@ TexelEncoding stbEncoding(std::span<const uint8_t> bytes, bool linear)
     return linear ? TexelEncoding::Unorm8 : TexelEncoding::Srgb8;
 }
 
+TextureImage decodeHdr(std::span<const uint8_t> bytes, const std::string& file)
+{
+    const ImageExtent extent = radianceHdrExtent(bytes, bytes.size(), file);
+    checkSize(file, extent.width, extent.height);
+    RadianceHdrImage decoded = decodeRadianceHdr(bytes, file);
+    TextureImage texture{RgbaImage(), TexelEncoding::Half};
+    texture.pixels.width = extent.width;
+    texture.pixels.height = extent.height;
+    texture.pixels.rgba = std::move(decoded.rgba);
+    return texture;
+}
+
 TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, bool linear)
 {
     const auto* data = bytes.data();
@@ -214,6 +227,11 @@ TextureHeader readTextureHeader(std::span<const uint8_t> bytes, const std::strin
         checkSize(name, extent.width, extent.height);
         return {extent.width, extent.height, TexelEncoding::Half};
     }
+    if (isRadianceHdr(bytes)) {
+        const ImageExtent extent = radianceHdrExtent(bytes, bytes.size(), name);
+        checkSize(name, extent.width, extent.height);
+        return {extent.width, extent.height, TexelEncoding::Half};
+    }
     const ImageExtent extent = stbHeader(bytes, name);
     return {extent.width, extent.height, stbEncoding(bytes, linear)};
 }
@@ -226,7 +244,8 @@ TextureImage loadTextureImage(const fs::path& file, bool linear)
 TextureImage decodeTextureImage(std::span<const uint8_t> bytes, const std::string& name, bool linear)
 {
     if (bytes.empty()) fail(name, "empty file, not an image");
-    if (isExr(bytes)) return decodeExr(bytes, name); // EXR is linear whatever `linear` says
+    if (isExr(bytes)) return decodeExr(bytes, name);         // EXR is linear whatever `linear` says
+    if (isRadianceHdr(bytes)) return decodeHdr(bytes, name); // so is HDR
     return decodeStb(bytes, name, linear);
 }
 

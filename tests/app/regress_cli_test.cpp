@@ -367,6 +367,46 @@ TEST_F(RegressCli, ManifestErrorsNameFileLineAndColumn)
                      {"--filter no-such-case", "no case"});
 }
 
+// Case names are what a child is started with and what every report writes
+// unescaped: an empty name once made a child take itself for the parent and
+// start the suite again (hundreds of processes within seconds).
+TEST_F(RegressCli, CaseNamesAreCheckedWhereTheyStand)
+{
+    ManifestCase c = shipped("extreme/kappa-shadow", 8);
+    const fs::path suite = m_dir / "suite.toml";
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"", "a case name cannot be empty"},
+        {"x\\u0001y", "not 0x01"},
+        {"a,Fail", "not ','"},
+        {"with space", "not ' '"},
+        {std::string(97, 'n'), "at most 96 bytes, this one 97"},
+    };
+    for (const auto& [name, message] : bad) {
+        c.name = name;
+        writeText(suite, manifestText({c}));
+        // The name's line: [suite], seed, blank, [[case]], name.
+        const ProcessResult result = regress({"--suite", suite.string()});
+        expectInputError(result, {suite.string() + ":5:", "case[0].name", message});
+    }
+    // A child is a child whatever its case name: it never runs the suite.
+    c.name = "ok";
+    writeText(suite, manifestText({c}));
+    const ProcessResult child = regress({"--suite", suite.string(), "--run-case", ""});
+    expectInputError(child, {"--run-case  needs --case-result FILE"});
+}
+
+TEST_F(RegressCli, CaseTimeoutMustBeAPositiveFiniteNumber)
+{
+    const fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8)});
+    for (const std::string value : {"nan", "inf", "-1", "0", "1e999", "3s"}) {
+        const ProcessResult result = regress({"--suite", suite.string(), "--case-timeout", value});
+        EXPECT_NE(result.exitCode, 0) << value;
+        EXPECT_NE(result.output.find("--case-timeout"), std::string::npos) << value << ": " << result.output;
+        EXPECT_NE(result.output.find("positive finite number of seconds"), std::string::npos)
+            << value << ": " << result.output;
+    }
+}
+
 // ------------------------------------------------------------ --update
 
 // --update renders the vkrt-made references (never a Mitsuba one, never with a

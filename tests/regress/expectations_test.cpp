@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -113,6 +114,35 @@ TEST_F(RegressExpectations, PatternsMatchAnywhereAndBadOnesNameTheLine)
             std::string::npos)
             << error.what();
     }
+}
+
+// Patterns are matched in time linear in the name (RE2): the nested stars that
+// take a backtracking matcher over 30 s on one name take microseconds, and a
+// line of 100,000 characters (a crash of the recursive matcher) is refused.
+TEST_F(RegressExpectations, PatternsCannotHangOrCrashTheRun)
+{
+    const Expectations e = readExpectations({}, write("flakes.txt", "^(.*.*.*.*.*.*.*.*.*.*)*Q$\n"), {});
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < 100; ++i)
+        EXPECT_FALSE(e.isKnownFlake(std::string(200, 'a') + "/validation-case-" + std::to_string(i)));
+    EXPECT_TRUE(e.isKnownFlake("aQ"));
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+    for (const char* option : {"--flakes", "--skips"}) {
+        try {
+            readNamePatterns(write("long.txt", "x\n" + std::string(100000, 'a') + "\n"), option);
+            ADD_FAILURE() << option << ": a 100,000-byte line was accepted";
+        } catch (const InputError& error) {
+            const std::string message = error.what();
+            EXPECT_NE(message.find((m_dir / "long.txt").string() + ":2: a line of 100000 bytes, more than the 1024"),
+                      std::string::npos)
+                << message;
+            EXPECT_LT(message.size(), 400u) << "the line is echoed cut to 96 bytes";
+        }
+    }
+    // A baseline line as long is refused the same way, echoed cut.
+    const std::string error = baselineError(std::string(8 << 20, 'n') + ",Fail\n");
+    EXPECT_NE(error.find(":1: a line of 8388613 bytes"), std::string::npos) << error.substr(0, 300);
+    EXPECT_LT(error.size(), 400u);
 }
 
 TEST_F(RegressExpectations, BaselineLineNamingNoCaseIsReported)
