@@ -5,12 +5,14 @@
 // adds the progressive generator and the documentation.
 #include "gpu/VulkanContext.h"
 #include "io/ExrFile.h"
+#include "io/OutputPaths.h"
 #include "render/ErrorMetrics.h"
 #include "render/GpuScene.h"
 #include "render/KernelVariant.h"
 #include "render/RenderOutput.h"
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
+#include "scene/MaterialUse.h"
 #include "scene/SceneOverrides.h"
 #include "scene/SceneParser.h"
 #include "util/Error.h"
@@ -157,7 +159,13 @@ void setMaterial(PyScene& s, const std::string& name, const std::string& table)
     try {
         Material material =
             parseMaterialTable(table, "<material " + name + ">", name, std::filesystem::path(s.source).parent_path());
-        *it = std::move(material);
+        // Where the scene uses it, as the parser checks each object (an
+        // emissive material on a sphere was accepted and its emission ignored).
+        std::swap(*it, material);
+        if (auto problem = materialUseProblem(s.scene, uint32_t(it - s.scene.materials.begin()))) {
+            std::swap(*it, material);
+            throw py::value_error("set_material(\"" + name + "\"): " + *problem);
+        }
     } catch (const SceneError& error) {
         raiseSceneError(error);
     }
@@ -280,10 +288,14 @@ struct PyResult {
     std::string stoppedBy;
     bool interrupted = false;
     py::object errorEstimate = py::none(); ///< {"rmse", "rel_mse"} from the kernel's variance, or None
+    std::string scenePath;                 ///< the render's input, which save() must not overwrite
 
+    /// The command line's rule (io/OutputPaths.h): the output may not be the
+    /// scene file, and must be a place vkrt can write.
     void save(const std::filesystem::path& path) const
     {
         py::gil_scoped_release release;
+        checkOutputs({{"the scene file", scenePath}}, {{"save()'s path", path}});
         writeRenderOutput(path, *output);
     }
 };
@@ -318,6 +330,7 @@ std::unique_ptr<PyResult> resultOf(RenderOutput rendered, const std::optional<Es
             view(output.channels[k].values, uint32_t(output.channels[k].names.size()));
     for (const auto& [key, value] : output.metadata) result->metadata[py::str(key)] = metadataValue(value);
     result->spp = session.spp();
+    result->scenePath = session.scene().path;
     result->renderSeconds = session.renderSeconds();
     if (session.stoppedBy()) result->stoppedBy = stopReasonName(*session.stoppedBy());
     result->interrupted = session.outcome().kind == OutcomeKind::Interrupted;

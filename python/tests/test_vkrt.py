@@ -80,10 +80,78 @@ def test_a_missing_file_is_a_scene_error_without_position(tmp_path):
     (dict(width=0), "width"),
     (dict(accel="embree"), "accel"),
     (dict(time_budget=-1.0), "time_budget"),
+    (dict(spp=-1), "spp: must be between 1 and 1073741824"),
+    (dict(spp=2**40), "spp: must be between"),
+    (dict(spp=2**31, time_budget=1), "spp: must be between"),
+    (dict(width=-5), "width: must be between 1 and 16384"),
+    (dict(seed=-1), "seed: must be between 0 and 4294967295"),
 ])
 def test_bad_arguments_raise_value_errors_naming_them(scene, arguments, words):
     with pytest.raises(ValueError, match=words):
         vkrt.render(scene, **{**SMALL, **arguments})
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda s: vkrt.render(s, accel=None, **SMALL), "accel: expected one of 'auto', 'own', 'driver', got NoneType"),
+    (lambda s: vkrt.render(s, aovs=None, **SMALL), "aovs: expected a name or a list of names"),
+    (lambda s: vkrt.render(s, spp="3", **SMALL), "spp: expected an integer, got str"),
+    (lambda s: vkrt.render(s, spp=True, **SMALL), "spp: expected an integer, got bool"),
+    (lambda s: vkrt.render(s, time_budget="1", **SMALL), "time_budget: expected a number or None"),
+    (lambda s: next(vkrt.progressive(s, batches="3", **SMALL)), "batches: expected an integer, got str"),
+])
+def test_wrong_types_raise_type_errors_naming_the_argument(scene, call, words):
+    with pytest.raises(TypeError) as caught:
+        call(scene)
+    assert words in str(caught.value)
+    assert "__init__" not in str(caught.value), "pybind11's own message lists the native signature"
+
+
+def test_a_device_index_is_accepted_as_the_command_line_takes_it(scene):
+    by_index = vkrt.render(scene, spp=1, seed=2, width=8, height=8, device=0 if not DEVICE else int(DEVICE))
+    assert by_index.image.shape == (8, 8, 3)
+
+
+def test_a_result_is_not_saved_over_the_scene_it_rendered(tmp_path):
+    scene_file = tmp_path / "x.toml"
+    scene_file.write_text('[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 40\n[background]\ncolor = 0.5\n')
+    before = scene_file.read_bytes()
+    result = vkrt.render(vkrt.Scene.load(scene_file), spp=1, **SMALL)
+    with pytest.raises(Exception, match="the scene file"):
+        result.save(scene_file)
+    assert scene_file.read_bytes() == before
+
+
+def test_a_material_is_checked_where_the_scene_uses_it():
+    scene = vkrt.Scene.from_toml("""
+[camera]
+eye = [0, 1, 4]
+target = [0, 0, 0]
+fov = 40
+[materials.white]
+type = "pbr"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "white"
+[[objects]]
+shape = "plane"
+point = [0, -1, 0]
+normal = [0, 1, 0]
+material = "white"
+""")
+    with pytest.raises(ValueError, match="only meshes can use an emissive material"):
+        scene.set_material("white", type="pbr", emission=5)
+    # Refused, the material is what it was: no emission.
+    assert vkrt.render(scene, spp=1, width=8, height=8, device=DEVICE).image.max() == 0.0
+
+
+def test_camera_values_beyond_float32_are_refused(scene):
+    copy = scene.copy()
+    with pytest.raises(ValueError, match="aperture_radius: must be between 0 and 1e"):
+        copy.set_camera(aperture=1e300)
+    with pytest.raises(ValueError, match="focus_distance"):
+        copy.set_camera(aperture=0.1, focus_distance=1e20)
 
 
 def test_a_device_that_does_not_exist_is_named(scene):

@@ -19,6 +19,7 @@ between submissions.
 """
 
 import json as _json
+import numbers as _numbers
 import os as _os
 import signal as _signal
 import threading as _threading
@@ -201,14 +202,72 @@ class Result:
         return f"vkrt.Result({w}x{h}, spp={self.spp}, render_seconds={self.render_seconds:.3f})"
 
 
+# The command line's limits (docs/cli.md): --spp up to 2^30, image sides up
+# to 16384 pixels, 32-bit seeds.
+_MAX_SPP = 1 << 30
+_MAX_SIDE = 16384
+_MAX_SEED = (1 << 32) - 1
+
+
+def _integer(name, value, low, high):
+    """`value` as an int in [low, high]: TypeError for a non-integer (bools
+    included), ValueError naming the argument and the range otherwise."""
+    if isinstance(value, bool) or not isinstance(value, _numbers.Integral):
+        raise TypeError(f"{name}: expected an integer, got {type(value).__name__} {value!r}")
+    if not low <= value <= high:
+        raise ValueError(f"{name}: must be between {low} and {high}, got {value}")
+    return int(value)
+
+
+def _real(name, value):
+    """`value` as a float, or None: TypeError for anything but a real number."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
+        raise TypeError(f"{name}: expected a number or None, got {type(value).__name__} {value!r}")
+    return float(value)
+
+
+def _text(name, value, allowed=None):
+    if not isinstance(value, str):
+        what = f"one of {', '.join(repr(a) for a in allowed)}" if allowed else "a string"
+        raise TypeError(f"{name}: expected {what}, got {type(value).__name__} {value!r}")
+    return value
+
+
+def _aov_list(aovs):
+    """The AOV names: one name, or an iterable of names."""
+    if isinstance(aovs, str):
+        return [aovs]
+    try:
+        names = list(aovs)
+    except TypeError:
+        names = None
+    if names is None or not all(isinstance(name, str) for name in names):
+        raise TypeError('aovs: expected a name or a list of names ("albedo", "normal", "depth", "position"), '
+                        f"got {aovs!r}")
+    return names
+
+
 def _session(scene, spp, width, height, seed, sampler, integrator, device, time_budget, target_error, variance,
              aovs, accel):
+    """The native session, every argument checked here first: a wrong type or
+    range names the argument, as the command line names its option."""
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: expected a vkrt.Scene, got {type(scene).__name__}")
-    if isinstance(aovs, str):
-        aovs = [aovs]
-    return _vkrt.Session(scene._native, spp, width, height, seed, sampler, integrator, device, time_budget,
-                         target_error, bool(variance), list(aovs), accel)
+    spp = None if spp is None else _integer("spp", spp, 1, _MAX_SPP)
+    width = None if width is None else _integer("width", width, 1, _MAX_SIDE)
+    height = None if height is None else _integer("height", height, 1, _MAX_SIDE)
+    seed = _integer("seed", seed, 0, _MAX_SEED)
+    sampler = _text("sampler", sampler, ("auto", "sobol", "independent"))
+    integrator = None if integrator is None else _text("integrator", integrator, ("path", "whitted"))
+    if isinstance(device, _numbers.Integral) and not isinstance(device, bool):
+        device = str(_integer("device", device, 0, 1 << 16))  # an index, as `--device 1`
+    device = _text("device", device)
+    accel = _text("accel", accel, ("auto", "own", "driver"))
+    return _vkrt.Session(scene._native, spp, width, height, seed, sampler, integrator, device,
+                         _real("time_budget", time_budget), _real("target_error", target_error), bool(variance),
+                         _aov_list(aovs), accel)
 
 
 def render(scene, spp=None, width=None, height=None, seed=0, sampler="auto", integrator=None, device="",
@@ -282,8 +341,10 @@ def progressive(scene, batches=8, spp_per_batch=1, width=None, height=None, seed
     samples finished so far with ``interrupted`` set, and ends. A second
     Ctrl-C raises KeyboardInterrupt.
     """
-    if batches < 1 or spp_per_batch < 1:
-        raise ValueError("batches and spp_per_batch: must be at least 1")
+    batches = _integer("batches", batches, 1, _MAX_SPP)
+    spp_per_batch = _integer("spp_per_batch", spp_per_batch, 1, _MAX_SPP)
+    if batches * spp_per_batch > _MAX_SPP:
+        raise ValueError(f"batches * spp_per_batch: at most {_MAX_SPP} samples per pixel, got {batches * spp_per_batch}")
     session = _session(scene, batches * spp_per_batch, width, height, seed, sampler, integrator, device, None, None,
                        variance, aovs, accel)
     with _FirstCtrlCStops(session) as ctrl_c:

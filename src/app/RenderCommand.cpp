@@ -213,6 +213,11 @@ void printSummary(const RenderFacts& facts)
     if (facts.counters.rejectedSamples)
         std::fprintf(stderr, "warning: %llu non-finite samples were rejected\n",
                      static_cast<unsigned long long>(facts.counters.rejectedSamples));
+    if (facts.counters.overflowedPixels)
+        std::fprintf(stderr,
+                     "warning: %llu pixels overflowed float32 (radiance too large for its sum over the samples): "
+                     "they are inf in the image\n",
+                     static_cast<unsigned long long>(facts.counters.overflowedPixels));
     if (facts.counters.budgetExceeded && facts.loopCapped)
         std::fprintf(stderr, "warning: %u invocations reached the device's loop cap; the image may be wrong\n",
                      facts.counters.budgetExceeded);
@@ -280,6 +285,7 @@ JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& 
     json["firstFrameSeconds"] = nullptr; // render's warm-up frame is inside startupSeconds; `vkrt info` measures it
     json["samplesPerSecond"] = facts.samplesPerSecond;
     json["rejectedSamples"] = facts.counters.rejectedSamples;
+    json["overflowedPixels"] = facts.counters.overflowedPixels;
     json["loopCap"] = {{"capped", facts.loopCapped},
                        {"budget", valueOrNull(session.context().loopCap().budget)},
                        {"invocationsAtCap", facts.counters.budgetExceeded}};

@@ -2,6 +2,7 @@
 
 #include "mesh/GltfJson.h"
 #include "util/Error.h"
+#include "util/KernelLimits.h"
 
 #include <nlohmann/json.hpp>
 
@@ -572,8 +573,11 @@ void readTextureTransform(const fs::path& file, const json* info, const char* sl
         const json* value = member(*transform, key);
         if (!value) return fallback;
         if (!value->is_array() || value->size() != 2 || !(*value)[0].is_number() || !(*value)[1].is_number() ||
-            !std::isfinite((*value)[0].get<double>()) || !std::isfinite((*value)[1].get<double>()))
-            fail(file, where + "." + key + ": expected two finite numbers");
+            !(std::abs((*value)[0].get<double>()) <= kMaxKernelMagnitude) ||
+            !(std::abs((*value)[1].get<double>()) <= kMaxKernelMagnitude))
+            fail(file, where + "." + key +
+                           ": expected two numbers of magnitude at most 1e18 (the kernel's float32 "
+                           "texture coordinates)");
         return glm::dvec2((*value)[0].get<double>(), (*value)[1].get<double>());
     };
     texture->offset = pair("offset", glm::dvec2(0.0));
@@ -886,9 +890,9 @@ std::string describeMaterial(size_t index, const json& material)
 
 std::vector<const std::optional<FileTexture>*> FileMaterial::textureSlots() const
 {
-    return {&baseColorTexture,   &metallicRoughnessTexture,   &normalTexture,          &emissiveTexture,
-            &specularTexture,    &specularColorTexture,       &sheenColorTexture,      &sheenRoughnessTexture,
-            &clearcoatTexture,   &clearcoatRoughnessTexture,  &clearcoatNormalTexture, &transmissionTexture,
+    return {&baseColorTexture,   &metallicRoughnessTexture,    &normalTexture,          &emissiveTexture,
+            &specularTexture,    &specularColorTexture,        &sheenColorTexture,      &sheenRoughnessTexture,
+            &clearcoatTexture,   &clearcoatRoughnessTexture,   &clearcoatNormalTexture, &transmissionTexture,
             &iridescenceTexture, &iridescenceThicknessTexture, &anisotropyTexture};
 }
 

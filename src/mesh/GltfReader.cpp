@@ -492,6 +492,11 @@ struct MeshBuilder {
         } else {
             for (uint32_t i = 0; i < count; ++i) sequence[i] = i;
         }
+        // glTF 3.7.2.1: TRIANGLES' vertex count is a multiple of 3; a stray
+        // index or two would otherwise be dropped without a word.
+        if (mode == kTriangles && sequence.size() % 3 != 0)
+            fail(d.file, where + ": a TRIANGLES primitive of " + std::to_string(sequence.size()) + " " +
+                             (member(primitive, "indices") ? "indices" : "vertices") + ", not a multiple of 3");
         if (out.positions.size() + count > UINT32_MAX) fail(d.file, "a mesh has more than 2^32 vertices");
         const auto base = uint32_t(out.positions.size());
         for (uint64_t i = 0; i < count; ++i) {

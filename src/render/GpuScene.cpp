@@ -6,6 +6,7 @@
 #include "mesh/MeshGeometry.h"
 #include "render/EmissionPower.h"
 #include "scene/FeatureSet.h"
+#include "scene/SceneOverrides.h"
 #include "scene/kinds/Kinds.h"
 #include "shared/Bindings.h"
 
@@ -527,8 +528,10 @@ void convertMeshes(const Scene& scene, const GpuSceneStatic& fixed, const glm::d
 
 void convertCamera(const Camera& camera, gpu::SceneUniforms& u)
 {
-    glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
-    glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+    // Scaled before normalising (SceneOverrides' normalized): an up of
+    // (0, 1e-300, 0), valid, made glm::normalize divide by a length that underflows to 0.
+    glm::dvec3 forward = *normalized(difference(camera.eye, camera.target));
+    glm::dvec3 right = *normalized(glm::cross(forward, *normalized(camera.up)));
     glm::dvec3 up = glm::cross(right, forward);
     // Perspective: scaled to the plane one unit ahead; orthographic: the view's half extents.
     double halfHeight =

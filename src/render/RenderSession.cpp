@@ -215,6 +215,7 @@ Film RenderSession::film() const
 Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) const
 {
     const Renderer& renderer = *m_renderer;
+    const RenderCounters counters = renderer.counters();
     Metadata metadata{
         {"vkrtVersion", std::string(VKRT_VERSION)},
         {"spp", int64_t(renderer.completedFrames())},
@@ -228,8 +229,10 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
         {"kernelVariant", renderer.variant().describe() + (m_config.uber ? " (uber)" : "")},
         {"sampler", samplerName(sampler())},
         {"accel", accelName(accel())},
-        {"rejectedSamples", int64_t(renderer.counters().rejectedSamples)},
+        {"rejectedSamples", int64_t(counters.rejectedSamples)},
     };
+    // Said wherever the image goes: an inf pixel is never written without it.
+    if (counters.overflowedPixels) metadata["overflowedPixels"] = int64_t(counters.overflowedPixels);
     // Whether the device may have cut loops short (docs/platform.md).
     metadata["loopCap"] = m_context.loopCap().describe();
     if (m_stoppedBy) metadata["stoppedBy"] = stopReasonName(*m_stoppedBy);

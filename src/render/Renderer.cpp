@@ -33,10 +33,10 @@ void checkSamplesPerInvocation(const LoopCap& cap, uint32_t samplesPerInvocation
 }
 
 /// The uber kernel's features: every feature, except that the glTF alpha
-/// test, emission textures, second uv set and pbr layers (transmission, iridescence, anisotropy) come only with a scene that uses
-/// them. Measured on Mesa 26.1's lavapipe (LLVM 19.1): an uber kernel with either, rendering a scene without them,
-/// crashed the driver (SIGSEGV in the dispatch; Mesa 25.0 ran it), while their own variants render right on both. Until
-/// the cause is found the uber kernel does not carry code for data the scene lacks.
+/// test, emission textures, second uv set and pbr layers (transmission, iridescence, anisotropy) come only with a scene
+/// that uses them. Measured on Mesa 26.1's lavapipe (LLVM 19.1): an uber kernel with either, rendering a scene without
+/// them, crashed the driver (SIGSEGV in the dispatch; Mesa 25.0 ran it), while their own variants render right on both.
+/// Until the cause is found the uber kernel does not carry code for data the scene lacks.
 FeatureSet uberFeatures(const Scene& scene)
 {
     FeatureSet features = FeatureSet::everything(scene.render.integrator);
@@ -699,7 +699,11 @@ RenderCounters Renderer::counters() const
     const auto* pixels = reinterpret_cast<const gpu::AccumPixel*>(accumBytes.data());
     RenderCounters counters;
     size_t pixelCount = size_t(width()) * height();
-    for (size_t i = 0; i < pixelCount; ++i) counters.rejectedSamples += m_frames - pixels[i].count;
+    for (size_t i = 0; i < pixelCount; ++i) {
+        counters.rejectedSamples += m_frames - pixels[i].count;
+        const glm::vec3 sum = pixels[i].sum;
+        if (!std::isfinite(sum.x) || !std::isfinite(sum.y) || !std::isfinite(sum.z)) ++counters.overflowedPixels;
+    }
     auto statsBytes = m_stats.download(m_context);
     const auto* stats = reinterpret_cast<const gpu::RenderStats*>(statsBytes.data());
     counters.maxLoopIterations = stats->maxLoopIterations;

@@ -27,8 +27,9 @@ struct RenderOptions {
     bool aov = false;          ///< also average the AOVs (albedo, normal, depth, position; a kernel-variant flag)
     bool sobol = false;        ///< Owen-scrambled Sobol' sampler (variance, if asked for, from batches)
     bool storageScene = false; ///< scene arrays in storage buffers even when they fit uniform ones
-    bool driverAccel = false;  ///< the driver's traversal (VK_KHR_ray_query) instead of vkrt's BVH (a kernel-variant flag)
-    uint32_t firstFrame = 0;   ///< index of the first frame (sample) rendered: a shard's start
+    bool driverAccel =
+        false; ///< the driver's traversal (VK_KHR_ray_query) instead of vkrt's BVH (a kernel-variant flag)
+    uint32_t firstFrame = 0; ///< index of the first frame (sample) rendered: a shard's start
     /// Frames one invocation runs back to back per dispatch (path
     /// regeneration); 0: the device's default (samplesPerInvocationFor).
     /// The image does not depend on it (up to float rounding where a cubemap
@@ -61,7 +62,10 @@ struct AovImages {
 };
 
 struct RenderCounters {
-    uint64_t rejectedSamples = 0;   ///< non-finite samples dropped (all pixels)
+    uint64_t rejectedSamples = 0; ///< non-finite samples dropped (all pixels)
+    /// Pixels whose accumulated sum is not finite although every sample was:
+    /// radiance so large that its sum overflowed float32. Their mean is inf.
+    uint64_t overflowedPixels = 0;
     uint32_t maxLoopIterations = 0; ///< largest loop count of one sample seen
     uint32_t budgetExceeded = 0;    ///< invocations that reached lavapipe's loop budget
 };

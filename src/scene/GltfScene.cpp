@@ -97,8 +97,17 @@ Camera cameraFrom(const GltfModel& model, const GltfPlaced& placed, const Aabb& 
         c.fovY = glm::degrees(definition.yfov);
         aspect = definition.aspectRatio.value_or(aspect);
     }
-    c.width = 640;
-    c.height = uint32_t(std::clamp(std::lround(640.0 / aspect), 1l, long(SceneLimits::maxImageSide)));
+    // 640 pixels on the longer side: a tall camera gets a tall image, not one
+    // 640 wide and thousands high. An aspect that leaves the shorter side
+    // under a pixel is no image.
+    const double longer = 640.0;
+    const double shorter = aspect >= 1.0 ? longer / aspect : longer * aspect;
+    if (!(shorter >= 0.5))
+        fail(model.file, where + ": the aspect ratio " + formatNumber(aspect) + " leaves an image of " +
+                             std::to_string(int(longer)) + " pixels less than one pixel " +
+                             (aspect >= 1.0 ? "high" : "wide") + " (vkrt renders aspect ratios from 1:640 to 640:1)");
+    c.width = uint32_t(aspect >= 1.0 ? longer : std::lround(shorter));
+    c.height = uint32_t(aspect >= 1.0 ? std::lround(shorter) : longer);
     if (auto problem = cameraProblem(c)) fail(model.file, where + ": " + *problem);
     return c;
 }

@@ -1,6 +1,7 @@
 #include "scene/SceneOverrides.h"
 
 #include "scene/TomlReader.h"
+#include "util/KernelLimits.h"
 
 #include <algorithm>
 #include <cmath>
@@ -37,13 +38,17 @@ std::optional<std::string> upProblem(const Camera& camera)
 
 std::optional<std::string> lensProblem(const Camera& camera)
 {
-    if (!(camera.apertureRadius >= 0 && std::isfinite(camera.apertureRadius)))
-        return "aperture_radius: must be finite and at least 0, got " + formatNumber(camera.apertureRadius);
-    if (camera.focusDistance && !(*camera.focusDistance > 0 && std::isfinite(*camera.focusDistance)))
-        return "focus_distance: must be finite and positive, got " + formatNumber(*camera.focusDistance);
-    // The default, the distance to the target, can overflow for far-apart finite points.
-    if (camera.thinLens() && !std::isfinite(camera.resolvedFocusDistance()))
-        return std::string("focus_distance: the distance from eye to target overflows; set focus_distance");
+    const std::string range = " (the kernel's float32 holds lengths up to " + formatNumber(kMaxKernelMagnitude) + ")";
+    if (!(camera.apertureRadius >= 0 && camera.apertureRadius <= kMaxKernelMagnitude))
+        return "aperture_radius: must be between 0 and " + formatNumber(kMaxKernelMagnitude) + ", got " +
+               formatNumber(camera.apertureRadius) + range;
+    if (camera.focusDistance && !(*camera.focusDistance > 0 && *camera.focusDistance <= kMaxKernelMagnitude))
+        return "focus_distance: must be positive and at most " + formatNumber(kMaxKernelMagnitude) + ", got " +
+               formatNumber(*camera.focusDistance) + range;
+    // The default, the distance to the target, can be as far for far-apart points.
+    if (camera.thinLens() && !(camera.resolvedFocusDistance() <= kMaxKernelMagnitude))
+        return "focus_distance: the distance from eye to target, " + formatNumber(camera.resolvedFocusDistance()) +
+               ", is too far to focus at" + range + "; set focus_distance";
     if (!(camera.orthographicHeight >= 0 && std::isfinite(camera.orthographicHeight)))
         return "orthographic height: must be finite and at least 0, got " + formatNumber(camera.orthographicHeight);
     if (camera.orthographic() && camera.thinLens())

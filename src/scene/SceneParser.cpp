@@ -7,6 +7,8 @@
 // reading itself is scene/TomlReader.h; this file knows what a scene holds.
 #include "scene/SceneParser.h"
 
+#include "scene/MaterialUse.h"
+
 #include "material/Metals.h"
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
@@ -573,9 +575,8 @@ void readObject(const TableField& table, const MaterialIndex& materials, ParseCo
     const bool mesh = kind.read == readMesh;
     if (mesh && readString(materialField) == kFileMaterial) return readMesh(table, kFileMaterialIndex, context);
     const uint32_t material = materials.resolve(materialField);
-    if (!mesh && scene.materials[material].emission != Color(0.0))
-        materialField.fail("material " + quote(scene.materials[material].name) +
-                           " emits; only meshes can use an emissive material (use a mesh, or a [[lights]] entry)");
+    if (!mesh)
+        if (auto problem = nonMeshMaterialProblem(scene.materials[material])) materialField.fail(*problem);
     kind.read(table, material, context);
 }
 

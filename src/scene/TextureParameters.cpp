@@ -1,6 +1,9 @@
 #include "scene/TextureParameters.h"
 
+#include "util/KernelLimits.h"
+
 #include <array>
+#include <cmath>
 #include <string_view>
 
 namespace vkrt {
@@ -29,8 +32,8 @@ std::pair<TextureWrap, TextureWrap> readWrap(const Field& field)
         return {both, both};
     }
     const toml::array& pair = *field.node().as_array();
-    if (pair.size() != 2) field.fail("expected a wrap mode or a pair [u, v] of them, got " +
-                                     std::to_string(pair.size()) + " element(s)");
+    if (pair.size() != 2)
+        field.fail("expected a wrap mode or a pair [u, v] of them, got " + std::to_string(pair.size()) + " element(s)");
     return {readWrapMode(field.element(0, *pair.get(0))), readWrapMode(field.element(1, *pair.get(1)))};
 }
 
@@ -40,6 +43,9 @@ glm::dvec2 readUvScale(const Field& field)
     auto component = [](const Field& f) {
         const double value = readNumber(f);
         if (value == 0.0) f.fail("must not be zero (every point would read one texel)");
+        if (std::abs(value) > kMaxKernelMagnitude)
+            f.fail("must be at most " + formatNumber(kMaxKernelMagnitude) +
+                   " in magnitude (the kernel's float32 texture coordinates), got " + formatNumber(value));
         return value;
     };
     if (!field.node().is_array()) return glm::dvec2(component(field));
@@ -79,7 +85,8 @@ MaterialTexture readTextureTable(const Field& field, TextureUse use, TextureAtla
         readOr(table, "filter", TextureFilter{}, [](const Field& f) { return readChoice(f, "filter", filters).value; });
     MaterialTexture texture;
     texture.scale = readOr(table, "scale", glm::dvec2(1.0), readUvScale);
-    texture.channel = readOr(table, "channel", 0u, [](const Field& f) { return readChoice(f, "channel", channels).value; });
+    texture.channel =
+        readOr(table, "channel", 0u, [](const Field& f) { return readChoice(f, "channel", channels).value; });
     if (normalStrength) *normalStrength = readOr(table, "strength", 1.0, readNonNegative);
     texture.record = atlas.add(request, file.location());
     return texture;

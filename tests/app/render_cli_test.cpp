@@ -284,6 +284,33 @@ TEST_F(RenderCli, SceneErrorsNameFileLineAndColumn)
     EXPECT_NE(missing.output.find("nope.toml"), std::string::npos) << missing.output;
 }
 
+// A sky of 3e38 is a finite radiance, and so is each sample; two samples'
+// sum is not. Such pixels are never written without a word: a warning, the
+// JSON summary and the EXR's metadata count them.
+TEST_F(RenderCli, PixelsWhoseSumOverflowsFloat32AreCounted)
+{
+    const fs::path scene = m_dir / "bright.toml";
+    writeText(scene, "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 40\nwidth = 8\nheight = 6\n"
+                     "[background]\ncolor = 3e38\n");
+    std::vector<std::string> args = {"render", scene.string(),
+                                     "-o",     (m_dir / "bright.exr").string(),
+                                     "--spp",  "2",
+                                     "--json", (m_dir / "bright.json").string()};
+    if (const char* device = std::getenv("VKRT_TEST_DEVICE")) args.insert(args.end(), {"--device", device});
+    const ProcessResult r = runVkrt(args);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("warning: 48 pixels overflowed float32"), std::string::npos) << r.output;
+    std::ifstream json(m_dir / "bright.json");
+    const std::string summary((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+    EXPECT_NE(summary.find("\"overflowedPixels\": 48"), std::string::npos) << summary;
+    EXPECT_EQ(intAttribute(readExr(m_dir / "bright.exr").metadata, "overflowedPixels"), 48);
+    // One sample's sum is the sample: nothing overflows, nothing is said.
+    args[5] = "1";
+    const ProcessResult one = runVkrt(args);
+    EXPECT_EQ(one.output.find("overflowed"), std::string::npos) << one.output;
+    EXPECT_EQ(intAttribute(readExr(m_dir / "bright.exr").metadata, "overflowedPixels"), -1);
+}
+
 TEST_F(RenderCli, FailedRunLeavesExistingOutputUntouched)
 {
     writeText(m_dir / "keep.exr", "previous contents");

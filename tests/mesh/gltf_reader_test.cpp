@@ -483,5 +483,24 @@ TEST(GltfReader, BadAccessorsAndIndicesAreNamed)
     EXPECT_NE(error.find("accessor 0"), std::string::npos) << error;
 }
 
+// glTF 3.7.2.1: a TRIANGLES primitive's vertex count is a multiple of 3; the
+// sweep's 8 indices had their last two dropped without a word.
+TEST(GltfReader, TrianglesOfAnIndexCountNotAMultipleOfThreeAreRefused)
+{
+    GltfBuilder b;
+    const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
+    b.node({{"mesh", b.mesh({{"POSITION", positions}}, b.indices({0, 1, 2, 1, 3, 2, 0, 1}))}});
+    const std::string error = errorOf([&] { readGltfModel(b.write("eight.gltf")); });
+    EXPECT_NE(error.find(
+                  "eight.gltf: meshes[0].primitives[0]: a TRIANGLES primitive of 8 indices, not a multiple of 3"),
+              std::string::npos)
+        << error;
+    GltfBuilder unindexed;
+    const uint32_t four = unindexed.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
+    unindexed.node({{"mesh", unindexed.mesh({{"POSITION", four}})}});
+    const std::string second = errorOf([&] { readGltfModel(unindexed.write("four.gltf")); });
+    EXPECT_NE(second.find("a TRIANGLES primitive of 4 vertices, not a multiple of 3"), std::string::npos) << second;
+}
+
 } // namespace
 } // namespace vkrt::test

@@ -288,6 +288,19 @@ TEST_F(ExtremeTransform, TranslatedSceneRendersTheSameImage)
     }
 }
 
+// An up vector of length 1e-300 is valid (only its direction matters): the
+// camera's frame was normalised by a length that underflowed to 0, and every
+// pixel came out black.
+TEST_F(ExtremeTransform, ATinyUpVectorGivesTheSameImage)
+{
+    Scene tiny = loadExtreme("transform.toml");
+    tiny.camera.up *= 1e-300;
+    ASSERT_GT(glm::length(tiny.camera.up / 1e-300), 0.5);
+    const Render r = render(tiny, {16, 1, false});
+    EXPECT_EQ(nonFinite(r.mean), 0u);
+    EXPECT_EQ(r.mean.rgb, shortReference().mean.rgb);
+}
+
 // Positions are camera-relative, so scaling tests that spawned-ray offsets
 // scale with the scene: a fixed offset (bug B1) brightened contact shadows and
 // skipped glass at 1e-4.

@@ -114,9 +114,10 @@ TEST(GltfScene, WithoutCameraOrLightsItFramesTheBoxUnderAWhiteSky)
 
 TEST(GltfScene, BadCamerasAndLightsNameTheFile)
 {
-    const fs::path a = writeTriangle("gltf-zero-fov",
-                                     R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}])",
-                                     R"("scenes": [{"nodes": [0, 1]}],
+    const fs::path a =
+        writeTriangle("gltf-zero-fov",
+                      R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}])",
+                      R"("scenes": [{"nodes": [0, 1]}],
         "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}])");
     std::string error = errorOf([&] { parseGltfScene(a.string()); });
     EXPECT_NE(error.find(a.string() + ": cameras[0].perspective.yfov: must be strictly between 0 and pi"),
@@ -136,6 +137,37 @@ TEST(GltfScene, BadCamerasAndLightsNameTheFile)
     writeText(c, "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [");
     error = errorOf([&] { parseGltfScene(c.string()); });
     EXPECT_NE(error.find("broken.gltf"), std::string::npos) << error;
+}
+
+// The image is 640 pixels on its longer side: a tall camera (the sweep's
+// aspectRatio 0.01 made a 640 x 16384 image, 30 s and 929 MB) gets a tall,
+// narrow image; one whose shorter side would be under a pixel is refused.
+TEST(GltfScene, ExtremeAspectRatiosGiveSmallImagesOrAnError)
+{
+    auto cameraWithAspect = [](const std::string& aspect) {
+        return R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1, "aspectRatio": )" +
+               aspect + "}}]";
+    };
+    const std::string nodes =
+        R"("scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}])";
+    const Scene tall = parseGltfScene(writeTriangle("gltf-tall", cameraWithAspect("0.01"), nodes).string());
+    EXPECT_EQ(tall.camera.width, 6u);
+    EXPECT_EQ(tall.camera.height, 640u);
+    const Scene wide = parseGltfScene(writeTriangle("gltf-wide", cameraWithAspect("2"), nodes).string());
+    EXPECT_EQ(wide.camera.width, 640u);
+    EXPECT_EQ(wide.camera.height, 320u);
+    for (const char* aspect : {"1e-300", "1e300"}) {
+        const fs::path file = writeTriangle("gltf-thin", cameraWithAspect(aspect), nodes);
+        const std::string error = errorOf([&] { parseGltfScene(file.string()); });
+        EXPECT_NE(error.find(file.string() + ": cameras[0]"), std::string::npos) << error;
+        EXPECT_NE(error.find("less than one pixel"), std::string::npos) << error;
+    }
+    // A zero rotation quaternion on the camera's node is no rotation to repair.
+    const fs::path zero = writeTriangle(
+        "gltf-zero-rotation", cameraWithAspect("1.5"),
+        R"("scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"camera": 0, "rotation": [0, 0, 0, 0]}])");
+    const std::string error = errorOf([&] { parseGltfScene(zero.string()); });
+    EXPECT_NE(error.find("nodes[1].rotation: a rotation quaternion must not be zero"), std::string::npos) << error;
 }
 
 TEST(GltfScene, CamerasAreListedInFileOrderAndOrthographicOnesKeepTheirView)

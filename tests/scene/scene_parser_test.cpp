@@ -774,6 +774,14 @@ const std::vector<BadScene> kBadScenes = {
      "background.color: must be at most 3.4e38"},
     // Issue 28: the thin lens, suns, spots and lat-long maps.
     {"NegativeAperture", kCamera + "aperture_radius = -0.1\n", 5, 19, "camera.aperture_radius: must be >= 0, got -0.1"},
+    // Issue 43: what the kernel's float32 holds (a focus at 1e20 rendered black).
+    {"FocusBeyondTheKernelsFloats", kCamera + "aperture_radius = 0.1\nfocus_distance = 1e20\n", 1, 1,
+     "camera: focus_distance: must be positive and at most 1e+18, got 1e+20"},
+    {"ApertureBeyondTheKernelsFloats", kCamera + "aperture_radius = 1e300\n", 1, 1,
+     "camera: aperture_radius: must be between 0 and 1e+18, got 1e+300"},
+    {"TextureScaleBeyondTheKernelsFloats",
+     kCamera + "[materials.m]\ntype = \"lambert\"\nalbedo = { texture = \"a.png\", scale = [1e39, 1] }\n", 7, 40,
+     "materials.m.albedo.scale[0]: must be at most 1e+18 in magnitude"},
     {"ZeroFocusDistance", kCamera + "focus_distance = 0\n", 5, 18, "camera.focus_distance: must be > 0, got 0"},
     {"SunWithoutDirection", kCamera + "[[lights]]\ntype = \"directional\"\ndirection = [0, 0, 0]\nirradiance = 1\n", 7,
      13, "lights[0].direction: must not be zero-length"},

@@ -6,6 +6,7 @@
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
 #include "scene/FileMaterialImport.h"
+#include "scene/MaterialUse.h"
 #include "scene/SceneOverrides.h"
 #include "scene/SceneValues.h"
 #include "scene/kinds/Kinds.h"
@@ -37,7 +38,6 @@ KeyList meshKeys()
 namespace {
 
 namespace fs = std::filesystem;
-
 
 std::vector<uint32_t> fileMaterialsOf(const MeshGeometry& geometry, const Field& materialField, ParseContext& context)
 {
@@ -133,19 +133,8 @@ std::vector<uint32_t> materialsOf(const Mesh& mesh)
 /// Textures need the file's texture coordinates; an emissive material needs no `emission` of the mesh's own.
 void checkMeshMaterials(const Mesh& mesh, const Field& materialField, const Scene& scene)
 {
-    for (uint32_t index : materialsOf(mesh)) {
-        const Material& m = scene.materials[index];
-        if (m.readsUvSet(0) && mesh.geometry->data.uvs.empty())
-            materialField.fail("material " + quote(m.name) + " has textures, but the mesh file " +
-                               quote(mesh.geometry->file.string()) +
-                               " has no texture coordinates (export it with uvs)");
-        if (m.readsUvSet(1) && mesh.geometry->data.uvs1.empty())
-            materialField.fail("material " + quote(m.name) + " samples a texture through TEXCOORD_1, which the mesh " +
-                               quote(mesh.geometry->file.string()) + " does not have");
-        if (m.emission != Color(0.0) && mesh.emission != Color(0.0))
-            materialField.fail("material " + quote(m.name) +
-                               " emits already; give the mesh either `emission` or an emissive material");
-    }
+    for (uint32_t index : materialsOf(mesh))
+        if (auto problem = meshMaterialProblem(mesh, scene.materials[index])) materialField.fail(*problem);
 }
 
 } // namespace
