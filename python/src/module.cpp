@@ -588,6 +588,11 @@ PYBIND11_MODULE(_vkrt, m)
             if (a.width != b.width || a.height != b.height)
                 throw py::value_error("image and reference: different shapes");
             const MeasuredError e = measureError(a, b);
+            // No value finite in both (or an empty image): there is no error to report, and 0 would say "equal".
+            if (e.compared == 0)
+                throw py::value_error("image and reference: no value is finite in both (" +
+                                      std::to_string(e.nonFiniteA) + " non-finite in the image, " +
+                                      std::to_string(e.nonFiniteB) + " in the reference); nothing to compare");
             py::dict out;
             out["rmse"] = e.rmse;
             out["mse"] = e.rmse * e.rmse;

@@ -154,6 +154,13 @@ def test_camera_values_beyond_float32_are_refused(scene):
         copy.set_camera(aperture=0.1, focus_distance=1e20)
 
 
+def test_measure_error_with_nothing_comparable_is_an_error():
+    nan = np.full((2, 2, 3), np.nan, dtype=np.float32)
+    with pytest.raises(ValueError, match="nothing to compare"):
+        vkrt.measure_error(nan, np.zeros((2, 2, 3), dtype=np.float32))
+    assert vkrt.measure_error(np.ones((2, 2, 3)), np.ones((2, 2, 3)))["rmse"] == 0.0
+
+
 def test_a_device_that_does_not_exist_is_named(scene):
     with pytest.raises(Exception, match="no-such-device"):
         vkrt.render(scene, spp=1, width=8, height=8, device="no-such-device")

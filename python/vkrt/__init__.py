@@ -383,5 +383,6 @@ def measure_error(image, reference):
     width, 3)) as `vkrt compare` measures it, over the values finite in both:
     a dict with ``rmse``, ``mse``, ``rel_mse`` (squared difference over
     reference squared plus a small epsilon), ``mape``, ``max_abs``,
-    ``compared`` and the counts of non-finite values in each."""
+    ``compared`` and the counts of non-finite values in each. Raises
+    ValueError when no value is finite in both (nothing to compare)."""
     return _vkrt.measure_error(image, reference)

@@ -34,7 +34,13 @@ std::string echoed(const std::string& text)
 /// The file's lines, each with "file:line"; blank lines and `#` comments left out.
 std::vector<std::pair<std::string, std::string>> meaningfulLines(const fs::path& path, const std::string& option)
 {
-    if (!fs::is_regular_file(path)) throw InputError(option + " " + path.string() + ": no such file");
+    std::error_code error;
+    const fs::file_status status = fs::status(path, error);
+    if (!fs::exists(status)) throw InputError(option + " " + path.string() + ": no such file");
+    // A FIFO or a device could block or never end; a directory is no list.
+    if (!fs::is_regular_file(status))
+        throw InputError(option + " " + path.string() + ": is " +
+                         (fs::is_directory(status) ? "a directory" : "not a regular file") + ", not a text file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(option + " " + path.string() + ": cannot read it");
     std::vector<std::pair<std::string, std::string>> lines;

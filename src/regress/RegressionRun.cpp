@@ -9,6 +9,7 @@
 #include "regress/Reports.h"
 #include "regress/Suite.h"
 #include "render/RenderSession.h"
+#include "util/ChildProcess.h"
 #include "util/Error.h"
 
 #include <algorithm>
@@ -22,6 +23,8 @@
 #include <set>
 #include <sstream>
 #include <thread>
+
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -414,9 +417,11 @@ std::vector<RegressionCase> casesToRun(const std::vector<RegressionCase>& cases,
 
 unsigned jobsFor(const RegressOptions& options)
 {
-    if (options.jobs) return *options.jobs;
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    // More children than cores only share them (--jobs 10000 started every case at once).
+    if (options.jobs) return std::min(*options.jobs, cores);
     if (options.failOnSlowdown || options.compares()) return 1;
-    return std::max(1u, std::thread::hardware_concurrency());
+    return cores;
 }
 
 void createReportDir(const fs::path& dir)
@@ -455,6 +460,37 @@ void selectVulkanDriver(const fs::path& icdManifest)
     setenv("VK_ICD_FILENAMES", path.c_str(), 1); // older loaders
 }
 
+/// Seconds `vkrt devices` may take to open a driver before the run calls it hung.
+constexpr double kDriverProbeSeconds = 60.0;
+
+/// A driver under test is first opened in a child (`vkrt devices`) under a
+/// deadline, as every case is: an ICD manifest naming the Vulkan loader
+/// itself hung the parent in vkCreateInstance, with no timeout. A child that
+/// hangs or crashes fails the run as a device failure; one that ends, well or
+/// not, has shown that opening the driver returns, and the parent opens it
+/// (its own message names what the loader could not use).
+void proveDriverInChild(const RegressOptions& options)
+{
+    const double limit = std::min(options.caseTimeout.value_or(kDriverProbeSeconds), kDriverProbeSeconds);
+    const fs::path log = fs::temp_directory_path() / ("vkrt-driver-probe-" + std::to_string(getpid()) + ".log");
+    std::optional<ExitStatus> status;
+    {
+        ChildProcess child({currentExecutable().string(), "devices"}, log);
+        while (!(status = child.poll()) && child.seconds() < limit)
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (!status) child.kill();
+    }
+    std::error_code ignored;
+    fs::remove(log, ignored);
+    const std::string named = "--driver " + options.driver;
+    if (!status)
+        throw GpuError(named + ": opening the driver did not return within " + std::to_string(int(limit)) +
+                       " s (`vkrt devices` in a child hung; the run's process never opens it)");
+    if (status->signaled)
+        throw GpuError(named + ": opening the driver crashed (`vkrt devices` in a child was " + status->describe() +
+                       ")");
+}
+
 Outcome runRegression(const RegressOptions& options)
 {
     if (options.runCase) return runCaseForParent(options);
@@ -464,7 +500,10 @@ Outcome runRegression(const RegressOptions& options)
     const Expectations expectations = readExpectations(options.baseline, options.flakes, options.skips);
     warnAboutUnknownBaselineCases(suite, expectations);
     if (options.compares()) return compareDrivers(suite, cases, expectations, options);
-    if (!options.driver.empty()) selectVulkanDriver(options.driver);
+    if (!options.driver.empty()) {
+        selectVulkanDriver(options.driver);
+        proveDriverInChild(options);
+    }
     std::vector<PreparedCase> prepared;
     if (!options.update) prepared = prepareCases(suite, casesToRun(cases, expectations));
     if (!options.reportDir.empty()) createReportDir(options.reportDir);

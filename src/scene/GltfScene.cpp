@@ -251,7 +251,12 @@ Scene parseGltfScene(const std::string& path, const GltfSceneOptions& options)
         const std::string extension = lowercase(fs::path(map.path).extension().string());
         if (extension != ".exr" && extension != ".hdr")
             throw InputError("--environment " + map.path + ": an environment map must be a lat-long .exr or .hdr file");
-        if (!fs::is_regular_file(map.path)) throw InputError("--environment " + map.path + ": no such file");
+        std::error_code error;
+        const fs::file_status status = fs::status(map.path, error);
+        if (!fs::exists(status)) throw InputError("--environment " + map.path + ": no such file");
+        if (!fs::is_regular_file(status))
+            throw InputError("--environment " + map.path + ": is " +
+                             (fs::is_directory(status) ? "a directory" : "not a regular file") + ", not an image file");
         scene.background.environment = map;
     } else if (!lit) {
         scene.background.color = Color(1.0); // a file without lights: a white sky, as glTF viewers show it

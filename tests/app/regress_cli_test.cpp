@@ -395,6 +395,22 @@ TEST_F(RegressCli, CaseNamesAreCheckedWhereTheyStand)
     expectInputError(child, {"--run-case  needs --case-result FILE"});
 }
 
+// A manifest naming the Vulkan loader as the driver hung the parent in
+// vkCreateInstance for good; now the driver is opened in a child first, under
+// the case timeout, and the run ends as a device failure naming it.
+TEST_F(RegressCli, ADriverThatHangsOpeningIsATimeoutNotAHang)
+{
+    writeText(m_dir / "loader.json", "{\"file_format_version\": \"1.0.0\", \"ICD\": {\"library_path\": "
+                                     "\"libvulkan.so.1\", \"api_version\": \"1.3.0\"}}\n");
+    const auto start = std::chrono::steady_clock::now();
+    const ProcessResult r = regress({"--suite", writeManifest({shipped("extreme/kappa-shadow", 8)}).string(),
+                                     "--driver", (m_dir / "loader.json").string(), "--case-timeout", "2"});
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("loader.json: opening the driver did not return within 2 s"), std::string::npos)
+        << r.output;
+}
+
 TEST_F(RegressCli, CaseTimeoutMustBeAPositiveFiniteNumber)
 {
     const fs::path suite = writeManifest({shipped("extreme/kappa-shadow", 8)});

@@ -13,6 +13,8 @@
 #include <fstream>
 #include <string>
 
+#include <sys/stat.h>
+
 namespace vkrt {
 namespace {
 
@@ -143,6 +145,21 @@ TEST_F(RegressExpectations, PatternsCannotHangOrCrashTheRun)
     const std::string error = baselineError(std::string(8 << 20, 'n') + ",Fail\n");
     EXPECT_NE(error.find(":1: a line of 8388613 bytes"), std::string::npos) << error.substr(0, 300);
     EXPECT_LT(error.size(), 400u);
+}
+
+TEST_F(RegressExpectations, ADirectoryOrAFifoIsNamedForWhatItIs)
+{
+    fs::create_directories(m_dir / "folder");
+    ASSERT_EQ(mkfifo((m_dir / "pipe").c_str(), 0600), 0);
+    for (const auto& [name, what] :
+         {std::pair<const char*, const char*>{"folder", "is a directory"}, {"pipe", "is not a regular file"}}) {
+        try {
+            readBaseline(m_dir / name);
+            ADD_FAILURE() << name << " was read";
+        } catch (const InputError& error) {
+            EXPECT_NE(std::string(error.what()).find(std::string(": ") + what), std::string::npos) << error.what();
+        }
+    }
 }
 
 TEST_F(RegressExpectations, BaselineLineNamingNoCaseIsReported)

@@ -3,6 +3,8 @@
 // (scenes/gltf/lights-camera.toml, every number computed independently by
 // tools/gltf_writer.py) states them; the defaults for a file without camera
 // or lights; `[import] gltf`; and bad input named with the file.
+#include "mesh/MeshGeometry.h"
+#include "scene/FeatureSet.h"
 #include "scene/GltfScene.h"
 #include "scene/SceneParser.h"
 #include "support/GltfTestFiles.h"
@@ -11,6 +13,7 @@
 #include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -168,6 +171,28 @@ TEST(GltfScene, ExtremeAspectRatiosGiveSmallImagesOrAnError)
         R"("scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"camera": 0, "rotation": [0, 0, 0, 0]}])");
     const std::string error = errorOf([&] { parseGltfScene(zero.string()); });
     EXPECT_NE(error.find("nodes[1].rotation: a rotation quaternion must not be zero"), std::string::npos) << error;
+}
+
+// The anisotropy test scene: six spheres whose materials carry the file's
+// strengths and rotations, with the file's tangents, in the anisotropic kernel.
+TEST(GltfScene, AnisotropySpheresCarryTheirStrengthsRotationsAndTangents)
+{
+    const Scene scene = parseGltfScene((kSource / "scenes/gltf/anisotropy-spheres.gltf").string());
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    std::vector<std::pair<double, double>> layers;
+    for (const Material& m : scene.materials) layers.emplace_back(m.layers.anisotropy, m.layers.anisotropyRotation);
+    const double pi = glm::pi<double>();
+    for (const auto& expected :
+         std::vector<std::pair<double, double>>{{0.5, 0.0}, {1.0, 0.0}, {0.8, 0.0}, {0.8, pi / 4}, {0.8, pi / 2}}) {
+        const bool found = std::any_of(layers.begin(), layers.end(), [&](const auto& l) {
+            return std::abs(l.first - expected.first) < 1e-6 && std::abs(l.second - expected.second) < 1e-6;
+        });
+        EXPECT_TRUE(found) << "strength " << expected.first << ", rotation " << expected.second;
+    }
+    ASSERT_FALSE(scene.meshes.empty());
+    EXPECT_FALSE(scene.meshes[0].geometry->data.tangents.empty()) << "the file's TANGENT";
+    const FeatureSet features = featuresOf(scene);
+    EXPECT_TRUE(features.pbrAnisotropy && features.tangentFrames());
 }
 
 TEST(GltfScene, CamerasAreListedInFileOrderAndOrthographicOnesKeepTheirView)
