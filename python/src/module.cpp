@@ -13,6 +13,7 @@
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
 #include "scene/MaterialUse.h"
+#include "scene/SceneInputs.h"
 #include "scene/SceneOverrides.h"
 #include "scene/SceneParser.h"
 #include "util/Error.h"
@@ -288,14 +289,14 @@ struct PyResult {
     std::string stoppedBy;
     bool interrupted = false;
     py::object errorEstimate = py::none(); ///< {"rmse", "rel_mse"} from the kernel's variance, or None
-    std::string scenePath;                 ///< the render's input, which save() must not overwrite
+    std::vector<NamedFile> inputs; ///< the scene file and every file it read, which save() must not overwrite
 
     /// The command line's rule (io/OutputPaths.h): the output may not be the
-    /// scene file, and must be a place vkrt can write.
+    /// scene file or any file it read, and must be a place vkrt can write.
     void save(const std::filesystem::path& path) const
     {
         py::gil_scoped_release release;
-        checkOutputs({{"the scene file", scenePath}}, {{"save()'s path", path}});
+        checkOutputs(inputs, {{"save()'s path", path}});
         writeRenderOutput(path, *output);
     }
 };
@@ -330,7 +331,8 @@ std::unique_ptr<PyResult> resultOf(RenderOutput rendered, const std::optional<Es
             view(output.channels[k].values, uint32_t(output.channels[k].names.size()));
     for (const auto& [key, value] : output.metadata) result->metadata[py::str(key)] = metadataValue(value);
     result->spp = session.spp();
-    result->scenePath = session.scene().path;
+    result->inputs = filesTheSceneRead(session.scene());
+    result->inputs.push_back({"the scene file", session.scene().path});
     result->renderSeconds = session.renderSeconds();
     if (session.stoppedBy()) result->stoppedBy = stopReasonName(*session.stoppedBy());
     result->interrupted = session.outcome().kind == OutcomeKind::Interrupted;

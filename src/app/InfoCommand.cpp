@@ -3,6 +3,7 @@
 // `--json` writes the same facts as one JSON object (docs/machine-output.md).
 #include "app/Commands.h"
 #include "app/JsonOutput.h"
+#include "scene/SceneInputs.h"
 #include "io/AtomicFile.h"
 #include "mesh/MeshGeometry.h"
 #include "render/RenderSession.h"

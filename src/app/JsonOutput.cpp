@@ -1,9 +1,7 @@
 #include "app/JsonOutput.h"
 
 #include "io/AtomicFile.h"
-#include "mesh/MeshGeometry.h"
 #include "scene/Scene.h"
-#include "texture/TextureAtlas.h"
 #include "util/Error.h"
 
 #include <cerrno>
@@ -27,21 +25,6 @@ void writeJson(const std::string& path, const JsonObject& document)
     // One write of the whole text, then a checked flush: a reader of a pipe sees all or an error.
     if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
         throw InputError("--json -: cannot write to standard output: " + std::string(std::strerror(errno)));
-}
-
-std::vector<NamedFile> filesTheSceneRead(const Scene& scene)
-{
-    std::vector<NamedFile> files;
-    for (const Mesh& mesh : scene.meshes) files.push_back({"a mesh the scene loads", mesh.geometry->file});
-    if (scene.textures)
-        for (uint32_t r = 0; r < scene.textures->recordCount(); ++r)
-            files.push_back({"a texture the scene loads", scene.textures->nameOf(r)});
-    if (scene.background.cubemap)
-        for (const std::string& face : scene.background.cubemap->facePaths)
-            files.push_back({"a cube face the scene loads", face});
-    if (scene.background.environment)
-        files.push_back({"the environment map the scene loads", scene.background.environment->path});
-    return files;
 }
 
 } // namespace vkrt

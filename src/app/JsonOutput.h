@@ -40,9 +40,5 @@ JsonObject valueOrNull(const std::optional<T>& value)
     return value ? JsonObject(*value) : JsonObject(nullptr);
 }
 
-/// The files a parsed scene read besides itself (meshes, textures, cube
-/// faces): no output of a command may replace one (`-o sky/px.exr` must not
-/// overwrite one of its own faces).
-std::vector<NamedFile> filesTheSceneRead(const Scene& scene);
 
 } // namespace vkrt

@@ -4,6 +4,7 @@
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
 #include "app/JsonOutput.h"
+#include "scene/SceneInputs.h"
 #include "io/ExrFile.h"
 #include "io/OutputPaths.h"
 #include "io/PngFile.h"
