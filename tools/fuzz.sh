@@ -19,12 +19,12 @@ compiler=${VKRT_FUZZ_CXX:-clang++}
 started=$(date +%s)
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$compiler" \
   -DVKRT_FUZZ=ON >/dev/null
-cmake --build "$build" -j"${JOBS:-2}" --target fuzz_mesh_loader fuzz_scene_parser
+cmake --build "$build" -j"${JOBS:-2}" --target fuzz_mesh_loader fuzz_scene_parser fuzz_run_inputs
 echo "fuzz: build took $(($(date +%s) - started)) s"
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-mkdir -p "$work/mesh" "$work/scene" "$build/artifacts"
+mkdir -p "$work/mesh" "$work/scene" "$work/run" "$build/artifacts"
 
 # A mesh seed is one byte choosing the format (tests/fuzz/fuzz_mesh_loader.cpp:
 # 0 OBJ, 1 PLY, 2 glTF, 3 GLB) and then the file. Files over 64 KiB would only
@@ -158,6 +158,26 @@ for n in 127 129; do
     printf 1; for ((i = 1; i < n; i++)); do printf '}'; done; echo; } >"$work/scene/inline-$n.toml"
 done
 
+# fuzz_run_inputs: a selector byte (tests/fuzz/fuzz_run_inputs.cpp: 0 an
+# image, 1 a baseline, 2 a pattern list, 3 a suite manifest), then the file.
+run_seed() { # SELECTOR NAME
+  { printf "\\$(printf '%03o' "$1")"; cat; } >"$work/run/$2.seed"
+}
+# Radiance .hdr: a flat 4x2 image, an RLE 16x2 one (a repeated and a literal run per channel), the
+# sweep's zero-run file and a header claiming 8192x8192.
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n'; printf '\200\100\040\201%.0s' 1 2 3 4 5 6 7 8; } | run_seed 0 hdr-flat
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 16\n'
+  for row in 1 2; do printf '\002\002\000\020'; for c in 1 2 3; do printf '\210\200\010ABCDEFGH'; done
+    printf '\220\201'; done; } | run_seed 0 hdr-rle
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 64\n\002\002\000\100' | run_seed 0 hdr-zero-run
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 8192\n' | run_seed 0 hdr-claim
+for file in "$root"/scenes/validation/textures/*.png; do
+  if [[ -f $file && $(stat -c %s "$file") -le 65536 ]]; then run_seed 0 "$(basename "$file")" <"$file"; fi
+done
+printf '# known failures\nextreme/tir,Fail\nseed/glass,Crash,1.5\nvalidation/x,Timeout\n' | run_seed 1 baseline
+printf 'kappa-\n^seed/glass$\nvalidation/.*texture\n^(.*.*.*.*.*.*.*.*.*.*)*Q$\n' | run_seed 2 patterns
+run_seed 3 suite <"$root/tests/regress/suite.toml"
+
 status=0
 run() { # TARGET CORPUS
   echo "fuzz: running $1 for $seconds s on $(find "$2" -type f | wc -l) seeds"
@@ -172,4 +192,5 @@ run() { # TARGET CORPUS
 }
 run fuzz_mesh_loader "$work/mesh"
 run fuzz_scene_parser "$work/scene"
+run fuzz_run_inputs "$work/run"
 exit $status

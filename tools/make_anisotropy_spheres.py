@@ -42,6 +42,8 @@ import math
 import struct
 from pathlib import Path
 
+from gltf_writer import quat_from_mat3  # tools/gltf_writer.py, beside this script
+
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_OUTPUT = REPO / "scenes" / "gltf" / "anisotropy-spheres.gltf"
 
@@ -215,34 +217,14 @@ def material(name: str, strength: float, rotation: float) -> dict:
     }
 
 
-def quat_from_axes(x, y, z):
-    """The unit quaternion [x, y, z, w] of the rotation whose columns are the
-    orthonormal right-handed axes x, y, z (w >= 0)."""
-    m = [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]
-    trace = m[0][0] + m[1][1] + m[2][2]
-    if trace > 0.0:
-        s = 2.0 * math.sqrt(trace + 1.0)
-        q = [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, 0.25 * s]
-    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
-        s = 2.0 * math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2])
-        q = [0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s]
-    elif m[1][1] > m[2][2]:
-        s = 2.0 * math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2])
-        q = [(m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s]
-    else:
-        s = 2.0 * math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1])
-        q = [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s, (m[1][0] - m[0][1]) / s]
-    if q[3] < 0.0:
-        q = [-c for c in q]
-    return normalize(q)
-
-
 def facing(back, up=(0.0, 1.0, 0.0)):
     """The rotation of a node whose -Z points along -back (cameras look and
     lights shine down their node's -Z) with +Y as close to `up` as it can be."""
     z = normalize(back)
     x = normalize(cross(up, z))
-    return quat_from_axes(x, cross(z, x), z)
+    y = cross(z, x)
+    # The rotation whose columns are x, y, z, as rows for gltf_writer's conversion.
+    return quat_from_mat3([[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]])
 
 
 def sphere_nodes():

@@ -37,6 +37,9 @@ std::string xmlEscape(const std::string& text)
         else if (ch == '&') out += "&amp;";
         else if (ch == '"') out += "&quot;";
         else if (ch == '\n') out += "&#10;";
+        // XML 1.0 has no other control characters, not even as references:
+        // one in a message (a driver's, a file name's) made the report unreadable.
+        else if (static_cast<unsigned char>(ch) < 0x20 && ch != '\t' && ch != '\r') out += "\xEF\xBF\xBD";
         else out += ch;
     }
     return out;
