@@ -394,6 +394,22 @@ def quad(width: float = 1.0, height: float = 1.0, uv_repeat: Sequence[float] = (
     return MeshData(positions, [0, 1, 2, 0, 2, 3], [list(n) for n in normals], texcoords)
 
 
+def uv_sphere_indices(segments: int, rings: int) -> list[int]:
+    """Counter-clockwise triangles of a UV sphere whose vertices run ring by
+    ring, segments + 1 to a ring (a seam column); no slivers at the poles."""
+    indices = []
+    row = segments + 1
+    for ring in range(rings):
+        for seg in range(segments):
+            a, b = ring * row + seg, ring * row + seg + 1
+            c, d = a + row, b + row
+            if ring != 0:
+                indices += [a, c, b]
+            if ring != rings - 1:
+                indices += [b, c, d]
+    return indices
+
+
 def uv_sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> MeshData:
     """A UV sphere about the origin: `segments` around Y, `rings` from pole to
     pole, (segments + 1) x (rings + 1) vertices (a seam column and one vertex
@@ -413,15 +429,7 @@ def uv_sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> MeshD
             normals.append(n)
             positions.append([clean(radius * c) for c in n])
             texcoords.append([seg / segments, ring / rings])
-    row = segments + 1
-    for ring in range(rings):
-        for seg in range(segments):
-            a, b = ring * row + seg, ring * row + seg + 1
-            c, d = a + row, b + row
-            if ring != 0:
-                indices += [a, c, b]
-            if ring != rings - 1:
-                indices += [b, c, d]
+    indices += uv_sphere_indices(segments, rings)
     return MeshData(positions, indices, normals, texcoords)
 
 

@@ -42,7 +42,7 @@ import math
 import struct
 from pathlib import Path
 
-from gltf_writer import quat_from_mat3  # tools/gltf_writer.py, beside this script
+from gltf_writer import quat_from_mat3, uv_sphere_indices  # tools/gltf_writer.py, beside this script
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_OUTPUT = REPO / "scenes" / "gltf" / "anisotropy-spheres.gltf"
@@ -135,15 +135,7 @@ def uv_sphere(radius: float, segments: int, rings: int) -> dict:
             texcoords.append([seg / segments, ring / rings])
             # w = +1: cross(normal, east) is north, the image's up (decreasing v).
             tangents.append(tangent + [1.0])
-    row = segments + 1
-    for ring in range(rings):
-        for seg in range(segments):
-            a, b = ring * row + seg, ring * row + seg + 1
-            c, d = a + row, b + row
-            if ring != 0:
-                indices += [a, c, b]
-            if ring != rings - 1:
-                indices += [b, c, d]
+    indices += uv_sphere_indices(segments, rings)
     return {"POSITION": positions, "NORMAL": normals, "TEXCOORD_0": texcoords,
             "TANGENT": tangents, "indices": indices}
 
