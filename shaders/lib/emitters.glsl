@@ -99,10 +99,11 @@ LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo
 }
 #endif
 
-// One sample of all emitters with its shadow ray (the Whitted integrator).
+// One sample of all emitters with its shadow ray (the Whitted integrator;
+// with the light table they are one of its entries: directFromLights).
 vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
 {
-#ifdef VKRT_HAS_EMITTERS
+#if defined(VKRT_HAS_EMITTERS) && !defined(VKRT_LIGHT_TABLE)
     if (u.emitterCount == 0u)
         return vec3(0.0);
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);

@@ -139,6 +139,86 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 #include "lights/directional.glsl"
 #include "lights/spot.glsl"
 
+// ------------------------------------------------------------ the light table
+// Scenes with more point, spot and directional lights than the host lets the
+// kernel test one by one (src/render/LightTable.h) get VKRT_LIGHT_TABLE: every
+// such light and all emitters together are entries of one table chosen in
+// proportion to power (Walker's alias method), and a shading point draws
+// u.lightCandidates entries from it, of which one, chosen in proportion to its
+// unshadowed contribution, gets the shadow ray (resampled importance sampling,
+// Talbot et al. 2005: each candidate's sample divided by M times its table
+// probability, then LightReservoir). The cost no longer grows with the lights.
+// A light found by BSDF sampling (a soft sun, an emitter) is weighted with
+// the same M-times density: the host scales every emitter's pdf by M times
+// the emitters' entry (LightTable.cpp), so emitterOnHit needs no change.
+#ifdef VKRT_LIGHT_TABLE
+layout(scalar, binding = BINDING_LIGHT_TABLE) readonly buffer LightTableBlock { LightPick lightTable[]; };
+
+// The density of choosing one entry among the candidates: M times its probability.
+float tableSelection(uint entry) { return float(u.lightCandidates) * lightTable[entry].pdf; }
+
+// Walker's alias method over the table, as pickEmitter over the emitters.
+uint pickTableEntry(float uSlot, float uAlias)
+{
+    uint slot = min(uint(uSlot * float(u.lightTableCount)), u.lightTableCount - 1u);
+    return uAlias < lightTable[slot].aliasThreshold ? slot : lightTable[slot].alias;
+}
+
+// The table entry of light i of a kind: after the entries of every kind
+// before it in the registry (shared/Kinds.h).
+#define VKRT_TABLE_ENTRY_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if (kind == LIGHT_##KIND)                                                                \
+        return first + i;                                                                    \
+    first += tableEntries##Type();
+uint tableEntry(int kind, uint i)
+{
+    uint first = 0u;
+    VKRT_LIGHT_KINDS(VKRT_TABLE_ENTRY_OF_KIND)
+    return first + i;
+}
+
+// One entry's light sample, divided by the density of having drawn it; the
+// last entry samples every emitter (their pdfs carry that density already).
+#define VKRT_SAMPLE_TABLE_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if (i < tableEntries##Type())                                                          \
+        return sampleTable##Type(i, selection, m, hit, ns, wo, origin, rnd);               \
+    i -= tableEntries##Type();
+LightSample sampleTableEntry(uint entry, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, vec4 rnd)
+{
+    float selection = tableSelection(entry);
+    if (!(selection > 0.0))
+        return LightSample(vec3(0.0), origin); // a light of no power: never drawn but by rounding
+    uint i = entry;
+    VKRT_LIGHT_KINDS(VKRT_SAMPLE_TABLE_KIND)
+#ifdef VKRT_HAS_EMITTERS
+    return sampleEmitters(rnd, m, hit, ns, wo, origin);
+#else
+    return LightSample(vec3(0.0), origin);
+#endif
+}
+
+// The candidates drawn from the table, offered to the reservoir.
+void offerTableSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                       inout Sampler rng)
+{
+    for (uint c = 0u; c < u.lightCandidates; ++c) {
+        ++g_loopIterations;
+        vec4 pick = sampleNext4D(rng); // table slot, alias, the reservoir's choice
+        LightSample s = sampleTableEntry(pickTableEntry(pick.x, pick.y), m, hit, ns, wo, origin, sampleNext4D(rng));
+        offerLightSample(r, s, pick.z);
+    }
+}
+#endif
+
+float lightSelection(int kind, uint i)
+{
+#ifdef VKRT_LIGHT_TABLE
+    return tableSelection(tableEntry(kind, i));
+#else
+    return 1.0;
+#endif
+}
+
 #define VKRT_DIRECT_FROM_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     +directFrom##Type(m, hit, n, ns, wo, media, rng)
 #define VKRT_OFFER_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
@@ -195,10 +275,22 @@ vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf)
 }
 
 // Direct light from every light kind, each light with its own shadow ray
-// (the Whitted integrator, which adds one sample of the emitters to it).
+// (the Whitted integrator, which adds one sample of the emitters to it). With
+// the light table: its candidates, one of them with a shadow ray, emitters
+// included (directFromEmitters adds nothing then).
 vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
 {
+#ifdef VKRT_LIGHT_TABLE
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
+    offerTableSamples(r, m, hit, ns, wo, origin, rng);
+    if (r.totalWeight == 0.0)
+        return vec3(0.0);
+    return r.kept.unshadowed * (r.totalWeight / r.keptWeight) *
+           transmittanceFromSurface(hit, n, ns, origin, r.kept.target, media);
+#else
     return vec3(0.0) VKRT_LIGHT_KINDS(VKRT_DIRECT_FROM_KIND);
+#endif
 }
 
 // Next-event estimation from every light kind, the emitters and the
@@ -215,8 +307,12 @@ vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 ns, v
 {
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
+#ifdef VKRT_LIGHT_TABLE
+    offerTableSamples(r, m, hit, ns, wo, origin, rng);
+#else
     VKRT_LIGHT_KINDS(VKRT_OFFER_KIND)
     offerEmitterSample(r, m, hit, ns, wo, origin, rng);
+#endif
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     // The environment map is one more candidate: one shadow ray for all light.
     vec4 u4 = sampleNext4D(rng);

@@ -63,11 +63,13 @@ VKRT_CONSTANT(uint, BINDING_MESH_COLORS, BINDING_ENVIRONMENT + 20)
 // Per mesh triangle, beside meshUvs: the second texture coordinate set (MeshUvs
 // of glTF TEXCOORD_1; variants where some texture reads it).
 VKRT_CONSTANT(uint, BINDING_MESH_UVS1, BINDING_ENVIRONMENT + 21)
+// LightPick[]: the light table of scenes with many lights (VKRT_LIGHT_TABLE).
+VKRT_CONSTANT(uint, BINDING_LIGHT_TABLE, BINDING_ENVIRONMENT + 22)
 // Host only: a GLSL constant of a new value is emitted into every variant's
 // SPIR-V (glslang keeps folded constants), so a binding added for one feature
 // would change every kernel; the kernels never need the count.
 #ifdef __cplusplus
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 22)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 23)
 #endif
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);

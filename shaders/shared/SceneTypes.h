@@ -265,6 +265,19 @@ struct SpotLight {
     vec3 axis;
 };
 
+/// One entry of the light table, read only by variants with
+/// VKRT_LIGHT_TABLE (scenes with more point, spot and directional lights than
+/// the kernel tests one by one: src/render/LightTable.h). The entries are the
+/// table's lights of each light kind in registry order, one per record (none
+/// for triangle lights), then one entry for all emitters together when the
+/// scene has some. Chosen in proportion to power with Walker's alias method
+/// as emitters are; `pdf` is the probability of choosing the entry.
+struct LightPick {
+    float pdf;
+    float aliasThreshold;
+    uint alias;
+};
+
 /// A triangle light's geometry, camera-relative world space: what rays are
 /// tested against. What it emits is emitters[emitter] (Emitter), in the one
 /// alias table of every emitting triangle.
@@ -346,6 +359,14 @@ struct SceneUniforms {
     vec3 environmentAxisX;
     vec3 environmentAxisY;
     vec3 environmentAxisZ;
+    // Directional lights whose cone is wider than a point (oneMinusCos > 0):
+    // the first this many records, the only ones a ray that escapes can find.
+    uint softDirectionalLightCount;
+    // The light table (VKRT_LIGHT_TABLE): its entries (LightPick), and the
+    // candidates drawn from it at each shading point, of which one gets the
+    // shadow ray (lib/lights.glsl).
+    uint lightTableCount;
+    uint lightCandidates;
 };
 
 /// Per-batch values (push constants), pushed once per submission: lavapipe

@@ -42,7 +42,7 @@ constexpr bool bindingsDistinct()
                               BINDING_MATERIAL_TEXTURES, BINDING_MESH_UVS,       BINDING_MESH_TANGENTS,
                               BINDING_MESH_MATERIALS,    BINDING_FRAME_RUN,      BINDING_AOVS,
                               BINDING_TOP_LEVEL,         BINDING_MESH_COLORS,    BINDING_MATERIAL_ALPHA,
-                              BINDING_MESH_UVS1};
+                              BINDING_MESH_UVS1,         BINDING_LIGHT_TABLE};
     for (uint a : kSceneArrayBindings) {
         if (a >= BINDING_COUNT) return false;
         for (uint f : fixed)
@@ -54,10 +54,11 @@ constexpr bool bindingsDistinct()
     return true;
 }
 static_assert(bindingsDistinct(), "shared/Bindings.h: every scene array needs its own binding below BINDING_COUNT");
-static_assert(sizeof(SceneUniforms) == 168 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
+static_assert(sizeof(SceneUniforms) == 180 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
               "SceneUniforms holds one count per shape and light kind");
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
+static_assert(sizeof(LightPick) == 12);
 static_assert(sizeof(FrameRun) == 8);
 static_assert(sizeof(BvhNode) == 32);
 static_assert(sizeof(MeshTriangle) == 36);

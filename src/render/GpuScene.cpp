@@ -5,6 +5,7 @@
 
 #include "mesh/MeshGeometry.h"
 #include "render/EmissionPower.h"
+#include "render/LightTable.h"
 #include "scene/FeatureSet.h"
 #include "scene/SceneOverrides.h"
 #include "scene/kinds/Kinds.h"
@@ -263,7 +264,8 @@ std::array<glm::dvec3, 3> worldVertices(const Mesh& mesh, const MeshGeometry& g,
     return v;
 }
 
-/// Walker's alias table (Vose's construction) over non-negative weights.
+} // namespace
+
 EmitterTable aliasTable(const std::vector<double>& power)
 {
     EmitterTable table;
@@ -297,6 +299,8 @@ EmitterTable aliasTable(const std::vector<double>& power)
     for (uint32_t i : large) table.threshold[i] = 1.0f;
     return table;
 }
+
+namespace {
 
 /// Every emitter's power, in emitter order: the triangle lights, then each
 /// emissive mesh's triangles (a textured emission's power from the texture's
@@ -735,6 +739,13 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
 #undef VKRT_CONVERT_RECORDS
     convertTriangleLightEmitters(scene, fixed, data);
     convertMeshes(scene, fixed, scene.camera.eye, data);
+    // Soft suns first: the only ones an escaped ray can find (lib/lights/directional.glsl).
+    std::stable_partition(data.directionalLights.begin(), data.directionalLights.end(),
+                          [](const gpu::DirectionalLight& light) { return light.oneMinusCos > 0.0f; });
+    data.uniforms.softDirectionalLightCount =
+        uint32_t(std::count_if(data.directionalLights.begin(), data.directionalLights.end(),
+                               [](const gpu::DirectionalLight& light) { return light.oneMinusCos > 0.0f; }));
+    if (usesLightTable(scene)) buildLightTable(scene, fixed, data);
     if (fixed.top) {
         data.topNodes = refitTopLevel(*fixed.top, scene.camera.eye);
         data.topRefs = fixed.top->refs;

@@ -42,6 +42,10 @@ struct EmitterTable {
     double totalPower = 0.0;
 };
 
+/// Walker's alias table (Vose's construction) over non-negative weights: the
+/// emitters' and the light table's (render/LightTable.h).
+EmitterTable aliasTable(const std::vector<double>& power);
+
 /// Everything about a scene's meshes that no camera move changes: the
 /// geometries concatenated (each once, however many instances share it),
 /// the top-level BVH's topology and the emitters' alias table.
@@ -101,6 +105,7 @@ struct GpuSceneData {
     std::vector<gpu::BvhNode> topNodes;
     std::vector<uint32_t> topRefs;
     std::vector<gpu::Emitter> emitters;
+    std::vector<gpu::LightPick> lightTable; ///< only for scenes with many lights (render/LightTable.h)
     std::vector<gpu::Material> materials;
     // One array per shape and light kind (shared/Kinds.h), named as in Scene.
 #define VKRT_GPU_ARRAY_MEMBER(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \

@@ -45,6 +45,7 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     list.push_back({v.driverAccel, "VKRT_ACCEL_DRIVER", int(gpu::BINDING_TOP_LEVEL), "driver-accel"});
     list.push_back({meshes && f.meshNormals, "VKRT_HAS_MESH_NORMALS", int(gpu::BINDING_MESH_NORMALS), "mesh-normals"});
     list.push_back({f.emitters, "VKRT_HAS_EMITTERS", int(gpu::BINDING_EMITTERS), "emitters"});
+    list.push_back({f.lightTable, "VKRT_LIGHT_TABLE", int(gpu::BINDING_LIGHT_TABLE), "light-table"});
     // Textures: the texel buffer, the texture records and each material's slots;
     // meshes add their triangles' uvs, tangents for normal maps, and each
     // triangle's material when they use their file's materials.

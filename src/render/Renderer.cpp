@@ -1,5 +1,6 @@
 #include "render/Renderer.h"
 
+#include "render/LightTable.h"
 #include "render/RenderMemory.h"
 
 #include "render/Environment.h"
@@ -48,6 +49,7 @@ FeatureSet uberFeatures(const Scene& scene)
     features.pbrTransmission = own.pbrTransmission;
     features.pbrIridescence = own.pbrIridescence;
     features.pbrAnisotropy = own.pbrAnisotropy;
+    features.lightTable = own.lightTable; // the scene's lights decide how they are sampled
     return features;
 }
 
@@ -245,15 +247,11 @@ namespace {
 
 /// The light samples one shading point draws: one per record of every light
 /// kind, except that all emitters (triangle lights, emissive meshes) are one
-/// sample together (lib/lights.glsl).
+/// sample together; with the light table, its candidates (lib/lights.glsl).
 uint64_t sampledLightCount(const Scene& scene)
 {
-    uint64_t count = featuresOf(scene).emitters ? 1 : 0;
-#define VKRT_COUNT_SAMPLED(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
-    if constexpr (!std::is_same_v<Type, TriangleLight>) count += scene.array.size();
-    VKRT_LIGHT_KINDS(VKRT_COUNT_SAMPLED)
-#undef VKRT_COUNT_SAMPLED
-    return count;
+    if (usesLightTable(scene)) return kLightTableCandidates;
+    return (featuresOf(scene).emitters ? 1 : 0) + enumeratedLightCount(scene);
 }
 
 } // namespace
@@ -271,8 +269,9 @@ uint64_t worstCaseLoopIterations(const Scene& scene)
     bool glassShadows = whitted && featuresOf(scene).has(MaterialType::Dielectric);
     uint64_t shadowQuery = glassShadows ? gpu::MAX_SHADOW_CROSSINGS * (1 + hittables) : hittables;
     uint64_t lights = sampledLightCount(scene);
-    // A ray that escapes looks for every sun (lib/lights/directional.glsl).
-    uint64_t escape = scene.directionalLights.size();
+    // A ray that escapes looks for every soft sun (lib/lights/directional.glsl).
+    uint64_t escape = 0;
+    for (const DirectionalLight& light : scene.directionalLights) escape += light.angle > 0.0 ? 1 : 0;
     // A textured hit reads its material's slots in a loop (lib/material_textures.glsl).
     uint64_t textureSlots = featuresOf(scene).textures ? gpu::TEXTURE_SLOT_COUNT : 0;
     uint64_t perDepth = 1 + hittables + lights * (1 + shadowQuery) + escape + textureSlots;
@@ -463,6 +462,7 @@ void Renderer::uploadSceneBuffers()
     addStorage(gpu::BINDING_TOP_NODES, m_data.topNodes);
     addStorage(gpu::BINDING_TOP_REFS, m_data.topRefs);
     addStorage(gpu::BINDING_EMITTERS, m_data.emitters);
+    addStorage(gpu::BINDING_LIGHT_TABLE, m_data.lightTable);
     addStorage(gpu::BINDING_MATERIAL_TABLES, m_static.materialTables);
 }
 

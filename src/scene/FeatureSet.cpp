@@ -4,6 +4,7 @@
 #include "mesh/MeshGeometry.h"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace vkrt {
 
@@ -117,6 +118,18 @@ bool meshAlphaTested(const Scene& scene, const Mesh& mesh)
     return false;
 }
 
+size_t enumeratedLightCount(const Scene& scene)
+{
+    size_t count = 0;
+#define VKRT_COUNT_ENUMERATED(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if constexpr (!std::is_same_v<Type, TriangleLight>) count += scene.array.size();
+    VKRT_LIGHT_KINDS(VKRT_COUNT_ENUMERATED)
+#undef VKRT_COUNT_ENUMERATED
+    return count;
+}
+
+bool usesLightTable(const Scene& scene) { return enumeratedLightCount(scene) > kMaxEnumeratedLights; }
+
 FeatureSet featuresOf(const Scene& scene)
 {
     FeatureSet set;
@@ -130,6 +143,7 @@ FeatureSet featuresOf(const Scene& scene)
     set.integrator = scene.render.integrator;
     set.thinLens = scene.camera.thinLens();
     set.orthographic = scene.camera.orthographic();
+    set.lightTable = usesLightTable(scene);
     for (const TriangleLight& light : scene.triangleLights) set.emitters = set.emitters || emits(light);
     for (const Mesh& mesh : scene.meshes) {
         set.meshNormals = set.meshNormals || !mesh.geometry->data.normals.empty();

@@ -32,6 +32,7 @@ struct FeatureSet {
     bool thinLens = false;            ///< the camera has an aperture (depth of field)
     bool orthographic = false;        ///< the camera projects orthographically (parallel rays)
     bool alpha = false;               ///< some mesh material is alpha-tested (glTF alphaMode MASK or BLEND)
+    bool lightTable = false; ///< more lights than kMaxEnumeratedLights: sampled from a table (render/LightTable.h)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).
@@ -48,6 +49,17 @@ struct FeatureSet {
 };
 
 FeatureSet featuresOf(const Scene& scene);
+
+/// Point, spot and directional lights the kernel tests one by one at most;
+/// more go into the light table (render/LightTable.h).
+inline constexpr size_t kMaxEnumeratedLights = 8;
+
+/// The lights a shading point would sample one by one: every light that is
+/// not a triangle light (those are emitters, sampled together).
+size_t enumeratedLightCount(const Scene& scene);
+
+/// Whether the scene's lights go into the light table.
+bool usesLightTable(const Scene& scene);
 
 /// Whether the mesh's file colours its vertices (glTF COLOR_0) for its file
 /// materials: only a file's own materials take its colours.

@@ -47,10 +47,11 @@ vec3 sampleSunCone(DirectionalLight light, vec2 rnd)
 
 // One sun's light at a surface point before visibility: f * E * cos for a
 // delta sun, f * L * cos / pdf (MIS-weighted in the path integrator) for a
-// direction drawn in a soft sun's cone. The shadow ray's target is far along
-// the direction (FAR_LIGHT_DISTANCE).
-LightSample sampleDirectionalLight(DirectionalLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo,
-                                   vec3 origin, vec2 rnd)
+// direction drawn in a soft sun's cone; both divided by `selection`, the
+// density of having chosen this sun (1 where every sun is sampled; lib/lights.glsl:
+// tableSelection). The shadow ray's target is far along the direction (FAR_LIGHT_DISTANCE).
+LightSample sampleDirectionalLight(DirectionalLight light, float selection, Material m, SurfaceHit hit, vec3 ns,
+                                   vec3 wo, vec3 origin, vec2 rnd)
 {
     bool soft = light.oneMinusCos > 0.0;
     vec3 wi = soft ? sampleSunCone(light, rnd) : light.toLight;
@@ -60,15 +61,41 @@ LightSample sampleDirectionalLight(DirectionalLight light, Material m, SurfaceHi
         return LightSample(vec3(0.0), target);
     vec3 contribution = evalBsdf(m, ns, wo, wi) * light.radiance * cosTheta;
     if (soft) {
-        float lightPdf = sunConePdf(light);
+        float lightPdf = sunConePdf(light) * selection;
         contribution /= lightPdf;
 #ifdef VKRT_INTEGRATOR_PATH
         contribution *= powerHeuristic(lightPdf, pdfBsdf(m, ns, wo, wi));
 #endif
+    } else {
+        contribution /= selection;
     }
     return LightSample(contribution, target);
 }
 #endif
+
+// The suns' entries in the light table (VKRT_LIGHT_TABLE): one each.
+uint tableEntriesDirectionalLight()
+{
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+    return u.directionalLightCount;
+#else
+    return 0u;
+#endif
+}
+
+// Sun i drawn from the light table with density `selection`.
+LightSample sampleTableDirectionalLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo,
+                                        vec3 origin, vec4 rnd)
+{
+#ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
+    return sampleDirectionalLight(directionalLights[i], selection, m, hit, ns, wo, origin, rnd.xy);
+#else
+    return LightSample(vec3(0.0), origin);
+#endif
+}
+
+// The density of having chosen light i of a kind (lib/lights.glsl).
+float lightSelection(int kind, uint i);
 
 // Every sun, each with its shadow ray (the Whitted integrator).
 vec3 directFromDirectionalLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
@@ -79,7 +106,7 @@ vec3 directFromDirectionalLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     for (uint i = 0u; i < u.directionalLightCount; ++i) {
         ++g_loopIterations;
-        LightSample s = sampleDirectionalLight(directionalLights[i], m, hit, ns, wo, origin, sampleNext2D(rng));
+        LightSample s = sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, sampleNext2D(rng));
         if (s.unshadowed != vec3(0.0))
             radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
     }
@@ -95,24 +122,27 @@ void offerDirectionalLightSamples(inout LightReservoir r, Material m, SurfaceHit
     for (uint i = 0u; i < u.directionalLightCount; ++i) {
         ++g_loopIterations;
         vec4 u4 = sampleNext4D(rng);
-        offerLightSample(r, sampleDirectionalLight(directionalLights[i], m, hit, ns, wo, origin, u4.xy), u4.z);
+        offerLightSample(r, sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, u4.xy), u4.z);
     }
 #endif
 }
 
 // The soft suns a ray that escaped along `dir` sees: each with weight 1 after
 // a specular bounce or from the camera (`specular`), else its MIS weight
-// against the BSDF sample of density bsdfPdf (path integrator).
+// against the BSDF sample of density bsdfPdf (path integrator). The soft
+// suns come first (SceneUniforms::softDirectionalLightCount): a delta sun is
+// never seen, so a scene of many of them costs an escaped ray nothing.
 vec3 directionalOnEscape(vec3 dir, bool specular, float bsdfPdf)
 {
     vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    for (uint i = 0u; i < u.directionalLightCount; ++i) {
+    for (uint i = 0u; i < u.softDirectionalLightCount; ++i) {
         ++g_loopIterations;
         DirectionalLight light = directionalLights[i];
         if (!insideSunCone(light, dir))
             continue;
-        float weight = specular ? 1.0 : powerHeuristic(bsdfPdf, sunConePdf(light));
+        float weight =
+            specular ? 1.0 : powerHeuristic(bsdfPdf, sunConePdf(light) * lightSelection(LIGHT_DIRECTIONAL, i));
         radiance += light.radiance * weight;
     }
 #endif

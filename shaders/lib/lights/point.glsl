@@ -52,6 +52,30 @@ vec3 directFromPointLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, 
     return radiance;
 }
 
+// The point lights' entries in the light table (VKRT_LIGHT_TABLE): one each.
+uint tableEntriesPointLight()
+{
+#ifdef VKRT_HAS_POINT_LIGHTS
+    return u.pointLightCount;
+#else
+    return 0u;
+#endif
+}
+
+// Point light i drawn from the light table with density `selection`
+// (lib/lights.glsl: tableSelection): its sample divided by it.
+LightSample sampleTablePointLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                  vec4 rnd)
+{
+#ifdef VKRT_HAS_POINT_LIGHTS
+    LightSample s = samplePointLight(pointLights[i], m, hit, ns, wo);
+    s.unshadowed /= selection;
+    return s;
+#else
+    return LightSample(vec3(0.0), origin);
+#endif
+}
+
 // Every point light as a candidate of the path integrator's one shadow ray.
 void offerPointLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
                             inout Sampler rng)

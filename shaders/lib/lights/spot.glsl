@@ -62,6 +62,29 @@ vec3 directFromSpotLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, M
     return radiance;
 }
 
+// The spot lights' entries in the light table (VKRT_LIGHT_TABLE): one each.
+uint tableEntriesSpotLight()
+{
+#ifdef VKRT_HAS_SPOT_LIGHTS
+    return u.spotLightCount;
+#else
+    return 0u;
+#endif
+}
+
+// Spot light i drawn from the light table with density `selection`.
+LightSample sampleTableSpotLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                 vec4 rnd)
+{
+#ifdef VKRT_HAS_SPOT_LIGHTS
+    LightSample s = sampleSpotLight(spotLights[i], m, hit, ns, wo);
+    s.unshadowed /= selection;
+    return s;
+#else
+    return LightSample(vec3(0.0), origin);
+#endif
+}
+
 // Every spot light as a candidate of the path integrator's one shadow ray.
 void offerSpotLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
                            inout Sampler rng)

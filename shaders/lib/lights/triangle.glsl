@@ -54,6 +54,15 @@ vec3 directFromTriangleLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 w
     return vec3(0.0);
 }
 
+// No entries of their own in the light table: its last entry is every emitter.
+uint tableEntriesTriangleLight() { return 0u; }
+
+LightSample sampleTableTriangleLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo,
+                                     vec3 origin, vec4 rnd)
+{
+    return LightSample(vec3(0.0), origin);
+}
+
 void offerTriangleLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
                                inout Sampler rng)
 {
