@@ -175,7 +175,7 @@ def main() -> int:
                      "renderSeconds": seconds, "relMse": rel_mse, "kernel": runs[n][0]["kernel"]})
     base = rows[0]
     print(f"{args.kind} lights, {args.integrator}, {args.spp} spp, median of {args.runs}; "
-          f"device {runs[counts[0]][0]['device']}")
+          f"device {runs[counts[0]][0]['device']['driver']}")
     print(f"{'lights':>8} {'Msamples/s':>11} {'rate/1 light':>13} {'relMSE':>10} {'efficiency/1 light':>19}")
     for row in rows:
         efficiency = (base["relMse"] * base["renderSeconds"]) / (row["relMse"] * row["renderSeconds"])
