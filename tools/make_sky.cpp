@@ -17,6 +17,8 @@ int main(int argc, char** argv)
     uint32_t size = 128;
     uint32_t latLongWidth = 0;
     vkrt::SkyParameters sky;
+    // --help shows each option's default (the values above and SkyParameters').
+    app.option_defaults()->always_capture_default();
     app.add_option("directory", directory, "Output folder (created if missing)")->required();
     app.add_option("--size", size, "Face width and height in texels")->check(CLI::Range(1u, 4096u));
     app.add_option("--sun-elevation", sky.sunElevationDegrees, "Degrees above the horizon")

@@ -289,15 +289,17 @@ struct PyResult {
     std::string stoppedBy;
     bool interrupted = false;
     py::object errorEstimate = py::none(); ///< {"rmse", "rel_mse"} from the kernel's variance, or None
-    std::vector<NamedFile> inputs; ///< the scene file and every file it read, which save() must not overwrite
+    std::vector<NamedFile> inputs;         ///< the scene file and every file it read, which save() must not overwrite
 
     /// The command line's rule (io/OutputPaths.h): the output may not be the
     /// scene file or any file it read, and must be a place vkrt can write.
-    void save(const std::filesystem::path& path) const
+    /// The format comes from the extension (.exr or .png), as `vkrt render -o`'s.
+    void save(const std::filesystem::path& path, float exposure, bool filmic) const
     {
         py::gil_scoped_release release;
         checkOutputs(inputs, {{"save()'s path", path}});
-        writeRenderOutput(path, *output);
+        writeRenderImage(path, *output, PngLook{exposure, filmic ? ToneCurve::Filmic : ToneCurve::Clamp},
+                         "save()'s path");
     }
 };
 
@@ -536,8 +538,11 @@ PYBIND11_MODULE(_vkrt, m)
         .def_readonly("interrupted", &PyResult::interrupted)
         .def_readonly("error_estimate", &PyResult::errorEstimate)
         .def(
-            "save", [](const PyResult& r, const std::filesystem::path& path) { translated([&] { r.save(path); }); },
-            py::arg("path"));
+            "save",
+            [](const PyResult& r, const std::filesystem::path& path, float exposure, bool filmic) {
+                translated([&] { r.save(path, exposure, filmic); });
+            },
+            py::arg("path"), py::arg("exposure"), py::arg("filmic"));
 
     py::class_<PySession>(m, "Session")
         .def(py::init([](const PyScene& scene, std::optional<uint32_t> spp, std::optional<uint32_t> width,
@@ -622,6 +627,18 @@ PYBIND11_MODULE(_vkrt, m)
                 arrays["image"] = imageArray(std::move(contents.image.rgb), w, h, 3);
                 for (auto& [name, layer] : contents.layers)
                     arrays[py::str(name)] = imageArray(std::move(layer.rgb), w, h, 3);
+                // Other channels by group; vkrt's AOV channels under the names render() gives them.
+                const std::map<std::string, std::vector<std::string>> aovChannels{{"normal", {"N.X", "N.Y", "N.Z"}},
+                                                                                  {"position", {"P.X", "P.Y", "P.Z"}},
+                                                                                  {"depth", {"Z"}}};
+                for (auto& [group, channels] : contents.channels) {
+                    std::string key = group;
+                    for (const auto& [aov, names] : aovChannels)
+                        if (channels.names == names) key = aov;
+                    if (arrays.contains(key)) key = group; // never hide a layer of the same name
+                    const auto count = uint32_t(channels.names.size());
+                    arrays[py::str(key)] = imageArray(std::move(channels.values), w, h, count);
+                }
                 py::dict metadata;
                 for (const auto& [key, value] : contents.metadata) metadata[py::str(key)] = metadataValue(value);
                 return py::make_tuple(arrays, metadata);

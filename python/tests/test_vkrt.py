@@ -216,6 +216,36 @@ def test_the_image_equals_vkrt_render_bit_for_bit(scene, tmp_path):
             assert saved_metadata[key] == metadata[key], key
 
 
+def test_read_exr_returns_every_layer_render_writes(scene, tmp_path):
+    aovs = ["albedo", "depth", "normal", "position"]
+    r = vkrt.render(scene, spp=2, seed=4, variance=True, aovs=aovs, **SMALL)
+    saved = tmp_path / "layers.exr"
+    r.save(saved)
+    arrays, _ = vkrt.read_exr(saved)
+    assert set(arrays) == {"image", "variance", *aovs}
+    for name in ("image", "variance", *aovs):
+        assert arrays[name].shape == getattr(r, name).shape, name
+        assert np.array_equal(arrays[name], getattr(r, name), equal_nan=True), name
+
+
+def test_save_writes_the_format_its_extension_names(scene, tmp_path):
+    r = vkrt.render(scene, spp=2, seed=1, **SMALL)
+    png = tmp_path / "out.png"
+    r.save(png)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    r.save(tmp_path / "filmic.png", exposure=1.0, filmic=True)
+    assert (tmp_path / "filmic.png").read_bytes() != png.read_bytes()
+    for bad in ("out.jpg", "out"):
+        with pytest.raises(ValueError, match=r"\.exr \(OpenEXR"):
+            r.save(tmp_path / bad)
+        assert not (tmp_path / bad).exists()
+    with pytest.raises(ValueError, match="exposure"):
+        r.save(tmp_path / "x.png", exposure=float("nan"))
+    layered = vkrt.render(scene, spp=2, variance=True, **SMALL)
+    with pytest.raises(ValueError, match="variance"):
+        layered.save(tmp_path / "layered.png")
+
+
 def test_variance_and_aov_layers_equal_vkrt_render(scene, tmp_path):
     arrays, _ = cli_render(tmp_path, "--spp", "3", "--seed", "2", "--width", "48", "--height", "36", "--variance",
                            "--aov", "albedo")

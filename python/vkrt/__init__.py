@@ -192,10 +192,19 @@ class Result:
         self.interrupted = native.interrupted if interrupted is None else interrupted
         self.error_estimate = native.error_estimate
 
-    def save(self, path):
-        """Write the EXR `vkrt render` writes for the same render (mean,
-        variance and AOV layers, metadata), atomically."""
-        self._native.save(_os.fspath(path))
+    def save(self, path, exposure=0.0, filmic=False):
+        """Write the image `vkrt render -o PATH` writes for the same render,
+        atomically, in the format of path's extension: .exr (mean, variance
+        and AOV layers, metadata) or .png (the mean, 8-bit sRGB, scaled by
+        2**exposure and clamped, or through the ACES filmic curve with
+        filmic=True; a result with variance or AOV layers must go to an .exr).
+        Any other extension raises ValueError naming the formats."""
+        exposure = _real("exposure", exposure)
+        if exposure is None or not -64.0 <= exposure <= 64.0:
+            raise ValueError(f"exposure: must be between -64 and 64 stops, got {exposure}")
+        if not isinstance(filmic, bool):
+            raise TypeError(f"filmic: must be True or False, got {filmic!r}")
+        self._native.save(_os.fspath(path), exposure, filmic)
 
     def __repr__(self):
         h, w = self.image.shape[:2]
@@ -372,9 +381,15 @@ def devices():
 def read_exr(path):
     """Read an EXR with R, G, B channels (vkrt's or any tool's): returns
     ``(arrays, metadata)``, where ``arrays["image"]`` is float32 of shape
-    (height, width, 3) and any further RGB layers (``variance``, ``albedo``)
-    are under their names; ``metadata`` holds vkrt's header attributes.
-    Raises ValueError naming the file when it is missing or damaged."""
+    (height, width, 3), any further RGB layers (``variance``, ``albedo``)
+    are under their names, and every other channel is there too, grouped by
+    its layer: the AOVs `vkrt render --aov` writes as ``normal`` (N.X/Y/Z,
+    shape (height, width, 3)), ``position`` (P.X/Y/Z) and ``depth`` (Z,
+    shape (height, width)), as :func:`render` names them; other groups under
+    their layer's name, with one entry per channel along the last axis (a
+    lone channel of no layer, of shape (height, width)). ``metadata`` holds
+    vkrt's header attributes. Raises ValueError naming the file when it is
+    missing or damaged."""
     return _vkrt.read_exr(_os.fspath(path))
 
 

@@ -56,7 +56,7 @@ class Result:
     stopped_by: str
     interrupted: bool
     error_estimate: Optional[dict[str, float]]
-    def save(self, path: _Path) -> None: ...
+    def save(self, path: _Path, exposure: float = ..., filmic: bool = ...) -> None: ...
 
 def render(
     scene: Scene,

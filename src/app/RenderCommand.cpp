@@ -4,7 +4,7 @@
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
 #include "app/JsonOutput.h"
-#include "scene/SceneInputs.h"
+#include "io/AtomicFile.h"
 #include "io/ExrFile.h"
 #include "io/OutputPaths.h"
 #include "io/PngFile.h"
@@ -13,6 +13,7 @@
 #include "render/RenderOutput.h"
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
+#include "scene/SceneInputs.h"
 #include "scene/TomlReader.h"
 #include "util/Error.h"
 #include "util/Hash.h"
@@ -44,6 +45,7 @@ struct RenderCommandOptions {
     std::string device;
     std::string png;
     float exposure = 0.0f;
+    bool filmic = false;
     bool validation = false;
     bool uber = false;
     bool pixelCenters = false;
@@ -65,6 +67,7 @@ struct RenderCommandOptions {
     GltfSceneOptions gltf;                  ///< --camera, --scene, --environment (a glTF scene)
 
     VarianceNeeds varianceNeeds() const { return {variance, targetError || !report.empty()}; }
+    PngLook pngLook() const { return {exposure, filmic ? ToneCurve::Filmic : ToneCurve::Clamp}; }
     /// --spp caps the render; without it a time or error rule may run long.
     uint32_t maxSpp() const
     {
@@ -183,6 +186,10 @@ struct RenderFacts {
     RenderCounters counters;
     bool loopCapped = false; ///< only then do loop-cap hits make a wrong image
     std::string output;
+    std::vector<std::string> written; ///< every file the run wrote, in order (the summary names them)
+    StopReason stoppedBy = StopReason::SppReached;
+    std::optional<EstimatedError> estimated; ///< the error estimate at the stop, where one was made
+    std::optional<double> targetError;
 };
 
 RenderFacts renderFacts(const RenderSession& session, const LoopResult& loop, double startupSeconds,
@@ -202,15 +209,40 @@ RenderFacts renderFacts(const RenderSession& session, const LoopResult& loop, do
     facts.counters = renderer.counters();
     facts.loopCapped = session.context().loopCap().capped();
     facts.output = output;
+    facts.stoppedBy = session.stoppedBy().value_or(StopReason::SppReached);
     return facts;
+}
+
+/// Why the render stopped, in words: "spp", "time budget", "target error
+/// reached (estimated relMSE X <= T)", "interrupted".
+std::string stopSentence(const RenderFacts& facts)
+{
+    switch (facts.stoppedBy) {
+    case StopReason::TimeBudget: return "time budget";
+    case StopReason::Interrupted: return "interrupted";
+    case StopReason::TargetError: {
+        std::string text = "target error reached";
+        if (facts.estimated && facts.targetError) {
+            char buffer[96];
+            std::snprintf(buffer, sizeof buffer, ": estimated relMSE %.3g <= %.3g", facts.estimated->relMse,
+                          *facts.targetError);
+            text += buffer;
+        }
+        return text;
+    }
+    case StopReason::SppReached: break;
+    }
+    return "spp";
 }
 
 void printSummary(const RenderFacts& facts)
 {
-    std::fprintf(stderr, "%u spp  %.2f s  %ssamples/s  %s  (start-up %.2f s%s)  -> %s\n", facts.spp,
+    std::string files;
+    for (const std::string& file : facts.written) files += (files.empty() ? "" : ", ") + file;
+    std::fprintf(stderr, "%u spp  %.2f s  %ssamples/s  %s  (start-up %.2f s%s)  stopped: %s  -> %s\n", facts.spp,
                  facts.renderSeconds, humanCount(facts.samplesPerSecond).c_str(), facts.device.c_str(),
                  facts.startupSeconds, facts.kernelFromCache ? ", kernel cached" : ", kernel compiled",
-                 facts.output.c_str());
+                 stopSentence(facts).c_str(), files.c_str());
     if (facts.counters.rejectedSamples)
         std::fprintf(stderr, "warning: %llu non-finite samples were rejected\n",
                      static_cast<unsigned long long>(facts.counters.rejectedSamples));
@@ -252,10 +284,13 @@ JsonObject outputsJson(const RenderCommandOptions& options, const RenderFacts& f
     auto optionalPath = [](const std::string& path) { return path.empty() ? JsonObject(nullptr) : JsonObject(path); };
     JsonObject layerNames = JsonObject::array();
     for (const auto& [name, image] : layers) layerNames.push_back(name);
-    return {{"exr", facts.output},
+    const bool pngOutput = imageFormatOf(facts.output, "-o") == ImageFormat::Png;
+    return {{"exr", pngOutput ? JsonObject(nullptr) : JsonObject(facts.output)},
             {"exrLayers", layerNames},
-            {"png", optionalPath(options.png)},
-            {"report", optionalPath(options.report)}};
+            {"png", pngOutput ? JsonObject(facts.output) : optionalPath(options.png)},
+            {"previewPng", optionalPath(options.png)},
+            {"report", optionalPath(options.report)},
+            {"written", facts.written}};
 }
 
 JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& session, const RenderFacts& facts,
@@ -361,6 +396,19 @@ void checkRenderFiles(const RenderCommandOptions& options, const std::string& ou
 {
     checkOutputs({{"the scene file", options.scenePath}, {"--reference", options.reference}},
                  renderOutputs(options, output));
+    // The format comes from the extension: never EXR bytes under a .png name.
+    if (imageFormatOf(output, "-o") == ImageFormat::Png) {
+        const char* layerOption = options.variance ? "--variance" : !options.aovs.empty() ? "--aov" : nullptr;
+        if (layerOption)
+            throw InputError("-o " + output + ": " + layerOption +
+                             " writes EXR layers, which a PNG cannot hold; write an .exr (with --png for a preview)");
+        if (!options.shard.empty())
+            throw InputError("-o " + output + ": a shard is an EXR of sums that `vkrt merge` adds; write an .exr");
+    }
+    const bool pngDiscarded =
+        !options.png.empty() && resolveOutputTarget(options.png).kind == OutputTargetKind::Discarded;
+    if (!options.png.empty() && !pngDiscarded && imageFormatOf(options.png, "--png") != ImageFormat::Png)
+        throw InputError("--png " + options.png + ": names a PNG file, so it must end in .png");
 }
 
 Outcome runRender(const RenderCommandOptions& options)
@@ -379,6 +427,12 @@ Outcome runRender(const RenderCommandOptions& options)
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
     std::optional<Image> reference = loadReference(options, scene);
     if (interruptFlag()) return interruptedBeforeRendering();
+    // On a terminal, say what the silent seconds of a cold start are.
+    if (isatty(STDERR_FILENO))
+        std::fprintf(stderr,
+                     "vkrt: setting up %s: its buffers, and its kernel (compiled the first time a scene "
+                     "needs it, seconds; cached after)...\n",
+                     options.scenePath.c_str());
     RenderSession session(context, std::move(scene), sessionConfig(options, shard));
     double startupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -401,9 +455,13 @@ Outcome runRender(const RenderCommandOptions& options)
     const std::optional<EstimatedError> estimated = film.estimated;
     RenderOutput out = renderOutput(session, std::move(film), options.variance, aovNames);
     if (shard) addShard(*shard, options.spp, renderer, out.metadata, out.layers);
-    writeRenderOutput(output, out);
-    if (!options.png.empty()) writePng(options.png, out.mean, options.exposure);
-    const RenderFacts facts = renderFacts(session, loop, startupSeconds, output);
+    writeRenderImage(output, out, options.pngLook(), "-o");
+    if (!options.png.empty()) writePng(options.png, out.mean, options.exposure, options.pngLook().curve);
+    RenderFacts facts = renderFacts(session, loop, startupSeconds, output);
+    facts.estimated = estimated;
+    facts.targetError = options.targetError;
+    for (const std::string& file : {output, options.png, options.report, jsonOutputFile(options.json).path.string()})
+        if (!file.empty()) facts.written.push_back(file);
     printSummary(facts);
     if (!options.json.empty())
         writeJson(options.json, renderJson(options, session, facts, estimated, out.layers, shard,
@@ -443,7 +501,9 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("SCENE", options->scenePath,
                     "Scene file (TOML, see docs/scene-format.md; or a glTF .gltf/.glb file as a scene)")
         ->required();
-    cmd->add_option("-o,--output", options->output, "Output EXR (default: SCENE's name with .exr, here)");
+    cmd->add_option("-o,--output", options->output,
+                    "Output image: .exr (linear HDR, every layer) or .png (8-bit sRGB, tone-mapped as --exposure and "
+                    "--filmic say); default: SCENE's name with .exr, here");
     cmd->add_option("--spp", options->spp,
                     "Samples per pixel (default 64; with --time-budget or --target-error: no limit)")
         ->check(CLI::Range(1u, 1u << 30))
@@ -457,6 +517,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--exposure", options->exposure, "PNG exposure in stops (x 2^E)")
         ->check(finiteNumber)
         ->check(CLI::Range(-64.0, 64.0));
+    cmd->add_flag("--filmic", options->filmic,
+                  "PNG tone curve: ACES filmic (highlights roll off) instead of clamping, as the viewer's --filmic");
     cmd->add_flag("--validation", options->validation,
                   "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");

@@ -1,5 +1,6 @@
 // vkrt: a Vulkan compute ray tracer. This file only wires subcommands.
 #include "app/Commands.h"
+#include "app/Suggestions.h"
 #include "util/Error.h"
 #include "util/Signals.h"
 
@@ -31,6 +32,9 @@ int main(int argc, char** argv)
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         int code = app.exit(e);
+        if (code != 0)
+            if (auto hint = vkrt::commandLineSuggestion(app, argc, argv))
+                std::fprintf(stderr, "vkrt: %s\n", hint->c_str());
         return code == 0 ? vkrt::kExitOk : vkrt::kExitBadInput;
     }
     try {

@@ -86,6 +86,39 @@ void addReadSlices(Imf::FrameBuffer& frame, const Imf::Header& header, const std
     }
 }
 
+/// The channels that are neither the main R, G, B nor an RGB layer's, grouped
+/// by their layer (the part before the last '.'), in the file's order.
+std::map<std::string, ExrChannels> otherChannelsOf(const Imf::Header& header, const std::vector<std::string>& rgbLayers)
+{
+    std::set<std::string> taken{"R", "G", "B"};
+    for (const std::string& layer : rgbLayers)
+        for (int c = 0; c < 3; ++c) taken.insert(channelName(layer, c));
+    std::map<std::string, ExrChannels> groups;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        const std::string name = it.name();
+        if (taken.count(name)) continue;
+        const size_t dot = name.rfind('.');
+        groups[dot == std::string::npos ? name : name.substr(0, dot)].names.push_back(name);
+    }
+    return groups;
+}
+
+/// Slices for a group of channels, pixel-major as ExrChannels holds them; the
+/// values are reserved, not touched (readPixelsInStrips grows them).
+void addReadSlices(Imf::FrameBuffer& frame, const Imf::Header& header, ExrChannels& group, ImageExtent extent)
+{
+    const Imath::Box2i window = header.dataWindow();
+    const size_t stride = group.names.size();
+    group.values.reserve(size_t(extent.pixels()) * stride);
+    for (size_t c = 0; c < stride; ++c) {
+        char* base =
+            reinterpret_cast<char*>(group.values.data() + c) -
+            (int64_t(window.min.x) + int64_t(window.min.y) * int64_t(extent.width)) * int64_t(sizeof(float) * stride);
+        frame.insert(group.names[c],
+                     Imf::Slice(Imf::FLOAT, base, sizeof(float) * stride, sizeof(float) * stride * extent.width));
+    }
+}
+
 /// Rows per readPixels call: a multiple of every compression's block height (1, 16, 32, 256).
 constexpr int kStripRows = 256;
 
@@ -93,13 +126,16 @@ constexpr int kStripRows = 256;
 /// touched) only by the rows just read: a header that claims more pixels
 /// than the file holds fails at the first missing block, not after
 /// allocating them all.
-void readPixelsInStrips(Imf::InputFile& file, const std::vector<Image*>& images)
+void readPixelsInStrips(Imf::InputFile& file, const std::vector<Image*>& images,
+                        const std::vector<ExrChannels*>& groups = {})
 {
     const Imath::Box2i window = file.header().dataWindow();
     const int height = window.max.y - window.min.y + 1;
+    const size_t width = size_t(window.max.x - window.min.x + 1);
     for (int row = 0; row < height; row += kStripRows) {
         const int rows = std::min(kStripRows, height - row);
         for (Image* image : images) image->rgb.resize(size_t(row + rows) * image->width * 3);
+        for (ExrChannels* group : groups) group->values.resize(size_t(row + rows) * width * group->names.size());
         file.readPixels(window.min.y + row, window.min.y + row + rows - 1);
     }
 }
@@ -229,8 +265,8 @@ void addChannels(Imf::Header& header, Imf::FrameBuffer& frame, const ExrChannels
     for (size_t c = 0; c < stride; ++c) {
         header.channels().insert(channels.names[c], Imf::Channel(Imf::FLOAT));
         char* base = reinterpret_cast<char*>(const_cast<float*>(channels.values.data() + c));
-        frame.insert(channels.names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float) * stride,
-                                                   sizeof(float) * stride * width));
+        frame.insert(channels.names[c],
+                     Imf::Slice(Imf::FLOAT, base, sizeof(float) * stride, sizeof(float) * stride * width));
     }
 }
 
@@ -301,13 +337,20 @@ ExrContents readExr(const std::filesystem::path& path, const std::optional<Expec
         contents.image = unreadImage(extent);
         addReadSlices(frame, file.header(), "", contents.image, path);
         std::vector<Image*> images{&contents.image};
-        for (const auto& name : layerNamesOf(file.header())) {
+        const std::vector<std::string> rgbLayers = layerNamesOf(file.header());
+        for (const auto& name : rgbLayers) {
             Image& layer = contents.layers[name] = unreadImage(extent);
             addReadSlices(frame, file.header(), name, layer, path);
             images.push_back(&layer);
         }
+        contents.channels = otherChannelsOf(file.header(), rgbLayers);
+        std::vector<ExrChannels*> groups;
+        for (auto& [name, group] : contents.channels) {
+            addReadSlices(frame, file.header(), group, extent);
+            groups.push_back(&group);
+        }
         file.setFrameBuffer(frame);
-        readPixelsInStrips(file, images);
+        readPixelsInStrips(file, images, groups);
         contents.metadata = readAttributes(file.header());
         return contents;
     } catch (const InputError&) {

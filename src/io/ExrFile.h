@@ -17,18 +17,21 @@ namespace vkrt {
 using MetadataValue = std::variant<std::string, int64_t, double>;
 using Metadata = std::map<std::string, MetadataValue>;
 
-struct ExrContents {
-    Image image;
-    std::map<std::string, Image> layers; ///< extra layers by name
-    Metadata metadata;                   ///< vkrt's attributes (standard ones omitted)
-};
-
 /// Channels in other conventions than a layer's R, G, B: compositors' AOVs
 /// such as "N.X", "N.Y", "N.Z" or a lone "Z". `values` holds names.size()
-/// floats per pixel, pixel-major. Readers of vkrt (readExr) skip them.
+/// floats per pixel, pixel-major.
 struct ExrChannels {
     std::vector<std::string> names;
     std::vector<float> values;
+};
+
+struct ExrContents {
+    Image image;
+    std::map<std::string, Image> layers; ///< extra layers by name
+    /// Every other channel, grouped by layer ("N" holds N.X, N.Y, N.Z in the
+    /// file's order; a channel without a layer, such as "Z", is its own group).
+    std::map<std::string, ExrChannels> channels;
+    Metadata metadata; ///< vkrt's attributes (standard ones omitted)
 };
 
 /// Encodes the whole file in memory (ZIP, one part), then writes it with

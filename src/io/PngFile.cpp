@@ -19,20 +19,24 @@
 
 namespace vkrt {
 
-uint8_t toneMapToSrgb8(float linear, float exposure)
+uint8_t toneMapToSrgb8(float linear, float exposure, ToneCurve curve)
 {
     float v = linear * std::exp2(exposure);
     if (!(v > 0.0f)) return 0; // also maps NaN to black
+    if (curve == ToneCurve::Filmic) {
+        // An infinite radiance is white (inf / inf would be NaN).
+        v = std::isinf(v) ? 1.0f : (v * (2.51f * v + 0.03f)) / (v * (2.43f * v + 0.59f) + 0.14f);
+    }
     v = std::min(v, 1.0f);
     float encoded = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
     return uint8_t(std::lround(encoded * 255.0f));
 }
 
-std::vector<uint8_t> toneMapImage(const Image& image, float exposure)
+std::vector<uint8_t> toneMapImage(const Image& image, float exposure, ToneCurve curve)
 {
     std::vector<uint8_t> pixels(image.pixelCount() * 4, 255);
     for (size_t i = 0; i < image.pixelCount(); ++i)
-        for (int c = 0; c < 3; ++c) pixels[i * 4 + c] = toneMapToSrgb8(image.rgb[i * 3 + c], exposure);
+        for (int c = 0; c < 3; ++c) pixels[i * 4 + c] = toneMapToSrgb8(image.rgb[i * 3 + c], exposure, curve);
     return pixels;
 }
 
@@ -59,9 +63,9 @@ void writePngPixels(const std::filesystem::path& path, uint32_t width, uint32_t 
     writeBytesAtomically(path, encoded);
 }
 
-void writePng(const std::filesystem::path& path, const Image& image, float exposure)
+void writePng(const std::filesystem::path& path, const Image& image, float exposure, ToneCurve curve)
 {
-    writePngPixels(path, image.width, image.height, toneMapImage(image, exposure));
+    writePngPixels(path, image.width, image.height, toneMapImage(image, exposure, curve));
 }
 
 } // namespace vkrt

@@ -8,14 +8,20 @@
 
 namespace vkrt {
 
-/// Linear radiance -> display: scale by 2^exposure, clamp to [0,1], sRGB encode.
-uint8_t toneMapToSrgb8(float linear, float exposure);
+/// How linear radiance becomes display values (as the viewer's display
+/// kernel does, shaders/kernels/display.comp): clamped to [0, 1], or through
+/// the ACES filmic curve (Narkowicz's 2015 fit), which rolls highlights off.
+enum class ToneCurve { Clamp, Filmic };
+
+/// Linear radiance -> display: scale by 2^exposure, apply the curve, sRGB encode.
+uint8_t toneMapToSrgb8(float linear, float exposure, ToneCurve curve = ToneCurve::Clamp);
 
 /// Tone-mapped RGBA8 pixels (alpha 255), rows top to bottom.
-std::vector<uint8_t> toneMapImage(const Image& image, float exposure);
+std::vector<uint8_t> toneMapImage(const Image& image, float exposure, ToneCurve curve = ToneCurve::Clamp);
 
 /// Writes a PNG atomically; throws InputError naming the path.
-void writePng(const std::filesystem::path& path, const Image& image, float exposure);
+void writePng(const std::filesystem::path& path, const Image& image, float exposure,
+              ToneCurve curve = ToneCurve::Clamp);
 
 /// Writes already tone-mapped RGBA8 pixels (rows top to bottom) as a PNG, atomically.
 void writePngPixels(const std::filesystem::path& path, uint32_t width, uint32_t height,

@@ -1,9 +1,11 @@
 #include "render/RenderOutput.h"
 
+#include "io/AtomicFile.h"
 #include "scene/TomlReader.h"
 #include "util/Error.h"
 
 #include <algorithm>
+#include <cctype>
 
 namespace vkrt {
 
@@ -67,6 +69,33 @@ RenderOutput renderOutput(const RenderSession& session, Film film, bool variance
 void writeRenderOutput(const std::filesystem::path& path, const RenderOutput& output)
 {
     writeExr(path, output.mean, output.metadata, output.layers, output.channels);
+}
+
+ImageFormat imageFormatOf(const std::filesystem::path& path, const std::string& what)
+{
+    std::string extension = path.extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension == ".exr") return ImageFormat::Exr;
+    if (extension == ".png") return ImageFormat::Png;
+    if (resolveOutputTarget(path).kind == OutputTargetKind::Discarded) return ImageFormat::Exr;
+    throw InputError(
+        what + " " + path.string() + ": " +
+        (extension.empty() ? std::string("has no extension") : "unknown image format '" + extension + "'") +
+        "; vkrt writes .exr (OpenEXR: linear HDR, every layer) or .png (8-bit sRGB, tone-mapped)");
+}
+
+void writeRenderImage(const std::filesystem::path& path, const RenderOutput& output, const PngLook& look,
+                      const std::string& what)
+{
+    if (imageFormatOf(path, what) == ImageFormat::Exr) return writeRenderOutput(path, output);
+    if (!output.layers.empty() || !output.channels.empty()) {
+        std::string layers;
+        for (const auto& [name, layer] : output.layers) layers += (layers.empty() ? "" : ", ") + name;
+        for (const std::string& aov : output.channelAovs) layers += (layers.empty() ? "" : ", ") + aov;
+        throw InputError(what + " " + path.string() + ": a PNG holds only the image, not its " + layers +
+                         " layers; write an .exr (with --png for a preview)");
+    }
+    writePng(path, output.mean, look.exposure, look.curve);
 }
 
 } // namespace vkrt

@@ -4,6 +4,7 @@
 // front end (`vkrt render`, the Python module) so that they write the same
 // EXR from the same session.
 #include "io/ExrFile.h"
+#include "io/PngFile.h"
 #include "render/RenderSession.h"
 
 #include <map>
@@ -36,5 +37,29 @@ RenderOutput renderOutput(const RenderSession& session, Film film, bool variance
 
 /// Writes it as `vkrt render` does (atomically; io/ExrFile.h).
 void writeRenderOutput(const std::filesystem::path& path, const RenderOutput& output);
+
+/// The image formats a render's main output can have, chosen by its extension.
+enum class ImageFormat {
+    Exr, ///< .exr: OpenEXR, linear half/float, every layer and the metadata
+    Png, ///< .png: the mean only, tone-mapped to 8-bit sRGB
+};
+
+/// The format `path`'s extension names (case-insensitive; /dev/null is
+/// taken as EXR and discarded). Throws InputError "WHAT PATH: ..." listing the
+/// formats for any other extension or none.
+ImageFormat imageFormatOf(const std::filesystem::path& path, const std::string& what);
+
+/// How a PNG output maps radiance to display values (--exposure, --filmic).
+struct PngLook {
+    float exposure = 0.0f;
+    ToneCurve curve = ToneCurve::Clamp;
+};
+
+/// Writes the render to `path` in the format of its extension: the EXR of
+/// writeRenderOutput, or a PNG of the mean. A PNG cannot hold layers, so an
+/// output with a variance or AOV layer is refused there ("WHAT PATH: ...",
+/// InputError) rather than written without them.
+void writeRenderImage(const std::filesystem::path& path, const RenderOutput& output, const PngLook& look,
+                      const std::string& what);
 
 } // namespace vkrt

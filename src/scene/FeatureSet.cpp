@@ -50,6 +50,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.thinLens = true;
     all.orthographic = true;
     all.alpha = true;
+    all.lightTable = true; // compiled and reflected here; a render's uber kernel takes the scene's (uberFeatures)
     all.integrator = integrator;
     return all;
 }
@@ -116,6 +117,18 @@ bool meshAlphaTested(const Scene& scene, const Mesh& mesh)
     for (uint32_t index : mesh.fileMaterials)
         if (scene.materials[index].alphaTested()) return true;
     return false;
+}
+
+bool sceneGivesLight(const Scene& scene)
+{
+    if (scene.background.color != Color(0.0) || scene.background.cubemap || scene.background.environment) return true;
+    size_t lights = 0;
+#define VKRT_COUNT_LIGHTS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) lights += scene.array.size();
+    VKRT_LIGHT_KINDS(VKRT_COUNT_LIGHTS)
+#undef VKRT_COUNT_LIGHTS
+    if (lights > 0) return true;
+    return std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                       [&](const Mesh& mesh) { return meshEmits(scene, mesh); });
 }
 
 size_t enumeratedLightCount(const Scene& scene)

@@ -73,6 +73,10 @@ bool meshEmits(const Scene& scene, const Mesh& mesh);
 /// `emission` of its own (which replaces its materials' emission, texture and all).
 bool emissionTextured(const Material& material);
 bool meshEmissionTextured(const Scene& scene, const Mesh& mesh);
+/// Whether anything in the scene gives light: a light, an emitting mesh, an
+/// environment map or a background colour other than black.
+bool sceneGivesLight(const Scene& scene);
+
 /// Whether some material of the mesh is alpha-tested (MASK or BLEND).
 bool meshAlphaTested(const Scene& scene, const Mesh& mesh);
 

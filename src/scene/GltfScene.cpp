@@ -9,6 +9,7 @@
 #include "mesh/MeshGeometry.h"
 #include "scene/FileMaterialImport.h"
 #include "scene/SceneOverrides.h"
+#include "scene/SceneParser.h"
 #include "scene/TomlReader.h"
 #include "scene/kinds/Kinds.h"
 #include "texture/TextureAtlas.h"
@@ -257,6 +258,7 @@ Scene parseGltfScene(const std::string& path, const GltfSceneOptions& options)
         if (!fs::is_regular_file(status))
             throw InputError("--environment " + map.path + ": is " +
                              (fs::is_directory(status) ? "a directory" : "not a regular file") + ", not an image file");
+        if (auto warning = latLongShapeWarning(map, "--environment")) scene.warnings.push_back(*warning);
         scene.background.environment = map;
     } else if (!lit) {
         scene.background.color = Color(1.0); // a file without lights: a white sky, as glTF viewers show it

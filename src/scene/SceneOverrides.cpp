@@ -87,6 +87,20 @@ void applyResolution(Camera& camera, const ResolutionOverride& resolution)
     };
     uint32_t width = side(resolution.width, resolution.widthName, camera.width);
     uint32_t height = side(resolution.height, resolution.heightName, camera.height);
+    // One side alone keeps the scene's aspect ratio (--width 160 on a 640 x 480
+    // scene is 160 x 120, not a 160 x 480 sliver), rounded, at least 1 pixel.
+    auto scaled = [](uint32_t given, uint32_t from, uint32_t to) {
+        return uint32_t(std::max(1.0, std::round(double(given) * double(to) / double(from))));
+    };
+    if (resolution.width && !resolution.height) {
+        height = scaled(width, camera.width, camera.height);
+        if (auto problem = sideProblem(height))
+            throw InputError(resolution.widthName + ": " + *problem + " (the height that keeps the aspect ratio)");
+    } else if (resolution.height && !resolution.width) {
+        width = scaled(height, camera.height, camera.width);
+        if (auto problem = sideProblem(width))
+            throw InputError(resolution.heightName + ": " + *problem + " (the width that keeps the aspect ratio)");
+    }
     if (auto problem = pixelCountProblem(width, height))
         throw InputError((resolution.height ? resolution.heightName : resolution.widthName) + ": " + *problem);
     camera.width = width;

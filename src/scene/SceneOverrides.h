@@ -35,7 +35,8 @@ struct ResolutionOverride {
     std::string heightName = "--height";
 };
 
-/// Sets the camera's width and height; throws InputError "NAME: message" when
+/// Sets the camera's width and height; one of them alone keeps the camera's
+/// aspect ratio (the other side scaled and rounded). Throws InputError "NAME: message" when
 /// a side is outside [1, SceneLimits::maxImageSide] or width * height exceeds
 /// SceneLimits::maxImagePixels (blaming the height when it was given, as the
 /// parser does).

@@ -7,8 +7,10 @@
 // reading itself is scene/TomlReader.h; this file knows what a scene holds.
 #include "scene/SceneParser.h"
 
+#include "scene/FeatureSet.h"
 #include "scene/MaterialUse.h"
 
+#include "io/ImageHeader.h"
 #include "material/Metals.h"
 #include "mesh/MeshGeometry.h"
 #include "mesh/MeshLoader.h"
@@ -119,7 +121,7 @@ Camera readCamera(const TableField& table)
     camera.eye = readVector(table.require("eye"));
     camera.target = readTarget(table.require("target"), camera.eye);
     camera.up = readUp(table, *normalized(difference(camera.eye, camera.target)));
-    camera.fovY = readFov(table.require("fov"));
+    camera.fovY = readOr(table, "fov", camera.fovY, readFov); // 45 degrees, as Camera says
     readResolution(table, camera);
     camera.apertureRadius = readOr(table, "aperture_radius", 0.0, readNonNegative);
     if (const auto focus = table.find("focus_distance")) camera.focusDistance = readPositive(*focus);
@@ -730,6 +732,13 @@ Scene parseSceneString(std::string_view text, const std::string& path)
     const TomlSource source{path, fs::path(path).parent_path()};
     const toml::table root = parseToml(text, source);
     readScene(TableField(Field(source, root, "")), context);
+    if (scene.background.environment) {
+        if (auto warning = latLongShapeWarning(*scene.background.environment, path + ": background.environment.file"))
+            scene.warnings.push_back(*warning);
+    }
+    if (!sceneGivesLight(scene))
+        scene.warnings.push_back(path + ": nothing in the scene gives light (no [[lights]], no emission, a black "
+                                        "background without a map): the image will be black");
     scene.path = path;
     scene.fileHash = fnv1a64(text);
     if (textures->recordCount() > 0) scene.textures = std::move(textures);
@@ -751,6 +760,21 @@ Material parseMaterialTable(std::string_view text, const std::string& source, co
     if (material.hasTextures() || textures.recordCount() > 0)
         table.fail("a material set from outside the scene file cannot use textures (write it in the scene file)");
     return material;
+}
+
+std::optional<std::string> latLongShapeWarning(const EnvironmentMap& map, const std::string& what)
+{
+    ImageExtent extent;
+    try {
+        extent = imageFileExtent(map.path);
+    } catch (const InputError&) {
+        return std::nullopt;
+    }
+    const uint64_t w = extent.width, h = extent.height;
+    if (h == 0 || w == 2 * h || w == 2 * (h - 1)) return std::nullopt;
+    return what + " " + map.path + " is " + extent.str() +
+           ", not 2:1: a lat-long map spans 360 degrees across and 180 down, so it will look stretched (a "
+           "cubemap face is a [background.cubemap] face)";
 }
 
 Scene parseSceneFile(const std::string& path) { return parseSceneString(readFileBytes(path, "scene file"), path); }

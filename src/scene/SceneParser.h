@@ -5,6 +5,7 @@
 #include "scene/Scene.h"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -12,6 +13,11 @@ namespace vkrt {
 
 /// Reads, parses and validates a scene file; throws SceneError (with file:line:column) or InputError (unreadable file).
 Scene parseSceneFile(const std::string& path);
+
+/// A warning when a lat-long environment map is not 2:1 (width 2 h or
+/// 2 (h - 1)): a cubemap face or a photo read as a sky stretches it. Nothing
+/// when it is, or when its header cannot be read (the render names that error).
+std::optional<std::string> latLongShapeWarning(const EnvironmentMap& map, const std::string& what);
 
 /// Same for text in memory; `path` is used in messages and to resolve relative paths (cubemap faces) against its
 /// directory.

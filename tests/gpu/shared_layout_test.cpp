@@ -157,6 +157,12 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, environmentBlock),
         BLOCK_MEMBER(u, SceneUniforms, environmentAxisX),
         BLOCK_MEMBER(u, SceneUniforms, environmentAxisZ),
+        BLOCK_MEMBER(u, SceneUniforms, softDirectionalLightCount),
+        BLOCK_MEMBER(u, SceneUniforms, lightTableCount),
+        BLOCK_MEMBER(u, SceneUniforms, lightCandidates),
+        ARRAY_MEMBER(lightTable, LightPick, pdf),
+        ARRAY_MEMBER(lightTable, LightPick, aliasThreshold),
+        ARRAY_MEMBER(lightTable, LightPick, alias),
         BLOCK_MEMBER(frame, FrameConstants, firstFrame),
         BLOCK_MEMBER(frame, FrameConstants, seed),
     };
@@ -184,7 +190,8 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
     EXPECT_EQ(offsets.at("materials[0].clearcoatNormal") + 12, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].v2") + 12, int(sizeof(gpu::TriangleLight)));
-    EXPECT_EQ(offsets.at("u.environmentAxisZ") + 12, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("u.lightCandidates") + 4, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("lightTable[0].alias") + 4, int(sizeof(gpu::LightPick)));
     EXPECT_EQ(offsets.at("directionalLights[0].sin2Alpha") + 4, int(sizeof(gpu::DirectionalLight)));
     EXPECT_EQ(offsets.at("spotLights[0].axis") + 12, int(sizeof(gpu::SpotLight)));
     EXPECT_EQ(offsets.at("meshes[0].firstEmitter") + 4, int(sizeof(gpu::Mesh)));

@@ -507,6 +507,14 @@ color = 2
     expectVec(scene.background.color, {2, 2, 2});
 }
 
+TEST(SceneParserValid, FovDefaultsTo45Degrees)
+{
+    const Scene scene = parseSceneString("[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\nfov = 30\n");
+    EXPECT_DOUBLE_EQ(scene.camera.fovY, 30);
+    const Scene defaulted = parseSceneString("[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\n");
+    EXPECT_DOUBLE_EQ(defaulted.camera.fovY, 45);
+}
+
 TEST(SceneParserValid, UnusedMaterialIsFine)
 {
     const Scene scene = parseSceneString(kCamera + "[materials.unused]\ntype = \"mirror\"\n");
@@ -669,7 +677,7 @@ const std::vector<BadScene> kBadScenes = {
      "objects: expected an array of tables ([[objects]]), got a table"},
     {"MissingCamera", "[render]\nmax_depth = 3\n", 1, 1, "missing required table [camera]"},
     {"CameraNotATable", "camera = 3\n", 1, 10, "camera: expected a table, got an integer"},
-    {"MissingFov", "[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\n", 1, 1, "camera: missing required key 'fov'"},
+    {"MissingTarget", "[camera]\neye = [0, 1, 5]\nfov = 45\n", 1, 1, "camera: missing required key 'target'"},
     {"MissingEyeDottedCamera", "\ncamera.fov = 45\n", 2, 1, "camera: missing required key 'eye'"},
     {"WrongTypeString", "[camera]\neye = [0, 1, 5]\ntarget = [0, 1, 0]\nfov = \"45\"\n", 4, 7,
      "camera.fov: expected a number, got a string"},

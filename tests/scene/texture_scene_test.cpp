@@ -20,6 +20,8 @@ namespace vkrt::test {
 namespace {
 
 const std::string kCamera = "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov = 45\n";
+// Appended to every scene, so that a warning seen here is about what the test checks.
+const std::string kLight = "\n[[lights]]\ntype = \"point\"\nposition = [0, 3, 3]\nintensity = 1\n";
 
 class SceneParserTextures : public ::testing::Test {
 protected:
@@ -32,7 +34,7 @@ protected:
         std::ofstream(m_dir / "no-uvs.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     }
 
-    Scene parse(const std::string& body) const { return parseSceneString(kCamera + body, scenePath()); }
+    Scene parse(const std::string& body) const { return parseSceneString(kCamera + body + kLight, scenePath()); }
     std::string scenePath() const { return (m_dir / "scene.toml").string(); }
 
     /// The message of the SceneError `body` raises (empty if none).
