@@ -47,9 +47,9 @@ What both renderers are given
   and gives Cycles the same camera (position, axes, vertical fov) converted to
   Blender's Z-up world the way Blender's glTF importer converts the scene.
 * The light. Without KHR_lights_punctual lights: a constant white environment
-  of radiance 1 (vkrt's default for such a file; for a file with emissive
-  materials, whose vkrt default is black, a constant lat-long map of 1 is
-  passed with --environment; Cycles: world Background, white, strength 1).
+  of radiance 1 (vkrt is given a constant lat-long map of 1 with
+  --environment, in place of its grey studio default; Cycles: world
+  Background, white, strength 1).
   With punctual lights: a black world and the file's lights, converted to
   vkrt's radiometric reading (docs/scene-format.md: intensity taken as W/sr,
   directional as W/m^2, no 683 lm/W): Blender point and spot power = 4 pi I
@@ -710,11 +710,12 @@ def compare_model(name: str, source: Path, args, vkrt: Path, work: Path) -> dict
         exclusions.append(args.exclude[name])
     white_world = not lights
     environment = None
-    if white_world and has_emission(gltf):
+    if white_world:
+        # vkrt's own default for a file without lights is its grey studio
+        # gradient; the comparison lights both renderers alike, white.
         environment = work / "white.exr"
         if not environment.exists():
             write_white_exr(environment)
-        row["notes"].append("emissive: vkrt given a constant white --environment")
     camera_index = add_camera(gltf, camera, args.width / args.height)
     copy = write_temporary_copy(source, gltf)
     vkrt_exr, cycles_exr = work / f"{name}.vkrt.exr", work / f"{name}.cycles.exr"

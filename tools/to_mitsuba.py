@@ -1048,6 +1048,10 @@ def environment_map(mi, env: dict, files_dir: Path, path) -> dict:
     files_dir/environment_scaled.exr (exact: float32 in, float32 out)."""
     import numpy as np
 
+    if env.get("builtin") is not None:
+        _fail(path, "background.environment",
+              f"vkrt's built-in {env['builtin']} environment has no file: render the glTF scene with "
+              "--environment FILE to convert it")
     file = Path(env["file"])
     scale = [float(x) for x in env["scale"]]
     m = [[float(x) for x in row] for row in env["matrix"]]

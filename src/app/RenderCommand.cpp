@@ -551,8 +551,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--variant", options->gltf.variant,
                     "A glTF file's KHR_materials_variants variant: its name or index (default: the default materials)");
     cmd->add_option("--environment", options->gltf.environment,
-                    "A lat-long .exr or .hdr map lighting a glTF scene (default: white for a file without lights, "
-                    "else black)");
+                    "A lat-long .exr or .hdr map lighting a glTF scene (default: a grey studio gradient for a file "
+                    "without lights, else black; docs/scene-format.md)");
     cmd->add_option("--aov", options->aovs,
                     "Also write arbitrary output values as EXR layers, comma-separated: albedo (albedo.R/G/B), "
                     "normal (N.X/Y/Z, world space), depth (Z, camera space), position (P.X/Y/Z, world space); "

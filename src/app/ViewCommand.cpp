@@ -21,7 +21,9 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_option("--camera", o->gltf.camera, "glTF scene: the camera to look through (name or index)");
     cmd->add_option("--scene", o->gltf.scene, "glTF file: which of its scenes to show (name or index)");
     cmd->add_option("--variant", o->gltf.variant, "glTF file: a KHR_materials_variants variant (name or index)");
-    cmd->add_option("--environment", o->gltf.environment, "glTF scene: a lat-long .exr/.hdr map lighting it");
+    cmd->add_option("--environment", o->gltf.environment,
+                    "glTF scene: a lat-long .exr/.hdr map lighting it (default: the grey studio gradient for a file "
+                    "without lights, else black)");
     cmd->add_option("--device", o->device, "Vulkan device index or name");
     cmd->add_option("--seed", o->seed, "Random seed");
     addAccelOption(*cmd, o->accel);

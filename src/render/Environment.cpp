@@ -4,6 +4,7 @@
 #include "io/PngFile.h"
 #include "util/Error.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vkrt {
@@ -70,7 +71,6 @@ std::array<Image, 6> loadCubemapFaces(const Cubemap& cubemap)
     return faces;
 }
 
-
 namespace {
 
 void checkLatLongSize(const std::string& label, ImageExtent size)
@@ -79,14 +79,38 @@ void checkLatLongSize(const std::string& label, ImageExtent size)
         throw InputError(label + ": a lat-long map needs at least 2x2 texels, got " + size.str());
     if (size.width > kMaxLatLongSide || size.height > kMaxLatLongSide || size.pixels() > ImageLimits::maxPixels)
         throw InputError(label + ": a lat-long map may have at most " + std::to_string(kMaxLatLongSide) +
-                         " texels a side and " + std::to_string(ImageLimits::maxPixels) + " in all, got " +
-                         size.str());
+                         " texels a side and " + std::to_string(ImageLimits::maxPixels) + " in all, got " + size.str());
 }
 
 } // namespace
 
+Image studioEnvironment()
+{
+    constexpr uint32_t width = 256, height = 128;
+    Image image(width, height);
+    image.rgb.resize(size_t(width) * height * 3);
+    for (uint32_t j = 0; j < height; ++j) {
+        // The row's centre: y = cos(theta), theta = pi (j + 0.5) / height (row 0 looks up).
+        const double y = std::cos(3.14159265358979323846 * (j + 0.5) / height);
+        double radiance = 0.6 + 0.4 * y; // the sky: 1 at the zenith, 0.6 at the horizon
+        if (y < 0.0) {
+            const double t = std::min(1.0, -y / std::sin(15.0 * 3.14159265358979323846 / 180.0));
+            radiance = 0.6 + (0.25 - 0.6) * t * t * (3.0 - 2.0 * t); // smoothstep down to the ground's 0.25
+        }
+        for (uint32_t i = 0; i < width; ++i)
+            for (int c = 0; c < 3; ++c) image.rgb[(size_t(j) * width + i) * 3 + c] = float(radiance);
+    }
+    return image;
+}
+
 Image loadEnvironmentMap(const EnvironmentMap& map)
 {
+    if (map.studio) {
+        Image image = studioEnvironment();
+        for (size_t i = 0; i < image.rgb.size(); ++i)
+            image.rgb[i] = float(double(image.rgb[i]) * map.scale[int(i % 3)]);
+        return image;
+    }
     const std::string label = map.where.str() + ": background.environment.file: " + map.path;
     Image image;
     try {

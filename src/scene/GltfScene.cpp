@@ -242,7 +242,7 @@ Scene parseGltfScene(const std::string& path, const GltfSceneOptions& options)
     auto textures = std::make_shared<TextureAtlas>();
     ParseContext context{scene, *textures, meshes, {}};
     importGltf(path, options, true, context);
-    // Only KHR_lights_punctual lights switch the white sky off: emissive
+    // Only KHR_lights_punctual lights switch the studio light off: emissive
     // surfaces alone (a lamp, a helmet's display) keep it.
     const bool lit = !scene.pointLights.empty() || !scene.spotLights.empty() || !scene.directionalLights.empty();
     if (options.environment) {
@@ -261,7 +261,12 @@ Scene parseGltfScene(const std::string& path, const GltfSceneOptions& options)
         if (auto warning = latLongShapeWarning(map, "--environment")) scene.warnings.push_back(*warning);
         scene.background.environment = map;
     } else if (!lit) {
-        scene.background.color = Color(1.0); // a file without lights: a white sky, as glTF viewers show it
+        // A file without lights: the studio gradient, against which a white model still reads (a
+        // uniform sky lights a white model exactly as bright as itself).
+        EnvironmentMap studio;
+        studio.studio = true;
+        studio.where = {"the default studio environment", 0, 0};
+        scene.background.environment = studio;
     }
     scene.path = path;
     scene.fileHash = fnv1a64(readFileBytes(path, "glTF file", size_t(1) << 31));

@@ -183,10 +183,10 @@ enum class TextureSlot : uint32_t {
     Transmission = gpu::TEXTURE_SLOT_TRANSMISSION,                  ///< pbr transmission (R)
     Iridescence = gpu::TEXTURE_SLOT_IRIDESCENCE,                    ///< pbr iridescence (R)
     IridescenceThickness = gpu::TEXTURE_SLOT_IRIDESCENCE_THICKNESS, ///< pbr iridescence_thickness (G: min to max)
-    Anisotropy = gpu::TEXTURE_SLOT_ANISOTROPY,                      ///< pbr anisotropy_texture (RG direction, B strength)
-    ClearcoatNormal = gpu::TEXTURE_SLOT_CLEARCOAT_NORMAL,           ///< pbr clearcoat_normal_map
-    Normal = gpu::TEXTURE_SLOT_NORMAL,                              ///< tangent-space normal map
-    Emission = gpu::TEXTURE_SLOT_EMISSION, ///< emitted radiance (glTF emissiveTexture; meshes only)
+    Anisotropy = gpu::TEXTURE_SLOT_ANISOTROPY,            ///< pbr anisotropy_texture (RG direction, B strength)
+    ClearcoatNormal = gpu::TEXTURE_SLOT_CLEARCOAT_NORMAL, ///< pbr clearcoat_normal_map
+    Normal = gpu::TEXTURE_SLOT_NORMAL,                    ///< tangent-space normal map
+    Emission = gpu::TEXTURE_SLOT_EMISSION,                ///< emitted radiance (glTF emissiveTexture; meshes only)
 };
 inline constexpr size_t kTextureSlotCount = gpu::TEXTURE_SLOT_COUNT;
 
@@ -252,7 +252,7 @@ struct Material {
     /// Textured parameters; a texel multiplies the parameter's constant above
     /// (1 for the scene's textures, a glTF file's factor for its own).
     std::array<std::optional<MaterialTexture>, kTextureSlotCount> textures{};
-    double normalStrength = 1.0; ///< scales a normal map's tangent-plane components (glTF normalTexture.scale)
+    double normalStrength = 1.0;          ///< scales a normal map's tangent-plane components (glTF normalTexture.scale)
     double clearcoatNormalStrength = 1.0; ///< ... the clear coat's (glTF clearcoatNormalTexture.scale)
     /// Coverage (glTF alphaMode; meshes only): alpha = `alpha` times the colour
     /// texture's A channel; MASK keeps the surface where alpha >= alphaCutoff,
@@ -291,10 +291,7 @@ inline bool Material::hasTextures() const
     return false;
 }
 
-inline bool Material::hasPbrLayers() const
-{
-    return type == MaterialType::Pbr && (layers.active() || ior != 1.5);
-}
+inline bool Material::hasPbrLayers() const { return type == MaterialType::Pbr && (layers.active() || ior != 1.5); }
 
 inline bool Material::readsUvSet(uint32_t set) const
 {
@@ -393,7 +390,10 @@ struct Cubemap {
 /// (u, v) is (sin phi sin theta, cos theta, -cos phi sin theta), phi = 2 pi u,
 /// theta = pi v, and `rotation` turns it into the world's.
 struct EnvironmentMap {
-    std::string path; ///< .exr or .hdr, resolved relative to the scene file
+    std::string path; ///< .exr or .hdr, resolved relative to the scene file (empty for the studio)
+    /// The built-in studio gradient (render/Environment.h: studioEnvironment),
+    /// a glTF scene's default light: no file.
+    bool studio = false;
     Color scale{1.0};
     glm::dmat3 rotation{1.0};
     SourceLocation where; ///< the [background.environment] table

@@ -4,8 +4,8 @@
 #include "scene/FeatureSet.h"
 #include "texture/TextureAtlas.h"
 
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include <filesystem>
 #include <limits>
@@ -450,7 +450,8 @@ Json background(const Background& b)
         for (size_t i = 0; i < 6; ++i) out["cubemap"][faces[i]] = absolutePath(b.cubemap->facePaths[i]);
     }
     if (b.environment)
-        out["environment"] = {{"file", absolutePath(b.environment->path)},
+        out["environment"] = {{"file", b.environment->studio ? Json(nullptr) : Json(absolutePath(b.environment->path))},
+                              {"builtin", b.environment->studio ? Json("studio") : Json(nullptr)},
                               {"scale", vec(b.environment->scale)},
                               {"matrix", rows(b.environment->rotation)}};
     return out;

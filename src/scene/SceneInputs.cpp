@@ -15,7 +15,7 @@ std::vector<NamedFile> filesTheSceneRead(const Scene& scene)
     if (scene.background.cubemap)
         for (const std::string& face : scene.background.cubemap->facePaths)
             files.push_back({"a cube face the scene loads", face});
-    if (scene.background.environment)
+    if (scene.background.environment && !scene.background.environment->studio)
         files.push_back({"the environment map the scene loads", scene.background.environment->path});
     return files;
 }

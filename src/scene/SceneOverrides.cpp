@@ -92,14 +92,17 @@ void applyResolution(Camera& camera, const ResolutionOverride& resolution)
     auto scaled = [](uint32_t given, uint32_t from, uint32_t to) {
         return uint32_t(std::max(1.0, std::round(double(given) * double(to) / double(from))));
     };
+    const std::string aspect = std::to_string(camera.width) + "x" + std::to_string(camera.height);
     if (resolution.width && !resolution.height) {
         height = scaled(width, camera.width, camera.height);
         if (auto problem = sideProblem(height))
-            throw InputError(resolution.widthName + ": " + *problem + " (the height that keeps the aspect ratio)");
+            throw InputError(resolution.widthName + ": the height that keeps the scene's aspect ratio (" + aspect +
+                             ") " + *problem + "; give " + resolution.heightName + " too");
     } else if (resolution.height && !resolution.width) {
         width = scaled(height, camera.height, camera.width);
         if (auto problem = sideProblem(width))
-            throw InputError(resolution.heightName + ": " + *problem + " (the width that keeps the aspect ratio)");
+            throw InputError(resolution.heightName + ": the width that keeps the scene's aspect ratio (" + aspect +
+                             ") " + *problem + "; give " + resolution.widthName + " too");
     }
     if (auto problem = pixelCountProblem(width, height))
         throw InputError((resolution.height ? resolution.heightName : resolution.widthName) + ": " + *problem);

@@ -15,8 +15,8 @@
 #include "texture/TextureImage.h"
 #include "texture/TextureTestFiles.h"
 
-#include <gtest/gtest.h>
 #include <glm/gtc/constants.hpp>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -166,8 +166,8 @@ TEST(EmissionTable, OnlyATexturedEmissionChangesTheKernelVariant)
 
 // glTF import: the emissive texture becomes the material's emission slot
 // (sRGB, with its KHR_texture_transform), without the old "not supported"
-// warning; a file whose only emitters are emissive surfaces keeps the white sky.
-TEST(EmissionTable, TheEmissiveTextureIsImportedWithItsTransformAndTheSkyStaysWhite)
+// warning; a file whose only emitters are emissive surfaces keeps the studio light.
+TEST(EmissionTable, TheEmissiveTextureIsImportedWithItsTransformAndTheStudioStays)
 {
     const fs::path dir = freshTempDir("emission-import");
     writeBands(dir / "bands.png");
@@ -180,7 +180,8 @@ TEST(EmissionTable, TheEmissiveTextureIsImportedWithItsTransformAndTheSkyStaysWh
                      R"("KHR_materials_emissive_strength", "KHR_texture_transform"])");
     writeText(dir / "quads.gltf", quadsGltf({bandQuad(0)}, material));
     const Scene scene = parseGltfScene((dir / "quads.gltf").string());
-    EXPECT_EQ(scene.background.color, Color(1.0)) << "emissive surfaces alone switched the white sky off";
+    ASSERT_TRUE(scene.background.environment.has_value()) << "emissive surfaces alone switched the studio off";
+    EXPECT_TRUE(scene.background.environment->studio);
     ASSERT_EQ(scene.meshes.size(), 1u);
     ASSERT_GE(scene.meshes[0].fileMaterials.size(), 1u); // by file material index (glTF's default last)
     const Material& m = scene.materials[scene.meshes[0].fileMaterials[0]];

@@ -1,6 +1,7 @@
 // The lat-long map's sampling distribution (render/EnvironmentSampling.h):
 // CDFs that are valid (non-decreasing from 0 to 1), weights where the map
 // has light, and a grid that stays bounded for the largest maps.
+#include "render/Environment.h"
 #include "render/EnvironmentSampling.h"
 
 #include <gtest/gtest.h>
@@ -76,6 +77,45 @@ TEST(LatLongDistribution, LargeMapsGroupCellsIntoBlocks)
     // A constant map: the last column of blocks holds half a block's weight.
     const float* row = d.cdf.data() + 1026 + 512 * 2050;
     EXPECT_NEAR((row[2049] - row[2048]) / (row[1] - row[0]), 0.5, 1e-3);
+}
+
+// The studio environment, a glTF scene's default (docs/scene-format.md): a
+// 2:1 grey map, 1 at the zenith, 0.6 at the horizon, 0.25 for the ground,
+// never brighter further down; a white surface facing up sees more than the
+// horizon behind it, one facing down less.
+TEST(StudioEnvironment, IsTheDocumentedNeutralGradient)
+{
+    const Image map = studioEnvironment();
+    ASSERT_EQ(map.width, 2 * map.height);
+    const auto at = [&](uint32_t row, uint32_t column, int c) {
+        return map.rgb[(size_t(row) * map.width + column) * 3 + c];
+    };
+    const double pi = 3.14159265358979323846;
+    for (uint32_t j = 0; j < map.height; ++j) {
+        const double y = std::cos(pi * (j + 0.5) / map.height);
+        for (uint32_t i : {0u, map.width / 3, map.width - 1})
+            for (int c = 0; c < 3; ++c) ASSERT_EQ(at(j, i, c), at(j, 0, 0)) << "row " << j << " is not one grey";
+        if (j > 0) {
+            EXPECT_LE(at(j, 0, 0), at(j - 1, 0, 0)) << "row " << j;
+        }
+        if (y >= 0.0) {
+            EXPECT_NEAR(at(j, 0, 0), 0.6 + 0.4 * y, 1e-6) << "row " << j;
+        }
+        if (y < -std::sin(15.0 * pi / 180.0)) {
+            EXPECT_FLOAT_EQ(at(j, 0, 0), 0.25f) << "row " << j;
+        }
+    }
+    EXPECT_NEAR(at(0, 0, 0), 1.0, 1e-3);
+    EXPECT_NEAR(at(map.height / 2 - 1, 0, 0), 0.6, 0.02);
+    // Cosine-weighted mean radiance seen by a surface facing up, and down (the irradiance over pi).
+    double up = 0.0, down = 0.0, upWeight = 0.0, downWeight = 0.0;
+    for (uint32_t j = 0; j < map.height; ++j) {
+        const double theta = pi * (j + 0.5) / map.height, y = std::cos(theta), area = std::sin(theta);
+        (y > 0.0 ? up : down) += at(j, 0, 0) * std::abs(y) * area;
+        (y > 0.0 ? upWeight : downWeight) += std::abs(y) * area;
+    }
+    EXPECT_GT(up / upWeight, 0.8);      // brighter than the horizon's 0.6 behind a model
+    EXPECT_LT(down / downWeight, 0.35); // darker
 }
 
 } // namespace

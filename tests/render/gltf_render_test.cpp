@@ -6,8 +6,8 @@
 // KHR_texture_transform against the same quad with the transform baked into
 // its uvs (scenes/gltf/texture-transform*.gltf).
 #include "mesh/MeshGeometry.h"
-#include "render/Renderer.h"
 #include "render/RenderSession.h"
+#include "render/Renderer.h"
 #include "scene/FeatureSet.h"
 #include "scene/GltfScene.h"
 #include "scene/SceneParser.h"
@@ -66,6 +66,14 @@ void expectStatisticallyEqual(const Rendered& a, const Rendered& b, const std::s
     }
 }
 
+/// The white sky these closed forms were written for, in place of a glTF
+/// file's studio default (render/Environment.h: studioEnvironment).
+void useWhiteSky(Scene& scene)
+{
+    scene.background.environment.reset();
+    scene.background.color = Color(1.0);
+}
+
 TEST_F(GltfRender, AGltfSceneRendersAsItsHandWrittenToml)
 {
     const Scene toml = parseSceneFile((kSource / "scenes/gltf/lights-camera.toml").string());
@@ -110,7 +118,8 @@ std::string instancedGltf()
   "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1], "metallicFactor": 0,
                                           "roughnessFactor": 0.5}, "doubleSided": true}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 3, "material": 0}]}],
-  "buffers": [{"uri": ")" + dataUri("application/octet-stream", instanceBuffer()) + R"(", "byteLength": 140}],
+  "buffers": [{"uri": ")" +
+           dataUri("application/octet-stream", instanceBuffer()) + R"(", "byteLength": 140}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24},
                   {"buffer": 0, "byteOffset": 60, "byteLength": 24}, {"buffer": 0, "byteOffset": 84, "byteLength": 6},
                   {"buffer": 0, "byteOffset": 92, "byteLength": 24}, {"buffer": 0, "byteOffset": 116, "byteLength": 24}],
@@ -131,6 +140,7 @@ TEST_F(GltfRender, InstancesRenderAsTheFlattenedMesh)
     const fs::path dir = freshTempDir("gltf-instances");
     std::ofstream(dir / "instances.gltf") << instancedGltf();
     Scene instanced = parseGltfScene((dir / "instances.gltf").string());
+    useWhiteSky(instanced);
     ASSERT_EQ(instanced.meshes.size(), 5u);
     applyResolution(instanced.camera, {160, 120});
     const Scene flat = parseSceneString(R"(
@@ -147,7 +157,8 @@ height = 120
 color = [1, 1, 1]
 [[objects]]
 shape = "mesh"
-file = ")" + (dir / "instances.gltf").string() + R"("
+file = ")" + (dir / "instances.gltf").string() +
+                                        R"("
 material = "file"
 )");
     ASSERT_EQ(flat.meshes.size(), 1u);
@@ -158,10 +169,11 @@ material = "file"
 /// A 2 x 2 quad in the z = 0 plane (a black dielectric) seen by an
 /// orthographic camera `distance` ahead of it on +z, its view 4 wide and 3 tall.
 /// With `colorAlpha`, the quad's vertices get COLOR_0 = (1, 1, 1, colorAlpha).
-std::string orthographicQuadGltf(double distance,
-                                 const std::string& material = R"({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1],
+std::string
+orthographicQuadGltf(double distance,
+                     const std::string& material = R"({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1],
                                                                    "metallicFactor": 0}})",
-                                 const std::string& extensionsUsed = "[]", std::optional<float> colorAlpha = {})
+                     const std::string& extensionsUsed = "[]", std::optional<float> colorAlpha = {})
 {
     std::string bytes;
     for (float v : {-1.f, -1.f, 0.f, 1.f, -1.f, 0.f, 1.f, 1.f, 0.f, -1.f, 1.f, 0.f}) put(bytes, v);
@@ -171,12 +183,15 @@ std::string orthographicQuadGltf(double distance,
     const std::string colors = colorAlpha ? R"(, "COLOR_0": 2)" : "";
     return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}], "extensionsUsed": )" +
            extensionsUsed + R"(,
-  "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, )" + std::to_string(distance) + R"(]}],
+  "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, )" +
+           std::to_string(distance) + R"(]}],
   "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1.5, "znear": 0.01, "zfar": 100}}],
-  "materials": [)" + material + R"(],
-  "meshes": [{"primitives": [{"attributes": {"POSITION": 0)" + colors + R"(}, "indices": 1, "material": 0}]}],
-  "buffers": [{"uri": ")" + dataUri("application/octet-stream", bytes) + R"(", "byteLength": )" +
-           std::to_string(bytes.size()) + R"(}],
+  "materials": [)" +
+           material + R"(],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0)" +
+           colors + R"(}, "indices": 1, "material": 0}]}],
+  "buffers": [{"uri": ")" +
+           dataUri("application/octet-stream", bytes) + R"(", "byteLength": )" + std::to_string(bytes.size()) + R"(}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12})" +
            (colorAlpha ? R"(, {"buffer": 0, "byteOffset": 60, "byteLength": 64})" : "") + R"(],
   "accessors": [
@@ -195,6 +210,8 @@ TEST_F(GltfRender, AnOrthographicCameraSeesTheSameAtEveryDistance)
     std::ofstream(dir / "far.gltf") << orthographicQuadGltf(20.0);
     Scene near = parseGltfScene((dir / "near.gltf").string());
     Scene far = parseGltfScene((dir / "far.gltf").string());
+    useWhiteSky(near);
+    useWhiteSky(far);
     EXPECT_EQ(near.camera.orthographicHeight, 3.0);
     EXPECT_EQ(double(near.camera.width) / near.camera.height, 640.0 / 480.0);
     for (Scene* s : {&near, &far}) applyResolution(s->camera, {160, 120});
@@ -242,6 +259,7 @@ TEST_F(GltfRender, VertexColoursTintTheBaseColourAndTheirAlphaCutsOut)
     std::ofstream(dir / "cut.gltf") << orthographicQuadGltf(2.0, mask, "[]", 0.25f);
     for (const char* name : {"kept.gltf", "cut.gltf"}) {
         Scene scene = parseGltfScene((dir / name).string());
+        useWhiteSky(scene);
         applyResolution(scene.camera, {160, 120});
         EXPECT_TRUE(featuresOf(scene).vertexColors && featuresOf(scene).alpha) << name;
         const Rendered r = render(scene, 5, 8);

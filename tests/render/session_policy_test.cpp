@@ -109,13 +109,27 @@ TEST(SceneOverrides, ResolutionErrorsNameTheOptionWithTheParsersWording)
                   applyResolution(camera, {16384u, 16384u});
               }),
               "--height: width * height = 268435456 pixels exceeds the limit of 67108864");
+    // One side alone keeps the aspect ratio: the other side follows, and is checked.
     camera.height = 16384;
     EXPECT_EQ(errorOf([&] {
                   applyResolution(camera, {8192u, std::nullopt});
               }),
-              "--width: width * height = 134217728 pixels exceeds the limit of 67108864")
-        << "only the width was given: it is to blame";
+              "--width: the height that keeps the scene's aspect ratio (640x16384) must be between 1 and 16384, got "
+              "209715; give --height too");
     EXPECT_EQ(camera.width, 640u) << "a refused override changes nothing";
+    camera.width = camera.height = 4096;
+    EXPECT_EQ(errorOf([&] {
+                  applyResolution(camera, {16384u, std::nullopt});
+              }),
+              "--width: width * height = 268435456 pixels exceeds the limit of 67108864")
+        << "only the width was given: it is to blame";
+    applyResolution(camera, {std::nullopt, 100u});
+    EXPECT_EQ(camera.width, 100u);
+    EXPECT_EQ(camera.height, 100u);
+    camera.width = 640;
+    camera.height = 480;
+    applyResolution(camera, {161u, std::nullopt});
+    EXPECT_EQ(camera.height, 121u) << "161 x 480 / 640 = 120.75, rounded";
 }
 
 TEST(SceneOverrides, SuiteCaseErrorsNameTheSuiteAndCase)

@@ -105,10 +105,13 @@ fs::path writeTriangle(const std::string& name, const std::string& rest,
     return dir / "scene.gltf";
 }
 
-TEST(GltfScene, WithoutCameraOrLightsItFramesTheBoxUnderAWhiteSky)
+TEST(GltfScene, WithoutCameraOrLightsItFramesTheBoxInTheStudio)
 {
     const Scene scene = parseGltfScene(writeTriangle("gltf-bare", "").string());
-    EXPECT_EQ(scene.background.color, Color(1.0));
+    ASSERT_TRUE(scene.background.environment.has_value());
+    EXPECT_TRUE(scene.background.environment->studio);
+    EXPECT_TRUE(scene.background.environment->path.empty());
+    EXPECT_EQ(scene.background.color, Color(0.0));
     // The triangle (0,0,0) (1,0,0) (0,1,0) is in front of the camera.
     const glm::dvec3 view = glm::normalize(scene.camera.target - scene.camera.eye);
     EXPECT_GT(glm::dot(glm::dvec3(1.0 / 3, 1.0 / 3, 0) - scene.camera.eye, view), 0.0);
