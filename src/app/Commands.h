@@ -16,6 +16,10 @@ namespace vkrt {
 
 using CommandRunner = std::function<int()>;
 
+/// `vkrt --version`: the version, the git commit it was built from, and the
+/// Vulkan device (and driver) a command would use by default, or why none.
+std::string versionText();
+
 CommandRunner addRenderCommand(CLI::App& app);
 CommandRunner addDevicesCommand(CLI::App& app);
 CommandRunner addInfoCommand(CLI::App& app);

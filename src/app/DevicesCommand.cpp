@@ -4,6 +4,8 @@
 #include "gpu/VulkanContext.h"
 #include "util/Error.h"
 
+#include "GitCommit.h"
+
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -32,6 +34,21 @@ std::string traversalSummary(const DeviceInfo& d)
 }
 
 } // namespace
+
+std::string versionText()
+{
+    std::string text = "vkrt " VKRT_VERSION " (commit " VKRT_GIT_COMMIT ")\n";
+    try {
+        tuneSoftwareRasterizerThreads();
+        const std::vector<DeviceInfo> devices = listVulkanDevices();
+        const DeviceInfo& d = devices.at(defaultDeviceIndex(devices));
+        text += "Vulkan device: " + d.name + " (" + d.typeName() + ", Vulkan " + d.apiVersionString() + ", " +
+                d.driver + ")";
+    } catch (const std::exception& e) {
+        text += "Vulkan device: none usable (" + std::string(e.what()) + "); `vkrt devices` says why";
+    }
+    return text;
+}
 
 CommandRunner addDevicesCommand(CLI::App& app)
 {

@@ -31,10 +31,11 @@ CommandRunner addViewCommand(CLI::App& app)
     cmd->add_option("--width", o->width, "Render width (default: the scene's)");
     cmd->add_option("--height", o->height, "Render height (default: the scene's)");
     cmd->add_option("--frames", o->frames, "Render this many frames, then exit")->check(CLI::Range(0u, 1u << 24));
-    cmd->add_option("--screenshot", o->screenshot, "With --frames: save the displayed image (PNG) before exiting")
-        ->needs(cmd->get_option("--frames"));
-    cmd->add_option("--script", o->script, "Run a scripted session (see src/view/ViewerScript.h)")
-        ->excludes(cmd->get_option("--frames"));
+    cmd->add_option("--screenshot", o->screenshot,
+                    "Save the displayed image (PNG) after --frames frames (64 without it), then exit");
+    cmd->add_option("--script", o->script, "Run a scripted session (docs/viewer.md)")
+        ->excludes(cmd->get_option("--frames"))
+        ->excludes(cmd->get_option("--screenshot"));
     cmd->add_option("--exposure", o->exposure, "Display exposure in stops")->check(CLI::Range(-64.0, 64.0));
     cmd->add_flag("--filmic", o->filmic, "Filmic tone curve instead of clamping");
     cmd->add_flag("--variance", o->variance, "Estimate variance (shows the estimated error in the title)");

@@ -1,5 +1,6 @@
 // vkrt: a Vulkan compute ray tracer. This file only wires subcommands.
 #include "app/Commands.h"
+#include "app/ManPage.h"
 #include "app/Suggestions.h"
 #include "util/Error.h"
 #include "util/Signals.h"
@@ -13,7 +14,10 @@ int main(int argc, char** argv)
     // Temporary outputs go with any SIGINT/SIGTERM/SIGHUP; a driver crash is named as such.
     vkrt::installSignalHandlers({vkrt::kExitInterrupted, vkrt::kExitDriverCrashed});
     CLI::App app("vkrt - Vulkan compute ray tracer", "vkrt");
-    app.set_version_flag("--version", VKRT_VERSION);
+    app.set_version_flag(
+        "--version", [] { return vkrt::versionText(); },
+        "Print the version, the commit it was built "
+        "from and the Vulkan device it would use");
     app.require_subcommand(1);
     std::vector<std::pair<CLI::App*, vkrt::CommandRunner>> commands;
     // Each add*Command registers one subcommand: pair it with its runner.
@@ -27,6 +31,13 @@ int main(int argc, char** argv)
     add(vkrt::addMergeCommand(app));
     add(vkrt::addRegressCommand(app));
     add(vkrt::addDevicesCommand(app));
+    // Hidden: the build writes the manual page with it (build/vkrt.1).
+    CLI::App* man = app.add_subcommand("man", "Print the manual page (roff) made from these option definitions");
+    man->group("");
+    commands.emplace_back(man, [&app] {
+        std::fputs(vkrt::manPage(app).c_str(), stdout);
+        return int(vkrt::kExitOk);
+    });
 
     try {
         app.parse(argc, argv);

@@ -17,11 +17,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <optional>
-#include <utility>
 #include <cstdio>
 #include <deque>
 #include <memory>
+#include <optional>
+#include <utility>
 
 namespace vkrt {
 
@@ -132,9 +132,9 @@ private:
     std::deque<std::string> m_keys;    ///< pressed keys not yet handled
     bool m_dragging = false;
     double m_lastX = 0, m_lastY = 0;
-    double m_pressX = 0, m_pressY = 0;                          ///< where the left button went down
-    std::optional<std::pair<double, double>> m_pendingFocus;    ///< a click, as fractions of the window
-    std::optional<std::string> m_pendingOpen;                   ///< a scene file dropped on the window
+    double m_pressX = 0, m_pressY = 0;                       ///< where the left button went down
+    std::optional<std::pair<double, double>> m_pendingFocus; ///< a click, as fractions of the window
+    std::optional<std::string> m_pendingOpen;                ///< a scene file dropped on the window
     double m_pendingYaw = 0, m_pendingPitch = 0, m_pendingZoom = 1;
     Clock::time_point m_rateStart = Clock::now();
     uint64_t m_rateSamples = 0;
@@ -158,6 +158,8 @@ private:
     void updateTitle(bool force = false);
     void save(const std::string& exrPath);
     void screenshot(const std::string& pngPath);
+    /// The displayed image to `pngPath`, and a line on standard output saying so (scripts, --screenshot).
+    void screenshotAndSay(const std::string& pngPath);
     void runScript(const std::vector<ViewerCommand>& commands);
     void runInteractive();
 };
@@ -439,6 +441,14 @@ void Viewer::screenshot(const std::string& pngPath)
     writePngPixels(pngPath, renderer().width(), renderer().height(), m_display->readPixels());
 }
 
+void Viewer::screenshotAndSay(const std::string& pngPath)
+{
+    present();
+    screenshot(pngPath);
+    std::printf("saved %s (%u spp)\n", pngPath.c_str(), renderer().completedFrames());
+    std::fflush(stdout);
+}
+
 void Viewer::runScript(const std::vector<ViewerCommand>& commands)
 {
     for (const ViewerCommand& c : commands) {
@@ -457,7 +467,7 @@ void Viewer::runScript(const std::vector<ViewerCommand>& commands)
         else if (c.name == "exposure") m_exposure = float(c.numbers[0]);
         else if (c.name == "key") handleKey(c.text);
         else if (c.name == "save") save(c.text);
-        else if (c.name == "screenshot") present(), screenshot(c.text);
+        else if (c.name == "screenshot") screenshotAndSay(c.text);
     }
 }
 
@@ -494,8 +504,10 @@ std::vector<ViewerCommand> scriptFor(const ViewOptions& options)
 {
     if (!options.script.empty()) return readViewerScript(options.script);
     std::vector<ViewerCommand> commands;
-    if (options.frames) {
-        commands.push_back({"frames", {double(*options.frames)}, "", 0});
+    // --screenshot alone renders this many frames first.
+    constexpr uint32_t kScreenshotFrames = 64;
+    if (options.frames || !options.screenshot.empty()) {
+        commands.push_back({"frames", {double(options.frames.value_or(kScreenshotFrames))}, "", 0});
         if (!options.screenshot.empty()) commands.push_back({"screenshot", {}, options.screenshot, 0});
     }
     return commands;

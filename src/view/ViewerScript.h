@@ -1,6 +1,7 @@
 #pragma once
 // Scripted viewer sessions (`vkrt view --script FILE`), used by tests and for
-// reproducible demos. One command per line; '#' starts a comment:
+// reproducible demos (docs/viewer.md documents them for users: keep the two
+// alike). One command per line; '#' starts a comment:
 //   frames N            render and display N frames
 //   orbit YAW PITCH     degrees (like dragging with the mouse)
 //   fly RIGHT UP FWD    in units of the eye-target distance (like WASD/QE)

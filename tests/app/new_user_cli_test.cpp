@@ -250,6 +250,39 @@ TEST_F(NewUserCli, OnATerminalTheStartUpSaysWhatItIsDoing)
     EXPECT_EQ(piped.output.find("setting up"), std::string::npos) << piped.output;
 }
 
+TEST_F(NewUserCli, VersionNamesTheCommitAndTheDevice)
+{
+    const ProcessResult r = runVkrt({"--version"});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(
+        std::regex_search(r.output, std::regex("vkrt " VKRT_VERSION R"( \(commit ([0-9a-f]{7,}(-dirty)?|unknown)\))")))
+        << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(Vulkan device: [^\n]+, Vulkan \d)"))) << r.output;
+}
+
+TEST_F(NewUserCli, TheManPageListsEveryOptionOfEveryCommand)
+{
+    const ProcessResult page = runVkrt({"man"});
+    ASSERT_EQ(page.exitCode, 0) << page.output;
+    EXPECT_EQ(page.output.rfind(".TH VKRT 1", 0), 0u) << page.output.substr(0, 200);
+    // Every option each command's --help shows is on the page (both come from one definition).
+    for (const std::string command : {"render", "view", "info", "compare", "merge", "regress", "devices"}) {
+        EXPECT_NE(page.output.find(".SS " + command + "\n"), std::string::npos) << command;
+        const ProcessResult help = runVkrt({command, "--help"});
+        const std::regex option(R"((^|[\s,])(--[a-z][a-z0-9-]*))");
+        int seen = 0;
+        for (std::sregex_iterator it(help.output.begin(), help.output.end(), option), end; it != end; ++it) {
+            std::string escaped;
+            for (char c : (*it)[2].str()) escaped += c == '-' ? std::string("\\-") : std::string(1, c);
+            EXPECT_NE(page.output.find(escaped), std::string::npos) << command << " " << (*it)[2];
+            ++seen;
+        }
+        EXPECT_GT(seen, 0) << command;
+    }
+    // The build writes it beside the binary.
+    EXPECT_TRUE(fs::exists(fs::path(VKRT_BINARY).parent_path() / "vkrt.1"));
+}
+
 /// The backticked keys of the first column of the table under `heading` in docs/machine-output.md.
 std::set<std::string> documentedKeys(const std::string& heading)
 {

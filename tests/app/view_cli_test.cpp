@@ -47,6 +47,18 @@ protected:
     fs::path m_dir;
 };
 
+// --screenshot alone renders 64 frames first (docs/viewer.md), and says what it saved.
+TEST_F(ViewCli, AScreenshotAloneIsTakenAfter64Frames)
+{
+    ProcessResult view =
+        runViewer({kScene, "--screenshot", (m_dir / "alone.png").string(), "--width", "32", "--height", "24"});
+    ASSERT_EQ(view.exitCode, 0) << view.output;
+    EXPECT_NE(view.output.find("saved " + (m_dir / "alone.png").string() + " (64 spp)"), std::string::npos)
+        << view.output;
+    int w = 0, h = 0;
+    EXPECT_EQ(readPngPixels(m_dir / "alone.png", w, h).size(), size_t(32 * 24 * 4));
+}
+
 // 16 frames in the viewer and `vkrt render --spp 16` accumulate the same
 // samples (same seed); their 8-bit images may differ only by the rounding of
 // the tone map (GPU float vs host double mean): at most 1 step, on few values.
@@ -55,6 +67,8 @@ TEST_F(ViewCli, ScreenshotMatchesRenderAfterToneMapping)
     ProcessResult view = runViewer({kScene, "--frames", "16", "--screenshot", (m_dir / "view.png").string(), "--width",
                                     "160", "--height", "120", "--seed", "4", "--validation"});
     ASSERT_EQ(view.exitCode, 0) << view.output;
+    EXPECT_NE(view.output.find("saved " + (m_dir / "view.png").string() + " (16 spp)"), std::string::npos)
+        << view.output;
     ProcessResult render = runVkrt({"render", kScene, "--spp", "16", "--width", "160", "--height", "120", "--seed", "4",
                                     "-o", (m_dir / "r.exr").string(), "--png", (m_dir / "render.png").string()});
     ASSERT_EQ(render.exitCode, 0) << render.output;
