@@ -740,11 +740,10 @@ GpuSceneData convertScene(const Scene& scene, const FrameSettings& settings, con
     convertTriangleLightEmitters(scene, fixed, data);
     convertMeshes(scene, fixed, scene.camera.eye, data);
     // Soft suns first: the only ones an escaped ray can find (lib/lights/directional.glsl).
-    std::stable_partition(data.directionalLights.begin(), data.directionalLights.end(),
-                          [](const gpu::DirectionalLight& light) { return light.oneMinusCos > 0.0f; });
-    data.uniforms.softDirectionalLightCount =
-        uint32_t(std::count_if(data.directionalLights.begin(), data.directionalLights.end(),
-                               [](const gpu::DirectionalLight& light) { return light.oneMinusCos > 0.0f; }));
+    const auto firstDelta =
+        std::stable_partition(data.directionalLights.begin(), data.directionalLights.end(),
+                              [](const gpu::DirectionalLight& light) { return light.oneMinusCos > 0.0f; });
+    data.uniforms.softDirectionalLightCount = uint32_t(firstDelta - data.directionalLights.begin());
     if (usesLightTable(scene)) buildLightTable(scene, fixed, data);
     if (fixed.top) {
         data.topNodes = refitTopLevel(*fixed.top, scene.camera.eye);
