@@ -1,22 +1,29 @@
 #!/usr/bin/env python3
-"""Does `--target-error T` keep its promise? For every validation scene with
-a reference (tests/references/validation/NAME/mean.exr, Mitsuba 3), render
-SEEDS runs up to MAX spp with `--report` and `--reference`: each run's CSV
-holds, at every checkpoint (1, 2, 4, ... spp), vkrt's estimated relMSE and
-the true relMSE against the reference. Stop rules are then replayed on those
-trajectories for each target: where would the rule have stopped, and was the
-true relMSE there at most T? The oracle stops at the first checkpoint whose
-true relMSE is at most T.
+"""Does `--target-error T` keep its promise (a true relMSE <= T in at least 95 % of runs)?
 
-    tools/target_error_coverage.py [--vkrt build/vkrt] [--seeds 20] [--max-spp 4096]
-        [--targets 0.03,0.01,0.003] [--scenes conductor,plastic,...] [--json out.json] [--cache DIR]
+For every validation scene with a reference (tests/references/validation/NAME/
+mean.exr, Mitsuba 3), SEEDS runs of each target T:
+
+  vkrt render SCENE --target-error T --spp MAX --seed S --report R --reference REF
+
+The report's last row is the stop: its spp and the true relMSE there. A run
+that reaches MAX spp first did not stop on the target and is counted apart
+(`capped`). The same seeds are also rendered once to MAX spp with a report at
+every power of two: the oracle, the fewest spp whose true relMSE meets T
+(interpolated as 1 / spp between the checkpoints around it), is what the rule's
+cost is measured against; and --replay replays rules on those trajectories
+(estimates only) without running vkrt again.
+
+    tools/target_error_coverage.py [--vkrt build/vkrt] [--seeds 20] [--max-spp 1024]
+        [--targets 0.03,0.01,0.003] [--scenes conductor,plastic,...] [--sampler auto] [--replay]
+        [--json out.json] [--cache DIR] [--verbose]
 
 The true relMSE has the reference's own noise subtracted (its variance.exr
-over reference^2 + 0.01, the relMSE's epsilon), so that a target below the
-reference's noise is still judged fairly. Prints, per rule and target: the
-share of runs whose true relMSE at the stop is at most T (the promise is 95 %),
-the median spp, and the median ratio of spp to the oracle's. Runs are cached
-in --cache (default: a temporary directory) by scene, seed and max spp.
+over reference^2 + 0.01, the relMSE's epsilon), so that a target near the
+reference's noise is still judged fairly. Prints, per target (and rule): runs
+that met it of those that stopped on it, the share, runs capped, the median
+spp and the median ratio of spp to the oracle's. Runs are cached in --cache
+(default: a temporary directory) by scene, seed, target and MAX spp.
 """
 from __future__ import annotations
 
@@ -53,69 +60,98 @@ def reference_noise(name: str) -> float:
     return float(np.mean(v[finite] / (m[finite] ** 2 + EPSILON)))
 
 
-def trajectory(args, name: str, seed: int, cache: Path) -> list[dict]:
-    """One run's checkpoints: spp, estimated and true relMSE (reference noise subtracted)."""
-    report = cache / f"{name}-seed{seed}-max{args.max_spp}.csv"
+def run_report(args, name: str, seed: int, report: Path, extra: list[str]) -> list[dict]:
+    """Renders (unless the report is cached) and returns its rows."""
     if not report.exists():
         scene = ROOT / "scenes" / "validation" / f"{name}.toml"
         reference = ROOT / "tests" / "references" / "validation" / name / "mean.exr"
         command = [args.vkrt, "render", str(scene), "--spp", str(args.max_spp), "--seed", str(seed),
-                   "--report", str(report), "--reference", str(reference), "-o", "/dev/null"]
+                   "--sampler", args.sampler, "--report", str(report), "--reference", str(reference),
+                   "-o", "/dev/null", *extra]
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:
             sys.exit(f"target_error_coverage: {' '.join(command)} failed:\n{done.stderr}")
-    rows = []
     with report.open() as f:
         lines = [line for line in f if not line.startswith("#")]
-    for row in csv.DictReader(lines):
-        rows.append({"spp": int(row["spp"]), "estimated": float(row["est_relmse"]),
-                     "true": float(row["relmse"])})
-    return rows
+    return [{"spp": int(row["spp"]), "estimated": float(row["est_relmse"]),
+             "upper": float(row["est_relmse_upper"]), "dof": float(row["est_dof"]),
+             "true": float(row["relmse"])} for row in csv.DictReader(lines)]
 
 
-# --------------------------------------------------------------- stop rules
-# Each rule sees the checkpoints up to the current one (estimates only, never
-# the true error) and says whether to stop there.
+def oracle_spp(rows: list[dict], target: float) -> float:
+    """The fewest spp whose true relMSE meets the target, interpolated as 1 / spp
+    between the checkpoints around the first that meets it; the last spp if none does."""
+    for before, after in zip([None] + rows[:-1], rows):
+        if after["true"] <= target:
+            if before is None or not before["true"] > target:
+                return after["spp"]
+            # true ~ c / spp^k between the two checkpoints
+            slope = math.log(after["spp"] / before["spp"]) / math.log(before["true"] / max(after["true"], 1e-30))
+            return min(after["spp"], before["spp"] * (before["true"] / target) ** slope)
+    return rows[-1]["spp"]
+
+
+# --------------------------------------------------------------- replayed rules
+# Each sees the checkpoints up to the current one (estimates only, never the
+# true error) and says whether to stop there. Checkpoints are powers of two
+# here; vkrt's own rule also looks where it expects the target met.
 
 def rule_point_estimate(history, target):
-    """Today's rule: the estimate below the target."""
+    """The estimate below the target."""
     return history[-1]["estimated"] < target
 
 
-def rule_settled(history, target, min_spp=16, growth=1.25):
-    """The estimate below the target, at least min_spp, and the per-sample
-    variance (estimate x spp) no longer growing: at most `growth` times the
-    previous checkpoint's (a heavy tail still being found makes it grow)."""
-    now = history[-1]
-    if now["spp"] < min_spp or len(history) < 2 or not now["estimated"] < target:
-        return False
-    before = history[-2]
-    return now["estimated"] * now["spp"] <= growth * before["estimated"] * before["spp"]
+def rule_upper_bound(history, target):
+    """vkrt's rule: the estimate's upper confidence bound below the target."""
+    return history[-1]["upper"] < target
 
 
 RULES = {
-    "estimate < T (today)": rule_point_estimate,
-    "settled, >= 16 spp": rule_settled,
-    "settled, >= 32 spp": lambda h, t: rule_settled(h, t, min_spp=32),
+    "estimate < T": rule_point_estimate,
+    "upper bound < T": rule_upper_bound,
 }
 
 
-def stop_of(rows, rule, target):
+def replayed_stop(rows, rule, target):
+    """The checkpoint where the rule stops, or None where it never does (the spp cap)."""
     for i in range(len(rows)):
         if rule(rows[: i + 1], target):
             return rows[i]
-    return rows[-1]
+    return None
+
+
+def summarize(label, target, stops):
+    """stops: (name, seed, stop row or None, oracle spp) per run."""
+    met, capped, spps, ratios, missed = 0, 0, [], [], []
+    for name, seed, stop, oracle in stops:
+        if stop is None:
+            capped += 1
+            continue
+        met += stop["true"] <= target
+        if stop["true"] > target:
+            missed.append(f"{name}/{seed}@{stop['spp']}:{stop['true'] / target:.2f}T")
+        spps.append(stop["spp"])
+        ratios.append(stop["spp"] / oracle)
+    count = len(spps)
+    return {"rule": label, "target": target, "stopped": count, "capped": capped, "met": met,
+            "share": met / count if count else math.nan,
+            "medianSpp": statistics.median(spps) if spps else math.nan,
+            "medianSppOverOracle": statistics.median(ratios) if ratios else math.nan, "missed": missed}
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--vkrt", default=str(ROOT / "build" / "vkrt"))
     parser.add_argument("--seeds", type=int, default=20)
-    parser.add_argument("--max-spp", type=int, default=4096)
+    parser.add_argument("--max-spp", type=int, default=1024)
     parser.add_argument("--targets", default="0.03,0.01,0.003")
     parser.add_argument("--scenes", help="comma-separated names (default: every scene with a reference)")
+    parser.add_argument("--sampler", default="auto", choices=["auto", "sobol", "independent"],
+                        help="vkrt's --sampler (auto: Sobol', whose 8 batches give the estimate)")
+    parser.add_argument("--replay", action="store_true", help="also replay rules on the power-of-two trajectories")
     parser.add_argument("--cache", help="keep the runs' reports here")
     parser.add_argument("--json", help="also write the table as JSON")
+    parser.add_argument("--verbose", action="store_true", help="name the runs that missed the target")
     args = parser.parse_args()
     targets = [float(t) for t in args.targets.split(",")]
     references = ROOT / "tests" / "references" / "validation"
@@ -126,38 +162,48 @@ def main() -> int:
     cache = Path(args.cache or temporary.name)
     cache.mkdir(parents=True, exist_ok=True)
 
-    runs = {}
+    def denoised(rows, noise):
+        for row in rows:
+            row["true"] = max(0.0, row["true"] - noise)
+        return rows
+
+    sampler = "" if args.sampler == "auto" else f"-{args.sampler}"  # in the cache's file names
+    trajectories, direct = {}, {}
     for name in names:
         noise = reference_noise(name)
-        runs[name] = []
         for seed in range(args.seeds):
-            rows = trajectory(args, name, seed, cache)
-            for row in rows:
-                row["true"] = max(0.0, row["true"] - noise)
-            runs[name].append(rows)
+            trajectories[name, seed] = denoised(
+                run_report(args, name, seed, cache / f"{name}-seed{seed}-max{args.max_spp}{sampler}.csv", []), noise)
+            for target in targets:
+                report = cache / f"{name}-seed{seed}-target{target:g}-max{args.max_spp}{sampler}.csv"
+                rows = denoised(run_report(args, name, seed, report, ["--target-error", str(target)]), noise)
+                # The last row is the stop; at the cap with the bound still above the target it is not one.
+                last = rows[-1]
+                direct[name, seed, target] = last if last["upper"] < target else None
 
     table = []
-    for rule_name, rule in RULES.items():
-        for target in targets:
-            met, spps, ratios = 0, [], []
-            for name in names:
-                for rows in runs[name]:
-                    stop = stop_of(rows, rule, target)
-                    oracle = next((r for r in rows if r["true"] <= target), rows[-1])
-                    met += stop["true"] <= target
-                    spps.append(stop["spp"])
-                    ratios.append(stop["spp"] / oracle["spp"])
-            count = len(spps)
-            table.append({"rule": rule_name, "target": target, "runs": count, "met": met,
-                          "share": met / count, "medianSpp": statistics.median(spps),
-                          "medianSppOverOracle": statistics.median(ratios)})
-    print(f"{len(names)} scenes x {args.seeds} seeds, up to {args.max_spp} spp")
-    print(f"{'rule':<26} {'target':>8} {'met':>9} {'share':>7} {'median spp':>11} {'spp/oracle':>11}")
+    for target in targets:
+        table.append(summarize("vkrt --target-error", target, [
+            (name, seed, direct[name, seed, target], oracle_spp(trajectories[name, seed], target))
+            for name in names for seed in range(args.seeds)]))
+    if args.replay:
+        for label, rule in RULES.items():
+            for target in targets:
+                table.append(summarize(f"replayed: {label}", target, [
+                    (name, seed, replayed_stop(rows, rule, target), oracle_spp(rows, target))
+                    for (name, seed), rows in trajectories.items()]))
+
+    print(f"{len(names)} scenes x {args.seeds} seeds, up to {args.max_spp} spp, sampler {args.sampler}")
+    print(f"{'rule':<28} {'target':>7} {'met/stopped':>12} {'share':>7} {'capped':>7} {'median spp':>11} "
+          f"{'spp/oracle':>11}")
     for row in table:
-        print(f"{row['rule']:<26} {row['target']:>8g} {row['met']:>4}/{row['runs']:<4} {row['share']:>7.1%} "
-              f"{row['medianSpp']:>11g} {row['medianSppOverOracle']:>11.2f}")
+        print(f"{row['rule']:<28} {row['target']:>7g} {row['met']:>5}/{row['stopped']:<6} {row['share']:>7.1%} "
+              f"{row['capped']:>7} {row['medianSpp']:>11g} {row['medianSppOverOracle']:>11.2f}")
+        if args.verbose and row["missed"]:
+            print("    missed: " + " ".join(row["missed"]))
     if args.json:
-        Path(args.json).write_text(json.dumps({"scenes": names, "seeds": args.seeds, "rows": table}, indent=1) + "\n")
+        Path(args.json).write_text(json.dumps({"scenes": names, "seeds": args.seeds, "maxSpp": args.max_spp,
+                                               "sampler": args.sampler, "rows": table}, indent=1) + "\n")
     return 0
 
 

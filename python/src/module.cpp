@@ -313,6 +313,7 @@ std::unique_ptr<PyResult> resultOf(RenderOutput rendered, const std::optional<Es
         py::dict error;
         error["rmse"] = estimated->rmse;
         error["rel_mse"] = estimated->relMse;
+        error["rel_mse_upper"] = estimated->relMseUpper;
         result->errorEstimate = error;
     }
     auto shared = std::make_shared<const RenderOutput>(std::move(rendered));

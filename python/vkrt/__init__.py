@@ -169,7 +169,8 @@ class Result:
     (height, width, 3) and ``depth`` (height, width), each when asked for.
     Absent arrays are None. ``metadata`` holds what the EXR's header gets.
     ``error_estimate`` is the image's estimated error, ``{"rmse": ...,
-    "rel_mse": ...}``, when the render estimated variance (``variance=True``
+    "rel_mse": ..., "rel_mse_upper": ...}`` (the last a 95 % upper confidence
+    bound on rel_mse, the value ``target_error`` stops on), when the render estimated variance (``variance=True``
     or ``target_error``), else None. ``spp``, ``render_seconds`` (rendering
     only: no start-up or kernel compile), ``stopped_by`` ("spp",
     "time-budget", "target-error", "interrupted") and ``interrupted``

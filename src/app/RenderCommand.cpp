@@ -214,7 +214,7 @@ RenderFacts renderFacts(const RenderSession& session, const LoopResult& loop, do
 }
 
 /// Why the render stopped, in words: "spp", "time budget", "target error
-/// reached (estimated relMSE X <= T)", "interrupted".
+/// reached: estimated relMSE X, upper bound Y < T", "interrupted".
 std::string stopSentence(const RenderFacts& facts)
 {
     switch (facts.stoppedBy) {
@@ -224,8 +224,8 @@ std::string stopSentence(const RenderFacts& facts)
         std::string text = "target error reached";
         if (facts.estimated && facts.targetError) {
             char buffer[96];
-            std::snprintf(buffer, sizeof buffer, ": estimated relMSE %.3g <= %.3g", facts.estimated->relMse,
-                          *facts.targetError);
+            std::snprintf(buffer, sizeof buffer, ": estimated relMSE %.3g, upper bound %.3g < %.3g",
+                          facts.estimated->relMse, facts.estimated->relMseUpper, *facts.targetError);
             text += buffer;
         }
         return text;
@@ -264,6 +264,9 @@ JsonObject errorEstimateJson(const RenderSession& session, const std::optional<E
     const Renderer& renderer = session.renderer();
     return {{"rmse", estimated->rmse},
             {"relMse", estimated->relMse},
+            {"relMseUpper", estimated->relMseUpper},
+            {"relMseConfidence", kRelMseConfidence},
+            {"relMseDegreesOfFreedom", estimated->degreesOfFreedom},
             {"degreesOfFreedom", renderer.varianceDegreesOfFreedom()},
             {"estimator", session.sampler() == Sampler::Sobol ? "batches" : "independent-samples"}};
 }
@@ -373,7 +376,7 @@ LoopResult renderWithProgress(RenderSession& session, std::optional<ConvergenceR
     hooks.onProgress = [&](uint32_t done) { progress.update(done); };
     if (report)
         hooks.onCheckpoint = [&](uint32_t spp, double seconds, const Film& film) {
-            report->add(spp, seconds, film.mean, *film.variance);
+            report->add(spp, seconds, film.mean, *film.estimated);
             lastCheckpoint = spp;
         };
     LoopResult loop = session.run(hooks);
@@ -450,7 +453,7 @@ Outcome runRender(const RenderCommandOptions& options)
     if (film.variance) {
         warnIfTooFewForAnEstimate(renderer);
         if (report && lastCheckpoint != renderer.completedFrames())
-            report->add(renderer.completedFrames(), loop.renderSeconds, film.mean, *film.variance); // the last row
+            report->add(renderer.completedFrames(), loop.renderSeconds, film.mean, *film.estimated); // the last row
     }
     const std::optional<EstimatedError> estimated = film.estimated;
     RenderOutput out = renderOutput(session, std::move(film), options.variance, aovNames);

@@ -4,6 +4,7 @@
 #include "util/Signals.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cstring>
 #include <thread>
@@ -81,13 +82,15 @@ std::string rayQueryMissing(const vk::raii::PhysicalDevice& device)
 {
     const auto available = device.enumerateDeviceExtensionProperties();
     for (const char* name : kRayQueryExtensions) {
-        bool found = std::any_of(available.begin(), available.end(),
-                                 [&](const vk::ExtensionProperties& p) { return std::strcmp(p.extensionName, name) == 0; });
+        bool found = std::any_of(available.begin(), available.end(), [&](const vk::ExtensionProperties& p) {
+            return std::strcmp(p.extensionName, name) == 0;
+        });
         if (!found) return std::string("the extension ") + name;
     }
-    auto features = device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features,
-                                        vk::PhysicalDeviceAccelerationStructureFeaturesKHR,
-                                        vk::PhysicalDeviceRayQueryFeaturesKHR>();
+    auto features =
+        device
+            .getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features,
+                          vk::PhysicalDeviceAccelerationStructureFeaturesKHR, vk::PhysicalDeviceRayQueryFeaturesKHR>();
     if (!features.get<vk::PhysicalDeviceVulkan12Features>().bufferDeviceAddress)
         return "the bufferDeviceAddress feature";
     if (!features.get<vk::PhysicalDeviceAccelerationStructureFeaturesKHR>().accelerationStructure)
@@ -196,10 +199,18 @@ void VulkanContext::createInstance(bool validation, const std::optional<Presenta
     if (validation) {
         layers.push_back(kValidationLayer);
         extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME); // the layer provides it
     }
     if (presentation)
         for (const auto& e : presentation->instanceExtensions) extensions.push_back(e.c_str());
-    m_instance = vk::raii::Instance(m_context, vk::InstanceCreateInfo({}, &app, layers, extensions));
+    vk::InstanceCreateInfo instanceInfo({}, &app, layers, extensions);
+    // With validation, synchronization validation too: a missing barrier
+    // between dispatches is invisible on lavapipe (it runs them in order) but
+    // a race on a GPU, which none has run here (docs/platform.md).
+    const std::array enabledFeatures{vk::ValidationFeatureEnableEXT::eSynchronizationValidation};
+    vk::ValidationFeaturesEXT features(enabledFeatures, {});
+    if (validation) instanceInfo.pNext = &features;
+    m_instance = vk::raii::Instance(m_context, instanceInfo);
     if (presentation) m_surface = vk::raii::SurfaceKHR(m_instance, presentation->createSurface(*m_instance));
     if (!validation) return;
     using Severity = vk::DebugUtilsMessageSeverityFlagBitsEXT;

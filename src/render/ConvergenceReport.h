@@ -26,7 +26,7 @@ public:
 
     /// Adds a row for the current image and rewrites the file atomically, so
     /// the file on disk is always complete.
-    void add(uint32_t spp, double renderSeconds, const Image& mean, const Image& varianceOfMean);
+    void add(uint32_t spp, double renderSeconds, const Image& mean, const EstimatedError& estimated);
 
     const std::vector<ConvergenceRow>& rows() const { return m_rows; }
     /// The CSV text (header comment, column names, rows).

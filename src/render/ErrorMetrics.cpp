@@ -1,5 +1,6 @@
 #include "render/ErrorMetrics.h"
 
+#include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 #include <algorithm>
@@ -7,19 +8,40 @@
 
 namespace vkrt {
 
-EstimatedError estimateError(const Image& mean, const Image& varianceOfMean)
+EstimatedError estimateError(const Image& mean, const Image& varianceOfMean, double pixelDegreesOfFreedom)
 {
-    double sumVariance = 0.0, sumRelative = 0.0;
+    double sumVariance = 0.0, sumRelative = 0.0, sumSquaredTerms = 0.0;
     size_t n = 0;
     for (size_t i = 0; i < mean.rgb.size(); ++i) {
         double v = varianceOfMean.rgb[i], m = mean.rgb[i];
         if (!std::isfinite(v) || !std::isfinite(m)) continue;
+        double lowerValue = std::max(std::abs(m) - std::sqrt(v), 0.0);
+        double term = v / (lowerValue * lowerValue + kRelMseEpsilon);
         sumVariance += v;
-        sumRelative += v / (m * m + kRelMseEpsilon);
+        sumRelative += term;
+        sumSquaredTerms += term * term;
         ++n;
     }
-    if (n == 0) return {INFINITY, INFINITY};
-    return {std::sqrt(sumVariance / double(n)), sumRelative / double(n)};
+    if (n == 0 || !(pixelDegreesOfFreedom > 0.0)) return {INFINITY, INFINITY, INFINITY, 0.0};
+    EstimatedError e;
+    e.rmse = std::sqrt(sumVariance / double(n));
+    e.relMse = sumRelative / double(n);
+    if (sumRelative == 0.0) return e; // no noise anywhere: a bound of 0 too
+    // Each term is its pixel's sigma^2 chi2_d / d: the sum's Satterthwaite
+    // degrees of freedom are (sum t)^2 / sum(t^2 / d).
+    e.degreesOfFreedom = std::isinf(pixelDegreesOfFreedom)
+                             ? INFINITY
+                             : sumRelative * sumRelative / (sumSquaredTerms / pixelDegreesOfFreedom);
+    e.relMseUpper = e.relMse * varianceUpperFactor(e.degreesOfFreedom, kRelMseConfidence);
+    return e;
+}
+
+double varianceUpperFactor(double degreesOfFreedom, double confidence)
+{
+    if (!(degreesOfFreedom > 0.0)) return INFINITY;
+    if (std::isinf(degreesOfFreedom) || degreesOfFreedom > 1e7) return 1.0;
+    boost::math::chi_squared chi2(degreesOfFreedom);
+    return degreesOfFreedom / boost::math::quantile(chi2, 1.0 - confidence);
 }
 
 MeasuredError measureError(const Image& image, const Image& reference)

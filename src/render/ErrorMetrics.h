@@ -14,11 +14,36 @@ inline constexpr double kRelMseEpsilon = 0.01;
 
 struct EstimatedError {
     double rmse = 0.0;   ///< sqrt(mean over values of Var[mean])
-    double relMse = 0.0; ///< mean of Var[mean] / (mean^2 + epsilon)
+    double relMse = 0.0; ///< mean of Var[mean] / (max(|mean| - sigma, 0)^2 + epsilon), sigma = sqrt(Var[mean])
+    /// A one-sided upper confidence bound on relMse (kRelMseConfidence): relMse
+    /// times nu / chi2_{1 - confidence}(nu), nu its degrees of freedom below.
+    double relMseUpper = 0.0;
+    /// relMse's effective degrees of freedom (Welch-Satterthwaite over the
+    /// values' terms, each with the per-pixel variance's degrees of freedom):
+    /// few where a handful of pixels carry the estimate, many where it is spread.
+    double degreesOfFreedom = 0.0;
 };
 
-/// From per-pixel variance of the mean; non-finite variances are skipped.
-EstimatedError estimateError(const Image& mean, const Image& varianceOfMean);
+/// The confidence of EstimatedError::relMseUpper, the bound --target-error stops on.
+inline constexpr double kRelMseConfidence = 0.95;
+
+/// From per-pixel variance of the mean, estimated with `pixelDegreesOfFreedom`
+/// (VARIANCE_BATCHES - 1 from batch means, spp - 1 from independent samples);
+/// non-finite values and variances are skipped.
+///
+/// The relMSE's denominator is the true value squared, which the render only
+/// estimates. Its own mean squared overstates it where a rare bright sample
+/// (a firefly) raised both mean and variance, and so understates the error
+/// exactly where it is largest (measured: 3-8x too low on the glossy
+/// validation scenes). The value one standard error below the mean is a lower
+/// confidence bound on the true value; squared, it keeps a firefly pixel's
+/// term large and converges to the mean as the noise falls (docs/convergence.md).
+EstimatedError estimateError(const Image& mean, const Image& varianceOfMean, double pixelDegreesOfFreedom);
+
+/// nu / chi2_{1 - confidence}(nu): a variance estimated with nu degrees of
+/// freedom times this is its one-sided upper confidence bound (1 at nu = inf,
+/// +inf at nu <= 0).
+double varianceUpperFactor(double degreesOfFreedom, double confidence);
 
 struct MeasuredError {
     double rmse = 0.0;

@@ -18,10 +18,10 @@ bool interrupted(const StopRules& rules) { return rules.interrupt && rules.inter
 /// Frames for the next submission: about kTargetSubmitSeconds of work, never
 /// past the next checkpoint or the spp limit, and never (by the measured
 /// frame time) past the time budget.
-uint32_t framesForNextBatch(uint32_t batch, uint32_t done, const StopRules& rules, double elapsed,
+uint32_t framesForNextBatch(uint32_t batch, uint32_t done, uint32_t checkpoint, const StopRules& rules, double elapsed,
                             double secondsPerFrame)
 {
-    uint32_t frames = std::min({batch, rules.maxSpp - done, nextCheckpoint(done) - done});
+    uint32_t frames = std::min({batch, rules.maxSpp - done, checkpoint - done});
     if (rules.timeBudgetSeconds && secondsPerFrame > 0.0) {
         // Spend half the remaining time per batch, and go one frame at a time
         // at the end, so that a slow frame overshoots the budget by itself only.
@@ -47,6 +47,15 @@ uint32_t nextCheckpoint(uint32_t spp)
     return next;
 }
 
+std::optional<uint32_t> sppExpectedToMeet(uint32_t spp, double bound, double target, uint32_t granularity)
+{
+    if (!std::isfinite(bound) || !(bound > target) || !(target > 0.0) || granularity == 0) return std::nullopt;
+    double expected = std::ceil(double(spp) * bound / target * 1.05 / granularity) * granularity;
+    double ahead = (double(spp) / granularity + 1.0) * granularity;
+    double next = std::min(std::max(expected, ahead), double(1u << 31));
+    return uint32_t(next);
+}
+
 std::string stopReasonName(StopReason reason)
 {
     switch (reason) {
@@ -64,6 +73,7 @@ LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules, const std::
     LoopResult result;
     BatchPacer pacer(kTargetSubmitSeconds);
     double secondsPerFrame = 0.0;
+    std::optional<uint32_t> requested; // a checkpoint the handler asked for
     while (true) {
         uint32_t done = renderer.completedFrames();
         if (done >= rules.maxSpp) break;
@@ -75,7 +85,10 @@ LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules, const std::
             result.reason = StopReason::TimeBudget;
             break;
         }
-        uint32_t frames = framesForNextBatch(pacer.nextFrames(), done, rules, result.renderSeconds, secondsPerFrame);
+        uint32_t checkpoint = nextCheckpoint(done);
+        if (requested && *requested > done) checkpoint = std::min(checkpoint, *requested);
+        uint32_t frames =
+            framesForNextBatch(pacer.nextFrames(), done, checkpoint, rules, result.renderSeconds, secondsPerFrame);
         auto start = Clock::now();
         renderer.renderFrames(frames);
         double seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -84,11 +97,14 @@ LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules, const std::
         pacer.record(frames, seconds);
         done = renderer.completedFrames();
         if (onProgress) onProgress(done);
-        bool atCheckpoint = (done & (done - 1)) == 0 || done == rules.maxSpp;
-        if (atCheckpoint && onCheckpoint && onCheckpoint(done, result.renderSeconds)) {
+        bool atCheckpoint = done == checkpoint || done == rules.maxSpp;
+        if (!atCheckpoint || !onCheckpoint) continue;
+        CheckpointDecision decision = onCheckpoint(done, result.renderSeconds);
+        if (decision.stop) {
             result.reason = StopReason::TargetError;
             break;
         }
+        requested = decision.nextSpp;
     }
     return result;
 }

@@ -2,8 +2,9 @@
 // Drives a Renderer until a stop rule fires. Frames are batched into
 // submissions of about a quarter second (so progress and Ctrl-C stay
 // responsive without paying a submission per frame), and batches end exactly
-// at the checkpoints 1, 2, 4, 8, ... spp, where convergence reports and the
-// target-error rule look at the image.
+// at the checkpoints 1, 2, 4, 8, ... spp (and where the target-error rule
+// expects its target met), where convergence reports and the target-error
+// rule look at the image.
 #include "render/Renderer.h"
 
 #include <atomic>
@@ -54,9 +55,17 @@ private:
     uint32_t m_frames = 1;
 };
 
-/// Called at every checkpoint (spp a power of two, and the final spp) with
-/// the render time so far; returning true stops the render (target reached).
-using CheckpointHandler = std::function<bool(uint32_t spp, double renderSeconds)>;
+/// What a checkpoint handler decides: stop (target reached), or go on, with
+/// an extra checkpoint at `nextSpp` where it expects the target to be met
+/// (one before the next power of two; the loop ignores one not ahead of it).
+struct CheckpointDecision {
+    bool stop = false;
+    std::optional<uint32_t> nextSpp;
+};
+
+/// Called at every checkpoint (spp a power of two, one a handler asked for,
+/// and the final spp) with the render time so far.
+using CheckpointHandler = std::function<CheckpointDecision(uint32_t spp, double renderSeconds)>;
 
 LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules,
                          const std::function<void(uint32_t framesDone)>& onProgress = {},
@@ -64,5 +73,12 @@ LoopResult runRenderLoop(Renderer& renderer, const StopRules& rules,
 
 /// The next power of two strictly above `spp`.
 uint32_t nextCheckpoint(uint32_t spp);
+
+/// Where an error bound of `bound` at `spp` should fall to `target`: a
+/// relMSE falls as 1 / spp, so at spp * bound / target; aimed 5 % past that,
+/// rounded up to a multiple of `granularity` (the variance batches, so that
+/// they stay equal) and at least one granule ahead. None for a bound that is
+/// not finite (no estimate yet) or already at the target.
+std::optional<uint32_t> sppExpectedToMeet(uint32_t spp, double bound, double target, uint32_t granularity);
 
 } // namespace vkrt

@@ -138,13 +138,21 @@ void RenderSession::startAfresh()
     m_stoppedBy.reset();
 }
 
-bool RenderSession::atCheckpoint(const RunHooks& hooks, uint32_t spp, double seconds) const
+CheckpointDecision RenderSession::atCheckpoint(const RunHooks& hooks, uint32_t spp, double seconds) const
 {
     const std::optional<double>& target = m_config.stop.targetRelMse;
-    if (!hooks.onCheckpoint && !target) return false; // no read-back needed
+    if (!hooks.onCheckpoint && !target) return {}; // no read-back needed
     Film current = film();
     if (hooks.onCheckpoint) hooks.onCheckpoint(spp, seconds, current);
-    return target && current.estimated && current.estimated->relMse < *target;
+    if (!target || !current.estimated) return {};
+    // The bound, not the point estimate: the estimate at few samples is
+    // noisy, and stopping on it broke the target in most runs (docs/convergence.md).
+    const double bound = current.estimated->relMseUpper;
+    if (bound < *target) return {true, std::nullopt};
+    // Look again where the bound should meet the target, not only at the
+    // next doubling (which would cost up to twice the samples needed).
+    const uint32_t granularity = sampler() == Sampler::Sobol ? gpu::VARIANCE_BATCHES : 1;
+    return {false, sppExpectedToMeet(spp, bound, *target, granularity)};
 }
 
 LoopResult RenderSession::run(const RunHooks& hooks)
@@ -207,7 +215,7 @@ Film RenderSession::film() const
     Film film{m_renderer->mean(), std::nullopt, std::nullopt};
     if (m_renderer->variant().variance) {
         film.variance = m_renderer->varianceOfMean();
-        film.estimated = estimateError(film.mean, *film.variance);
+        film.estimated = estimateError(film.mean, *film.variance, double(m_renderer->varianceDegreesOfFreedom()));
     }
     return film;
 }
@@ -247,6 +255,7 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
     if (film.estimated) {
         metadata["estimatedRmse"] = film.estimated->rmse;
         metadata["estimatedRelMse"] = film.estimated->relMse;
+        metadata["estimatedRelMseUpper"] = film.estimated->relMseUpper;
     }
     if (m_config.stop.timeBudgetSeconds) metadata["timeBudgetSeconds"] = *m_config.stop.timeBudgetSeconds;
     if (m_config.stop.targetRelMse) metadata["targetRelMse"] = *m_config.stop.targetRelMse;

@@ -141,7 +141,7 @@ private:
 
     void createRenderer();
     void startAfresh();
-    bool atCheckpoint(const RunHooks& hooks, uint32_t spp, double seconds) const;
+    CheckpointDecision atCheckpoint(const RunHooks& hooks, uint32_t spp, double seconds) const;
 };
 
 // ---------------------------------------------------------------- Ctrl-C

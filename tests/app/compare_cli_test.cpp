@@ -33,7 +33,7 @@ protected:
 
 struct CsvRow {
     uint32_t spp;
-    double seconds, estRmse, estRelMse;
+    double seconds, estRmse, estRelMse, estRelMseUpper, estDegreesOfFreedom;
 };
 
 std::vector<CsvRow> readReport(const fs::path& path)
@@ -44,7 +44,8 @@ std::vector<CsvRow> readReport(const fs::path& path)
     while (std::getline(in, line)) {
         if (line.empty() || line[0] == '#' || line.rfind("spp", 0) == 0) continue;
         CsvRow r{};
-        std::sscanf(line.c_str(), "%u,%lf,%lf,%lf", &r.spp, &r.seconds, &r.estRmse, &r.estRelMse);
+        std::sscanf(line.c_str(), "%u,%lf,%lf,%lf,%lf,%lf", &r.spp, &r.seconds, &r.estRmse, &r.estRelMse,
+                    &r.estRelMseUpper, &r.estDegreesOfFreedom);
         rows.push_back(r);
     }
     return rows;
@@ -141,18 +142,23 @@ TEST_F(StatsCli, CompareRefusesLyingHeadersQuicklyAndInLittleMemory)
     }
 }
 
-TEST_F(StatsCli, TargetErrorStopsAtTheFirstCheckpointBelowIt)
+// It stops on the estimate's upper confidence bound, not on the estimate.
+TEST_F(StatsCli, TargetErrorStopsAtTheFirstCheckpointWhoseUpperBoundIsBelowIt)
 {
     ProcessResult r = render("t.exr", {"--target-error", "0.02", "--report", (m_dir / "t.csv").string()});
     ASSERT_EQ(r.exitCode, 0) << r.output;
     auto rows = readReport(m_dir / "t.csv");
     ASSERT_GE(rows.size(), 2u);
-    for (size_t i = 0; i + 1 < rows.size(); ++i) EXPECT_GE(rows[i].estRelMse, 0.02) << "spp " << rows[i].spp;
-    EXPECT_LT(rows.back().estRelMse, 0.02);
+    for (size_t i = 0; i + 1 < rows.size(); ++i) EXPECT_GE(rows[i].estRelMseUpper, 0.02) << "spp " << rows[i].spp;
+    EXPECT_LT(rows.back().estRelMseUpper, 0.02);
+    EXPECT_LT(rows.back().estRelMse, rows.back().estRelMseUpper);
+    EXPECT_GT(rows.back().estDegreesOfFreedom, 0.0);
     ExrContents exr = readExr(m_dir / "t.exr");
     EXPECT_EQ(std::get<std::string>(exr.metadata.at("stoppedBy")), "target-error");
     EXPECT_EQ(std::get<int64_t>(exr.metadata.at("spp")), int64_t(rows.back().spp));
-    EXPECT_LT(std::get<double>(exr.metadata.at("estimatedRelMse")), 0.02);
+    EXPECT_LT(std::get<double>(exr.metadata.at("estimatedRelMseUpper")), 0.02);
+    const double upper = std::get<double>(exr.metadata.at("estimatedRelMseUpper"));
+    EXPECT_NEAR(upper, rows.back().estRelMseUpper, 1e-8 * upper) << "the CSV's 9 digits";
 }
 
 TEST_F(StatsCli, TimeBudgetStopsWithinOneFrame)
@@ -180,7 +186,9 @@ TEST_F(StatsCli, ReportHasGeometricRowsAndTheLast)
     std::stringstream text;
     text << in.rdbuf();
     EXPECT_NE(text.str().find("startup_seconds="), std::string::npos);
-    EXPECT_NE(text.str().find("spp,seconds,est_rmse,est_relmse,rmse,relmse,mape"), std::string::npos) << text.str();
+    EXPECT_NE(text.str().find("spp,seconds,est_rmse,est_relmse,est_relmse_upper,est_dof,rmse,relmse,mape"),
+              std::string::npos)
+        << text.str();
     auto rows = readReport(m_dir / "r.csv");
     std::vector<uint32_t> spps;
     for (const auto& row : rows) spps.push_back(row.spp);

@@ -210,6 +210,11 @@ TEST_F(Json, RenderReportsTheErrorEstimateTheExrRecords)
     EXPECT_EQ(doc["errorEstimate"]["relMse"].get<double>(), attribute<double>(exr.metadata, "estimatedRelMse"));
     EXPECT_EQ(doc["errorEstimate"]["degreesOfFreedom"], attribute<int64_t>(exr.metadata, "varianceDegreesOfFreedom"));
     EXPECT_EQ(doc["errorEstimate"]["estimator"], "independent-samples");
+    EXPECT_EQ(doc["errorEstimate"]["relMseUpper"].get<double>(),
+              attribute<double>(exr.metadata, "estimatedRelMseUpper"));
+    EXPECT_GT(doc["errorEstimate"]["relMseUpper"].get<double>(), doc["errorEstimate"]["relMse"].get<double>());
+    EXPECT_EQ(doc["errorEstimate"]["relMseConfidence"], 0.95);
+    EXPECT_GT(doc["errorEstimate"]["relMseDegreesOfFreedom"].get<double>(), 0.0);
     EXPECT_EQ(doc["outputs"]["exrLayers"], json::array({"variance"}));
     EXPECT_EQ(doc["outputs"]["png"], (m_dir / "a.png").string());
 }

@@ -100,8 +100,11 @@ protected:
         for (uint32_t spp = 1; spp <= 1024; spp *= 2) {
             renderer.renderFrames(spp - renderer.completedFrames());
             Image mean = renderer.mean();
-            errors.push_back({spp, std::pow(measureError(mean, exact).rmse, 2),
-                              std::pow(estimateError(mean, renderer.varianceOfMean()).rmse, 2)});
+            errors.push_back(
+                {spp, std::pow(measureError(mean, exact).rmse, 2),
+                 std::pow(
+                     estimateError(mean, renderer.varianceOfMean(), double(renderer.varianceDegreesOfFreedom())).rmse,
+                     2)});
         }
         return errors;
     }

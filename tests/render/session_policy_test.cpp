@@ -187,6 +187,18 @@ TEST(BatchPacer, GrowsAtMostTwofoldTowardsTheTargetAndShrinksAtOnce)
     EXPECT_EQ(pacer.nextFrames(), 1u);
 }
 
+// The target-error rule looks again where the bound should meet the target
+// (relMSE ~ 1 / spp), 5 % past it, on a whole number of batches.
+TEST(TargetErrorSchedule, NextCheckpointIsWhereTheBoundShouldMeetTheTarget)
+{
+    EXPECT_EQ(sppExpectedToMeet(64, 0.02, 0.01, 8), 136u);  // 128 * 1.05 = 134.4, up to a multiple of 8
+    EXPECT_EQ(sppExpectedToMeet(64, 0.0101, 0.01, 8), 72u); // at least one batch round ahead
+    EXPECT_EQ(sppExpectedToMeet(3, 0.5, 0.1, 1), 16u);      // 15.75 samples
+    EXPECT_EQ(sppExpectedToMeet(64, 0.01, 0.01, 8), std::nullopt) << "already met";
+    EXPECT_EQ(sppExpectedToMeet(64, INFINITY, 0.01, 8), std::nullopt) << "no estimate yet";
+    EXPECT_EQ(sppExpectedToMeet(1u << 30, 1e6, 1e-6, 8), 1u << 31) << "clamped";
+}
+
 // ---------------------------------------------------------------- Ctrl-C
 
 std::atomic<int> g_previousHandlerCalls{0};
