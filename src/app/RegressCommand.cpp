@@ -1,6 +1,7 @@
 // `vkrt regress`: the regression suite (src/regress/RegressionRun.cpp).
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
+#include "app/InjectOption.h"
 #include "io/OutputPaths.h"
 #include "regress/RegressionRun.h"
 #include "util/Error.h"
@@ -113,10 +114,12 @@ CommandRunner addRegressCommand(CLI::App& app)
                   "Run every case with both traversal backends (--accel own and driver) and compare their images "
                   "and times");
     addAccelOption(*cmd, o->accel);
+    addInjectOption(*cmd, o->injectFault);
     cmd->add_option("--kernel-define", *defines, "NAME=VALUE define for every kernel (test hooks)")->group("");
     addChildOptions(cmd, *o, *extras);
     return [o, defines, extras] {
         applyExtras(*o, *extras);
+        o->injectFault = applyInjectOption(o->injectFault); // before any case: the children inherit it
         if (!o->runCase) checkRegressFiles(*o);
         o->kernelDefines = parseKernelDefines(*defines);
         return exitCodeFor(runRegression(*o));

@@ -3,6 +3,7 @@
 // accumulated, with its true spp in the metadata.
 #include "app/Commands.h"
 #include "app/ExitCodes.h"
+#include "app/InjectOption.h"
 #include "app/JsonOutput.h"
 #include "io/AtomicFile.h"
 #include "io/ExrFile.h"
@@ -61,6 +62,7 @@ struct RenderCommandOptions {
     std::string shard;                      ///< "i/n" (docs/farm.md)
     uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
+    std::string injectFault;                ///< --inject: a SPIR-V fault (gpu/SpirvFault.h)
     uint64_t maxBandBytes = 0;              ///< test hook: bands of at most this many bytes per buffer
     uint64_t maxTextureChunkBytes = 0;      ///< test hook: texel buffers of at most this many bytes
     std::vector<std::string> aovs;          ///< --aov albedo,normal,depth,position
@@ -578,7 +580,11 @@ CommandRunner addRenderCommand(CLI::App& app)
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40))
         ->group("");
     addTextureChunkOption(*cmd, options->maxTextureChunkBytes);
-    return [options] { return exitCodeFor(runRender(*options)); };
+    addInjectOption(*cmd, options->injectFault);
+    return [options] {
+        applyInjectOption(options->injectFault);
+        return exitCodeFor(runRender(*options));
+    };
 }
 
 } // namespace vkrt

@@ -1,9 +1,11 @@
 #include "gpu/ComputeKernel.h"
 
+#include "gpu/SpirvFault.h"
 #include "shared/Bindings.h"
 #include "util/Error.h"
 
 #include <algorithm>
+#include <optional>
 
 namespace vkrt {
 
@@ -30,6 +32,13 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
       m_pushConstantSize(pushConstantSize)
 {
     const auto& device = context.device();
+    // The fault injector (gpu/SpirvFault.h) changes only what the driver
+    // runs: the SPIR-V cache keeps the kernel as compiled.
+    std::vector<uint32_t> faulty;
+    if (std::optional<SpirvFault> fault = spirvFaultFromEnvironment()) {
+        faulty = injectSpirvFault(spirv, *fault);
+        spirv = faulty;
+    }
     m_module = vk::raii::ShaderModule(device, vk::ShaderModuleCreateInfo({}, spirv.size_bytes(), spirv.data()));
 
     std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;

@@ -330,7 +330,8 @@ private:
             writeBytesAtomically(dir / "failures.csv", resultsCsv(lines, true));
             writeBytesAtomically(dir / "compare.csv", compareCsv());
         }
-        if (!m_options.junit.empty()) writeBytesAtomically(m_options.junit, junitReport(lines));
+        if (!m_options.junit.empty())
+            writeBytesAtomically(m_options.junit, junitReport(lines, junitProperties(m_options.injectFault)));
     }
 };
 

@@ -291,7 +291,8 @@ private:
             writeText(dir / "results.csv", resultsCsv(lines, false));
             writeText(dir / "failures.csv", resultsCsv(lines, true));
         }
-        if (!m_options.junit.empty()) writeText(m_options.junit, junitReport(lines));
+        if (!m_options.junit.empty())
+            writeText(m_options.junit, junitReport(lines, junitProperties(m_options.injectFault)));
     }
 };
 
@@ -306,6 +307,7 @@ RunDescription describeRun(const VulkanContext& context, const RegressionSuite& 
     run.jobs = jobsFor(options);
     run.accel = accelChoiceName(options.accel);
     run.kernelDefines = options.kernelDefines;
+    run.injectFault = options.injectFault;
     run.baseline = options.baseline;
     run.flakes = options.flakes;
     run.skips = options.skips;
@@ -379,6 +381,8 @@ void refuseContradictions(const RegressOptions& options)
     if (options.update && !options.kernelDefines.empty())
         throw InputError(
             "--update cannot be combined with --kernel-define: references must come from unmodified kernels");
+    if (options.update && !options.injectFault.empty())
+        throw InputError("--update cannot be combined with --inject: references must come from unmodified kernels");
     const bool expectations = !options.baseline.empty() || !options.flakes.empty() || !options.skips.empty();
     if (options.update && expectations)
         throw InputError("--update renders the references of the --filter'ed cases; it takes no --baseline, "

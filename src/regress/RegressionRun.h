@@ -27,6 +27,7 @@ struct RegressOptions {
     bool failOnSlowdown = false;
     AccelChoice accel = AccelChoice::Auto;   ///< --accel: the traversal backend of every case
     std::vector<Define> kernelDefines;       ///< test hooks: build every kernel with these
+    std::string injectFault;                 ///< --inject: the SPIR-V fault every kernel runs with (gpu/SpirvFault.h)
     std::optional<unsigned> jobs;            ///< --jobs: child processes at once, 0: in this process (default: jobsFor)
     std::optional<double> caseTimeout;       ///< --case-timeout: seconds per case process (default: caseTimeoutSeconds)
     std::filesystem::path baseline;          ///< --baseline: expected failures, `case-name,Status` lines

@@ -82,6 +82,7 @@ std::string markdownHeader(const RegressionSuite& suite, const std::vector<CaseR
        << jobsLine(run.jobs) << "- accel: " << run.accel << "\n";
     for (const Define& d : run.kernelDefines)
         md << "- kernel define (test hook): `" << d.first << "=" << d.second << "`\n";
+    if (!run.injectFault.empty()) md << "- injected SPIR-V fault: `" << run.injectFault << "`\n";
     md << expectationsLine(run) << "- rule: " << ruleDescription(suite) << "\n- result: **" << statusCounts(lines)
        << "**, " << unexpectedCount(lines) << " unexpected";
     if (results.size() < status.total)
@@ -191,7 +192,14 @@ std::string resultsCsv(const std::vector<StatusLine>& lines, bool unexpectedOnly
     return csv;
 }
 
-std::string junitReport(const std::vector<StatusLine>& lines)
+std::vector<std::pair<std::string, std::string>> junitProperties(const std::string& injectFault)
+{
+    if (injectFault.empty()) return {};
+    return {{"inject", injectFault}};
+}
+
+std::string junitReport(const std::vector<StatusLine>& lines,
+                        const std::vector<std::pair<std::string, std::string>>& properties)
 {
     std::ostringstream xml;
     size_t failures = 0, errors = 0, skipped = 0;
@@ -205,6 +213,12 @@ std::string junitReport(const std::vector<StatusLine>& lines)
     xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuite name=\"vkrt-regress\" tests=\"" << lines.size()
         << "\" failures=\"" << failures << "\" errors=\"" << errors << "\" skipped=\"" << skipped << "\" time=\""
         << total << "\">\n";
+    if (!properties.empty()) {
+        xml << "  <properties>\n";
+        for (const auto& [name, value] : properties)
+            xml << "    <property name=\"" << xmlEscape(name) << "\" value=\"" << xmlEscape(value) << "\"/>\n";
+        xml << "  </properties>\n";
+    }
     for (const StatusLine& l : lines) {
         xml << "  <testcase classname=\"vkrt.regress\" name=\"" << xmlEscape(l.name) << "\" time=\"" << l.duration
             << "\"";

@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vkrt {
@@ -30,6 +31,7 @@ struct RunDescription {
     unsigned jobs = 0;          ///< child processes at once; 0: in this process
     std::string accel;          ///< --accel
     std::vector<Define> kernelDefines;
+    std::string injectFault; ///< --inject: the SPIR-V fault injected, or empty
     std::filesystem::path baseline, flakes, skips;
     const Expectations* expectations = nullptr;
 };
@@ -60,8 +62,13 @@ std::string resultsCsv(const std::vector<StatusLine>& lines, bool unexpectedOnly
 
 /// One <testcase> per line: a <failure> for Fail and UnexpectedPass, an
 /// <error> for Crash and Timeout, <skipped/> for Skip; the rest pass (a
-/// Flake's or ExpectedFail's story in <system-out>).
-std::string junitReport(const std::vector<StatusLine>& lines);
+/// Flake's or ExpectedFail's story in <system-out>). The run's `properties`
+/// (name, value), if any, go in the suite's <properties>.
+std::string junitReport(const std::vector<StatusLine>& lines,
+                        const std::vector<std::pair<std::string, std::string>>& properties = {});
+
+/// The JUnit properties of a run: the injected SPIR-V fault, if any.
+std::vector<std::pair<std::string, std::string>> junitProperties(const std::string& injectFault);
 
 std::string markdownReport(const RegressionSuite& suite, const std::vector<CaseResult>& results, RunStatus status,
                            const RunDescription& run);

@@ -1,0 +1,57 @@
+#pragma once
+// A SPIR-V fault injector: a shim between vkrt and the driver. It rewrites the
+// SPIR-V handed to vkCreateShaderModule so that the driver runs subtly wrong
+// arithmetic, to measure how much driver breakage `vkrt regress` catches
+// (`vkrt regress --inject FAULT`). Pure functions on SPIR-V words, no Vulkan.
+//
+// Faults (one at a time):
+//   scale:CLASS:EPS  every 32-bit float (scalar or vector) result of CLASS is
+//                    multiplied by 1 + EPS (|EPS| < 1); CLASS is FMul, FAdd,
+//                    FSub, FDiv, or a GLSL.std.450 instruction: Sqrt,
+//                    InverseSqrt, Exp, Log, Pow, Sin, Cos, Atan2, Acos, Exp2,
+//                    Log2, Fma
+//   compare:lt-le    < and <= swapped (ordered and unordered)
+//   compare:gt-ge    > and >= swapped (ordered and unordered)
+//   nan-minmax       GLSL.std.450 FMin/FMax/NMin/NMax become a < b ? a : b
+//                    and a > b ? a : b (b when a is NaN)
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace vkrt {
+
+enum class SpirvFaultKind { Scale, Compare, NanMinMax };
+
+/// One fault to inject, as parseSpirvFault reads it.
+struct SpirvFault {
+    SpirvFaultKind kind = SpirvFaultKind::Scale;
+    std::string spec; ///< as written, e.g. "scale:FMul:0.1"
+    /// Scale: the instruction, a core opcode, or OpExtInst (12) with a GLSL.std.450 number.
+    uint32_t opcode = 0;
+    uint32_t extInstruction = 0;
+    double epsilon = 0.0;
+    /// Compare: opcode pairs exchanged with each other.
+    std::vector<std::pair<uint32_t, uint32_t>> swaps;
+};
+
+/// The environment variable that makes every ComputeKernel inject a fault.
+inline constexpr const char* kInjectFaultVariable = "VKRT_INJECT_FAULT";
+
+/// Reads a fault spec (grammar above); InputError naming the bad part and the valid choices.
+SpirvFault parseSpirvFault(const std::string& spec);
+
+/// The module with `fault` injected (a valid module again, its id bound
+/// raised as needed); `changed` receives the number of instructions changed.
+/// Throws InternalError for words that are not a SPIR-V module.
+std::vector<uint32_t> injectSpirvFault(std::span<const uint32_t> spirv, const SpirvFault& fault,
+                                       size_t* changed = nullptr);
+
+/// The fault $VKRT_INJECT_FAULT names, if set and not empty; an InputError
+/// naming the variable if it is not a fault. Read at every call (kernels are
+/// made rarely), so a test may change it between kernels.
+std::optional<SpirvFault> spirvFaultFromEnvironment();
+
+} // namespace vkrt

@@ -1,0 +1,111 @@
+// The SPIR-V fault injector (gpu/SpirvFault.h) on the device: a kernel made
+// while $VKRT_INJECT_FAULT names a fault runs the changed arithmetic, exactly
+// (1 + EPS) times the clean result in float32, and `vkrt regress --inject`
+// refuses a bad fault as a usage error naming the option.
+#include "gpu/SpirvFault.h"
+#include "support/ProbeKernel.h"
+#include "support/TestSupport.h"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vkrt::test {
+namespace {
+
+/// Sets $VKRT_INJECT_FAULT (unset for nullopt) for its lifetime, then restores it.
+class InjectedFault {
+public:
+    explicit InjectedFault(const std::optional<std::string>& spec)
+    {
+        if (const char* old = std::getenv(kInjectFaultVariable)) m_previous = old;
+        if (spec) setenv(kInjectFaultVariable, spec->c_str(), 1);
+        else unsetenv(kInjectFaultVariable);
+    }
+    ~InjectedFault()
+    {
+        if (m_previous) setenv(kInjectFaultVariable, m_previous->c_str(), 1);
+        else unsetenv(kInjectFaultVariable);
+    }
+    InjectedFault(const InjectedFault&) = delete;
+    InjectedFault& operator=(const InjectedFault&) = delete;
+
+private:
+    std::optional<std::string> m_previous;
+};
+
+// (x, y) pairs; outputs are (x * y, sqrt(x), min(x, y), max(x, y)) each.
+const std::vector<float> kInputs{2.0f, 3.0f, 0.7f, 1.3f, 10.0f, -0.25f, 1e-3f, 12345.678f, 0.5f, 0.5f};
+constexpr uint32_t kPairs = 5;
+
+std::vector<float> runProbeWith(const std::optional<std::string>& fault)
+{
+    InjectedFault injected(fault);
+    return runProbe("spirv_fault_probe", kInputs, 4 * kPairs, kPairs);
+}
+
+/// Distance in units in the last place between two finite floats of one sign.
+int64_t ulps(float a, float b)
+{
+    return std::abs(int64_t(std::bit_cast<int32_t>(a)) - int64_t(std::bit_cast<int32_t>(b)));
+}
+
+/// Output `slot` of each pair is (1 + eps) times the clean one, within 1 ulp; the others are unchanged.
+void expectScaled(const std::vector<float>& clean, const std::vector<float>& faulty, size_t slot, double eps)
+{
+    const float factor = float(1.0 + eps);
+    for (size_t i = 0; i < kPairs; ++i)
+        for (size_t k = 0; k < 4; ++k) {
+            const float expected = k == slot ? clean[4 * i + k] * factor : clean[4 * i + k];
+            EXPECT_LE(ulps(faulty[4 * i + k], expected), 1)
+                << "pair " << i << " output " << k << ": " << faulty[4 * i + k] << " expected " << expected;
+        }
+}
+
+TEST(SpirvFaultProbe, ScaledResultsAreExactlyOnePlusEpsTimesTheCleanOnes)
+{
+    const std::vector<float> clean = runProbeWith(std::nullopt);
+    for (size_t i = 0; i < kPairs; ++i) {
+        const float x = kInputs[2 * i], y = kInputs[2 * i + 1];
+        EXPECT_LE(ulps(clean[4 * i], x * y), 1) << i;
+        if (x >= 0) {
+            EXPECT_LE(ulps(clean[4 * i + 1], std::sqrt(x)), 3) << i; // GLSL's sqrt: 3 ulp
+        }
+    }
+    expectScaled(clean, runProbeWith("scale:FMul:0.1"), 0, 0.1);
+    expectScaled(clean, runProbeWith("scale:Sqrt:-0.01"), 1, -0.01);
+    expectScaled(clean, runProbeWith("scale:FMul:0"), 0, 0.0); // the injector alone changes nothing
+    EXPECT_EQ(runProbeWith(std::nullopt), clean) << "a kernel made after the variable is unset is clean";
+}
+
+TEST(SpirvFaultProbe, NanMinMaxReturnsTheSecondOperandForNaN)
+{
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    InjectedFault injected("nan-minmax");
+    std::vector<float> out = runProbe("spirv_fault_probe", {1.0f, nan, 2.0f, 3.0f}, 8, 2);
+    EXPECT_TRUE(std::isnan(out[2])) << "min(1, NaN) with the fault: 1 < NaN is false, so NaN";
+    EXPECT_TRUE(std::isnan(out[3])) << "max(1, NaN) with the fault";
+    EXPECT_EQ(out[6], 2.0f);
+    EXPECT_EQ(out[7], 3.0f);
+}
+
+TEST(SpirvFaultCli, BadFaultIsAUsageErrorNamingTheOption)
+{
+    ProcessResult r = runVkrt({"regress", "--inject", "bogus"});
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--inject"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("'bogus'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("scale:CLASS:EPS"), std::string::npos) << r.output;
+    r = runVkrt({"regress", "--inject", "scale:FMul:0.1", "--update", "--filter", "no-such-case"});
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--update cannot be combined with --inject"), std::string::npos) << r.output;
+}
+
+} // namespace
+} // namespace vkrt::test

@@ -1,0 +1,310 @@
+// The SPIR-V fault injector (gpu/SpirvFault.h) on modules glslang compiles,
+// no device needed: specs are read or refused with messages that name the
+// problem, each fault changes exactly the instructions it names, and the
+// result is still a valid module (SPIRV-Tools' validator, where the build
+// has it).
+#include "gpu/ShaderCompiler.h"
+#include "gpu/SpirvFault.h"
+#include "render/KernelVariant.h"
+#include "support/TestSupport.h"
+#include "util/Error.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#ifdef VKRT_HAVE_SPIRV_TOOLS
+#include <spirv-tools/libspirv.hpp>
+#endif
+
+namespace vkrt::test {
+namespace {
+
+// ---------------------------------------------------------------- specs
+
+void expectSpecError(const std::string& spec, const std::vector<std::string>& fragments)
+{
+    try {
+        parseSpirvFault(spec);
+        ADD_FAILURE() << "'" << spec << "' was accepted";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        for (const std::string& f : fragments) EXPECT_NE(message.find(f), std::string::npos) << f << "\n" << message;
+    }
+}
+
+TEST(SpirvFaultSpec, ReadsEveryForm)
+{
+    SpirvFault mul = parseSpirvFault("scale:FMul:0.1");
+    EXPECT_EQ(mul.kind, SpirvFaultKind::Scale);
+    EXPECT_EQ(mul.opcode, 133u);
+    EXPECT_DOUBLE_EQ(mul.epsilon, 0.1);
+    EXPECT_EQ(mul.spec, "scale:FMul:0.1");
+    SpirvFault sqrt = parseSpirvFault("scale:Sqrt:-1e-3");
+    EXPECT_EQ(sqrt.opcode, 12u);
+    EXPECT_EQ(sqrt.extInstruction, 31u);
+    EXPECT_DOUBLE_EQ(sqrt.epsilon, -1e-3);
+    EXPECT_EQ(parseSpirvFault("scale:Fma:0.5").extInstruction, 50u);
+    EXPECT_EQ(parseSpirvFault("compare:lt-le").kind, SpirvFaultKind::Compare);
+    EXPECT_EQ(parseSpirvFault("compare:gt-ge").swaps.size(), 2u);
+    EXPECT_EQ(parseSpirvFault("nan-minmax").kind, SpirvFaultKind::NanMinMax);
+}
+
+TEST(SpirvFaultSpec, RefusalsNameTheProblemAndTheChoices)
+{
+    expectSpecError("bogus", {"'bogus'", "unknown fault", "scale:CLASS:EPS", "compare:lt-le", "nan-minmax"});
+    expectSpecError("", {"unknown fault"});
+    expectSpecError("scale:FMull:0.1", {"unknown instruction class 'FMull'", "FMul", "InverseSqrt", "Fma"});
+    expectSpecError("scale:FMul", {"scale:CLASS:EPS"});
+    expectSpecError("scale:FMul:0.1:2", {"scale:CLASS:EPS"});
+    expectSpecError("scale:FMul:", {"EPS ''", "|EPS| < 1"});
+    expectSpecError("scale:FMul:1", {"EPS 1 is out of range", "|EPS| < 1"});
+    expectSpecError("scale:FMul:-1.5", {"out of range"});
+    expectSpecError("scale:FMul:inf", {"EPS 'inf'", "finite"});
+    expectSpecError("scale:FMul:0.1x", {"EPS '0.1x'"});
+    expectSpecError("compare", {"compare:lt-le", "compare:gt-ge"});
+    expectSpecError("compare:lt-ge", {"'lt-ge'", "compare:lt-le", "compare:gt-ge"});
+    expectSpecError("nan-minmax:1", {"no arguments"});
+}
+
+TEST(SpirvFaultSpec, EnvironmentIsReadAtEachCallAndNamedInErrors)
+{
+    unsetenv(kInjectFaultVariable);
+    EXPECT_FALSE(spirvFaultFromEnvironment());
+    setenv(kInjectFaultVariable, "compare:gt-ge", 1);
+    ASSERT_TRUE(spirvFaultFromEnvironment());
+    EXPECT_EQ(spirvFaultFromEnvironment()->spec, "compare:gt-ge");
+    setenv(kInjectFaultVariable, "scale:Nope:0.1", 1);
+    try {
+        spirvFaultFromEnvironment();
+        ADD_FAILURE() << "a bad value was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("VKRT_INJECT_FAULT"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'Nope'"), std::string::npos) << e.what();
+    }
+    setenv(kInjectFaultVariable, "", 1);
+    EXPECT_FALSE(spirvFaultFromEnvironment());
+    unsetenv(kInjectFaultVariable);
+}
+
+// ---------------------------------------------------------------- modules
+
+/// Two float multiplications (a float and a vec3 one), a sqrt, comparisons
+/// and scalar and vector min/max, on values the compiler cannot fold.
+std::vector<uint32_t> compileSample()
+{
+    const auto root = freshTempDir("spirv-fault") / "shaders";
+    writeText(root / "kernels/sample.comp", R"(#version 460
+layout(local_size_x = 1) in;
+layout(std430, binding = 0) buffer Data { vec4 v[]; };
+void main()
+{
+    float a = v[0].x, b = v[0].y;
+    vec3 p = v[1].xyz, q = v[2].xyz;
+    float s = a * b;
+    vec3 r = p * q;
+    float t = sqrt(a);
+    v[3] = vec4(r, s + t);
+    v[4] = vec4(a < b ? 1.0 : 0.0, a <= b ? 1.0 : 0.0, min(a, b), max(a, b));
+    v[5] = vec4(min(p, q), 0.0);
+    v[6] = vec4(max(p, q), 0.0);
+}
+)");
+    return compileGlsl(KernelSource{root, "kernels/sample.comp", {}});
+}
+
+const std::vector<uint32_t>& sample()
+{
+    static const std::vector<uint32_t> spirv = compileSample();
+    return spirv;
+}
+
+struct Inst {
+    size_t offset;
+    uint32_t opcode, words;
+};
+
+std::vector<Inst> instructions(const std::vector<uint32_t>& spirv)
+{
+    std::vector<Inst> list;
+    for (size_t at = 5; at < spirv.size(); at += spirv[at] >> 16) {
+        list.push_back({at, spirv[at] & 0xffff, spirv[at] >> 16});
+        if ((spirv[at] >> 16) == 0) break;
+    }
+    return list;
+}
+
+size_t countOpcode(const std::vector<uint32_t>& spirv, uint32_t opcode)
+{
+    auto list = instructions(spirv);
+    return size_t(std::count_if(list.begin(), list.end(), [&](const Inst& i) { return i.opcode == opcode; }));
+}
+
+/// OpExtInst instructions of GLSL.std.450 number `instruction` (the module imports only that set).
+size_t countGlsl(const std::vector<uint32_t>& spirv, uint32_t instruction)
+{
+    auto list = instructions(spirv);
+    return size_t(std::count_if(list.begin(), list.end(), [&](const Inst& i) {
+        return i.opcode == 12 && i.words >= 5 && spirv[i.offset + 4] == instruction;
+    }));
+}
+
+/// SPIRV-Tools' verdict on a module ("" when valid), or "" without SPIRV-Tools.
+std::string validationErrors(const std::vector<uint32_t>& spirv)
+{
+#ifdef VKRT_HAVE_SPIRV_TOOLS
+    spvtools::SpirvTools tools(SPV_ENV_VULKAN_1_2); // glslang targets Vulkan 1.2 (gpu/ShaderCompiler.cpp)
+    std::string messages;
+    tools.SetMessageConsumer([&](spv_message_level_t, const char*, const spv_position_t&, const char* message) {
+        messages += std::string(message) + "\n";
+    });
+    spvtools::ValidatorOptions options;
+    options.SetScalarBlockLayout(true); // as the device is asked for (GL_EXT_scalar_block_layout)
+    return tools.Validate(spirv.data(), spirv.size(), options) ? "" : messages.empty() ? "invalid" : messages;
+#else
+    (void)spirv;
+    return "";
+#endif
+}
+
+constexpr uint32_t kFMul = 133, kSelect = 169, kFOrdLessThan = 184, kFOrdLessThanEqual = 188;
+constexpr uint32_t kSqrt = 31, kFMin = 37, kFMax = 40;
+
+TEST(SpirvFault, TheSampleIsValidAndHasWhatTheTestsExpect)
+{
+#ifdef VKRT_HAVE_SPIRV_TOOLS
+    std::vector<uint32_t> broken = sample();
+    broken[3] = 2; // an id bound below the ids used
+    EXPECT_NE(validationErrors(broken), "") << "the validator must see a broken module";
+#else
+    std::cout << "SPIRV-Tools not in this build: modules are not validated\n";
+#endif
+    EXPECT_EQ(validationErrors(sample()), "");
+    EXPECT_EQ(countOpcode(sample(), kFMul), 2u);
+    EXPECT_EQ(countGlsl(sample(), kSqrt), 1u);
+    EXPECT_EQ(countOpcode(sample(), kFOrdLessThan), 1u);
+    EXPECT_EQ(countOpcode(sample(), kFOrdLessThanEqual), 1u);
+    EXPECT_EQ(countGlsl(sample(), kFMin) + countGlsl(sample(), kFMax), 4u);
+}
+
+TEST(SpirvFault, ScaleFollowsEachMultiplicationWithOneMore)
+{
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(sample(), parseSpirvFault("scale:FMul:0.1"), &changed);
+    EXPECT_EQ(changed, 2u);
+    EXPECT_EQ(countOpcode(out, kFMul), 4u);
+    // Two unscaled results, the float constant 1.1 and its vec3.
+    EXPECT_EQ(out[3], sample()[3] + 4);
+    EXPECT_EQ(countOpcode(out, 43) - countOpcode(sample(), 43), 1u);
+    EXPECT_EQ(countOpcode(out, 44) - countOpcode(sample(), 44), 1u);
+    EXPECT_EQ(out.size(), sample().size() + 2 * 5 + 4 + 6);
+    EXPECT_EQ(validationErrors(out), "");
+    // Each new multiplication takes the instruction before it as its operand.
+    auto list = instructions(out);
+    for (size_t k = 1; k < list.size(); ++k)
+        if (list[k].opcode == kFMul && list[k - 1].opcode == kFMul) {
+            EXPECT_EQ(out[list[k].offset + 3], out[list[k - 1].offset + 2]);
+            EXPECT_EQ(out[list[k].offset + 1], out[list[k - 1].offset + 1]);
+        }
+}
+
+TEST(SpirvFault, ScaleOfAnExtendedInstruction)
+{
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(sample(), parseSpirvFault("scale:Sqrt:-0.01"), &changed);
+    EXPECT_EQ(changed, 1u);
+    EXPECT_EQ(countOpcode(out, kFMul), 3u);
+    EXPECT_EQ(countGlsl(out, kSqrt), 1u);
+    EXPECT_EQ(out[3], sample()[3] + 2);
+    EXPECT_EQ(validationErrors(out), "");
+    EXPECT_EQ(injectSpirvFault(sample(), parseSpirvFault("scale:Exp:0.1"), &changed), sample());
+    EXPECT_EQ(changed, 0u) << "no exp in the sample: nothing changes";
+}
+
+TEST(SpirvFault, CompareSwapsOpcodesAndNothingElse)
+{
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(sample(), parseSpirvFault("compare:lt-le"), &changed);
+    EXPECT_EQ(changed, 2u);
+    ASSERT_EQ(out.size(), sample().size());
+    size_t differing = 0;
+    for (const Inst& i : instructions(sample())) {
+        for (size_t w = 0; w < i.words; ++w) {
+            if (out[i.offset + w] == sample()[i.offset + w]) continue;
+            ++differing;
+            EXPECT_EQ(w, 0u) << "only opcodes change";
+            EXPECT_TRUE(i.opcode == kFOrdLessThan || i.opcode == kFOrdLessThanEqual) << i.opcode;
+        }
+    }
+    EXPECT_EQ(differing, 2u);
+    EXPECT_TRUE(std::equal(out.begin(), out.begin() + 5, sample().begin())) << "the header is kept";
+    EXPECT_EQ(countOpcode(out, kFOrdLessThan), 1u);
+    EXPECT_EQ(validationErrors(out), "");
+    EXPECT_EQ(injectSpirvFault(out, parseSpirvFault("compare:lt-le")), sample()) << "swapping twice restores";
+    injectSpirvFault(sample(), parseSpirvFault("compare:gt-ge"), &changed);
+    EXPECT_EQ(changed, 0u) << "the sample has no > or >=";
+}
+
+TEST(SpirvFault, NanMinMaxBecomesCompareAndSelect)
+{
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(sample(), parseSpirvFault("nan-minmax"), &changed);
+    EXPECT_EQ(changed, 4u);
+    EXPECT_EQ(countGlsl(out, kFMin) + countGlsl(out, kFMax), 0u);
+    EXPECT_EQ(countOpcode(out, kSelect) - countOpcode(sample(), kSelect), 4u);
+    EXPECT_EQ(countOpcode(out, kFOrdLessThan), 1u + 2u);
+    EXPECT_EQ(countOpcode(out, 186), 2u) << "max: OpFOrdGreaterThan";
+    EXPECT_EQ(validationErrors(out), "");
+}
+
+// Every fault on the path tracer's all-features kernel: the module stays valid,
+// and the common instructions are found.
+TEST(SpirvFault, EveryFaultKeepsTheRenderKernelValid)
+{
+    KernelVariant variant{FeatureSet::everything(Integrator::Path)};
+    variant.variance = true;
+    const std::vector<uint32_t> kernel =
+        compileGlsl(KernelSource{defaultShaderRoot(), "kernels/render.comp", variant.defines()});
+    ASSERT_EQ(validationErrors(kernel), "");
+    const std::vector<std::string> classes{"FMul", "FAdd", "FSub", "FDiv",  "Sqrt", "InverseSqrt", "Exp",  "Log",
+                                           "Pow",  "Sin",  "Cos",  "Atan2", "Acos", "Exp2",        "Log2", "Fma"};
+    std::vector<std::string> specs{"compare:lt-le", "compare:gt-ge", "nan-minmax"};
+    for (const std::string& c : classes) specs.push_back("scale:" + c + ":-0.001");
+    for (const std::string& spec : specs) {
+        size_t changed = 0;
+        std::vector<uint32_t> out = injectSpirvFault(kernel, parseSpirvFault(spec), &changed);
+        EXPECT_EQ(validationErrors(out), "") << spec;
+        const bool common = spec.find("FMul") != std::string::npos || spec.find("compare") != std::string::npos;
+        if (common || spec == "nan-minmax") {
+            EXPECT_GT(changed, 0u) << spec;
+        }
+    }
+}
+
+TEST(SpirvFault, MalformedModulesAreRefused)
+{
+    const SpirvFault fault = parseSpirvFault("scale:FMul:0.1");
+    std::vector<uint32_t> words = sample();
+    words[0] = 0x03022307;
+    EXPECT_THROW(injectSpirvFault(words, fault), InternalError) << "byte-swapped magic";
+    EXPECT_THROW(injectSpirvFault(std::vector<uint32_t>(sample().begin(), sample().begin() + 4), fault), InternalError);
+    words = sample();
+    words[5] &= 0xffff; // a word count of zero
+    EXPECT_THROW(injectSpirvFault(words, fault), InternalError);
+    words = sample();
+    words[5] |= 0xfff0u << 16; // the first instruction runs past the end
+    EXPECT_THROW(injectSpirvFault(words, fault), InternalError);
+    // An instruction nobody knows is copied as it is.
+    words = sample();
+    words.push_back(2u << 16 | 0xfffe);
+    words.push_back(7);
+    std::vector<uint32_t> out = injectSpirvFault(words, parseSpirvFault("compare:gt-ge"));
+    EXPECT_EQ(out, words);
+}
+
+} // namespace
+} // namespace vkrt::test
