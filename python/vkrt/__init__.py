@@ -169,9 +169,10 @@ class Result:
     (height, width, 3) and ``depth`` (height, width), each when asked for.
     Absent arrays are None. ``metadata`` holds what the EXR's header gets.
     ``error_estimate`` is the image's estimated error, ``{"rmse": ...,
-    "rel_mse": ..., "rel_mse_upper": ...}`` (the last a 95 % upper confidence
-    bound on rel_mse, the value ``target_error`` stops on), when the render estimated variance (``variance=True``
-    or ``target_error``), else None. ``spp``, ``render_seconds`` (rendering
+    "rel_mse": ..., "rel_mse_upper": ...}`` (the last a 95 % upper
+    confidence bound on rel_mse, the value ``target_error`` stops on), when
+    the render estimated variance (``variance=True`` or ``target_error``),
+    else None. ``spp``, ``render_seconds`` (rendering
     only: no start-up or kernel compile), ``stopped_by`` ("spp",
     "time-budget", "target-error", "interrupted") and ``interrupted``
     describe the run.
@@ -296,7 +297,9 @@ def render(scene, spp=None, width=None, height=None, seed=0, sampler="auto", int
     - ``device``: a device index or a case-insensitive part of its name
       (as listed by :func:`devices`); "" picks the default.
     - ``time_budget``: stop after this many seconds of rendering.
-    - ``target_error``: stop once the estimated relative MSE is below this.
+    - ``target_error``: stop once the 95 % upper confidence bound on the
+      estimated relative MSE is below this (docs/convergence.md: the true
+      relMSE then meets it in at least 95 % of runs).
     - ``variance``: also estimate each pixel's variance (``result.variance``).
     - ``aovs``: any of "albedo", "normal", "depth", "position".
     - ``accel``: the traversal backend, "auto", "own" or "driver".

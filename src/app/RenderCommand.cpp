@@ -531,7 +531,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_option("--time-budget", options->timeBudget, "Stop after this many seconds of rendering")
         ->check(positiveFiniteNumber("seconds"));
     cmd->add_option("--target-error", options->targetError,
-                    "Stop once the estimated relMSE falls below this (checked at 1, 2, 4, ... spp)")
+                    "Stop once the estimated relMSE's 95 % upper bound falls below this (the true relMSE then "
+                    "meets it in 95 % of runs: docs/convergence.md)")
         ->check(positiveFiniteNumber("relMSE"));
     cmd->add_option("--report", options->report, "Write a convergence CSV (error against time, docs/convergence.md)");
     cmd->add_option("--json", options->json,
