@@ -32,7 +32,8 @@ void addInjectOption(CLI::App& command, std::string& fault)
                     "Inject a SPIR-V fault into every kernel the driver runs, to measure what the tests catch: "
                     "scale:CLASS:EPS (CLASS's float results x (1 + EPS); FMul, FAdd, FSub, FDiv, Sqrt, "
                     "InverseSqrt, Exp, Log, Pow, Sin, Cos, Atan2, Acos, Exp2, Log2, Fma), compare:lt-le, "
-                    "compare:gt-ge (swap < and <=, > and >=), nan-minmax (min/max mishandle NaN)")
+                    "compare:gt-ge (swap < and <=, > and >=), nan-minmax (min/max mishandle NaN), or the legal "
+                    "variation contract (a * b + c fused into fma where not precise)")
         ->check(CLI::Validator(checkFault, ""))
         ->type_name("FAULT");
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <utility>
 
 namespace vkrt {
@@ -21,7 +22,8 @@ constexpr size_t kBoundWord = 3;
 /// The opcodes the faults read or write (SPIR-V specification, section 3.52).
 namespace op {
 constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeBool = 20, TypeFloat = 22, TypeVector = 23, Constant = 43,
-                   ConstantComposite = 44, Function = 54, FAdd = 129, FSub = 131, FMul = 133, FDiv = 136, Select = 169,
+                   ConstantComposite = 44, Function = 54, Decorate = 71, FNegate = 127, FAdd = 129, FSub = 131,
+                   FMul = 133, FDiv = 136, Select = 169,
                    FOrdLessThan = 184, FUnordLessThan = 185, FOrdGreaterThan = 186, FUnordGreaterThan = 187,
                    FOrdLessThanEqual = 188, FUnordLessThanEqual = 189, FOrdGreaterThanEqual = 190,
                    FUnordGreaterThanEqual = 191;
@@ -29,8 +31,10 @@ constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeBool = 20, TypeFloat = 
 
 /// GLSL.std.450 extended instruction numbers.
 namespace glsl {
-constexpr uint32_t FMin = 37, FMax = 40, NMin = 79, NMax = 80;
+constexpr uint32_t FMin = 37, FMax = 40, Fma = 50, NMin = 79, NMax = 80;
 } // namespace glsl
+
+constexpr uint32_t kNoContraction = 42; ///< SPIR-V decoration
 
 struct ScaleClass {
     const char* name;
@@ -47,7 +51,7 @@ constexpr ScaleClass kScaleClasses[] = {
     {"Fma", op::ExtInst, 50},
 };
 
-constexpr const char* kFaultChoices = "scale:CLASS:EPS, compare:lt-le, compare:gt-ge or nan-minmax";
+constexpr const char* kFaultChoices = "scale:CLASS:EPS, compare:lt-le, compare:gt-ge, nan-minmax or contract";
 
 uint32_t firstWord(uint32_t wordCount, uint32_t opcode) { return wordCount << 16 | opcode; }
 
@@ -196,6 +200,11 @@ private:
     uint32_t m_boolType = 0;
     std::map<uint32_t, uint32_t> m_boolVectors;    ///< component count -> type id
     std::map<uint32_t, uint32_t> m_scaleConstants; ///< type id -> its 1 + EPS
+    std::set<uint32_t> m_precise;                  ///< ids decorated NoContraction
+    /// Contractible float multiplies seen so far: result id -> its two operands
+    /// (a definition precedes its uses in a module's order, so an add's product is known).
+    std::map<uint32_t, std::pair<uint32_t, uint32_t>> m_products;
+    std::map<uint32_t, uint32_t> m_productTypes; ///< result id -> type id
     std::vector<uint32_t> m_declarations, m_body;
     std::optional<size_t> m_firstFunction; ///< where in m_body
 
@@ -224,6 +233,7 @@ private:
         else if (opcode == op::TypeFloat && inst.size() >= 3) m_floatTypes[inst[1]] = {inst[2], 1, inst[1]};
         else if (opcode == op::TypeBool && inst.size() >= 2) m_boolType = inst[1];
         else if (opcode == op::TypeVector && inst.size() >= 4) noteVector(inst[1], inst[2], inst[3]);
+        else if (opcode == op::Decorate && inst.size() >= 3 && inst[2] == kNoContraction) m_precise.insert(inst[1]);
     }
 
     void noteVector(uint32_t id, uint32_t component, uint32_t count)
@@ -240,6 +250,7 @@ private:
         case SpirvFaultKind::Scale: return scale(inst);
         case SpirvFaultKind::Compare: return swapCompare(inst);
         case SpirvFaultKind::NanMinMax: return replaceMinMax(inst);
+        case SpirvFaultKind::Contract: return contract(inst);
         }
         return false;
     }
@@ -280,6 +291,41 @@ private:
             m_declarations.insert(m_declarations.end(), type.components, component);
         }
         return m_scaleConstants[typeId] = id;
+    }
+
+    // ---- contract: `p = x * y; r = p + c` becomes `r = Fma(x, y, c)`; `r = p - c`
+    // becomes `n = -c; r = Fma(x, y, n)`. The product stays (other uses, if any).
+
+    bool contract(std::span<const uint32_t> inst)
+    {
+        const uint32_t opcode = inst[0] & 0xffff;
+        if (inst.size() != 5 || m_glslSet == 0 || !m_floatTypes.count(inst[1]) || m_precise.count(inst[2]))
+            return false;
+        if (opcode == op::FMul) {
+            m_products[inst[2]] = {inst[3], inst[4]};
+            m_productTypes[inst[2]] = inst[1];
+            return false;
+        }
+        if (opcode != op::FAdd && opcode != op::FSub) return false;
+        const uint32_t type = inst[1], result = inst[2];
+        const bool firstIsProduct = isProductOf(inst[3], type);
+        const bool secondIsProduct = opcode == op::FAdd && isProductOf(inst[4], type);
+        if (!firstIsProduct && !secondIsProduct) return false;
+        const auto [x, y] = m_products.at(firstIsProduct ? inst[3] : inst[4]);
+        uint32_t addend = firstIsProduct ? inst[4] : inst[3];
+        if (opcode == op::FSub) {
+            const uint32_t negated = freshId();
+            emit({firstWord(4, op::FNegate), type, negated, addend});
+            addend = negated;
+        }
+        emit({firstWord(8, op::ExtInst), type, result, m_glslSet, glsl::Fma, x, y, addend});
+        return true;
+    }
+
+    bool isProductOf(uint32_t id, uint32_t type) const
+    {
+        auto product = m_productTypes.find(id);
+        return product != m_productTypes.end() && product->second == type;
     }
 
     // ---- compare: one opcode for another
@@ -333,6 +379,10 @@ SpirvFault parseSpirvFault(const std::string& spec)
     const std::vector<std::string> parts = splitAtColons(spec);
     if (parts[0] == "scale") return scaleFault(spec, parts);
     if (parts[0] == "compare") return compareFault(spec, parts);
+    if (parts[0] == "contract") {
+        if (parts.size() != 1) badSpec(spec, "contract takes no arguments");
+        return SpirvFault{SpirvFaultKind::Contract, spec};
+    }
     if (parts[0] == "nan-minmax") {
         if (parts.size() != 1) badSpec(spec, "nan-minmax takes no arguments");
         return SpirvFault{SpirvFaultKind::NanMinMax, spec};

@@ -14,6 +14,10 @@
 //   compare:gt-ge    > and >= swapped (ordered and unordered)
 //   nan-minmax       GLSL.std.450 FMin/FMax/NMin/NMax become a < b ? a : b
 //                    and a > b ? a : b (b when a is NaN)
+//   contract         a legal variation, not a fault: a float multiply whose
+//                    only purpose is an add (a*b + c, c + a*b, a*b - c) is
+//                    fused into GLSL.std.450 Fma where neither instruction is
+//                    NoContraction (`precise`), as SPIR-V lets a driver do
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -23,7 +27,7 @@
 
 namespace vkrt {
 
-enum class SpirvFaultKind { Scale, Compare, NanMinMax };
+enum class SpirvFaultKind { Scale, Compare, NanMinMax, Contract };
 
 /// One fault to inject, as parseSpirvFault reads it.
 struct SpirvFault {

@@ -225,6 +225,29 @@ TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
     EXPECT_FALSE(fs::exists(report / "seed_baseline-result.png"));
 }
 
+// The suite's power in CI (docs/regress.md, "injected faults"): a 5 % error in
+// every float multiply the driver runs is caught by both glass cases, and the
+// legal variation `contract` (products fused into adds where SPIR-V allows it:
+// what Mesa 26 does and Mesa 25 does not) passes them. The fault reaches the
+// children, and report.md and the JUnit file record it.
+TEST_F(RegressCli, AnInjectedFaultIsCaughtAndALegalContractionIsNot)
+{
+    fs::path junit = m_dir / "junit.xml", report = m_dir / "faulty";
+    ProcessResult r = regress({"--filter", "extreme/kappa-", "--inject", "scale:FMul:0.05", "--junit",
+                               junit.string(), "--report-dir", report.string()});
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    std::map<std::string, std::string> outcome = junitOutcomes(junit);
+    EXPECT_EQ(outcome.size(), 2u) << r.output;
+    EXPECT_EQ(outcome["extreme/kappa-halfspace"], "failure") << r.output;
+    EXPECT_EQ(outcome["extreme/kappa-shadow"], "failure") << r.output;
+    EXPECT_NE(readFile(report / "report.md").find("scale:FMul:0.05"), std::string::npos);
+    EXPECT_NE(readFile(junit).find("scale:FMul:0.05"), std::string::npos);
+
+    r = regress({"--filter", "extreme/kappa-", "--inject", "contract", "--report-dir", (m_dir / "legal").string()});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(readFile(m_dir / "legal" / "report.md").find("contract"), std::string::npos);
+}
+
 // ------------------------------------------------------------ seed consistency
 
 // Ten runs of a small suite with seed offsets 1..10. Each case of a correct

@@ -52,11 +52,13 @@ TEST(SpirvFaultSpec, ReadsEveryForm)
     EXPECT_EQ(parseSpirvFault("compare:lt-le").kind, SpirvFaultKind::Compare);
     EXPECT_EQ(parseSpirvFault("compare:gt-ge").swaps.size(), 2u);
     EXPECT_EQ(parseSpirvFault("nan-minmax").kind, SpirvFaultKind::NanMinMax);
+    EXPECT_EQ(parseSpirvFault("contract").kind, SpirvFaultKind::Contract);
 }
 
 TEST(SpirvFaultSpec, RefusalsNameTheProblemAndTheChoices)
 {
-    expectSpecError("bogus", {"'bogus'", "unknown fault", "scale:CLASS:EPS", "compare:lt-le", "nan-minmax"});
+    expectSpecError("bogus",
+                    {"'bogus'", "unknown fault", "scale:CLASS:EPS", "compare:lt-le", "nan-minmax", "contract"});
     expectSpecError("", {"unknown fault"});
     expectSpecError("scale:FMull:0.1", {"unknown instruction class 'FMull'", "FMul", "InverseSqrt", "Fma"});
     expectSpecError("scale:FMul", {"scale:CLASS:EPS"});
@@ -69,6 +71,7 @@ TEST(SpirvFaultSpec, RefusalsNameTheProblemAndTheChoices)
     expectSpecError("compare", {"compare:lt-le", "compare:gt-ge"});
     expectSpecError("compare:lt-ge", {"'lt-ge'", "compare:lt-le", "compare:gt-ge"});
     expectSpecError("nan-minmax:1", {"no arguments"});
+    expectSpecError("contract:1", {"no arguments"});
 }
 
 TEST(SpirvFaultSpec, EnvironmentIsReadAtEachCallAndNamedInErrors)
@@ -261,6 +264,52 @@ TEST(SpirvFault, NanMinMaxBecomesCompareAndSelect)
     EXPECT_EQ(validationErrors(out), "");
 }
 
+/// Products that feed additions: plain, precise, subtracted, and one whose
+/// product is used again.
+std::vector<uint32_t> compileContractionSample()
+{
+    const auto root = freshTempDir("spirv-contract") / "shaders";
+    writeText(root / "kernels/contract.comp", R"(#version 460
+layout(local_size_x = 1) in;
+layout(std430, binding = 0) buffer Data { vec4 v[]; };
+void main()
+{
+    float a = v[0].x, b = v[0].y, c = v[0].z;
+    vec3 p = v[1].xyz, q = v[2].xyz, o = v[3].xyz;
+    float plain = c + a * b;
+    vec3 vector = p * q + o;
+    float subtracted = a * c - b;
+    precise float kept = b * c + a;
+    v[4] = vec4(vector, plain);
+    v[5] = vec4(subtracted, kept, 0.0, 0.0);
+}
+)");
+    return compileGlsl(KernelSource{root, "kernels/contract.comp", {}});
+}
+
+constexpr uint32_t kFma = 50, kFNegate = 127, kFAdd = 129, kFSub = 131;
+
+// contract is the legal variation: each product that only feeds an add or a
+// subtraction becomes one Fma, except where `precise` forbids it.
+TEST(SpirvFault, ContractFusesProductsIntoAddsUnlessPrecise)
+{
+    const std::vector<uint32_t> clean = compileContractionSample();
+    ASSERT_EQ(validationErrors(clean), "");
+    ASSERT_EQ(countGlsl(clean, kFma), 0u);
+    ASSERT_EQ(countOpcode(clean, kFAdd), 3u);
+    ASSERT_EQ(countOpcode(clean, kFSub), 1u);
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(clean, parseSpirvFault("contract"), &changed);
+    EXPECT_EQ(changed, 3u) << "c + a*b, p*q + o and a*c - b; not the precise b*c + a";
+    EXPECT_EQ(countGlsl(out, kFma), 3u);
+    EXPECT_EQ(countOpcode(out, kFAdd), 1u) << "the precise addition stays";
+    EXPECT_EQ(countOpcode(out, kFSub), 0u);
+    EXPECT_EQ(countOpcode(out, kFNegate), 1u) << "a*c - b is Fma(a, c, -b)";
+    EXPECT_EQ(validationErrors(out), "");
+    EXPECT_EQ(countGlsl(injectSpirvFault(sample(), parseSpirvFault("contract"), &changed), kFma), 1u);
+    EXPECT_EQ(changed, 1u) << "the sample's s + t, where s = a * b";
+}
+
 // Every fault on the path tracer's all-features kernel: the module stays valid,
 // and the common instructions are found.
 TEST(SpirvFault, EveryFaultKeepsTheRenderKernelValid)
@@ -272,14 +321,14 @@ TEST(SpirvFault, EveryFaultKeepsTheRenderKernelValid)
     ASSERT_EQ(validationErrors(kernel), "");
     const std::vector<std::string> classes{"FMul", "FAdd", "FSub", "FDiv",  "Sqrt", "InverseSqrt", "Exp",  "Log",
                                            "Pow",  "Sin",  "Cos",  "Atan2", "Acos", "Exp2",        "Log2", "Fma"};
-    std::vector<std::string> specs{"compare:lt-le", "compare:gt-ge", "nan-minmax"};
+    std::vector<std::string> specs{"compare:lt-le", "compare:gt-ge", "nan-minmax", "contract"};
     for (const std::string& c : classes) specs.push_back("scale:" + c + ":-0.001");
     for (const std::string& spec : specs) {
         size_t changed = 0;
         std::vector<uint32_t> out = injectSpirvFault(kernel, parseSpirvFault(spec), &changed);
         EXPECT_EQ(validationErrors(out), "") << spec;
         const bool common = spec.find("FMul") != std::string::npos || spec.find("compare") != std::string::npos;
-        if (common || spec == "nan-minmax") {
+        if (common || spec == "nan-minmax" || spec == "contract") {
             EXPECT_GT(changed, 0u) << spec;
         }
     }
