@@ -17,7 +17,10 @@
 //   contract         a legal variation, not a fault: a float multiply whose
 //                    only purpose is an add (a*b + c, c + a*b, a*b - c) is
 //                    fused into GLSL.std.450 Fma where neither instruction is
-//                    NoContraction (`precise`), as SPIR-V lets a driver do
+//                    NoContraction (`precise`), as SPIR-V lets a driver do;
+//                    only where the product is the add's operand itself
+//                    (glslang keeps locals in memory: a product stored to a
+//                    variable first stays apart), a subset of what a driver may fuse
 #include <cstddef>
 #include <cstdint>
 #include <optional>
