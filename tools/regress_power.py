@@ -12,8 +12,11 @@ do: the suite must pass every one; a failure there is a false alarm).
 
 Each fault is one whole suite run (its kernels compile afresh: the faulty
 SPIR-V is new to the driver's cache). A fault is caught when the run fails;
-the table names the cases that failed. The control runs use --seed-offset 1..N
-with no fault: every failure there is a false alarm. Prints a markdown table
+the table names the cases that failed, and how many instructions of the
+suite's kernels the fault changes (a fault with none cannot be caught). A
+clean run comes first (its SPIR-V cache is what that count reads); the
+control runs use --seed-offset 1..N with no fault: every failure there, or
+under a legal variation, is a false alarm. Prints a markdown table
 (docs/regress.md quotes it) and optionally writes JSON.
 """
 from __future__ import annotations
@@ -21,6 +24,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -47,14 +51,80 @@ LADDERS = {
 LEGAL = set(LADDERS["legal"])
 
 
-def run_suite(args, out: Path, extra: list[str]) -> dict:
+# ---------------------------------------------------------------- census
+# How many instructions each fault would change in the kernels the suite
+# runs: a fault with nothing to change cannot be caught, and is reported as
+# such, not as missed. The same rules as src/gpu/SpirvFault.cpp, on the clean
+# SPIR-V that a run with its own VKRT_CACHE_DIR leaves there.
+
+GLSL_NUMBERS = {"Sqrt": 31, "InverseSqrt": 32, "Exp": 27, "Log": 28, "Pow": 26, "Sin": 13, "Cos": 14,
+                "Atan2": 25, "Acos": 17, "Exp2": 29, "Log2": 30, "Fma": 50}
+CORE_OPCODES = {"FMul": 133, "FAdd": 129, "FSub": 131, "FDiv": 136}
+COMPARE_OPCODES = {"lt-le": {184, 185, 188, 189}, "gt-ge": {186, 187, 190, 191}}
+MINMAX_NUMBERS = {37, 40, 79, 80}
+NO_CONTRACTION = 42
+
+
+def instructions(path: Path):
+    """(opcode, operand words) of each instruction of a SPIR-V file."""
+    data = path.read_bytes()
+    words = [int.from_bytes(data[i:i + 4], "little") for i in range(0, len(data) - 3, 4)]
+    if len(words) < 5 or words[0] != 0x07230203:
+        return
+    at = 5
+    while at < len(words):
+        count = words[at] >> 16
+        if count == 0:
+            return
+        yield words[at] & 0xFFFF, words[at + 1:at + count]
+        at += count
+
+
+def count_fault_sites(path: Path, fault: str) -> int:
+    """The instructions `fault` would change in one module."""
+    glsl_set, float32, precise, products = None, set(), set(), {}
+    kind, *rest = fault.split(":")
+    sites = 0
+    for opcode, ops in instructions(path):
+        if opcode == 11 and bytes(b for w in ops[1:] for b in w.to_bytes(4, "little")).rstrip(b"\0") == b"GLSL.std.450":
+            glsl_set = ops[0]
+        elif opcode == 22 and len(ops) >= 2 and ops[1] == 32:
+            float32.add(ops[0])
+        elif opcode == 23 and ops[1] in float32:
+            float32.add(ops[0])
+        elif opcode == 71 and len(ops) >= 2 and ops[1] == NO_CONTRACTION:
+            precise.add(ops[0])
+        elif kind == "scale" and rest and rest[0] in CORE_OPCODES:
+            sites += opcode == CORE_OPCODES[rest[0]] and ops[0] in float32
+        elif kind == "scale" and rest:
+            sites += opcode == 12 and ops[2] == glsl_set and ops[3] == GLSL_NUMBERS[rest[0]] and ops[0] in float32
+        elif kind == "compare" and rest:
+            sites += opcode in COMPARE_OPCODES[rest[0]]
+        elif kind == "nan-minmax":
+            sites += opcode == 12 and ops[2] == glsl_set and ops[3] in MINMAX_NUMBERS
+        elif kind == "contract" and glsl_set is not None and len(ops) == 4 and ops[1] not in precise:
+            if opcode == 133:
+                products[ops[1]] = ops[0]
+            elif opcode in (129, 131):
+                sites += products.get(ops[2]) == ops[0] or (opcode == 129 and products.get(ops[3]) == ops[0])
+    return sites
+
+
+def census(spirv_dir: Path, faults: list[str]) -> dict[str, int]:
+    modules = sorted(spirv_dir.rglob("*.spv"))
+    return {fault: sum(count_fault_sites(m, fault) for m in modules) for fault in faults}
+
+
+# ---------------------------------------------------------------- runs
+
+def run_suite(args, out: Path, extra: list[str], env: dict | None = None) -> dict:
     """One `vkrt regress` run: exit status, failing cases, seconds."""
     out.mkdir(parents=True, exist_ok=True)
     command = [args.vkrt, "regress", "--jobs", str(args.jobs), "--report-dir", str(out), *extra]
     for case in args.filter or []:
         command += ["--filter", case]
     start = time.monotonic()
-    done = subprocess.run(command, capture_output=True, text=True)
+    done = subprocess.run(command, capture_output=True, text=True, env={**os.environ, **(env or {})})
     seconds = time.monotonic() - start
     if done.returncode not in (0, 4):  # 4: a case failed (src/app/ExitCodes.h)
         sys.exit(f"regress_power: {' '.join(command)} exited {done.returncode}:\n{done.stderr[-2000:]}")
@@ -81,29 +151,38 @@ def main() -> int:
     temporary = None if args.out else tempfile.TemporaryDirectory(prefix="vkrt-power-")
     out = Path(args.out or temporary.name)
 
-    rows = []
+    # A clean run first, with a SPIR-V cache of its own: the control at the
+    # suite's own seeds, and the kernels the census counts in.
+    spirv = out / "census-spirv"
+    clean = run_suite(args, out / "clean", [], {"VKRT_CACHE_DIR": str(spirv)})
+    sites = census(spirv, faults)
+    rows = [{"fault": "none", "caught": clean["exit"] != 0, "sites": None, **clean}]
+    print(f"regress_power: clean run: {'FALSE ALARM' if clean['exit'] else 'pass'} ({clean['seconds']} s)",
+          file=sys.stderr)
     for fault in faults:
         result = run_suite(args, out / fault.replace(":", "_"), ["--inject", fault])
-        rows.append({"fault": fault, "caught": result["exit"] != 0, **result})
+        rows.append({"fault": fault, "caught": result["exit"] != 0, "sites": sites[fault], **result})
         verdict = ("FALSE ALARM" if rows[-1]["caught"] else "pass") if fault in LEGAL else \
             ("caught" if rows[-1]["caught"] else "MISSED")
         print(f"regress_power: {fault}: {verdict} "
               f"({len(result['failed'])} cases, {result['seconds']} s)", file=sys.stderr)
     for seed in range(1, args.control_seeds + 1):
         result = run_suite(args, out / f"control-{seed}", ["--seed-offset", str(seed)])
-        rows.append({"fault": f"none (--seed-offset {seed})", "caught": result["exit"] != 0, **result})
+        rows.append({"fault": f"none (--seed-offset {seed})", "caught": result["exit"] != 0, "sites": None,
+                     **result})
         print(f"regress_power: control seed {seed}: {'FALSE ALARM' if rows[-1]['caught'] else 'pass'}",
               file=sys.stderr)
 
-    print("| fault | suite | cases that failed | seconds |")
-    print("| --- | --- | --- | ---: |")
+    print("| fault | instructions it changes | suite | cases that failed | seconds |")
+    print("| --- | ---: | --- | --- | ---: |")
     for row in rows:
         control = row["fault"].startswith("none") or row["fault"] in LEGAL
         verdict = ("false alarm" if row["caught"] else "passes") if control else \
-            ("caught" if row["caught"] else "**missed**")
+            ("caught" if row["caught"] else "not used by the kernels" if row["sites"] == 0 else "**missed**")
         cases = ", ".join(f"`{c}`" for c in row["failed"][:6]) + (" …" if len(row["failed"]) > 6 else "")
-        print(f"| `{row['fault']}` | {verdict} | {len(row['failed'])}: {cases} | {row['seconds']} |"
-              if row["failed"] else f"| `{row['fault']}` | {verdict} | 0 | {row['seconds']} |")
+        sites = "" if row["sites"] is None else str(row["sites"])
+        failed = f"{len(row['failed'])}: {cases}" if row["failed"] else "0"
+        print(f"| `{row['fault']}` | {sites} | {verdict} | {failed} | {row['seconds']} |")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1) + "\n")
     return 0
