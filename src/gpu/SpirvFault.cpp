@@ -23,10 +23,9 @@ constexpr size_t kBoundWord = 3;
 namespace op {
 constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeBool = 20, TypeFloat = 22, TypeVector = 23, Constant = 43,
                    ConstantComposite = 44, Function = 54, Decorate = 71, FNegate = 127, FAdd = 129, FSub = 131,
-                   FMul = 133, FDiv = 136, Select = 169,
-                   FOrdLessThan = 184, FUnordLessThan = 185, FOrdGreaterThan = 186, FUnordGreaterThan = 187,
-                   FOrdLessThanEqual = 188, FUnordLessThanEqual = 189, FOrdGreaterThanEqual = 190,
-                   FUnordGreaterThanEqual = 191;
+                   FMul = 133, FDiv = 136, Select = 169, FOrdLessThan = 184, FUnordLessThan = 185,
+                   FOrdGreaterThan = 186, FUnordGreaterThan = 187, FOrdLessThanEqual = 188, FUnordLessThanEqual = 189,
+                   FOrdGreaterThanEqual = 190, FUnordGreaterThanEqual = 191;
 } // namespace op
 
 /// GLSL.std.450 extended instruction numbers.

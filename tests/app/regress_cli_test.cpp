@@ -233,8 +233,8 @@ TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
 TEST_F(RegressCli, AnInjectedFaultIsCaughtAndALegalContractionIsNot)
 {
     fs::path junit = m_dir / "junit.xml", report = m_dir / "faulty";
-    ProcessResult r = regress({"--filter", "extreme/kappa-", "--inject", "scale:FMul:0.05", "--junit",
-                               junit.string(), "--report-dir", report.string()});
+    ProcessResult r = regress({"--filter", "extreme/kappa-", "--inject", "scale:FMul:0.05", "--junit", junit.string(),
+                               "--report-dir", report.string()});
     EXPECT_EQ(r.exitCode, 4) << r.output;
     std::map<std::string, std::string> outcome = junitOutcomes(junit);
     EXPECT_EQ(outcome.size(), 2u) << r.output;
