@@ -34,7 +34,12 @@ vec2 concentricDisk(vec2 u)
         r = o.y;
         theta = (PI / 2.0) - (PI / 4.0) * (o.x / o.y);
     }
-    return r * vec2(cos(theta), sin(theta));
+    // Vulkan lets a driver's sin and cos be off by 2^-11, so cos^2 + sin^2 may
+    // pass 1 and the point leave the disk: a cosine-weighted direction would
+    // then lie in the tangent plane, with density 0 (NaN weights, found with
+    // `vkrt regress --inject scale:Sin:4.4e-4`). The unit vector is made unit.
+    vec2 direction = vec2(cos(theta), sin(theta));
+    return r * direction * inversesqrt(dot(direction, direction));
 }
 
 // Cosine-weighted hemisphere around n (Malley's method); pdf = cos / pi.
