@@ -27,7 +27,12 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
                                                    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user)
 {
     std::string level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning";
-    static_cast<ValidationLog*>(user)->add("validation " + level + ": " + (data->pMessage ? data->pMessage : ""));
+    std::string message = data->pMessage ? data->pMessage : "";
+    // Newer layers (Debian 13's) keep the message's ID (VUID-..., SYNC-HAZARD-...)
+    // out of its text: it is named here, so that logs and tests can look for it.
+    if (data->pMessageIdName && *data->pMessageIdName && message.find(data->pMessageIdName) == std::string::npos)
+        message = "[" + std::string(data->pMessageIdName) + "] " + message;
+    static_cast<ValidationLog*>(user)->add("validation " + level + ": " + message);
     return VK_FALSE;
 }
 

@@ -102,8 +102,13 @@ void DisplayPass::recordBlit(vk::CommandBuffer cmd, vk::Image target, vk::Extent
 {
     using Layout = vk::ImageLayout;
     using Stage = vk::PipelineStageFlagBits;
+    // The submission waits for the swapchain image at the transfer stage, so
+    // the layout transition starts there too: from TOP_OF_PIPE it would not be
+    // chained to that wait and could run before the presentation engine has
+    // let go of the image (a WRITE_AFTER_READ hazard that Debian 13's
+    // synchronization validation reports).
     imageBarrier(cmd, target, Layout::eUndefined, Layout::eTransferDstOptimal, {}, vk::AccessFlagBits::eTransferWrite,
-                 Stage::eTopOfPipe, Stage::eTransfer);
+                 Stage::eTransfer, Stage::eTransfer);
     cmd.clearColorImage(target, Layout::eTransferDstOptimal, vk::ClearColorValue(std::array<float, 4>{0, 0, 0, 1}),
                         kColorRange);
     imageBarrier(cmd, target, Layout::eTransferDstOptimal, Layout::eTransferDstOptimal,
