@@ -96,16 +96,23 @@ TEST(SpirvFaultSpec, EnvironmentIsReadAtEachCallAndNamedInErrors)
 
 // ---------------------------------------------------------------- modules
 
+/// A one-invocation kernel over `vec4 v[]` whose main() is `body`, compiled by glslang.
+std::vector<uint32_t> compileKernelBody(const std::string& name, const std::string& body)
+{
+    const auto root = freshTempDir("spirv-fault-" + name) / "shaders";
+    writeText(root / ("kernels/" + name + ".comp"), "#version 460\n"
+                                                    "layout(local_size_x = 1) in;\n"
+                                                    "layout(std430, binding = 0) buffer Data { vec4 v[]; };\n"
+                                                    "void main()\n{\n" +
+                                                        body + "}\n");
+    return compileGlsl(KernelSource{root, "kernels/" + name + ".comp", {}});
+}
+
 /// Two float multiplications (a float and a vec3 one), a sqrt, comparisons
 /// and scalar and vector min/max, on values the compiler cannot fold.
 std::vector<uint32_t> compileSample()
 {
-    const auto root = freshTempDir("spirv-fault") / "shaders";
-    writeText(root / "kernels/sample.comp", R"(#version 460
-layout(local_size_x = 1) in;
-layout(std430, binding = 0) buffer Data { vec4 v[]; };
-void main()
-{
+    return compileKernelBody("sample", R"(
     float a = v[0].x, b = v[0].y;
     vec3 p = v[1].xyz, q = v[2].xyz;
     float s = a * b;
@@ -115,9 +122,7 @@ void main()
     v[4] = vec4(a < b ? 1.0 : 0.0, a <= b ? 1.0 : 0.0, min(a, b), max(a, b));
     v[5] = vec4(min(p, q), 0.0);
     v[6] = vec4(max(p, q), 0.0);
-}
 )");
-    return compileGlsl(KernelSource{root, "kernels/sample.comp", {}});
 }
 
 const std::vector<uint32_t>& sample()
@@ -268,12 +273,7 @@ TEST(SpirvFault, NanMinMaxBecomesCompareAndSelect)
 /// product is used again.
 std::vector<uint32_t> compileContractionSample()
 {
-    const auto root = freshTempDir("spirv-contract") / "shaders";
-    writeText(root / "kernels/contract.comp", R"(#version 460
-layout(local_size_x = 1) in;
-layout(std430, binding = 0) buffer Data { vec4 v[]; };
-void main()
-{
+    return compileKernelBody("contract", R"(
     float a = v[0].x, b = v[0].y, c = v[0].z;
     vec3 p = v[1].xyz, q = v[2].xyz, o = v[3].xyz;
     float plain = c + a * b;
@@ -285,9 +285,7 @@ void main()
     precise float kept = i * 1.5 + 0.25;
     v[4] = vec4(vector, plain);
     v[5] = vec4(subtracted, kept, 0.0, 0.0);
-}
 )");
-    return compileGlsl(KernelSource{root, "kernels/contract.comp", {}});
 }
 
 constexpr uint32_t kFma = 50, kFNegate = 127, kFAdd = 129, kFSub = 131;
