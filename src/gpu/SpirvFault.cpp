@@ -21,12 +21,19 @@ constexpr size_t kBoundWord = 3;
 
 /// The opcodes the faults read or write (SPIR-V specification, section 3.52).
 namespace op {
-constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeBool = 20, TypeFloat = 22, TypeVector = 23, Constant = 43,
-                   ConstantComposite = 44, Function = 54, Decorate = 71, FNegate = 127, FAdd = 129, FSub = 131,
-                   FMul = 133, FDiv = 136, Select = 169, FOrdLessThan = 184, FUnordLessThan = 185,
-                   FOrdGreaterThan = 186, FUnordGreaterThan = 187, FOrdLessThanEqual = 188, FUnordLessThanEqual = 189,
-                   FOrdGreaterThanEqual = 190, FUnordGreaterThanEqual = 191;
+constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeVoid = 19, TypeBool = 20, TypeInt = 21, TypeFloat = 22,
+                   TypeVector = 23, TypeRuntimeArray = 29, TypeStruct = 30, TypePointer = 32, TypeForwardPointer = 39,
+                   Constant = 43, ConstantComposite = 44, Function = 54, Variable = 59, Load = 61,
+                   AccessChain = 65, InBoundsAccessChain = 66, Decorate = 71, CompositeConstruct = 80,
+                   CompositeExtract = 81, ImageFetch = 95, Bitcast = 124, FNegate = 127, IAdd = 128, FAdd = 129,
+                   FSub = 131, IMul = 132, FMul = 133, FDiv = 136, UMod = 137, VectorTimesScalar = 142,
+                   Select = 169, IEqual = 170, FOrdLessThan = 184, FUnordLessThan = 185, FOrdGreaterThan = 186,
+                   FUnordGreaterThan = 187, FOrdLessThanEqual = 188, FUnordLessThanEqual = 189,
+                   FOrdGreaterThanEqual = 190, FUnordGreaterThanEqual = 191, ShiftRightLogical = 194,
+                   BitwiseXor = 198, RayQueryGetIntersectionT = 6018;
 } // namespace op
+
+constexpr uint32_t kStorageBufferClass = 12; ///< SPIR-V storage class
 
 /// GLSL.std.450 extended instruction numbers.
 namespace glsl {
@@ -47,10 +54,11 @@ constexpr ScaleClass kScaleClasses[] = {
     {"Exp", op::ExtInst, 27},  {"Log", op::ExtInst, 28},  {"Pow", op::ExtInst, 26},
     {"Sin", op::ExtInst, 13},  {"Cos", op::ExtInst, 14},  {"Atan2", op::ExtInst, 25},
     {"Acos", op::ExtInst, 17}, {"Exp2", op::ExtInst, 29}, {"Log2", op::ExtInst, 30},
-    {"Fma", op::ExtInst, 50},
+    {"Fma", op::ExtInst, 50},  {"RayQueryT", op::RayQueryGetIntersectionT, 0},
 };
 
-constexpr const char* kFaultChoices = "scale:CLASS:EPS, compare:lt-le, compare:gt-ge, nan-minmax or contract";
+constexpr const char* kFaultChoices = "scale:CLASS:EPS[:1inN], compare:lt-le, compare:gt-ge, nan-minmax, "
+                                      "neighbour-load[:1inN], texel-offset[:1inN] or contract";
 
 uint32_t firstWord(uint32_t wordCount, uint32_t opcode) { return wordCount << 16 | opcode; }
 
@@ -96,16 +104,41 @@ double epsilonOf(const std::string& spec, const std::string& text)
     return eps;
 }
 
+/// N of a "1inN" part: a whole number from 1 to 2^31.
+uint32_t oneInOf(const std::string& spec, const std::string& text)
+{
+    const std::string rule = " (write 1inN with N a whole number from 1 to 2147483648, e.g. 1in1000)";
+    if (text.rfind("1in", 0) != 0 || text.size() == 3) badSpec(spec, "'" + text + "' is not 1inN" + rule);
+    const std::string digits = text.substr(3);
+    if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 10)
+        badSpec(spec, "'" + text + "' is not 1inN" + rule);
+    const unsigned long long n = std::stoull(digits);
+    if (n < 1 || n > (1ull << 31)) badSpec(spec, "N in '" + text + "' is out of range" + rule);
+    return uint32_t(n);
+}
+
 SpirvFault scaleFault(const std::string& spec, const std::vector<std::string>& parts)
 {
-    if (parts.size() != 3)
-        badSpec(spec, "scale takes an instruction class and EPS: scale:CLASS:EPS, e.g. scale:FMul:0.01 (classes: " +
+    if (parts.size() != 3 && parts.size() != 4)
+        badSpec(spec, "scale takes an instruction class, EPS and optionally 1inN: scale:CLASS:EPS[:1inN], e.g. "
+                      "scale:FMul:0.01 or scale:FMul:0.5:1in1000 (classes: " +
                           scaleClassNames() + ")");
     const ScaleClass& c = scaleClassNamed(spec, parts[1]);
     SpirvFault fault{SpirvFaultKind::Scale, spec};
     fault.opcode = c.opcode;
     fault.extInstruction = c.extInstruction;
     fault.epsilon = epsilonOf(spec, parts[2]);
+    if (parts.size() == 4) fault.oneIn = oneInOf(spec, parts[3]);
+    return fault;
+}
+
+/// neighbour-load[:1inN] and texel-offset[:1inN].
+SpirvFault offsetFault(const std::string& spec, const std::vector<std::string>& parts, SpirvFaultKind kind)
+{
+    if (parts.size() > 2) badSpec(spec, parts[0] + " takes at most 1inN: " + parts[0] + "[:1inN], e.g. " + parts[0] +
+                                            ":1in100");
+    SpirvFault fault{kind, spec};
+    if (parts.size() == 2) fault.oneIn = oneInOf(spec, parts[1]);
     return fault;
 }
 
@@ -163,6 +196,20 @@ struct FloatType {
     uint32_t scalar = 0; ///< the component type's id
 };
 
+/// An integer scalar or vector type.
+struct IntType {
+    uint32_t width = 32;
+    bool isSigned = false;
+    uint32_t components = 1;
+    uint32_t scalar = 0; ///< the component type's id
+};
+
+bool declaresType(uint32_t opcode)
+{
+    return (opcode >= op::TypeVoid && opcode < op::TypeForwardPointer) || opcode == 4472 /* RayQueryKHR */ ||
+           opcode == 5341 /* AccelerationStructureKHR */;
+}
+
 // ---------------------------------------------------------------- rewriting
 
 /// One pass over a module: notes the declarations the faults need, rewrites
@@ -199,6 +246,19 @@ private:
     uint32_t m_boolType = 0;
     std::map<uint32_t, uint32_t> m_boolVectors;    ///< component count -> type id
     std::map<uint32_t, uint32_t> m_scaleConstants; ///< type id -> its 1 + EPS
+    uint32_t m_floatOne = 0; ///< the float32 1.0 declared here
+    std::map<uint32_t, IntType> m_intTypes;
+    uint32_t m_uintType = 0;                                        ///< 32-bit unsigned; 0 until known
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> m_intConstants; ///< (type, value) -> id, declared here
+    std::map<uint32_t, uint32_t> m_constantValues;                  ///< the module's 32-bit scalar constants
+    std::set<uint32_t> m_typeIds;
+    std::map<uint32_t, uint32_t> m_resultTypes;                     ///< value id -> type id
+    std::map<uint32_t, std::pair<uint32_t, uint32_t>> m_pointers;   ///< type id -> (storage class, pointee)
+    std::map<uint32_t, std::vector<uint32_t>> m_structs;            ///< type id -> member types
+    std::set<uint32_t> m_runtimeArrays;
+    /// Access chains into a storage buffer's runtime array (words as written),
+    /// and chains that go on from one of those.
+    std::map<uint32_t, std::vector<uint32_t>> m_elementChains;
     std::set<uint32_t> m_precise;                  ///< ids decorated NoContraction
     /// Contractible float multiplies seen so far: result id -> its two operands
     /// (a definition precedes its uses in a module's order, so an add's product is known).
@@ -223,22 +283,44 @@ private:
         return out;
     }
 
-    /// Remembers the GLSL.std.450 import and the float and bool types.
+    /// Remembers the GLSL.std.450 import, the types, constants, variables,
+    /// and the type of each value a function computes.
     void note(std::span<const uint32_t> inst)
     {
         const uint32_t opcode = inst[0] & 0xffff;
+        if (declaresType(opcode) && inst.size() >= 2) m_typeIds.insert(inst[1]);
         if (opcode == op::ExtInstImport && inst.size() >= 3 && literalString(inst.subspan(2)) == "GLSL.std.450")
             m_glslSet = inst[1];
         else if (opcode == op::TypeFloat && inst.size() >= 3) m_floatTypes[inst[1]] = {inst[2], 1, inst[1]};
+        else if (opcode == op::TypeInt && inst.size() >= 4) noteInt(inst[1], inst[2], inst[3] != 0);
         else if (opcode == op::TypeBool && inst.size() >= 2) m_boolType = inst[1];
         else if (opcode == op::TypeVector && inst.size() >= 4) noteVector(inst[1], inst[2], inst[3]);
+        else if (opcode == op::TypePointer && inst.size() >= 4) m_pointers[inst[1]] = {inst[2], inst[3]};
+        else if (opcode == op::TypeStruct && inst.size() >= 2)
+            m_structs[inst[1]].assign(inst.begin() + 2, inst.end());
+        else if (opcode == op::TypeRuntimeArray && inst.size() >= 3) m_runtimeArrays.insert(inst[1]);
         else if (opcode == op::Decorate && inst.size() >= 3 && inst[2] == kNoContraction) m_precise.insert(inst[1]);
+        else if (opcode == op::Constant && inst.size() == 4) m_constantValues[inst[2]] = inst[3];
+        // Declarations before the functions put other ids in word 1 (names,
+        // decorations); in a function, an instruction whose word 1 is a type
+        // has that type and its result in word 2.
+        const bool typed = m_firstFunction || opcode == op::Constant || opcode == op::ConstantComposite ||
+                           opcode == op::Variable;
+        if (typed && inst.size() >= 3 && m_typeIds.count(inst[1])) m_resultTypes[inst[2]] = inst[1];
+    }
+
+    void noteInt(uint32_t id, uint32_t width, bool isSigned)
+    {
+        m_intTypes[id] = {width, isSigned, 1, id};
+        if (width == 32 && !isSigned && m_uintType == 0) m_uintType = id;
     }
 
     void noteVector(uint32_t id, uint32_t component, uint32_t count)
     {
         if (auto scalar = m_floatTypes.find(component); scalar != m_floatTypes.end())
             m_floatTypes[id] = {scalar->second.width, count, component};
+        else if (auto integer = m_intTypes.find(component); integer != m_intTypes.end())
+            m_intTypes[id] = {integer->second.width, integer->second.isSigned, count, component};
         else if (m_boolType != 0 && component == m_boolType) m_boolVectors[count] = id;
     }
 
@@ -250,6 +332,8 @@ private:
         case SpirvFaultKind::Compare: return swapCompare(inst);
         case SpirvFaultKind::NanMinMax: return replaceMinMax(inst);
         case SpirvFaultKind::Contract: return contract(inst);
+        case SpirvFaultKind::NeighbourLoad: return loadNeighbour(inst);
+        case SpirvFaultKind::TexelOffset: return offsetTexelFetch(inst);
         }
         return false;
     }
@@ -267,12 +351,192 @@ private:
         const bool matches = m_fault.opcode == op::ExtInst ? isGlsl(inst, m_fault.extInstruction)
                                                            : opcode == m_fault.opcode && inst.size() >= 3;
         if (!matches) return false;
-        auto type = m_floatTypes.find(inst[1]);
-        if (type == m_floatTypes.end() || type->second.width != 32) return false;
+        auto found = m_floatTypes.find(inst[1]);
+        if (found == m_floatTypes.end() || found->second.width != 32) return false;
         const uint32_t result = inst[2], unscaled = freshId();
         m_body.insert(m_body.end(), inst.begin(), inst.end());
         m_body[m_body.size() - inst.size() + 2] = unscaled;
-        emit({firstWord(5, op::FMul), inst[1], result, unscaled, scaleConstant(inst[1])});
+        if (m_fault.oneIn == 1) {
+            emit({firstWord(5, op::FMul), inst[1], result, unscaled, scaleConstant(inst[1])});
+            return true;
+        }
+        // 1 in N: the factor is 1 + EPS where the first component's bits are selected, else 1.
+        const FloatType type = found->second;
+        uint32_t first = unscaled;
+        if (type.components > 1) {
+            first = freshId();
+            emit({firstWord(5, op::CompositeExtract), type.scalar, first, unscaled, 0});
+        }
+        const uint32_t bits = freshId(), factor = freshId();
+        emit({firstWord(4, op::Bitcast), uintType(), bits, first});
+        emit({firstWord(6, op::Select), type.scalar, factor, selects(bits), scaleConstant(type.scalar),
+              floatOne(type.scalar)});
+        if (type.components == 1) emit({firstWord(5, op::FMul), inst[1], result, unscaled, factor});
+        else emit({firstWord(5, op::VectorTimesScalar), inst[1], result, unscaled, factor});
+        return true;
+    }
+
+    uint32_t floatOne(uint32_t scalarType)
+    {
+        if (m_floatOne == 0) {
+            m_floatOne = freshId();
+            declare({firstWord(4, op::Constant), scalarType, m_floatOne, std::bit_cast<uint32_t>(1.0f)});
+        }
+        return m_floatOne;
+    }
+
+    // ---- 1 in N: a bool that is true where spirvFaultSelects(key, N)
+
+    uint32_t uintType()
+    {
+        if (m_uintType == 0) {
+            m_uintType = freshId();
+            declare({firstWord(4, op::TypeInt), m_uintType, 32, 0});
+            m_intTypes[m_uintType] = {32, false, 1, m_uintType};
+        }
+        return m_uintType;
+    }
+
+    /// A 32-bit integer constant of `type` (scalar), declared once.
+    uint32_t intConstant(uint32_t type, uint32_t value)
+    {
+        auto [slot, isNew] = m_intConstants.try_emplace({type, value}, 0);
+        if (isNew) {
+            slot->second = freshId();
+            declare({firstWord(4, op::Constant), type, slot->second, value});
+        }
+        return slot->second;
+    }
+
+    /// Emits spirvFaultSelects(key, N) for a uint `key`; returns the bool's id.
+    uint32_t selects(uint32_t key)
+    {
+        const uint32_t u = uintType();
+        uint32_t h = key;
+        for (uint32_t multiplier : {0x9E3779B1u, 0x85EBCA6Bu}) {
+            const uint32_t product = freshId(), shifted = freshId(), mixed = freshId();
+            const uint32_t shift = multiplier == 0x9E3779B1u ? 16 : 13;
+            emit({firstWord(5, op::IMul), u, product, h, intConstant(u, multiplier)});
+            emit({firstWord(5, op::ShiftRightLogical), u, shifted, product, intConstant(u, shift)});
+            emit({firstWord(5, op::BitwiseXor), u, mixed, product, shifted});
+            h = mixed;
+        }
+        const uint32_t remainder = freshId(), selected = freshId();
+        emit({firstWord(5, op::UMod), u, remainder, h, intConstant(u, m_fault.oneIn)});
+        emit({firstWord(5, op::IEqual), boolTypeFor(1), selected, remainder, intConstant(u, 0)});
+        return selected;
+    }
+
+    /// `value` (a 32-bit integer scalar) as a uint, for selects().
+    uint32_t asUint(uint32_t value)
+    {
+        if (m_resultTypes.at(value) == uintType()) return value;
+        const uint32_t bits = freshId();
+        emit({firstWord(4, op::Bitcast), uintType(), bits, value});
+        return bits;
+    }
+
+    /// `index + 1`, or `index + (selected ? 1 : 0)` for 1 in N: `index` a 32-bit integer scalar.
+    uint32_t nextIndex(uint32_t index, uint32_t key)
+    {
+        const uint32_t type = m_resultTypes.at(index), one = intConstant(type, 1);
+        uint32_t step = one;
+        if (m_fault.oneIn != 1) {
+            step = freshId();
+            emit({firstWord(6, op::Select), type, step, selects(key), one, intConstant(type, 0)});
+        }
+        const uint32_t next = freshId();
+        emit({firstWord(5, op::IAdd), type, next, index, step});
+        return next;
+    }
+
+    bool isInt32Scalar(uint32_t value) const
+    {
+        auto type = m_resultTypes.find(value);
+        if (type == m_resultTypes.end()) return false;
+        auto integer = m_intTypes.find(type->second);
+        return integer != m_intTypes.end() && integer->second.width == 32 && integer->second.components == 1;
+    }
+
+    // ---- neighbour-load: `p = &buffer.array[i]...; x = *p` becomes `x = *&buffer.array[i + 1]...`
+
+    bool loadNeighbour(std::span<const uint32_t> inst)
+    {
+        const uint32_t opcode = inst[0] & 0xffff;
+        if ((opcode == op::AccessChain || opcode == op::InBoundsAccessChain) && inst.size() >= 5) {
+            if (m_elementChains.count(inst[3]) || isArrayElement(inst))
+                m_elementChains[inst[2]].assign(inst.begin(), inst.end());
+            return false;
+        }
+        if (opcode != op::Load || inst.size() < 4 || !m_elementChains.count(inst[3])) return false;
+        const uint32_t pointer = neighbourChain(inst[3]);
+        if (pointer == 0) return false;
+        m_body.insert(m_body.end(), inst.begin(), inst.end());
+        m_body[m_body.size() - inst.size() + 3] = pointer;
+        return true;
+    }
+
+    /// An access chain from a storage-buffer variable through a runtime-array
+    /// member to an element whose index is computed (not a constant).
+    bool isArrayElement(std::span<const uint32_t> chain) const
+    {
+        if (chain.size() < 6) return false;
+        auto base = m_resultTypes.find(chain[3]);
+        if (base == m_resultTypes.end()) return false;
+        auto pointer = m_pointers.find(base->second);
+        if (pointer == m_pointers.end() || pointer->second.first != kStorageBufferClass) return false;
+        auto members = m_structs.find(pointer->second.second);
+        auto member = m_constantValues.find(chain[4]);
+        if (members == m_structs.end() || member == m_constantValues.end() || member->second >= members->second.size())
+            return false;
+        return m_runtimeArrays.count(members->second[member->second]) && !m_constantValues.count(chain[5]) &&
+               isInt32Scalar(chain[5]);
+    }
+
+    /// A copy of chain `id` that reaches the next element (emitted here); 0 if it cannot.
+    uint32_t neighbourChain(uint32_t id)
+    {
+        std::vector<uint32_t> words = m_elementChains.at(id);
+        if (m_elementChains.count(words[3])) {
+            words[3] = neighbourChain(words[3]);
+            if (words[3] == 0) return 0;
+        } else {
+            words[5] = nextIndex(words[5], asUint(words[5]));
+        }
+        words[2] = freshId();
+        m_body.insert(m_body.end(), words.begin(), words.end());
+        return words[2];
+    }
+
+    // ---- texel-offset: texelFetch(image, (x, y)) reads (x + 1, y)
+
+    bool offsetTexelFetch(std::span<const uint32_t> inst)
+    {
+        if ((inst[0] & 0xffff) != op::ImageFetch || inst.size() < 5) return false;
+        auto coordinateType = m_resultTypes.find(inst[4]);
+        if (coordinateType == m_resultTypes.end()) return false;
+        auto type = m_intTypes.find(coordinateType->second);
+        if (type == m_intTypes.end() || type->second.width != 32 || type->second.components < 2) return false;
+        const uint32_t coordinate = inst[4], vector = coordinateType->second, scalar = type->second.scalar;
+        const uint32_t x = freshId(), y = freshId();
+        emit({firstWord(5, op::CompositeExtract), scalar, x, coordinate, 0});
+        emit({firstWord(5, op::CompositeExtract), scalar, y, coordinate, 1});
+        m_resultTypes[x] = m_resultTypes[y] = scalar;
+        // The key x + 65536 y picks texels, not values: the same texel is wrong for every ray.
+        const uint32_t yHigh = freshId(), key = freshId();
+        emit({firstWord(5, op::IMul), uintType(), yHigh, asUint(y), intConstant(uintType(), 65536)});
+        emit({firstWord(5, op::IAdd), uintType(), key, asUint(x), yHigh});
+        const uint32_t nextX = nextIndex(x, key), shifted = freshId();
+        std::vector<uint32_t> construct{firstWord(3 + type->second.components, op::CompositeConstruct), vector,
+                                        shifted, nextX, y};
+        for (uint32_t k = 2; k < type->second.components; ++k) {
+            const uint32_t component = freshId();
+            emit({firstWord(5, op::CompositeExtract), scalar, component, coordinate, k});
+            construct.push_back(component);
+        }
+        m_body.insert(m_body.end(), construct.begin(), construct.end());
+        m_body.insert(m_body.end(), inst.begin(), inst.end());
+        m_body[m_body.size() - inst.size() + 4] = shifted;
         return true;
     }
 
@@ -382,6 +646,8 @@ SpirvFault parseSpirvFault(const std::string& spec)
         if (parts.size() != 1) badSpec(spec, "contract takes no arguments");
         return SpirvFault{SpirvFaultKind::Contract, spec};
     }
+    if (parts[0] == "neighbour-load") return offsetFault(spec, parts, SpirvFaultKind::NeighbourLoad);
+    if (parts[0] == "texel-offset") return offsetFault(spec, parts, SpirvFaultKind::TexelOffset);
     if (parts[0] == "nan-minmax") {
         if (parts.size() != 1) badSpec(spec, "nan-minmax takes no arguments");
         return SpirvFault{SpirvFaultKind::NanMinMax, spec};

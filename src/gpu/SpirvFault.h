@@ -7,9 +7,17 @@
 // Faults (one at a time):
 //   scale:CLASS:EPS  every 32-bit float (scalar or vector) result of CLASS is
 //                    multiplied by 1 + EPS (|EPS| < 1); CLASS is FMul, FAdd,
-//                    FSub, FDiv, or a GLSL.std.450 instruction: Sqrt,
+//                    FSub, FDiv, a GLSL.std.450 instruction: Sqrt,
 //                    InverseSqrt, Exp, Log, Pow, Sin, Cos, Atan2, Acos, Exp2,
-//                    Log2, Fma
+//                    Log2, Fma, or RayQueryT (the t a ray query reports)
+//   scale:CLASS:EPS:1inN  the same for 1 in N results only: those whose
+//                    float bits (the first component's) spirvFaultSelects,
+//                    a fault that depends on the operands, as miscompiles do
+//   neighbour-load[:1inN]  a load through a storage-buffer array element
+//                    a[i] reads a[i + 1] instead, for every i or for the 1 in
+//                    N indices that spirvFaultSelects (stores are untouched)
+//   texel-offset[:1inN]  texelFetch(image, (x, y)) reads (x + 1, y), for every
+//                    texel or for 1 in N (spirvFaultSelects(x + 65536 y))
 //   compare:lt-le    < and <= swapped (ordered and unordered)
 //   compare:gt-ge    > and >= swapped (ordered and unordered)
 //   nan-minmax       GLSL.std.450 FMin/FMax/NMin/NMax become a < b ? a : b
@@ -30,7 +38,7 @@
 
 namespace vkrt {
 
-enum class SpirvFaultKind { Scale, Compare, NanMinMax, Contract };
+enum class SpirvFaultKind { Scale, Compare, NanMinMax, Contract, NeighbourLoad, TexelOffset };
 
 /// One fault to inject, as parseSpirvFault reads it.
 struct SpirvFault {
@@ -40,9 +48,24 @@ struct SpirvFault {
     uint32_t opcode = 0;
     uint32_t extInstruction = 0;
     double epsilon = 0.0;
+    /// Scale, NeighbourLoad, TexelOffset: the fault hits 1 in oneIn values (1: all).
+    uint32_t oneIn = 1;
     /// Compare: opcode pairs exchanged with each other.
     std::vector<std::pair<uint32_t, uint32_t>> swaps;
 };
+
+/// Whether a fault of `1inN` hits the value whose 32 bits are `key`: a
+/// 32-bit integer hash of the key (multiply, shift, xor twice) is a multiple
+/// of N. The injected kernels compute the same in SPIR-V; tests predict
+/// from it which results a fault changes.
+constexpr bool spirvFaultSelects(uint32_t key, uint32_t oneIn)
+{
+    uint32_t h = key * 0x9E3779B1u;
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    return h % oneIn == 0;
+}
 
 /// The environment variable that makes every ComputeKernel inject a fault.
 inline constexpr const char* kInjectFaultVariable = "VKRT_INJECT_FAULT";

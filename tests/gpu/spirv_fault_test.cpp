@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -53,16 +55,50 @@ TEST(SpirvFaultSpec, ReadsEveryForm)
     EXPECT_EQ(parseSpirvFault("compare:gt-ge").swaps.size(), 2u);
     EXPECT_EQ(parseSpirvFault("nan-minmax").kind, SpirvFaultKind::NanMinMax);
     EXPECT_EQ(parseSpirvFault("contract").kind, SpirvFaultKind::Contract);
+    EXPECT_EQ(mul.oneIn, 1u);
+    SpirvFault rare = parseSpirvFault("scale:FMul:0.5:1in1000");
+    EXPECT_EQ(rare.opcode, 133u);
+    EXPECT_DOUBLE_EQ(rare.epsilon, 0.5);
+    EXPECT_EQ(rare.oneIn, 1000u);
+    EXPECT_EQ(parseSpirvFault("scale:RayQueryT:0.01").opcode, 6018u) << "OpRayQueryGetIntersectionTKHR";
+    EXPECT_EQ(parseSpirvFault("neighbour-load").kind, SpirvFaultKind::NeighbourLoad);
+    EXPECT_EQ(parseSpirvFault("neighbour-load").oneIn, 1u);
+    EXPECT_EQ(parseSpirvFault("neighbour-load:1in10").oneIn, 10u);
+    EXPECT_EQ(parseSpirvFault("texel-offset:1in2147483648").oneIn, 2147483648u);
+    EXPECT_EQ(parseSpirvFault("texel-offset").kind, SpirvFaultKind::TexelOffset);
+}
+
+// The hash that picks 1 in N values: deterministic, and close to 1 in N.
+TEST(SpirvFaultSpec, OneInNSelectsAboutOneInN)
+{
+    for (uint32_t n : {1u, 7u, 100u}) {
+        uint32_t selected = 0;
+        constexpr uint32_t kKeys = 700000;
+        for (uint32_t key = 0; key < kKeys; ++key) selected += spirvFaultSelects(key * 2654435761u + 12345u, n);
+        const double expected = double(kKeys) / n, sigma = std::sqrt(expected * (1.0 - 1.0 / n));
+        EXPECT_LE(std::abs(selected - expected), 5.0 * sigma + 1e-9) << "1 in " << n << ": " << selected;
+    }
+    // Float bits of nearby values (the scale fault's keys) are picked as evenly.
+    uint32_t selected = 0;
+    for (int k = 0; k < 100000; ++k) selected += spirvFaultSelects(std::bit_cast<uint32_t>(1.0f + k * 1e-5f), 10);
+    EXPECT_NEAR(selected, 10000.0, 5.0 * std::sqrt(9000.0));
 }
 
 TEST(SpirvFaultSpec, RefusalsNameTheProblemAndTheChoices)
 {
-    expectSpecError("bogus",
-                    {"'bogus'", "unknown fault", "scale:CLASS:EPS", "compare:lt-le", "nan-minmax", "contract"});
+    expectSpecError("bogus", {"'bogus'", "unknown fault", "scale:CLASS:EPS", "compare:lt-le", "nan-minmax", "contract",
+                              "neighbour-load", "texel-offset"});
     expectSpecError("", {"unknown fault"});
     expectSpecError("scale:FMull:0.1", {"unknown instruction class 'FMull'", "FMul", "InverseSqrt", "Fma"});
     expectSpecError("scale:FMul", {"scale:CLASS:EPS"});
-    expectSpecError("scale:FMul:0.1:2", {"scale:CLASS:EPS"});
+    expectSpecError("scale:FMul:0.1:2", {"'2' is not 1inN", "1in1000"});
+    expectSpecError("scale:FMul:0.1:1in0", {"out of range", "1inN"});
+    expectSpecError("scale:FMul:0.1:1in2147483649", {"out of range"});
+    expectSpecError("scale:FMul:0.1:1in10:5", {"scale:CLASS:EPS[:1inN]"});
+    expectSpecError("neighbour-load:1inx", {"'1inx' is not 1inN"});
+    expectSpecError("neighbour-load:1in-3", {"'1in-3' is not 1inN"});
+    expectSpecError("texel-offset:1in", {"'1in' is not 1inN"});
+    expectSpecError("texel-offset:1in5:3", {"at most 1inN", "texel-offset[:1inN]"});
     expectSpecError("scale:FMul:", {"EPS ''", "|EPS| < 1"});
     expectSpecError("scale:FMul:1", {"EPS 1 is out of range", "|EPS| < 1"});
     expectSpecError("scale:FMul:-1.5", {"out of range"});
@@ -96,15 +132,15 @@ TEST(SpirvFaultSpec, EnvironmentIsReadAtEachCallAndNamedInErrors)
 
 // ---------------------------------------------------------------- modules
 
-/// A one-invocation kernel over `vec4 v[]` whose main() is `body`, compiled by glslang.
-std::vector<uint32_t> compileKernelBody(const std::string& name, const std::string& body)
+/// A one-invocation kernel over `vec4 v[]` (and `declarations`) whose main() is `body`, compiled by glslang.
+std::vector<uint32_t> compileKernelBody(const std::string& name, const std::string& body,
+                                        const std::string& declarations = "")
 {
     const auto root = freshTempDir("spirv-fault-" + name) / "shaders";
     writeText(root / ("kernels/" + name + ".comp"), "#version 460\n"
                                                     "layout(local_size_x = 1) in;\n"
-                                                    "layout(std430, binding = 0) buffer Data { vec4 v[]; };\n"
-                                                    "void main()\n{\n" +
-                                                        body + "}\n");
+                                                    "layout(std430, binding = 0) buffer Data { vec4 v[]; };\n" +
+                                                        declarations + "void main()\n{\n" + body + "}\n");
     return compileGlsl(KernelSource{root, "kernels/" + name + ".comp", {}});
 }
 
@@ -233,6 +269,73 @@ TEST(SpirvFault, ScaleOfAnExtendedInstruction)
     EXPECT_EQ(changed, 0u) << "no exp in the sample: nothing changes";
 }
 
+constexpr uint32_t kBitcast = 124, kUMod = 137, kVectorTimesScalar = 142, kLoad = 61, kStore = 62,
+                   kAccessChain = 65, kImageFetch = 95, kIAdd = 128;
+
+// 1 in N: the product is multiplied by a factor chosen from 1 + EPS and 1 by
+// the hash of the first component's bits.
+TEST(SpirvFault, ScaleOneInNSelectsTheFactorByTheResultsBits)
+{
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(sample(), parseSpirvFault("scale:FMul:0.5:1in10"), &changed);
+    EXPECT_EQ(changed, 2u);
+    EXPECT_EQ(validationErrors(out), "");
+    EXPECT_EQ(countOpcode(out, kFMul), 2u + 1u) << "the float product is scaled by FMul";
+    EXPECT_EQ(countOpcode(out, kVectorTimesScalar), 1u) << "the vec3 product by VectorTimesScalar";
+    EXPECT_EQ(countOpcode(out, kBitcast), 2u);
+    EXPECT_EQ(countOpcode(out, kUMod), 2u);
+    EXPECT_EQ(countOpcode(out, kSelect) - countOpcode(sample(), kSelect), 2u);
+}
+
+/// Loads of computed elements of a storage buffer (one as a whole vec4, one
+/// through a member), a load of a constant element, and stores.
+std::vector<uint32_t> compileLoadSample()
+{
+    return compileKernelBody("load", R"(
+    int i = int(v[0].w);
+    vec4 whole = v[i];
+    float member = v[i + 2].y;
+    v[i + 1] = whole * member;
+)");
+}
+
+TEST(SpirvFault, NeighbourLoadReadsTheNextElementAndLeavesStoresAlone)
+{
+    const std::vector<uint32_t> clean = compileLoadSample();
+    ASSERT_EQ(validationErrors(clean), "");
+    for (const std::string spec : {"neighbour-load", "neighbour-load:1in3"}) {
+        size_t changed = 0;
+        std::vector<uint32_t> out = injectSpirvFault(clean, parseSpirvFault(spec), &changed);
+        EXPECT_EQ(changed, 2u) << spec << ": v[i] and v[i + 2].y; not v[0].w (a constant index)";
+        EXPECT_EQ(validationErrors(out), "") << spec;
+        EXPECT_EQ(countOpcode(out, kLoad), countOpcode(clean, kLoad)) << spec;
+        EXPECT_EQ(countOpcode(out, kStore), countOpcode(clean, kStore)) << spec;
+        EXPECT_EQ(countOpcode(out, kAccessChain), countOpcode(clean, kAccessChain) + 2) << spec;
+        EXPECT_EQ(countOpcode(out, kUMod), spec == "neighbour-load" ? 0u : 2u) << spec;
+    }
+    size_t changed = 0;
+    EXPECT_EQ(injectSpirvFault(sample(), parseSpirvFault("neighbour-load"), &changed), sample());
+    EXPECT_EQ(changed, 0u) << "the sample reads v[0], v[1], v[2]: constant indices";
+}
+
+TEST(SpirvFault, TexelOffsetMovesTheFetchedTexel)
+{
+    const std::vector<uint32_t> clean =
+        compileKernelBody("fetch", "    v[1] = texelFetch(image, ivec2(v[0].xy), 0);\n",
+                          "layout(binding = 1) uniform sampler2D image;\n");
+    ASSERT_EQ(validationErrors(clean), "");
+    ASSERT_EQ(countOpcode(clean, kImageFetch), 1u);
+    for (const std::string spec : {"texel-offset", "texel-offset:1in4"}) {
+        size_t changed = 0;
+        std::vector<uint32_t> out = injectSpirvFault(clean, parseSpirvFault(spec), &changed);
+        EXPECT_EQ(changed, 1u) << spec;
+        EXPECT_EQ(validationErrors(out), "") << spec;
+        EXPECT_EQ(countOpcode(out, kImageFetch), 1u) << spec;
+        EXPECT_EQ(countOpcode(out, kIAdd) - countOpcode(clean, kIAdd), 2u) << spec << ": the key, and x + 1";
+        EXPECT_EQ(countOpcode(out, kUMod), spec == "texel-offset" ? 0u : 1u) << spec;
+    }
+}
+
 TEST(SpirvFault, CompareSwapsOpcodesAndNothingElse)
 {
     size_t changed = 0;
@@ -322,13 +425,17 @@ TEST(SpirvFault, EveryFaultKeepsTheRenderKernelValid)
     ASSERT_EQ(validationErrors(kernel), "");
     const std::vector<std::string> classes{"FMul", "FAdd", "FSub", "FDiv",  "Sqrt", "InverseSqrt", "Exp",  "Log",
                                            "Pow",  "Sin",  "Cos",  "Atan2", "Acos", "Exp2",        "Log2", "Fma"};
-    std::vector<std::string> specs{"compare:lt-le", "compare:gt-ge", "nan-minmax", "contract"};
+    std::vector<std::string> specs{"compare:lt-le",  "compare:gt-ge",          "nan-minmax",
+                                   "contract",       "neighbour-load",         "neighbour-load:1in100",
+                                   "texel-offset",   "texel-offset:1in9",      "scale:FMul:0.5:1in1000",
+                                   "scale:Sqrt:-0.9:1in7", "scale:RayQueryT:0.01"};
     for (const std::string& c : classes) specs.push_back("scale:" + c + ":-0.001");
     for (const std::string& spec : specs) {
         size_t changed = 0;
         std::vector<uint32_t> out = injectSpirvFault(kernel, parseSpirvFault(spec), &changed);
         EXPECT_EQ(validationErrors(out), "") << spec;
-        const bool common = spec.find("FMul") != std::string::npos || spec.find("compare") != std::string::npos;
+        const bool common = spec.find("FMul") != std::string::npos || spec.find("compare") != std::string::npos ||
+                            spec.find("neighbour-load") != std::string::npos;
         if (common || spec == "nan-minmax" || spec == "contract") {
             EXPECT_GT(changed, 0u) << spec;
         }
