@@ -22,7 +22,7 @@ vec3 mapToWorld(vec3 m) { return m.x * u.environmentAxisX + m.y * u.environmentA
 vec2 latLongUv(vec3 m)
 {
     float phi = atan(m.x, -m.z);
-    return vec2(phi < 0.0 ? phi * (0.5 * INV_PI) + 1.0 : phi * (0.5 * INV_PI), acos(clamp(m.y, -1.0, 1.0)) * INV_PI);
+    return vec2(phi < 0.0 ? phi * (0.5 * INV_PI) + 1.0 : phi * (0.5 * INV_PI), accurateAcos(m.y) * INV_PI);
 }
 
 vec3 latLongTexel(int i, int j) { return texelFetch(environmentLatLong, ivec2(i, j), 0).rgb; }

@@ -2,6 +2,27 @@
 #ifndef VKRT_SAMPLING_GLSL
 #define VKRT_SAMPLING_GLSL
 
+// acos from +, * and sqrt, to about 3e-7 radians over [-1, 1]: Abramowitz
+// and Stegun 4.4.46 (|error| <= 2e-8 before float rounding). A driver's own
+// acos may be off by 4096 ulp (Vulkan's precision table): at 2.4e-4 relative,
+// conformant, it moved a lat-long map's horizon by a twentieth of a pixel and
+// failed validation/environment-hdri (`tools/regress_power.py --ladder legal`).
+// vkrt's images should not depend on how good a conformant driver's acos is.
+float accurateAcos(float x)
+{
+    float a = min(abs(x), 1.0);
+    float p = -0.0012624911;
+    p = p * a + 0.0066700901;
+    p = p * a - 0.0170881256;
+    p = p * a + 0.0308918810;
+    p = p * a - 0.0501743046;
+    p = p * a + 0.0889789874;
+    p = p * a - 0.2145988016;
+    p = p * a + 1.5707963050;
+    float r = sqrt(1.0 - a) * p;
+    return x < 0.0 ? PI - r : r;
+}
+
 // Orthonormal basis around a unit vector without branches on the sign of
 // n.z (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 2017).
 void orthonormalBasis(vec3 n, out vec3 t, out vec3 b)

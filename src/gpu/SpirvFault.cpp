@@ -23,14 +23,14 @@ constexpr size_t kBoundWord = 3;
 namespace op {
 constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeVoid = 19, TypeBool = 20, TypeInt = 21, TypeFloat = 22,
                    TypeVector = 23, TypeRuntimeArray = 29, TypeStruct = 30, TypePointer = 32, TypeForwardPointer = 39,
-                   Constant = 43, ConstantComposite = 44, Function = 54, Variable = 59, Load = 61,
-                   AccessChain = 65, InBoundsAccessChain = 66, Decorate = 71, CompositeConstruct = 80,
-                   CompositeExtract = 81, ImageFetch = 95, Bitcast = 124, FNegate = 127, IAdd = 128, FAdd = 129,
-                   FSub = 131, IMul = 132, FMul = 133, FDiv = 136, UMod = 137, VectorTimesScalar = 142,
-                   Select = 169, IEqual = 170, FOrdLessThan = 184, FUnordLessThan = 185, FOrdGreaterThan = 186,
-                   FUnordGreaterThan = 187, FOrdLessThanEqual = 188, FUnordLessThanEqual = 189,
-                   FOrdGreaterThanEqual = 190, FUnordGreaterThanEqual = 191, ShiftRightLogical = 194,
-                   BitwiseXor = 198, RayQueryGetIntersectionT = 6018;
+                   Constant = 43, ConstantComposite = 44, Function = 54, Variable = 59, Load = 61, AccessChain = 65,
+                   InBoundsAccessChain = 66, Decorate = 71, CompositeConstruct = 80, CompositeExtract = 81,
+                   ImageFetch = 95, Bitcast = 124, FNegate = 127, IAdd = 128, FAdd = 129, FSub = 131, IMul = 132,
+                   FMul = 133, FDiv = 136, UMod = 137, VectorTimesScalar = 142, Select = 169, IEqual = 170,
+                   FOrdLessThan = 184, FUnordLessThan = 185, FOrdGreaterThan = 186, FUnordGreaterThan = 187,
+                   FOrdLessThanEqual = 188, FUnordLessThanEqual = 189, FOrdGreaterThanEqual = 190,
+                   FUnordGreaterThanEqual = 191, ShiftRightLogical = 194, BitwiseXor = 198,
+                   RayQueryGetIntersectionT = 6018;
 } // namespace op
 
 constexpr uint32_t kStorageBufferClass = 12; ///< SPIR-V storage class
@@ -49,12 +49,23 @@ struct ScaleClass {
 };
 
 constexpr ScaleClass kScaleClasses[] = {
-    {"FMul", op::FMul, 0},     {"FAdd", op::FAdd, 0},     {"FSub", op::FSub, 0},
-    {"FDiv", op::FDiv, 0},     {"Sqrt", op::ExtInst, 31}, {"InverseSqrt", op::ExtInst, 32},
-    {"Exp", op::ExtInst, 27},  {"Log", op::ExtInst, 28},  {"Pow", op::ExtInst, 26},
-    {"Sin", op::ExtInst, 13},  {"Cos", op::ExtInst, 14},  {"Atan2", op::ExtInst, 25},
-    {"Acos", op::ExtInst, 17}, {"Exp2", op::ExtInst, 29}, {"Log2", op::ExtInst, 30},
-    {"Fma", op::ExtInst, 50},  {"RayQueryT", op::RayQueryGetIntersectionT, 0},
+    {"FMul", op::FMul, 0},
+    {"FAdd", op::FAdd, 0},
+    {"FSub", op::FSub, 0},
+    {"FDiv", op::FDiv, 0},
+    {"Sqrt", op::ExtInst, 31},
+    {"InverseSqrt", op::ExtInst, 32},
+    {"Exp", op::ExtInst, 27},
+    {"Log", op::ExtInst, 28},
+    {"Pow", op::ExtInst, 26},
+    {"Sin", op::ExtInst, 13},
+    {"Cos", op::ExtInst, 14},
+    {"Atan2", op::ExtInst, 25},
+    {"Acos", op::ExtInst, 17},
+    {"Exp2", op::ExtInst, 29},
+    {"Log2", op::ExtInst, 30},
+    {"Fma", op::ExtInst, 50},
+    {"RayQueryT", op::RayQueryGetIntersectionT, 0},
 };
 
 constexpr const char* kFaultChoices = "scale:CLASS:EPS[:1inN], compare:lt-le, compare:gt-ge, nan-minmax, "
@@ -135,8 +146,8 @@ SpirvFault scaleFault(const std::string& spec, const std::vector<std::string>& p
 /// neighbour-load[:1inN] and texel-offset[:1inN].
 SpirvFault offsetFault(const std::string& spec, const std::vector<std::string>& parts, SpirvFaultKind kind)
 {
-    if (parts.size() > 2) badSpec(spec, parts[0] + " takes at most 1inN: " + parts[0] + "[:1inN], e.g. " + parts[0] +
-                                            ":1in100");
+    if (parts.size() > 2)
+        badSpec(spec, parts[0] + " takes at most 1inN: " + parts[0] + "[:1inN], e.g. " + parts[0] + ":1in100");
     SpirvFault fault{kind, spec};
     if (parts.size() == 2) fault.oneIn = oneInOf(spec, parts[1]);
     return fault;
@@ -246,20 +257,20 @@ private:
     uint32_t m_boolType = 0;
     std::map<uint32_t, uint32_t> m_boolVectors;    ///< component count -> type id
     std::map<uint32_t, uint32_t> m_scaleConstants; ///< type id -> its 1 + EPS
-    uint32_t m_floatOne = 0; ///< the float32 1.0 declared here
+    uint32_t m_floatOne = 0;                       ///< the float32 1.0 declared here
     std::map<uint32_t, IntType> m_intTypes;
-    uint32_t m_uintType = 0;                                        ///< 32-bit unsigned; 0 until known
+    uint32_t m_uintType = 0;                                          ///< 32-bit unsigned; 0 until known
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> m_intConstants; ///< (type, value) -> id, declared here
-    std::map<uint32_t, uint32_t> m_constantValues;                  ///< the module's 32-bit scalar constants
+    std::map<uint32_t, uint32_t> m_constantValues;                    ///< the module's 32-bit scalar constants
     std::set<uint32_t> m_typeIds;
-    std::map<uint32_t, uint32_t> m_resultTypes;                     ///< value id -> type id
-    std::map<uint32_t, std::pair<uint32_t, uint32_t>> m_pointers;   ///< type id -> (storage class, pointee)
-    std::map<uint32_t, std::vector<uint32_t>> m_structs;            ///< type id -> member types
+    std::map<uint32_t, uint32_t> m_resultTypes;                   ///< value id -> type id
+    std::map<uint32_t, std::pair<uint32_t, uint32_t>> m_pointers; ///< type id -> (storage class, pointee)
+    std::map<uint32_t, std::vector<uint32_t>> m_structs;          ///< type id -> member types
     std::set<uint32_t> m_runtimeArrays;
     /// Access chains into a storage buffer's runtime array (words as written),
     /// and chains that go on from one of those.
     std::map<uint32_t, std::vector<uint32_t>> m_elementChains;
-    std::set<uint32_t> m_precise;                  ///< ids decorated NoContraction
+    std::set<uint32_t> m_precise; ///< ids decorated NoContraction
     /// Contractible float multiplies seen so far: result id -> its two operands
     /// (a definition precedes its uses in a module's order, so an add's product is known).
     std::map<uint32_t, std::pair<uint32_t, uint32_t>> m_products;
@@ -296,16 +307,15 @@ private:
         else if (opcode == op::TypeBool && inst.size() >= 2) m_boolType = inst[1];
         else if (opcode == op::TypeVector && inst.size() >= 4) noteVector(inst[1], inst[2], inst[3]);
         else if (opcode == op::TypePointer && inst.size() >= 4) m_pointers[inst[1]] = {inst[2], inst[3]};
-        else if (opcode == op::TypeStruct && inst.size() >= 2)
-            m_structs[inst[1]].assign(inst.begin() + 2, inst.end());
+        else if (opcode == op::TypeStruct && inst.size() >= 2) m_structs[inst[1]].assign(inst.begin() + 2, inst.end());
         else if (opcode == op::TypeRuntimeArray && inst.size() >= 3) m_runtimeArrays.insert(inst[1]);
         else if (opcode == op::Decorate && inst.size() >= 3 && inst[2] == kNoContraction) m_precise.insert(inst[1]);
         else if (opcode == op::Constant && inst.size() == 4) m_constantValues[inst[2]] = inst[3];
         // Declarations before the functions put other ids in word 1 (names,
         // decorations); in a function, an instruction whose word 1 is a type
         // has that type and its result in word 2.
-        const bool typed = m_firstFunction || opcode == op::Constant || opcode == op::ConstantComposite ||
-                           opcode == op::Variable;
+        const bool typed =
+            m_firstFunction || opcode == op::Constant || opcode == op::ConstantComposite || opcode == op::Variable;
         if (typed && inst.size() >= 3 && m_typeIds.count(inst[1])) m_resultTypes[inst[2]] = inst[1];
     }
 
@@ -527,8 +537,8 @@ private:
         emit({firstWord(5, op::IMul), uintType(), yHigh, asUint(y), intConstant(uintType(), 65536)});
         emit({firstWord(5, op::IAdd), uintType(), key, asUint(x), yHigh});
         const uint32_t nextX = nextIndex(x, key), shifted = freshId();
-        std::vector<uint32_t> construct{firstWord(3 + type->second.components, op::CompositeConstruct), vector,
-                                        shifted, nextX, y};
+        std::vector<uint32_t> construct{firstWord(3 + type->second.components, op::CompositeConstruct), vector, shifted,
+                                        nextX, y};
         for (uint32_t k = 2; k < type->second.components; ++k) {
             const uint32_t component = freshId();
             emit({firstWord(5, op::CompositeExtract), scalar, component, coordinate, k});

@@ -572,5 +572,25 @@ TEST_F(TriangleSamplerProbe, TestsRejectSamplerWithoutSquareRoot)
     reportStat("WrongKsStatistic", ks);
 }
 
+// ---------------------------------------------------------------------------
+// accurateAcos (sampling.glsl): the lat-long map's theta, so that the image
+// does not depend on how far a conformant driver's acos is off (4096 ulp).
+
+TEST(AccurateAcosProbe, IsWithinTwoUlpOfPiEverywhere)
+{
+    std::vector<float> inputs;
+    for (int k = -4000; k <= 4000; ++k) inputs.push_back(float(k) / 4000.0f);
+    for (float x : {1.0f - 1e-7f, 1.0f - 6e-8f, -1.0f + 6e-8f, 0.9999f, -0.9999f, 1e-20f, -0.0f, 2.0f, -2.0f})
+        inputs.push_back(x);
+    const std::vector<float> out = runProbe("acos_probe", inputs, inputs.size(), uint32_t(inputs.size()));
+    double worst = 0.0;
+    for (size_t i = 0; i < inputs.size(); ++i) {
+        const double x = std::clamp(double(inputs[i]), -1.0, 1.0), want = std::acos(x);
+        worst = std::max(worst, std::abs(out[i] - want));
+        EXPECT_NEAR(out[i], want, 5e-7) << "acos(" << inputs[i] << ")";
+    }
+    std::cout << "accurateAcos: largest error " << worst << " rad\n";
+}
+
 } // namespace
 } // namespace vkrt::test

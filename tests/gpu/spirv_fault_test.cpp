@@ -269,8 +269,8 @@ TEST(SpirvFault, ScaleOfAnExtendedInstruction)
     EXPECT_EQ(changed, 0u) << "no exp in the sample: nothing changes";
 }
 
-constexpr uint32_t kBitcast = 124, kUMod = 137, kVectorTimesScalar = 142, kLoad = 61, kStore = 62,
-                   kAccessChain = 65, kImageFetch = 95, kIAdd = 128;
+constexpr uint32_t kBitcast = 124, kUMod = 137, kVectorTimesScalar = 142, kLoad = 61, kStore = 62, kAccessChain = 65,
+                   kImageFetch = 95, kIAdd = 128;
 
 // 1 in N: the product is multiplied by a factor chosen from 1 + EPS and 1 by
 // the hash of the first component's bits.
@@ -320,9 +320,8 @@ TEST(SpirvFault, NeighbourLoadReadsTheNextElementAndLeavesStoresAlone)
 
 TEST(SpirvFault, TexelOffsetMovesTheFetchedTexel)
 {
-    const std::vector<uint32_t> clean =
-        compileKernelBody("fetch", "    v[1] = texelFetch(image, ivec2(v[0].xy), 0);\n",
-                          "layout(binding = 1) uniform sampler2D image;\n");
+    const std::vector<uint32_t> clean = compileKernelBody("fetch", "    v[1] = texelFetch(image, ivec2(v[0].xy), 0);\n",
+                                                          "layout(binding = 1) uniform sampler2D image;\n");
     ASSERT_EQ(validationErrors(clean), "");
     ASSERT_EQ(countOpcode(clean, kImageFetch), 1u);
     for (const std::string spec : {"texel-offset", "texel-offset:1in4"}) {
@@ -425,10 +424,10 @@ TEST(SpirvFault, EveryFaultKeepsTheRenderKernelValid)
     ASSERT_EQ(validationErrors(kernel), "");
     const std::vector<std::string> classes{"FMul", "FAdd", "FSub", "FDiv",  "Sqrt", "InverseSqrt", "Exp",  "Log",
                                            "Pow",  "Sin",  "Cos",  "Atan2", "Acos", "Exp2",        "Log2", "Fma"};
-    std::vector<std::string> specs{"compare:lt-le",  "compare:gt-ge",          "nan-minmax",
-                                   "contract",       "neighbour-load",         "neighbour-load:1in100",
-                                   "texel-offset",   "texel-offset:1in9",      "scale:FMul:0.5:1in1000",
-                                   "scale:Sqrt:-0.9:1in7", "scale:RayQueryT:0.01"};
+    std::vector<std::string> specs{
+        "compare:lt-le",          "compare:gt-ge",         "nan-minmax",          "contract",
+        "neighbour-load",         "neighbour-load:1in100", "texel-offset",        "texel-offset:1in9",
+        "scale:FMul:0.5:1in1000", "scale:Sqrt:-0.9:1in7",  "scale:RayQueryT:0.01"};
     for (const std::string& c : classes) specs.push_back("scale:" + c + ":-0.001");
     for (const std::string& spec : specs) {
         size_t changed = 0;
