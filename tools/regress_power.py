@@ -3,12 +3,17 @@
 injected SPIR-V faults (`vkrt regress --inject FAULT`, src/gpu/SpirvFault.h)
 and, as the control, without one under other seeds (false alarms).
 
-    tools/regress_power.py [--vkrt build/vkrt] [--faults F1,F2,...] [--ladder classes|quick|legal]
+    tools/regress_power.py [--vkrt build/vkrt] [--faults F1,F2,...]
+        [--ladder classes|quick|legal|rare|memory|rayquery] [--accel own|driver]
         [--control-seeds N] [--filter CASE ...] [--jobs 2] [--out DIR] [--json FILE]
 
 Ladders: classes (each arithmetic class at 1e-2, the comparisons, NaN),
 quick (FMul and Sqrt at 1e-1 ... 1e-3), legal (what a conformant driver may
-do: the suite must pass every one; a failure there is a false alarm).
+do: the suite must pass every one; a failure there is a false alarm), rare
+(a product off by half in 1 of 10 ... 1 of 10^6 results), memory (a
+storage-buffer load or texel fetch that reads its neighbour, always or in 1
+of 10 ... 10^4), rayquery (the t a ray query reports, scaled; run it with
+--accel driver).
 
 Each fault is one whole suite run (its kernels compile afresh: the faulty
 SPIR-V is new to the driver's cache). A fault is caught when the run fails;
@@ -48,6 +53,16 @@ LADDERS = {
     # ulp), acos and atan2 to 4096 ulp (2.4e-4 relative is 4000 ulp at most).
     "legal": ["contract", "scale:Sin:4.4e-4", "scale:Sin:-4.4e-4", "scale:Cos:4.4e-4", "scale:Cos:-4.4e-4",
               "scale:Acos:2.4e-4", "scale:Atan2:-2.4e-4"],
+    # Faults in 1 of N results: an FMul off by half where a hash of its bits
+    # picks it (src/gpu/SpirvFault.h), from 1 in 10 to 1 in a million.
+    "rare": [f"scale:FMul:0.5:1in{n}" for n in (10, 100, 1000, 10**4, 10**5, 10**6)],
+    # Memory: a storage-buffer element load that reads the next element (BVH
+    # nodes, triangles, materials, texels of material textures), and a texel
+    # fetch of the lat-long map one texel to the right; always, then in 1 of N.
+    "memory": ["neighbour-load"] + [f"neighbour-load:1in{n}" for n in (10, 100, 1000, 10**4)]
+    + ["texel-offset"] + [f"texel-offset:1in{n}" for n in (10, 100, 1000)],
+    # Ray queries (--accel driver): the committed t the driver reports, scaled.
+    "rayquery": [f"scale:RayQueryT:{e}" for e in ("0.01", "0.001", "1e-4")],
 }
 LEGAL = set(LADDERS["legal"])
 
@@ -60,7 +75,7 @@ LEGAL = set(LADDERS["legal"])
 
 GLSL_NUMBERS = {"Sqrt": 31, "InverseSqrt": 32, "Exp": 27, "Log": 28, "Pow": 26, "Sin": 13, "Cos": 14,
                 "Atan2": 25, "Acos": 17, "Exp2": 29, "Log2": 30, "Fma": 50}
-CORE_OPCODES = {"FMul": 133, "FAdd": 129, "FSub": 131, "FDiv": 136}
+CORE_OPCODES = {"FMul": 133, "FAdd": 129, "FSub": 131, "FDiv": 136, "RayQueryT": 6018}
 COMPARE_OPCODES = {"lt-le": {184, 185, 188, 189}, "gt-ge": {186, 187, 190, 191}}
 MINMAX_NUMBERS = {37, 40, 79, 80}
 NO_CONTRACTION = 42
@@ -81,10 +96,52 @@ def instructions(path: Path):
         at += count
 
 
+def count_element_loads(path: Path) -> int:
+    """Loads through an access chain into a storage buffer's runtime array at
+    a computed index (or a chain that goes on from one): what neighbour-load
+    changes."""
+    types, pointers, structs, runtime_arrays, constants, int32 = set(), {}, {}, set(), {}, set()
+    result_types, chains, in_function, loads = {}, set(), False, 0
+    for opcode, ops in instructions(path):
+        if 19 <= opcode < 39 and ops:
+            types.add(ops[0])
+        if opcode == 21 and len(ops) >= 2 and ops[1] == 32:
+            int32.add(ops[0])
+        elif opcode == 32 and len(ops) >= 3:
+            pointers[ops[0]] = (ops[1], ops[2])
+        elif opcode == 30 and ops:
+            structs[ops[0]] = ops[1:]
+        elif opcode == 29 and ops:
+            runtime_arrays.add(ops[0])
+        elif opcode == 43 and len(ops) == 3:
+            constants[ops[1]] = ops[2]
+        elif opcode == 54:
+            in_function = True
+        if (in_function or opcode in (43, 44, 59)) and len(ops) >= 2 and ops[0] in types:
+            result_types[ops[1]] = ops[0]
+        if opcode in (65, 66) and len(ops) >= 4:
+            base = ops[2]
+            if base in chains:
+                chains.add(ops[1])
+            elif len(ops) >= 5:
+                storage, pointee = pointers.get(result_types.get(base), (None, None))
+                members = structs.get(pointee, [])
+                member = constants.get(ops[3])
+                if (storage == 12 and member is not None and member < len(members)
+                        and members[member] in runtime_arrays and ops[4] not in constants
+                        and result_types.get(ops[4]) in int32):
+                    chains.add(ops[1])
+        elif opcode == 61 and len(ops) >= 3 and ops[2] in chains:
+            loads += 1
+    return loads
+
+
 def count_fault_sites(path: Path, fault: str) -> int:
     """The instructions `fault` would change in one module."""
     glsl_set, float32, precise, products = None, set(), set(), {}
     kind, *rest = fault.split(":")
+    if kind == "neighbour-load":
+        return count_element_loads(path)
     sites = 0
     for opcode, ops in instructions(path):
         if opcode == 11 and bytes(b for w in ops[1:] for b in w.to_bytes(4, "little")).rstrip(b"\0") == b"GLSL.std.450":
@@ -101,6 +158,8 @@ def count_fault_sites(path: Path, fault: str) -> int:
             sites += opcode == 12 and ops[2] == glsl_set and ops[3] == GLSL_NUMBERS[rest[0]] and ops[0] in float32
         elif kind == "compare" and rest:
             sites += opcode in COMPARE_OPCODES[rest[0]]
+        elif kind == "texel-offset":
+            sites += opcode == 95
         elif kind == "nan-minmax":
             sites += opcode == 12 and ops[2] == glsl_set and ops[3] in MINMAX_NUMBERS
         elif kind == "contract" and glsl_set is not None and len(ops) == 4 and ops[1] not in precise:
@@ -122,6 +181,8 @@ def run_suite(args, out: Path, extra: list[str], env: dict | None = None) -> dic
     """One `vkrt regress` run: exit status, failing cases, seconds."""
     out.mkdir(parents=True, exist_ok=True)
     command = [args.vkrt, "regress", "--jobs", str(args.jobs), "--report-dir", str(out), *extra]
+    if args.accel:
+        command += ["--accel", args.accel]
     for case in args.filter or []:
         command += ["--filter", case]
     start = time.monotonic()
@@ -145,6 +206,7 @@ def main() -> int:
     parser.add_argument("--control-seeds", type=int, default=0, help="unmodified runs with --seed-offset 1..N")
     parser.add_argument("--filter", action="append", help="only these cases (vkrt regress --filter)")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--accel", choices=["own", "driver"], help="traversal backend of every run (rayquery: driver)")
     parser.add_argument("--out", help="keep each run's report here (default: a temporary folder)")
     parser.add_argument("--json", help="also write the rows as JSON")
     args = parser.parse_args()

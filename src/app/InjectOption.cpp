@@ -30,10 +30,12 @@ void addInjectOption(CLI::App& command, std::string& fault)
     command
         .add_option("--inject", fault,
                     "Inject a SPIR-V fault into every kernel the driver runs, to measure what the tests catch: "
-                    "scale:CLASS:EPS (CLASS's float results x (1 + EPS); FMul, FAdd, FSub, FDiv, Sqrt, "
-                    "InverseSqrt, Exp, Log, Pow, Sin, Cos, Atan2, Acos, Exp2, Log2, Fma), compare:lt-le, "
-                    "compare:gt-ge (swap < and <=, > and >=), nan-minmax (min/max mishandle NaN), or the legal "
-                    "variation contract (a * b + c fused into fma where not precise)")
+                    "scale:CLASS:EPS[:1inN] (CLASS's float results x (1 + EPS), all or 1 in N; FMul, FAdd, FSub, "
+                    "FDiv, Sqrt, InverseSqrt, Exp, Log, Pow, Sin, Cos, Atan2, Acos, Exp2, Log2, Fma, RayQueryT), "
+                    "compare:lt-le, compare:gt-ge (swap < and <=, > and >=), nan-minmax (min/max mishandle NaN), "
+                    "neighbour-load[:1inN] (a storage-buffer element load reads the next element), "
+                    "texel-offset[:1inN] (texelFetch reads the texel to the right), or the legal variation "
+                    "contract (a * b + c fused into fma where not precise)")
         ->check(CLI::Validator(checkFault, ""))
         ->type_name("FAULT");
 }

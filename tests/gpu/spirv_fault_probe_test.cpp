@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -82,6 +83,74 @@ TEST(SpirvFaultProbe, ScaledResultsAreExactlyOnePlusEpsTimesTheCleanOnes)
     expectScaled(clean, runProbeWith("scale:Sqrt:-0.01"), 1, -0.01);
     expectScaled(clean, runProbeWith("scale:FMul:0"), 0, 0.0); // the injector alone changes nothing
     EXPECT_EQ(runProbeWith(std::nullopt), clean) << "a kernel made after the variable is unset is clean";
+}
+
+/// kPairsMany distinct (x, y) pairs, x > 0.
+std::vector<float> manyPairs(uint32_t pairs)
+{
+    std::vector<float> input;
+    for (uint32_t i = 0; i < pairs; ++i) {
+        input.push_back(1.0f + 0.0137f * float(i));
+        input.push_back(0.5f + 0.0031f * float(i));
+    }
+    return input;
+}
+
+// 1 in N: exactly the products whose bits the hash picks are scaled, the
+// others are bit for bit the clean ones.
+TEST(SpirvFaultProbe, OneInNScalesExactlyTheResultsItsHashPicks)
+{
+    constexpr uint32_t kMany = 400;
+    const std::vector<float> input = manyPairs(kMany);
+    std::vector<float> clean, faulty;
+    {
+        InjectedFault none(std::nullopt);
+        clean = runProbe("spirv_fault_probe", input, 4 * kMany, kMany);
+    }
+    {
+        InjectedFault injected("scale:FMul:0.5:1in4");
+        faulty = runProbe("spirv_fault_probe", input, 4 * kMany, kMany);
+    }
+    uint32_t scaled = 0;
+    for (uint32_t i = 0; i < kMany; ++i) {
+        const bool picked = spirvFaultSelects(std::bit_cast<uint32_t>(clean[4 * i]), 4);
+        scaled += picked;
+        if (picked) {
+            EXPECT_LE(ulps(faulty[4 * i], clean[4 * i] * 1.5f), 1) << i;
+        } else {
+            EXPECT_EQ(faulty[4 * i], clean[4 * i]) << i;
+        }
+        for (uint32_t k = 1; k < 4; ++k) EXPECT_EQ(faulty[4 * i + k], clean[4 * i + k]) << i << " output " << k;
+    }
+    EXPECT_GT(scaled, 60u) << "about 100 of 400 are picked";
+    EXPECT_LT(scaled, 140u);
+}
+
+// neighbour-load: the load of inputs[k] reads inputs[k + 1], for every k or
+// for the indices the hash picks; the stores still go where they should.
+TEST(SpirvFaultProbe, NeighbourLoadReadsTheNextElement)
+{
+    constexpr uint32_t kMany = 200;
+    const std::vector<float> input = manyPairs(kMany);
+    for (uint32_t n : {1u, 3u}) {
+        const std::string spec = n == 1 ? "neighbour-load" : "neighbour-load:1in" + std::to_string(n);
+        InjectedFault injected(spec);
+        // The last pair would read one past the end: it is not run.
+        const std::vector<float> out = runProbe("spirv_fault_probe", input, 4 * kMany, kMany - 1);
+        uint32_t moved = 0;
+        for (uint32_t i = 0; i + 1 < kMany; ++i) {
+            const uint32_t xi = 2 * i + spirvFaultSelects(2 * i, n), yi = 2 * i + 1 + spirvFaultSelects(2 * i + 1, n);
+            moved += (xi != 2 * i) + (yi != 2 * i + 1);
+            const float x = input[xi], y = input[yi];
+            EXPECT_LE(ulps(out[4 * i], x * y), 1) << spec << " pair " << i;
+            EXPECT_EQ(out[4 * i + 2], std::min(x, y)) << spec << " pair " << i;
+            EXPECT_EQ(out[4 * i + 3], std::max(x, y)) << spec << " pair " << i;
+        }
+        if (n == 3) {
+            EXPECT_GT(moved, 90u) << "about 133 of 398 loads are moved";
+            EXPECT_LT(moved, 180u);
+        }
+    }
 }
 
 TEST(SpirvFaultProbe, NanMinMaxReturnsTheSecondOperandForNaN)
