@@ -4,7 +4,7 @@ injected SPIR-V faults (`vkrt regress --inject FAULT`, src/gpu/SpirvFault.h)
 and, as the control, without one under other seeds (false alarms).
 
     tools/regress_power.py [--vkrt build/vkrt] [--faults F1,F2,...]
-        [--ladder classes|quick|legal|rare|memory|rayquery] [--accel own|driver]
+        [--ladder classes|quick|legal|rare|memory|rayquery|none] [--accel own|driver]
         [--control-seeds N] [--filter CASE ...] [--jobs 2] [--out DIR] [--json FILE]
 
 Ladders: classes (each arithmetic class at 1e-2, the comparisons, NaN),
@@ -61,6 +61,8 @@ LADDERS = {
     # fetch of the lat-long map one texel to the right; always, then in 1 of N.
     "memory": ["neighbour-load"] + [f"neighbour-load:1in{n}" for n in (10, 100, 1000, 10**4)]
     + ["texel-offset"] + [f"texel-offset:1in{n}" for n in (10, 100, 1000)],
+    # No fault: the clean run and the --control-seeds runs only.
+    "none": [],
     # Ray queries (--accel driver): the committed t the driver reports, scaled.
     "rayquery": [f"scale:RayQueryT:{e}" for e in ("0.01", "0.001", "1e-4")],
 }
