@@ -13,7 +13,7 @@ do: the suite must pass every one; a failure there is a false alarm), rare
 (a product off by half in 1 of 10 ... 1 of 10^6 results), memory (a
 storage-buffer load or texel fetch that reads its neighbour, always or in 1
 of 10 ... 10^4), rayquery (the t a ray query reports, scaled; run it with
---accel driver).
+--accel driver), none (only the clean run and the control runs).
 
 Each fault is one whole suite run (its kernels compile afresh: the faulty
 SPIR-V is new to the driver's cache). A fault is caught when the run fails;
