@@ -4,7 +4,7 @@ injected SPIR-V faults (`vkrt regress --inject FAULT`, src/gpu/SpirvFault.h)
 and, as the control, without one under other seeds (false alarms).
 
     tools/regress_power.py [--vkrt build/vkrt] [--faults F1,F2,...]
-        [--ladder classes|quick|legal|rare|memory|rayquery|none] [--accel own|driver]
+        [--ladder classes|quick|legal|rare|memory|rayquery|loops|none] [--accel own|driver]
         [--control-seeds N] [--filter CASE ...] [--jobs 2] [--out DIR] [--json FILE]
 
 Ladders: classes (each arithmetic class at 1e-2, the comparisons, NaN),
@@ -13,7 +13,8 @@ do: the suite must pass every one; a failure there is a false alarm), rare
 (a product off by half in 1 of 10 ... 1 of 10^6 results), memory (a
 storage-buffer load or texel fetch that reads its neighbour, always or in 1
 of 10 ... 10^4), rayquery (the t a ray query reports, scaled; run it with
---accel driver), none (only the clean run and the control runs).
+--accel driver), loops (every loop cut after 65535 ... 100 passes of an
+invocation in all), none (only the clean run and the control runs).
 
 Each fault is one whole suite run (its kernels compile afresh: the faulty
 SPIR-V is new to the driver's cache). A fault is caught when the run fails;
@@ -61,6 +62,10 @@ LADDERS = {
     # fetch of the lat-long map one texel to the right; always, then in 1 of N.
     "memory": ["neighbour-load"] + [f"neighbour-load:1in{n}" for n in (10, 100, 1000, 10**4)]
     + ["texel-offset"] + [f"texel-offset:1in{n}" for n in (10, 100, 1000)],
+    # Control flow: every loop ends once the invocation has made N passes in
+    # all; N = 65535 is Mesa 22 lavapipe's real bug (docs/platform.md), the
+    # calibration point.
+    "loops": [f"loop-cut:{n}" for n in (65535, 10000, 1000, 100)],
     # No fault: the clean run and the --control-seeds runs only.
     "none": [],
     # Ray queries (--accel driver): the committed t the driver reports, scaled.
@@ -138,12 +143,27 @@ def count_element_loads(path: Path) -> int:
     return loads
 
 
+def count_loop_headers(path: Path) -> int:
+    """Loop headers whose branch can go to the loop's merge block: what loop-cut changes."""
+    headers, merge = 0, None
+    for opcode, ops in instructions(path):
+        if opcode == 246 and len(ops) >= 2:
+            merge = ops[0]
+            continue
+        if merge is not None:
+            headers += (opcode == 249 and len(ops) == 1) or (opcode == 250 and len(ops) >= 3 and merge in ops[1:3])
+        merge = None
+    return headers
+
+
 def count_fault_sites(path: Path, fault: str) -> int:
     """The instructions `fault` would change in one module."""
     glsl_set, float32, precise, products = None, set(), set(), {}
     kind, *rest = fault.split(":")
     if kind == "neighbour-load":
         return count_element_loads(path)
+    if kind == "loop-cut":
+        return count_loop_headers(path)
     sites = 0
     for opcode, ops in instructions(path):
         if opcode == 11 and bytes(b for w in ops[1:] for b in w.to_bytes(4, "little")).rstrip(b"\0") == b"GLSL.std.450":

@@ -21,6 +21,8 @@ constexpr size_t kBoundWord = 3;
 
 /// The opcodes the faults read or write (SPIR-V specification, section 3.52).
 namespace op {
+constexpr uint32_t EntryPoint = 15, Store = 62, LogicalOr = 166, LogicalAnd = 167, LogicalNot = 168, UGreaterThan = 172,
+                   LoopMerge = 246, Branch = 249, BranchConditional = 250;
 constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeVoid = 19, TypeBool = 20, TypeInt = 21, TypeFloat = 22,
                    TypeVector = 23, TypeRuntimeArray = 29, TypeStruct = 30, TypePointer = 32, TypeForwardPointer = 39,
                    Constant = 43, ConstantComposite = 44, Function = 54, Variable = 59, Load = 61, AccessChain = 65,
@@ -33,7 +35,7 @@ constexpr uint32_t ExtInstImport = 11, ExtInst = 12, TypeVoid = 19, TypeBool = 2
                    RayQueryGetIntersectionT = 6018;
 } // namespace op
 
-constexpr uint32_t kStorageBufferClass = 12; ///< SPIR-V storage class
+constexpr uint32_t kStorageBufferClass = 12, kPrivateClass = 6; ///< SPIR-V storage classes
 
 /// GLSL.std.450 extended instruction numbers.
 namespace glsl {
@@ -69,7 +71,7 @@ constexpr ScaleClass kScaleClasses[] = {
 };
 
 constexpr const char* kFaultChoices = "scale:CLASS:EPS[:1inN], compare:lt-le, compare:gt-ge, nan-minmax, "
-                                      "neighbour-load[:1inN], texel-offset[:1inN] or contract";
+                                      "neighbour-load[:1inN], texel-offset[:1inN], loop-cut:N or contract";
 
 uint32_t firstWord(uint32_t wordCount, uint32_t opcode) { return wordCount << 16 | opcode; }
 
@@ -116,15 +118,17 @@ double epsilonOf(const std::string& spec, const std::string& text)
 }
 
 /// N of a "1inN" part: a whole number from 1 to 2^31.
-uint32_t oneInOf(const std::string& spec, const std::string& text)
+uint32_t oneInOf(const std::string& spec, const std::string& text,
+                 const std::string& rule = " (write 1inN with N a whole number from 1 to 2147483648, e.g. 1in1000)")
 {
-    const std::string rule = " (write 1inN with N a whole number from 1 to 2147483648, e.g. 1in1000)";
-    if (text.rfind("1in", 0) != 0 || text.size() == 3) badSpec(spec, "'" + text + "' is not 1inN" + rule);
+    const bool isLoopCut = rule.find("loop-cut") != std::string::npos;
+    const std::string shown = isLoopCut ? text.substr(3) : text, form = isLoopCut ? "a number of passes" : "1inN";
+    if (text.rfind("1in", 0) != 0 || text.size() == 3) badSpec(spec, "'" + shown + "' is not " + form + rule);
     const std::string digits = text.substr(3);
     if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 10)
-        badSpec(spec, "'" + text + "' is not 1inN" + rule);
+        badSpec(spec, "'" + shown + "' is not " + form + rule);
     const unsigned long long n = std::stoull(digits);
-    if (n < 1 || n > (1ull << 31)) badSpec(spec, "N in '" + text + "' is out of range" + rule);
+    if (n < 1 || n > (1ull << 31)) badSpec(spec, "N in '" + shown + "' is out of range" + rule);
     return uint32_t(n);
 }
 
@@ -140,6 +144,15 @@ SpirvFault scaleFault(const std::string& spec, const std::vector<std::string>& p
     fault.extInstruction = c.extInstruction;
     fault.epsilon = epsilonOf(spec, parts[2]);
     if (parts.size() == 4) fault.oneIn = oneInOf(spec, parts[3]);
+    return fault;
+}
+
+SpirvFault loopCutFault(const std::string& spec, const std::vector<std::string>& parts)
+{
+    const std::string rule = " (loop-cut:N, N a whole number of loop passes from 1 to 2147483648, e.g. loop-cut:65535)";
+    if (parts.size() != 2) badSpec(spec, "loop-cut takes the number of passes" + rule);
+    SpirvFault fault{SpirvFaultKind::LoopCut, spec};
+    fault.loopPasses = oneInOf(spec, "1in" + parts[1], rule);
     return fault;
 }
 
@@ -240,8 +253,9 @@ public:
         size_t count = 0;
         for (std::span<const uint32_t> inst : instructionsOf(m_spirv)) {
             if ((inst[0] & 0xffff) == op::Function && !m_firstFunction) m_firstFunction = m_body.size();
+            if ((inst[0] & 0xffff) == op::EntryPoint) m_entryPointAt = m_body.size();
             note(inst);
-            if (rewrite(inst)) ++count;
+            if (rewrite(inst)) count += !std::exchange(m_heldBack, false);
             else m_body.insert(m_body.end(), inst.begin(), inst.end());
         }
         if (changed) *changed = count;
@@ -270,6 +284,12 @@ private:
     /// Access chains into a storage buffer's runtime array (words as written),
     /// and chains that go on from one of those.
     std::map<uint32_t, std::vector<uint32_t>> m_elementChains;
+    /// loop-cut: the Private counter of loop-header entries (0 until made),
+    /// and a header's OpLoopMerge held back until its branch is seen.
+    uint32_t m_passCounter = 0;
+    std::vector<uint32_t> m_heldLoopMerge;
+    bool m_heldBack = false;      ///< rewrite() kept the instruction to write later: not a change by itself
+    size_t m_entryPointAt = 0;    ///< where in m_body the OpEntryPoint is (its interface gains the counter)
     std::set<uint32_t> m_precise; ///< ids decorated NoContraction
     /// Contractible float multiplies seen so far: result id -> its two operands
     /// (a definition precedes its uses in a module's order, so an add's product is known).
@@ -288,7 +308,13 @@ private:
         std::vector<uint32_t> out(m_spirv.begin(), m_spirv.begin() + kHeaderWords);
         out[kBoundWord] = m_bound;
         const size_t split = m_firstFunction.value_or(m_body.size());
-        out.insert(out.end(), m_body.begin(), m_body.begin() + ptrdiff_t(split));
+        std::vector<uint32_t> declarations(m_body.begin(), m_body.begin() + ptrdiff_t(split));
+        if (m_passCounter != 0) { // SPIR-V 1.4 on: an entry point lists every global it uses
+            const uint32_t count = declarations.at(m_entryPointAt) >> 16;
+            declarations.insert(declarations.begin() + ptrdiff_t(m_entryPointAt + count), m_passCounter);
+            declarations[m_entryPointAt] += 1u << 16;
+        }
+        out.insert(out.end(), declarations.begin(), declarations.end());
         out.insert(out.end(), m_declarations.begin(), m_declarations.end());
         out.insert(out.end(), m_body.begin() + ptrdiff_t(split), m_body.end());
         return out;
@@ -344,6 +370,7 @@ private:
         case SpirvFaultKind::Contract: return contract(inst);
         case SpirvFaultKind::NeighbourLoad: return loadNeighbour(inst);
         case SpirvFaultKind::TexelOffset: return offsetTexelFetch(inst);
+        case SpirvFaultKind::LoopCut: return cutLoop(inst);
         }
         return false;
     }
@@ -466,6 +493,73 @@ private:
         if (type == m_resultTypes.end()) return false;
         auto integer = m_intTypes.find(type->second);
         return integer != m_intTypes.end() && integer->second.width == 32 && integer->second.components == 1;
+    }
+
+    // ---- loop-cut: each loop header counts its entries in a Private
+    // counter shared by all loops; once past N, the header leaves the loop.
+
+    bool cutLoop(std::span<const uint32_t> inst)
+    {
+        const uint32_t opcode = inst[0] & 0xffff;
+        if (opcode == op::LoopMerge && inst.size() >= 4) {
+            m_heldLoopMerge.assign(inst.begin(), inst.end());
+            m_heldBack = true;
+            return true; // written with its branch
+        }
+        if (m_heldLoopMerge.empty()) return false;
+        const std::vector<uint32_t> loopMerge = std::exchange(m_heldLoopMerge, {});
+        const uint32_t merge = loopMerge[1];
+        const bool isBranch = opcode == op::Branch && inst.size() == 2;
+        const bool isConditional =
+            opcode == op::BranchConditional && inst.size() >= 4 && (inst[2] == merge || inst[3] == merge);
+        if (!isBranch && !isConditional) { // a header that does not branch to its merge block: left alone
+            m_body.insert(m_body.end(), loopMerge.begin(), loopMerge.end());
+            return false;
+        }
+        const uint32_t over = emitPassCount();
+        if (isBranch) {
+            m_body.insert(m_body.end(), loopMerge.begin(), loopMerge.end());
+            emit({firstWord(4, op::BranchConditional), over, merge, inst[1]});
+            return true;
+        }
+        // Leave when the loop would, or when over: c || over if true leaves, c && !over if false does.
+        const uint32_t condition = freshId();
+        if (inst[2] == merge) {
+            emit({firstWord(5, op::LogicalOr), boolTypeFor(1), condition, inst[1], over});
+        } else {
+            const uint32_t stay = freshId();
+            emit({firstWord(4, op::LogicalNot), boolTypeFor(1), stay, over});
+            emit({firstWord(5, op::LogicalAnd), boolTypeFor(1), condition, inst[1], stay});
+        }
+        m_body.insert(m_body.end(), loopMerge.begin(), loopMerge.end());
+        std::vector<uint32_t> branch(inst.begin(), inst.end());
+        branch[1] = condition;
+        m_body.insert(m_body.end(), branch.begin(), branch.end());
+        return true;
+    }
+
+    /// counter += 1; returns the bool counter > N.
+    uint32_t emitPassCount()
+    {
+        const uint32_t u = uintType();
+        if (m_passCounter == 0) {
+            uint32_t pointer = 0;
+            for (const auto& [id, target] : m_pointers)
+                if (target == std::pair<uint32_t, uint32_t>{kPrivateClass, u}) pointer = id;
+            if (pointer == 0) {
+                pointer = freshId();
+                declare({firstWord(4, op::TypePointer), pointer, kPrivateClass, u});
+                m_pointers[pointer] = {kPrivateClass, u};
+            }
+            m_passCounter = freshId();
+            declare({firstWord(5, op::Variable), pointer, m_passCounter, kPrivateClass, intConstant(u, 0)});
+        }
+        const uint32_t before = freshId(), after = freshId(), over = freshId();
+        emit({firstWord(4, op::Load), u, before, m_passCounter});
+        emit({firstWord(5, op::IAdd), u, after, before, intConstant(u, 1)});
+        emit({firstWord(3, op::Store), m_passCounter, after});
+        emit({firstWord(5, op::UGreaterThan), boolTypeFor(1), over, after, intConstant(u, m_fault.loopPasses)});
+        return over;
     }
 
     // ---- neighbour-load: `p = &buffer.array[i]...; x = *p` becomes `x = *&buffer.array[i + 1]...`
@@ -658,6 +752,7 @@ SpirvFault parseSpirvFault(const std::string& spec)
     }
     if (parts[0] == "neighbour-load") return offsetFault(spec, parts, SpirvFaultKind::NeighbourLoad);
     if (parts[0] == "texel-offset") return offsetFault(spec, parts, SpirvFaultKind::TexelOffset);
+    if (parts[0] == "loop-cut") return loopCutFault(spec, parts);
     if (parts[0] == "nan-minmax") {
         if (parts.size() != 1) badSpec(spec, "nan-minmax takes no arguments");
         return SpirvFault{SpirvFaultKind::NanMinMax, spec};

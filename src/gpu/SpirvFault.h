@@ -18,6 +18,9 @@
 //                    N indices that spirvFaultSelects (stores are untouched)
 //   texel-offset[:1inN]  texelFetch(image, (x, y)) reads (x + 1, y), for every
 //                    texel or for 1 in N (spirvFaultSelects(x + 65536 y))
+//   loop-cut:N       every loop of an invocation ends once the invocation has
+//                    entered loop headers N times in all (Mesa 22 lavapipe's
+//                    real bug at N = 65535, counted per invocation here)
 //   compare:lt-le    < and <= swapped (ordered and unordered)
 //   compare:gt-ge    > and >= swapped (ordered and unordered)
 //   nan-minmax       GLSL.std.450 FMin/FMax/NMin/NMax become a < b ? a : b
@@ -38,7 +41,7 @@
 
 namespace vkrt {
 
-enum class SpirvFaultKind { Scale, Compare, NanMinMax, Contract, NeighbourLoad, TexelOffset };
+enum class SpirvFaultKind { Scale, Compare, NanMinMax, Contract, NeighbourLoad, TexelOffset, LoopCut };
 
 /// One fault to inject, as parseSpirvFault reads it.
 struct SpirvFault {
@@ -50,6 +53,8 @@ struct SpirvFault {
     double epsilon = 0.0;
     /// Scale, NeighbourLoad, TexelOffset: the fault hits 1 in oneIn values (1: all).
     uint32_t oneIn = 1;
+    /// LoopCut: the loop-header entries an invocation may make.
+    uint32_t loopPasses = 0;
     /// Compare: opcode pairs exchanged with each other.
     std::vector<std::pair<uint32_t, uint32_t>> swaps;
 };

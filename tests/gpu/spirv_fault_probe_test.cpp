@@ -153,6 +153,35 @@ TEST(SpirvFaultProbe, NeighbourLoadReadsTheNextElement)
     }
 }
 
+// loop-cut:N: the invocation's loops together make N passes, then every
+// loop ends (the first loop's N + 1st header entry leaves it, and so does
+// the second loop's first).
+TEST(SpirvFaultProbe, LoopCutEndsTheLoopsAfterNPassesInAll)
+{
+    const std::vector<float> input{50.0f, 99.0f, 100.0f, 1000.0f, 30.0f};
+    const uint32_t count = uint32_t(input.size());
+    {
+        InjectedFault none(std::nullopt);
+        const std::vector<float> clean = runProbe("loop_cut_probe", input, 2 * count, count);
+        for (uint32_t i = 0; i < count; ++i) {
+            EXPECT_EQ(clean[2 * i], input[i]) << i;
+            EXPECT_EQ(clean[2 * i + 1], input[i]) << i;
+        }
+    }
+    InjectedFault injected("loop-cut:100");
+    const std::vector<float> out = runProbe("loop_cut_probe", input, 2 * count, count);
+    for (uint32_t i = 0; i < count; ++i) {
+        // The first loop enters its header n + 1 times when it runs to the
+        // end (the last entry leaves); the second loop has what is left of 100.
+        const uint32_t n = uint32_t(input[i]);
+        const uint32_t first = std::min(n, 100u);
+        const uint32_t entriesLeft = n + 1 <= 100 ? 100 - (n + 1) : 0;
+        const uint32_t second = std::min(n, entriesLeft);
+        EXPECT_EQ(out[2 * i], float(first)) << "n = " << n;
+        EXPECT_EQ(out[2 * i + 1], float(second)) << "n = " << n;
+    }
+}
+
 TEST(SpirvFaultProbe, NanMinMaxReturnsTheSecondOperandForNaN)
 {
     const float nan = std::numeric_limits<float>::quiet_NaN();

@@ -66,6 +66,8 @@ TEST(SpirvFaultSpec, ReadsEveryForm)
     EXPECT_EQ(parseSpirvFault("neighbour-load:1in10").oneIn, 10u);
     EXPECT_EQ(parseSpirvFault("texel-offset:1in2147483648").oneIn, 2147483648u);
     EXPECT_EQ(parseSpirvFault("texel-offset").kind, SpirvFaultKind::TexelOffset);
+    EXPECT_EQ(parseSpirvFault("loop-cut:65535").kind, SpirvFaultKind::LoopCut);
+    EXPECT_EQ(parseSpirvFault("loop-cut:65535").loopPasses, 65535u);
 }
 
 // The hash that picks 1 in N values: deterministic, and close to 1 in N.
@@ -99,6 +101,9 @@ TEST(SpirvFaultSpec, RefusalsNameTheProblemAndTheChoices)
     expectSpecError("neighbour-load:1in-3", {"'1in-3' is not 1inN"});
     expectSpecError("texel-offset:1in", {"'1in' is not 1inN"});
     expectSpecError("texel-offset:1in5:3", {"at most 1inN", "texel-offset[:1inN]"});
+    expectSpecError("loop-cut", {"loop-cut:N", "loop-cut:65535"});
+    expectSpecError("loop-cut:0", {"N in '0' is out of range", "loop-cut:N"});
+    expectSpecError("loop-cut:many", {"'many' is not a number of passes"});
     expectSpecError("scale:FMul:", {"EPS ''", "|EPS| < 1"});
     expectSpecError("scale:FMul:1", {"EPS 1 is out of range", "|EPS| < 1"});
     expectSpecError("scale:FMul:-1.5", {"out of range"});
@@ -335,6 +340,49 @@ TEST(SpirvFault, TexelOffsetMovesTheFetchedTexel)
     }
 }
 
+/// A for loop, a while loop and a do-while loop.
+std::vector<uint32_t> compileLoopSample()
+{
+    return compileKernelBody("loops", R"(
+    uint n = uint(v[0].x), a = 0u, b = 0u, c = 0u;
+    for (uint k = 0u; k < n; ++k)
+        ++a;
+    while (b < n)
+        ++b;
+    do {
+        ++c;
+    } while (c < n);
+    v[1] = vec4(a, b, c, 0.0);
+)");
+}
+
+constexpr uint32_t kLoopMerge = 246, kBranchConditional = 250, kEntryPoint = 15, kVariable = 59;
+
+TEST(SpirvFault, LoopCutMakesEveryLoopHeaderCountAndLeave)
+{
+    const std::vector<uint32_t> clean = compileLoopSample();
+    ASSERT_EQ(validationErrors(clean), "");
+    ASSERT_EQ(countOpcode(clean, kLoopMerge), 3u);
+    size_t changed = 0;
+    std::vector<uint32_t> out = injectSpirvFault(clean, parseSpirvFault("loop-cut:100"), &changed);
+    EXPECT_EQ(changed, 3u);
+    EXPECT_EQ(validationErrors(out), "");
+    EXPECT_EQ(countOpcode(out, kLoopMerge), 3u);
+    EXPECT_EQ(countOpcode(out, kStore) - countOpcode(clean, kStore), 3u) << "one count per header";
+    EXPECT_EQ(countOpcode(out, kVariable) - countOpcode(clean, kVariable), 1u) << "one counter for all loops";
+    EXPECT_EQ(countOpcode(out, kBranchConditional) - countOpcode(clean, kBranchConditional), 3u)
+        << "each header's branch becomes conditional";
+    // The entry point lists the counter (SPIR-V 1.4 on): its instruction is one word longer.
+    const auto entryWords = [](const std::vector<uint32_t>& m) {
+        for (const Inst& i : instructions(m))
+            if (i.opcode == kEntryPoint) return i.words;
+        return 0u;
+    };
+    EXPECT_EQ(entryWords(out), entryWords(clean) + 1);
+    EXPECT_EQ(injectSpirvFault(sample(), parseSpirvFault("loop-cut:5"), &changed), sample());
+    EXPECT_EQ(changed, 0u) << "the sample has no loop";
+}
+
 TEST(SpirvFault, CompareSwapsOpcodesAndNothingElse)
 {
     size_t changed = 0;
@@ -425,16 +473,16 @@ TEST(SpirvFault, EveryFaultKeepsTheRenderKernelValid)
     const std::vector<std::string> classes{"FMul", "FAdd", "FSub", "FDiv",  "Sqrt", "InverseSqrt", "Exp",  "Log",
                                            "Pow",  "Sin",  "Cos",  "Atan2", "Acos", "Exp2",        "Log2", "Fma"};
     std::vector<std::string> specs{
-        "compare:lt-le",          "compare:gt-ge",         "nan-minmax",          "contract",
-        "neighbour-load",         "neighbour-load:1in100", "texel-offset",        "texel-offset:1in9",
-        "scale:FMul:0.5:1in1000", "scale:Sqrt:-0.9:1in7",  "scale:RayQueryT:0.01"};
+        "compare:lt-le",          "compare:gt-ge",         "nan-minmax",           "contract",
+        "neighbour-load",         "neighbour-load:1in100", "texel-offset",         "texel-offset:1in9",
+        "scale:FMul:0.5:1in1000", "scale:Sqrt:-0.9:1in7",  "scale:RayQueryT:0.01", "loop-cut:65535"};
     for (const std::string& c : classes) specs.push_back("scale:" + c + ":-0.001");
     for (const std::string& spec : specs) {
         size_t changed = 0;
         std::vector<uint32_t> out = injectSpirvFault(kernel, parseSpirvFault(spec), &changed);
         EXPECT_EQ(validationErrors(out), "") << spec;
         const bool common = spec.find("FMul") != std::string::npos || spec.find("compare") != std::string::npos ||
-                            spec.find("neighbour-load") != std::string::npos;
+                            spec.find("neighbour-load") != std::string::npos || spec == "loop-cut:65535";
         if (common || spec == "nan-minmax" || spec == "contract") {
             EXPECT_GT(changed, 0u) << spec;
         }
