@@ -5,7 +5,7 @@ and, as the control, without one under other seeds (false alarms).
 
     tools/regress_power.py [--vkrt build/vkrt] [--faults F1,F2,...]
         [--ladder classes|quick|legal|rare|memory|rayquery|loops|none] [--accel own|driver]
-        [--control-seeds N] [--filter CASE ...] [--jobs 2] [--out DIR] [--json FILE]
+        [--control-seeds N] [--filter CASE ...] [--jobs 2] [--case-timeout S] [--out DIR] [--json FILE]
 
 Ladders: classes (each arithmetic class at 1e-2, the comparisons, NaN),
 quick (FMul and Sqrt at 1e-1 ... 1e-3), legal (what a conformant driver may
@@ -205,6 +205,8 @@ def run_suite(args, out: Path, extra: list[str], env: dict | None = None) -> dic
     command = [args.vkrt, "regress", "--jobs", str(args.jobs), "--report-dir", str(out), *extra]
     if args.accel:
         command += ["--accel", args.accel]
+    if args.case_timeout:
+        command += ["--case-timeout", str(args.case_timeout)]
     for case in args.filter or []:
         command += ["--filter", case]
     start = time.monotonic()
@@ -228,6 +230,9 @@ def main() -> int:
     parser.add_argument("--control-seeds", type=int, default=0, help="unmodified runs with --seed-offset 1..N")
     parser.add_argument("--filter", action="append", help="only these cases (vkrt regress --filter)")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--case-timeout", type=float,
+                        help="vkrt regress --case-timeout: a fault that makes a case hang (a BVH walk sent in a "
+                             "circle) costs this, not the default minutes, twice")
     parser.add_argument("--accel", choices=["own", "driver"], help="traversal backend of every run (rayquery: driver)")
     parser.add_argument("--out", help="keep each run's report here (default: a temporary folder)")
     parser.add_argument("--json", help="also write the rows as JSON")
