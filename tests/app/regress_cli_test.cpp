@@ -228,8 +228,9 @@ TEST_F(RegressCli, FresnelBiasFailsTheGlassCasesOnly)
 // The suite's power in CI (docs/regress.md, "injected faults"): a 5 % error in
 // every float multiply the driver runs is caught by both glass cases, and the
 // legal variation `contract` (products fused into adds where SPIR-V allows it:
-// what Mesa 26 does and Mesa 25 does not) passes them. The fault reaches the
-// children, and report.md and the JUnit file record it.
+// what Mesa 26 does and Mesa 25 does not) passes them; a memory fault (loads
+// that read the next element) fails both. The fault reaches the children, and
+// report.md and the JUnit file record it.
 TEST_F(RegressCli, AnInjectedFaultIsCaughtAndALegalContractionIsNot)
 {
     fs::path junit = m_dir / "junit.xml", report = m_dir / "faulty";
@@ -246,6 +247,14 @@ TEST_F(RegressCli, AnInjectedFaultIsCaughtAndALegalContractionIsNot)
     r = regress({"--filter", "extreme/kappa-", "--inject", "contract", "--report-dir", (m_dir / "legal").string()});
     EXPECT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(readFile(m_dir / "legal" / "report.md").find("contract"), std::string::npos);
+
+    // A memory fault: every storage-buffer element load reads the next element.
+    fs::path memoryJunit = m_dir / "memory.xml";
+    r = regress({"--filter", "extreme/kappa-", "--inject", "neighbour-load", "--junit", memoryJunit.string()});
+    EXPECT_EQ(r.exitCode, 4) << r.output;
+    outcome = junitOutcomes(memoryJunit);
+    EXPECT_EQ(outcome["extreme/kappa-halfspace"], "failure") << r.output;
+    EXPECT_EQ(outcome["extreme/kappa-shadow"], "failure") << r.output;
 }
 
 // ------------------------------------------------------------ seed consistency
