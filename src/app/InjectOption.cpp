@@ -34,7 +34,8 @@ void addInjectOption(CLI::App& command, std::string& fault)
                     "FDiv, Sqrt, InverseSqrt, Exp, Log, Pow, Sin, Cos, Atan2, Acos, Exp2, Log2, Fma, RayQueryT), "
                     "compare:lt-le, compare:gt-ge (swap < and <=, > and >=), nan-minmax (min/max mishandle NaN), "
                     "neighbour-load[:1inN] (a storage-buffer element load reads the next element), "
-                    "texel-offset[:1inN] (texelFetch reads the texel to the right), or the legal variation "
+                    "texel-offset[:1inN] (texelFetch reads the texel to the right), loop-cut:N (loops end after N "
+                    "passes of an invocation in all), or the legal variation "
                     "contract (a * b + c fused into fma where not precise)")
         ->check(CLI::Validator(checkFault, ""))
         ->type_name("FAULT");

@@ -117,19 +117,28 @@ double epsilonOf(const std::string& spec, const std::string& text)
     return eps;
 }
 
-/// N of a "1inN" part: a whole number from 1 to 2^31.
-uint32_t oneInOf(const std::string& spec, const std::string& text,
-                 const std::string& rule = " (write 1inN with N a whole number from 1 to 2147483648, e.g. 1in1000)")
+/// A whole number from 1 to 2^31 written in `digits`, or nullopt (and
+/// `outOfRange` set when it is a number, but too small or too large).
+std::optional<uint32_t> countOf(const std::string& digits, bool& outOfRange)
 {
-    const bool isLoopCut = rule.find("loop-cut") != std::string::npos;
-    const std::string shown = isLoopCut ? text.substr(3) : text, form = isLoopCut ? "a number of passes" : "1inN";
-    if (text.rfind("1in", 0) != 0 || text.size() == 3) badSpec(spec, "'" + shown + "' is not " + form + rule);
-    const std::string digits = text.substr(3);
-    if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 10)
-        badSpec(spec, "'" + shown + "' is not " + form + rule);
+    outOfRange = false;
+    if (digits.empty() || digits.size() > 10 || digits.find_first_not_of("0123456789") != std::string::npos)
+        return std::nullopt;
     const unsigned long long n = std::stoull(digits);
-    if (n < 1 || n > (1ull << 31)) badSpec(spec, "N in '" + shown + "' is out of range" + rule);
+    outOfRange = n < 1 || n > (1ull << 31);
+    if (outOfRange) return std::nullopt;
     return uint32_t(n);
+}
+
+/// N of a "1inN" part.
+uint32_t oneInOf(const std::string& spec, const std::string& text)
+{
+    const std::string rule = " (write 1inN with N a whole number from 1 to 2147483648, e.g. 1in1000)";
+    bool outOfRange = false;
+    const std::optional<uint32_t> n = text.rfind("1in", 0) == 0 ? countOf(text.substr(3), outOfRange) : std::nullopt;
+    if (outOfRange) badSpec(spec, "N in '" + text + "' is out of range" + rule);
+    if (!n) badSpec(spec, "'" + text + "' is not 1inN" + rule);
+    return *n;
 }
 
 SpirvFault scaleFault(const std::string& spec, const std::vector<std::string>& parts)
@@ -152,7 +161,11 @@ SpirvFault loopCutFault(const std::string& spec, const std::vector<std::string>&
     const std::string rule = " (loop-cut:N, N a whole number of loop passes from 1 to 2147483648, e.g. loop-cut:65535)";
     if (parts.size() != 2) badSpec(spec, "loop-cut takes the number of passes" + rule);
     SpirvFault fault{SpirvFaultKind::LoopCut, spec};
-    fault.loopPasses = oneInOf(spec, "1in" + parts[1], rule);
+    bool outOfRange = false;
+    const std::optional<uint32_t> passes = countOf(parts[1], outOfRange);
+    if (outOfRange) badSpec(spec, "N in '" + parts[1] + "' is out of range" + rule);
+    if (!passes) badSpec(spec, "'" + parts[1] + "' is not a number of passes" + rule);
+    fault.loopPasses = *passes;
     return fault;
 }
 
