@@ -9,6 +9,11 @@
 #ifdef VKRT_GROUP_LOOP_COUNT
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #endif
+#ifdef VKRT_PACKET_TRAVERSAL
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_vote : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#endif
 #ifdef VKRT_TEXTURE_CHUNKS
 #extension GL_EXT_nonuniform_qualifier : require
 #endif

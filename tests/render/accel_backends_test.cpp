@@ -7,6 +7,10 @@
 // on the record and primitive it hits, and on t within the two error bounds.
 // A driver whose traversal misses a triangle, reports a farther one or
 // loses an instance fails here with the scene, the pixel and both hits.
+// The third: vkrt's own traversal as a packet walk (VKRT_PACKET_TRAVERSAL,
+// lib/shapes/mesh.glsl), a measurement hook since it does not pay on
+// lavapipe, must give the own lane walk's hits exactly: the same primitive
+// at the same t, ties at shared edges apart.
 // Also: a camera move rebuilds the driver's camera-relative structures (the
 // viewer's path), and --accel driver on a device without ray queries is
 // refused with what it lacks.
@@ -45,13 +49,16 @@ struct ProbedHit {
     double t = 0.0, error = 0.0, cosine = 1.0;
 };
 
-std::vector<ProbedHit> probeHits(const Scene& scene, bool driver)
+enum class Walk { Own, Driver, OwnPackets };
+
+std::vector<ProbedHit> probeHits(const Scene& scene, Walk walk)
 {
     RenderOptions options;
     options.seed = 11;
     options.aov = true;
-    options.driverAccel = driver;
+    options.driverAccel = walk == Walk::Driver;
     options.extraDefines = {{"VKRT_TEST_HIT_PROBE", "1"}};
+    if (walk == Walk::OwnPackets) options.extraDefines.emplace_back("VKRT_PACKET_TRAVERSAL", "1");
     options.cacheDirectory = testCacheDir();
     Renderer renderer(gpu(), scene, options);
     renderer.renderFrames(1);
@@ -82,10 +89,10 @@ std::string describe(const ProbedHit& h)
 
 struct Disagreements {
     uint64_t rays = 0, hits = 0;
-    uint64_t hitOrMiss = 0;     ///< one backend hit, the other did not
+    uint64_t hitOrMiss = 0;      ///< one backend hit, the other did not
     uint64_t otherPrimitive = 0; ///< different record or primitive at a distance outside both bounds
-    uint64_t tie = 0;           ///< different primitive at the same distance (a shared edge or vertex)
-    uint64_t distance = 0;      ///< same primitive, t outside both bounds
+    uint64_t tie = 0;            ///< different primitive at the same distance (a shared edge or vertex)
+    uint64_t distance = 0;       ///< same primitive, t outside both bounds
     std::string examples;
     double worstSteps = 0.0; ///< largest |t_own - t_driver| |cos| / (2^-24 t)
 };
@@ -137,18 +144,21 @@ TEST_F(AccelBackends, HitForHitOnOverOneHundredThousandCameraRays)
     // Meshes (instances, an emissive mesh, vertex normals, textures and uvs,
     // a glTF node hierarchy) and analytic kinds (spheres, boxes, triangles,
     // triangle lights, planes).
-    const char* scenes[] = {"scenes/validation/mesh-cornell.toml", "scenes/validation/mesh-bunny-diffuse.toml",
-                            "scenes/validation/mesh-smooth.toml",  "scenes/validation/textured.toml",
-                            "scenes/gltf/lights-camera.gltf",       "scenes/validation/lights.toml",
+    const char* scenes[] = {"scenes/validation/mesh-cornell.toml",
+                            "scenes/validation/mesh-bunny-diffuse.toml",
+                            "scenes/validation/mesh-smooth.toml",
+                            "scenes/validation/textured.toml",
+                            "scenes/gltf/lights-camera.gltf",
+                            "scenes/validation/lights.toml",
                             "scenes/seed/glass.toml"};
     Disagreements total;
     for (const char* file : scenes) {
         Scene scene = loadScene(root + "/" + file, ResolutionOverride{160, 120});
         const Disagreements d =
-            compareHits(file, scene.camera.width, probeHits(scene, false), probeHits(scene, true));
+            compareHits(file, scene.camera.width, probeHits(scene, Walk::Own), probeHits(scene, Walk::Driver));
         RecordProperty(std::string(file) + " rays/hits/hit-or-miss/other-primitive/ties/distance",
-                       std::to_string(d.rays) + "/" + std::to_string(d.hits) + "/" + std::to_string(d.hitOrMiss) +
-                           "/" + std::to_string(d.otherPrimitive) + "/" + std::to_string(d.tie) + "/" +
+                       std::to_string(d.rays) + "/" + std::to_string(d.hits) + "/" + std::to_string(d.hitOrMiss) + "/" +
+                           std::to_string(d.otherPrimitive) + "/" + std::to_string(d.tie) + "/" +
                            std::to_string(d.distance));
         std::printf("%s: %llu rays, %llu hits; disagreements: hit or miss %llu, closest primitive %llu, "
                     "distance %llu; ties at shared edges %llu; largest distance difference %.2f float steps "
@@ -163,7 +173,6 @@ TEST_F(AccelBackends, HitForHitOnOverOneHundredThousandCameraRays)
         total.tie += d.tie;
         total.distance += d.distance;
         total.examples += d.examples;
-
     }
     EXPECT_GE(total.rays, 100000u);
     EXPECT_GE(total.hits, 50000u);
@@ -175,6 +184,38 @@ TEST_F(AccelBackends, HitForHitOnOverOneHundredThousandCameraRays)
     EXPECT_LE(total.tie, total.hits / 1000) << total.examples;
 }
 
+TEST_F(AccelBackends, ThePacketWalkFindsTheLaneWalksHitsExactly)
+{
+    const std::string root = VKRT_TEST_SOURCE_DIR;
+    const char* scenes[] = {"scenes/validation/mesh-bunny-diffuse.toml", "scenes/validation/mesh-smooth.toml"};
+    uint64_t rays = 0, hits = 0, ties = 0, packetWalked = 0;
+    for (const char* file : scenes) {
+        Scene scene = loadScene(root + "/" + file, ResolutionOverride{160, 120});
+        ASSERT_FALSE(scene.meshes.empty()) << file;
+        const std::vector<ProbedHit> lanes = probeHits(scene, Walk::Own);
+        const std::vector<ProbedHit> packets = probeHits(scene, Walk::OwnPackets);
+        for (size_t i = 0; i < lanes.size(); ++i) {
+            const ProbedHit &a = lanes[i], &b = packets[i];
+            ++rays;
+            ASSERT_EQ(a.hit, b.hit) << file << " pixel " << i << ": " << describe(a) << " / " << describe(b);
+            if (!a.hit) continue;
+            ++hits;
+            packetWalked += a.kind == b.kind && a.kind == int(ShapeKind::Mesh) ? 1 : 0;
+            const bool samePrimitive = a.kind == b.kind && a.record == b.record && a.primitive == b.primitive;
+            if (!samePrimitive && a.t == b.t) {
+                ++ties;
+                continue;
+            }
+            ASSERT_TRUE(samePrimitive) << file << " pixel " << i << ": " << describe(a) << " / " << describe(b);
+            ASSERT_EQ(a.t, b.t) << file << " pixel " << i;
+            ASSERT_EQ(a.error, b.error) << file << " pixel " << i;
+        }
+    }
+    EXPECT_GE(hits, 30000u);
+    EXPECT_GE(packetWalked, 10000u); // mesh hits: what the packet walk found
+    EXPECT_LE(ties, hits / 1000);
+}
+
 // The driver's box structures and top level are camera-relative: a camera
 // move must rebuild them (Renderer::moveCamera, the viewer's path). With
 // analytic kinds only, both backends run the same intersection code on the
@@ -183,8 +224,8 @@ TEST_F(AccelBackends, HitForHitOnOverOneHundredThousandCameraRays)
 // the wrong place. The rebuild's time is what the viewer pays per move.
 TEST_F(AccelBackends, CameraMovesRebuildTheDriversStructures)
 {
-    Scene scene = loadScene(std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/validation/lights.toml",
-                            ResolutionOverride{64, 48});
+    Scene scene =
+        loadScene(std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/validation/lights.toml", ResolutionOverride{64, 48});
     Camera moved = scene.camera;
     moved.eye += glm::dvec3(0.7, 0.3, -0.5);
     auto render = [&](bool driver) {
