@@ -5,6 +5,7 @@
 #include "app/ExitCodes.h"
 #include "app/InjectOption.h"
 #include "app/JsonOutput.h"
+#include "app/VectorWidthRelaunch.h"
 #include "io/AtomicFile.h"
 #include "io/ExrFile.h"
 #include "io/OutputPaths.h"
@@ -59,6 +60,7 @@ struct RenderCommandOptions {
     bool sppGiven = false;
     std::string sampler = "auto";
     AccelChoice accel = AccelChoice::Auto;
+    VectorWidthChoice vectorWidth = VectorWidthChoice::Auto;
     std::string shard;                      ///< "i/n" (docs/farm.md)
     uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
     std::vector<std::string> kernelDefines; ///< NAME=VALUE (measurement hooks)
@@ -312,6 +314,7 @@ JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& 
     json["integrator"] = integratorName(scene.render.integrator);
     json["sampler"] = samplerName(session.sampler());
     json["accel"] = accelName(session.accel());
+    if (std::optional<int> bits = lavapipeVectorBits(device)) json["vectorWidth"] = *bits;
     json["kernel"] = {{"variant", renderer.variant().describe()},
                       {"uber", options.uber},
                       {"cacheKey", renderer.kernel().cacheKey},
@@ -416,6 +419,16 @@ void checkRenderFiles(const RenderCommandOptions& options, const std::string& ou
         throw InputError("--png " + options.png + ": names a PNG file, so it must end in .png");
 }
 
+/// Starts vkrt again with lavapipe at the width --vector-width chooses, before
+/// anything is compiled or written; returns when the running width is it.
+void startAtTheVectorWidth(const RenderCommandOptions& options, const VulkanContext& context, const Scene& scene)
+{
+    const bool driverAccel =
+        resolveAccel(options.accel, context.deviceInfo(), meshTriangleCount(scene)) == Accel::Driver;
+    const VectorWidthFacts facts = vectorWidthFacts(context, scene, driverAccel);
+    if (std::optional<int> bits = chooseVectorBits(options.vectorWidth, facts)) relaunchAtVectorWidth(*bits, facts);
+}
+
 Outcome runRender(const RenderCommandOptions& options)
 {
     // Ctrl-C asks to stop from the very start (even while a driver hangs creating the instance);
@@ -430,6 +443,7 @@ Outcome runRender(const RenderCommandOptions& options)
     refuseOverlappingFiles(filesTheSceneRead(scene), renderOutputs(options, output));
 
     VulkanContext context({options.device, options.validation || environmentFlag("VKRT_VALIDATION")});
+    startAtTheVectorWidth(options, context, scene);
     std::optional<Image> reference = loadReference(options, scene);
     if (interruptFlag()) return interruptedBeforeRendering();
     // On a terminal, say what the silent seconds of a cold start are.
@@ -549,6 +563,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
     addAccelOption(*cmd, options->accel);
+    addVectorWidthOption(*cmd, options->vectorWidth);
     cmd->add_option("--camera", options->gltf.camera,
                     "A glTF scene's camera to render through: its or its node's name, or its index (default: the "
                     "first)");

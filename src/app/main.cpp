@@ -2,6 +2,7 @@
 #include "app/Commands.h"
 #include "app/ManPage.h"
 #include "app/Suggestions.h"
+#include "app/VectorWidthRelaunch.h"
 #include "util/Error.h"
 #include "util/Signals.h"
 
@@ -11,6 +12,7 @@
 
 int main(int argc, char** argv)
 {
+    vkrt::rememberCommandLine(argc, argv); // --vector-width may start vkrt again with it
     // Temporary outputs go with any SIGINT/SIGTERM/SIGHUP; a driver crash is named as such.
     vkrt::installSignalHandlers({vkrt::kExitInterrupted, vkrt::kExitDriverCrashed});
     CLI::App app("vkrt - Vulkan compute ray tracer", "vkrt");

@@ -1,5 +1,7 @@
 #include "render/RenderSession.h"
 
+#include "gpu/VectorWidth.h"
+
 #include "scene/GltfScene.h"
 #include "scene/SceneParser.h"
 #include "util/Hash.h"
@@ -241,6 +243,8 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
     };
     // Said wherever the image goes: an inf pixel is never written without it.
     if (counters.overflowedPixels) metadata["overflowedPixels"] = int64_t(counters.overflowedPixels);
+    // lavapipe's SIMD width (vkrt render --vector-width).
+    if (std::optional<int> bits = lavapipeVectorBits(m_context.deviceInfo())) metadata["vectorWidth"] = int64_t(*bits);
     // Whether the device may have cut loops short (docs/platform.md).
     metadata["loopCap"] = m_context.loopCap().describe();
     if (m_stoppedBy) metadata["stoppedBy"] = stopReasonName(*m_stoppedBy);

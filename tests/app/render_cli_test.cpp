@@ -1,4 +1,5 @@
 // End-to-end tests of `vkrt render` and `vkrt devices` as a user runs them.
+#include "gpu/VectorWidth.h"
 #include "io/ExrFile.h"
 #include "shared/Bindings.h"
 #include "support/TestSupport.h"
@@ -85,6 +86,27 @@ TEST_F(RenderCli, WritesExrWithMetadataAndPng)
     // Non-interactive runs print exactly one summary line.
     EXPECT_NE(r.output.find("3 spp"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
+}
+
+// --vector-width: vkrt starts itself again with lavapipe at the width asked
+// for, and the EXR and the JSON say which width ran.
+TEST_F(RenderCli, VectorWidthRunsLavapipeAtTheWidthAskedFor)
+{
+    const std::optional<int> running = lavapipeVectorBits(gpu().deviceInfo());
+    if (!running) GTEST_SKIP() << gpu().deviceInfo().name << " is not lavapipe";
+    if (!cpuHasAvx512()) GTEST_SKIP() << "this CPU lacks AVX-512";
+    for (const char* bits : {"512", "256"}) {
+        const std::string exr = std::string("w") + bits + ".exr", json = (m_dir / (std::string(bits) + ".json"));
+        ProcessResult r = render(exr, {"--spp", "1", "--vector-width", bits, "--json", json});
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        EXPECT_EQ(intAttribute(readExr(m_dir / exr).metadata, "vectorWidth"), std::stoi(bits));
+        std::ifstream in(json);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        EXPECT_NE(text.find(std::string("\"vectorWidth\": ") + bits), std::string::npos) << text;
+    }
+    ProcessResult wrong = render("x.exr", {"--vector-width", "300"});
+    EXPECT_EQ(wrong.exitCode, 2);
+    EXPECT_NE(wrong.output.find("--vector-width 300: expected auto, 256 or 512"), std::string::npos) << wrong.output;
 }
 
 // --sampler auto: Sobol' unless a per-pixel variance layer is asked for; an
