@@ -3,12 +3,12 @@
 // `--json` writes the same facts as one JSON object (docs/machine-output.md).
 #include "app/Commands.h"
 #include "app/JsonOutput.h"
-#include "scene/SceneInputs.h"
 #include "io/AtomicFile.h"
 #include "mesh/MeshGeometry.h"
 #include "render/RenderSession.h"
 #include "scene/FeatureSet.h"
 #include "scene/SceneExport.h"
+#include "scene/SceneInputs.h"
 #include "texture/TextureAtlas.h"
 
 #include <CLI/CLI.hpp>
@@ -27,8 +27,8 @@ struct InfoOptions {
     std::string device;
     bool uber = false;
     AccelChoice accel = AccelChoice::Auto;
-    std::string json;      ///< --json FILE, or "-" for standard output
-    std::string sceneJson; ///< --scene-json FILE, or "-" for standard output
+    std::string json;                  ///< --json FILE, or "-" for standard output
+    std::string sceneJson;             ///< --scene-json FILE, or "-" for standard output
     uint64_t maxTextureChunkBytes = 0; ///< test hook: texel buffers of at most this many bytes
 };
 
@@ -195,6 +195,69 @@ JsonObject texturesJson(const TextureAtlas& textures, const TextureChunking& chu
             {"bufferBytes", textureBufferBytes(textures, chunking)}};
 }
 
+// ---------------------------------------------------------------- start-up
+
+/// Where a cold or warm start goes, each part once (seconds, wall).
+struct StartupSplit {
+    double parse = 0.0;    ///< reading the scene, besides the three below
+    double textures = 0.0; ///< decoding images or reading them from the texture cache (in parallel)
+    uint32_t texturesDecoded = 0, texturesFromCache = 0;
+    double meshLoad = 0.0;   ///< reading mesh files
+    double bvh = 0.0;        ///< mesh BVHs and the top level
+    double glslang = 0.0;    ///< compiling the kernel to SPIR-V (0 from the cache)
+    double setup = 0.0;      ///< buffers, pipeline, uploads: set-up besides glslang and the top level
+    double firstFrame = 0.0; ///< from set-up's end to the first frame: on lavapipe, its compile of the kernel
+    double total() const { return parse + textures + meshLoad + bvh + glslang + setup + firstFrame; }
+};
+
+StartupSplit startupSplit(const RenderSession& session, const InfoTimes& times)
+{
+    const Scene& scene = session.scene();
+    StartupSplit split;
+    if (scene.textures) {
+        const TextureLoadStats& load = scene.textures->loadStats();
+        split.textures = load.seconds;
+        split.texturesDecoded = load.decoded;
+        split.texturesFromCache = load.fromCache;
+    }
+    double topBuild = 0.0;
+    if (!scene.meshes.empty()) {
+        const MeshFacts facts = meshFacts(scene, session.renderer().meshData());
+        split.meshLoad = facts.loadSeconds;
+        split.bvh = facts.buildSeconds + facts.topBuildSeconds;
+        topBuild = facts.topBuildSeconds;
+    }
+    split.parse = std::max(0.0, times.parse - split.textures - split.meshLoad - (split.bvh - topBuild));
+    split.glslang = session.renderer().kernel().compileSeconds;
+    split.setup = std::max(0.0, times.setup - split.glslang - topBuild);
+    split.firstFrame = std::max(0.0, times.firstFrame - times.setup);
+    return split;
+}
+
+void printStartup(std::FILE* out, const StartupSplit& s)
+{
+    std::fprintf(out,
+                 "start-up:       %.3f s: parse %.3f, textures %.3f (%u decoded, %u from the texture cache), mesh "
+                 "files %.3f, BVH %.3f, glslang %.3f, set-up %.3f, first frame %.3f (the driver's compile and "
+                 "one frame)\n",
+                 s.total(), s.parse, s.textures, s.texturesDecoded, s.texturesFromCache, s.meshLoad, s.bvh, s.glslang,
+                 s.setup, s.firstFrame);
+}
+
+JsonObject startupJson(const StartupSplit& s)
+{
+    return {{"parseSeconds", s.parse},
+            {"texturesSeconds", s.textures},
+            {"texturesDecoded", s.texturesDecoded},
+            {"texturesFromCache", s.texturesFromCache},
+            {"meshFilesSeconds", s.meshLoad},
+            {"bvhSeconds", s.bvh},
+            {"glslangSeconds", s.glslang},
+            {"setupSeconds", s.setup},
+            {"firstFrameSeconds", s.firstFrame},
+            {"totalSeconds", s.total()}};
+}
+
 // ---------------------------------------------------------------- the whole report
 
 /// The worst-case loop passes of one invocation; none for meshes (BVH traversal has no static bound).
@@ -253,6 +316,7 @@ void printInfo(std::FILE* out, const RenderSession& session, const InfoOptions& 
     std::fprintf(out, "set-up:         %.3f s (parse excluded: compile or load, pipeline, buffers)\n", times.setup);
     std::fprintf(out, "first frame:    %.3f s after set-up began (includes the driver's shader compile)\n",
                  times.firstFrame);
+    printStartup(out, startupSplit(session, times));
     std::fprintf(out, "loop cap:       %s\n", session.context().loopCap().describe().c_str());
     printAccel(out, session);
     std::fprintf(out, "camera move:    %.4f s (the viewer's pause per move: re-upload%s)\n", times.cameraMove,
@@ -326,6 +390,7 @@ JsonObject infoJson(const RenderSession& session, const InfoOptions& options, co
     json["setupSeconds"] = times.setup;
     json["firstFrameSeconds"] = times.firstFrame;
     json["cameraMoveSeconds"] = times.cameraMove;
+    json["startup"] = startupJson(startupSplit(session, times));
     json["loopCap"] = {{"capped", cap.capped()}, {"budget", valueOrNull(cap.budget)}, {"description", cap.describe()}};
     json["loopPassesWorstCase"] = valueOrNull(staticLoopBound(scene));
     json["meshes"] =

@@ -242,6 +242,7 @@ Scene parseGltfScene(const std::string& path, const GltfSceneOptions& options)
     auto textures = std::make_shared<TextureAtlas>();
     ParseContext context{scene, *textures, meshes, {}};
     importGltf(path, options, true, context);
+    textures->settle(); // the images, decoded in parallel: a bad one is refused here
     // Only KHR_lights_punctual lights switch the studio light off: emissive
     // surfaces alone (a lamp, a helmet's display) keep it.
     const bool lit = !scene.pointLights.empty() || !scene.spotLights.empty() || !scene.directionalLights.empty();

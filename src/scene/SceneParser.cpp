@@ -732,6 +732,7 @@ Scene parseSceneString(std::string_view text, const std::string& path)
     const TomlSource source{path, fs::path(path).parent_path()};
     const toml::table root = parseToml(text, source);
     readScene(TableField(Field(source, root, "")), context);
+    textures->settle(); // the images, decoded in parallel: a bad one is refused here, at its key
     if (scene.background.environment) {
         if (auto warning = latLongShapeWarning(*scene.background.environment, path + ": background.environment.file"))
             scene.warnings.push_back(*warning);

@@ -1,13 +1,19 @@
 #include "texture/TextureAtlas.h"
 
 #include "texture/MipPyramid.h"
+#include "texture/TextureCache.h"
+#include "util/Error.h"
 
 #include <Imath/half.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
+#include <chrono>
 #include <cmath>
+#include <exception>
 #include <sstream>
+#include <thread>
 
 namespace vkrt {
 
@@ -57,6 +63,29 @@ void appendLevel(const RgbaImage& level, uint32_t format, std::vector<uint32_t>&
     }
 }
 
+} // namespace
+
+EncodedTexture encodeTexture(TextureImage image)
+{
+    EncodedTexture encoded;
+    encoded.width = image.pixels.width;
+    encoded.height = image.pixels.height;
+    encoded.format = formatOf(image.encoding);
+    for (size_t i = 0; i < image.pixels.texelCount(); ++i)
+        for (int c = 0; c < 4; ++c) encoded.mean[c] += image.pixels.rgba[i * 4 + c];
+    for (double& m : encoded.mean) m /= double(image.pixels.texelCount());
+    // The pyramid takes level 0 over: no second copy of the largest level.
+    for (const RgbaImage& level : buildMipPyramid(std::move(image.pixels))) {
+        encoded.levelWords.push_back(encoded.words.size());
+        appendLevel(level, encoded.format, encoded.words);
+    }
+    encoded.levels = uint32_t(encoded.levelWords.size());
+    VKRT_CHECK(encoded.levels <= gpu::TEXTURE_MAX_LEVELS);
+    return encoded;
+}
+
+namespace {
+
 std::string mebibytes(uint64_t bytes)
 {
     std::ostringstream text;
@@ -85,42 +114,128 @@ void TextureAtlas::reserveTexels(const TextureHeader& header, const std::string&
     m_texels += header.texels();
 }
 
-uint32_t TextureAtlas::addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear)
+uint32_t TextureAtlas::addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
+                                  const SourceLocation& where)
 {
-    reserveTexels(readTextureHeader(bytes, name, linear), name);
-    return addImage(decodeTextureImage(bytes, name, linear), name);
+    const TextureHeader header = readTextureHeader(bytes, name, linear);
+    reserveTexels(header, name);
+    // Decoded later, with the scene's other images, in parallel (settle).
+    StoredImage stored;
+    stored.name = name;
+    stored.width = header.width;
+    stored.height = header.height;
+    m_images.push_back(std::move(stored));
+    m_pending.push_back({m_images.size() - 1, std::vector<uint8_t>(bytes.begin(), bytes.end()), linear, where});
+    return uint32_t(m_images.size() - 1);
 }
 
 uint32_t TextureAtlas::addImage(TextureImage image, const std::string& name)
 {
     StoredImage stored;
     stored.name = name;
-    stored.width = image.pixels.width;
-    stored.height = image.pixels.height;
-    stored.format = formatOf(image.encoding);
-    for (size_t i = 0; i < image.pixels.texelCount(); ++i)
-        for (int c = 0; c < 4; ++c) stored.mean[c] += image.pixels.rgba[i * 4 + c];
-    for (double& m : stored.mean) m /= double(image.pixels.texelCount());
-    // The pyramid takes level 0 over: no second copy of the largest level.
-    for (const RgbaImage& level : buildMipPyramid(std::move(image.pixels))) {
-        stored.levelWords.push_back(stored.words.size());
-        appendLevel(level, stored.format, stored.words);
-    }
-    stored.levels = uint32_t(stored.levelWords.size());
-    VKRT_CHECK(stored.levels <= gpu::TEXTURE_MAX_LEVELS);
-    // Half-float images start at an even word, so that no two-word texel
-    // straddles two chunks (each holds an even number of words).
-    if (stored.format == gpu::TEXTURE_FORMAT_RGBA16F) m_words += m_words % 2;
-    stored.firstWord = m_words;
-    m_words += stored.words.size();
+    stored.encoded = encodeTexture(std::move(image));
+    stored.width = stored.encoded.width;
+    stored.height = stored.encoded.height;
     m_images.push_back(std::move(stored));
     return uint32_t(m_images.size() - 1);
+}
+
+namespace {
+
+/// One pending image's outcome: its encoding, or why it could not be decoded.
+struct DecodeOutcome {
+    EncodedTexture encoded;
+    std::exception_ptr error;
+    bool fromCache = false;
+};
+
+DecodeOutcome decodeThroughCache(const TextureCache& cache, std::span<const uint8_t> bytes, const std::string& name,
+                                 bool linear, uint32_t width, uint32_t height)
+{
+    DecodeOutcome outcome;
+    try {
+        const std::string key = TextureCache::keyOf(bytes, linear);
+        if (std::optional<EncodedTexture> cached = cache.load(key);
+            cached && cached->width == width && cached->height == height) {
+            outcome.encoded = std::move(*cached);
+            outcome.fromCache = true;
+            return outcome;
+        }
+        outcome.encoded = encodeTexture(decodeTextureImage(bytes, name, linear));
+        cache.store(key, outcome.encoded);
+    } catch (...) {
+        outcome.error = std::current_exception();
+    }
+    return outcome;
+}
+
+} // namespace
+
+void TextureAtlas::settle() const
+{
+    if (!m_pending.empty()) {
+        const auto start = std::chrono::steady_clock::now();
+        const TextureCache cache(TextureCache::defaultDirectory());
+        std::vector<DecodeOutcome> outcomes(m_pending.size());
+        // A few workers, not one thread per image: each holds a decoded
+        // level 0 in floats (64 MiB for a 2048x2048 image) while it works.
+        std::atomic<size_t> next{0};
+        auto work = [&] {
+            for (size_t i; (i = next++) < m_pending.size();) {
+                const PendingImage& job = m_pending[i];
+                const StoredImage& image = m_images[job.image];
+                outcomes[i] = decodeThroughCache(cache, job.bytes, image.name, job.linear, image.width, image.height);
+            }
+        };
+        const size_t workers = std::min<size_t>(m_pending.size(), std::max(1u, std::thread::hardware_concurrency()));
+        std::vector<std::thread> threads;
+        for (size_t w = 1; w < workers; ++w) threads.emplace_back(work);
+        work();
+        for (std::thread& thread : threads) thread.join();
+        std::vector<PendingImage> pending = std::move(m_pending);
+        m_pending.clear();
+        m_load.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        for (size_t i = 0; i < pending.size(); ++i) {
+            if (outcomes[i].error) rethrowAt(outcomes[i].error, pending[i].where);
+            m_images[pending[i].image].encoded = std::move(outcomes[i].encoded);
+            ++(outcomes[i].fromCache ? m_load.fromCache : m_load.decoded);
+        }
+    }
+    // Places in the packed buffer, in the order the images were added.
+    for (; m_placed < m_images.size(); ++m_placed) {
+        StoredImage& image = m_images[m_placed];
+        VKRT_CHECK(image.encoded.levels >= 1 && image.encoded.levels <= gpu::TEXTURE_MAX_LEVELS);
+        // Half-float images start at an even word, so that no two-word texel
+        // straddles two chunks (each holds an even number of words).
+        if (image.encoded.format == gpu::TEXTURE_FORMAT_RGBA16F) m_words += m_words % 2;
+        image.firstWord = m_words;
+        m_words += image.encoded.words.size();
+    }
+}
+
+void TextureAtlas::rethrowAt(const std::exception_ptr& error, const SourceLocation& where)
+{
+    try {
+        std::rethrow_exception(error);
+    } catch (const SceneError&) {
+        throw;
+    } catch (const InputError& input) {
+        if (where.file.empty()) throw;
+        throw SceneError(where, input.what());
+    }
+}
+
+const TextureLoadStats& TextureAtlas::loadStats() const
+{
+    settle();
+    return m_load;
 }
 
 std::array<double, 4> TextureAtlas::meanOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[m_records[record].image].mean;
+    settle();
+    return m_images[m_records[record].image].encoded.mean;
 }
 
 const std::string& TextureAtlas::nameOf(uint32_t record) const
@@ -144,7 +259,8 @@ uint32_t TextureAtlas::heightOf(uint32_t record) const
 uint32_t TextureAtlas::levelsOf(uint32_t record) const
 {
     VKRT_CHECK(record < m_records.size());
-    return m_images[m_records[record].image].levels;
+    settle();
+    return m_images[m_records[record].image].encoded.levels;
 }
 
 namespace {
@@ -176,8 +292,8 @@ std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t lev
 {
     const uint64_t index = uint64_t(y) * width + x;
     std::array<double, 4> texel{};
-    if (image.format == gpu::TEXTURE_FORMAT_RGBA16F) {
-        const uint32_t* words = &image.words[levelWord + 2 * index];
+    if (image.encoded.format == gpu::TEXTURE_FORMAT_RGBA16F) {
+        const uint32_t* words = &image.encoded.words[levelWord + 2 * index];
         for (int c = 0; c < 4; ++c) {
             Imath::half h;
             h.setBits(uint16_t(words[c / 2] >> (16 * (c % 2))));
@@ -194,8 +310,8 @@ std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t lev
         }
         return t;
     }();
-    const uint32_t word = image.words[levelWord + index];
-    const bool srgb = image.format == gpu::TEXTURE_FORMAT_RGBA8_SRGB;
+    const uint32_t word = image.encoded.words[levelWord + index];
+    const bool srgb = image.encoded.format == gpu::TEXTURE_FORMAT_RGBA8_SRGB;
     for (int c = 0; c < 4; ++c) texel[c] = tables[srgb && c < 3 ? 1 : 0][(word >> (8 * c)) & 0xffu];
     return texel;
 }
@@ -203,11 +319,12 @@ std::array<double, 4> TextureAtlas::fetch(const StoredImage& image, uint64_t lev
 std::array<double, 4> TextureAtlas::sampleLevel(uint32_t record, double u, double v, uint32_t level) const
 {
     VKRT_CHECK(record < m_records.size());
+    settle();
     const auto& [imageIndex, wrapU, wrapV, filter] = m_records[record];
     const StoredImage& image = m_images[imageIndex];
-    VKRT_CHECK(level < image.levels);
+    VKRT_CHECK(level < image.encoded.levels);
     const int64_t w = mipSize(image.width, level), h = mipSize(image.height, level);
-    const uint64_t at = image.levelWords[level];
+    const uint64_t at = image.encoded.levelWords[level];
     if (filter.magNearest) {
         // Texel i spans [i, i + 1) of the continuous coordinates.
         const auto i = int64_t(std::floor(wrapCoordinate(u, wrapU) * double(w)));
@@ -254,7 +371,7 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
     if (found == m_imageByFile.end()) {
         uint32_t image = 0;
         try {
-            image = addDecoded(readTextureFile(request.file), request.file.string(), request.linear);
+            image = addDecoded(readTextureFile(request.file), request.file.string(), request.linear, where);
         } catch (const SceneError&) {
             throw;
         } catch (const InputError& error) {
@@ -302,10 +419,12 @@ std::span<const uint32_t> TextureBuffers::chunk(uint32_t index) const
 
 TextureChunking TextureAtlas::chunking(const TextureStorageLimits& limits) const
 {
+    settle();
     const TextureChunking chunks = textureChunkingFor(m_words, limits);
     if (chunks.count <= limits.maxBuffers && texelBytes() <= limits.memoryBytes) return chunks;
-    const auto largest = std::max_element(m_images.begin(), m_images.end(),
-                                          [](const auto& a, const auto& b) { return a.words.size() < b.words.size(); });
+    const auto largest = std::max_element(m_images.begin(), m_images.end(), [](const auto& a, const auto& b) {
+        return a.encoded.words.size() < b.encoded.words.size();
+    });
     const std::string room = chunks.count > limits.maxBuffers
                                  ? std::to_string(chunks.count) + " storage buffers of " +
                                        mebibytes(uint64_t(4) << chunks.shift) +
@@ -315,18 +434,19 @@ TextureChunking TextureAtlas::chunking(const TextureStorageLimits& limits) const
     throw InputError("textures need " + mebibytes(texelBytes()) + " of GPU storage (all mip levels), more than " +
                      "this device can hold: " + room + "; the largest is " + largest->name + " (" +
                      std::to_string(largest->width) + "x" + std::to_string(largest->height) + ", " +
-                     mebibytes(largest->words.size() * 4) + ")");
+                     mebibytes(largest->encoded.words.size() * 4) + ")");
 }
 
 std::vector<gpu::TextureRecord> TextureAtlas::records() const
 {
+    settle();
     std::vector<gpu::TextureRecord> records;
     for (const auto& [imageIndex, wrapU, wrapV, filter] : m_records) {
         const StoredImage& image = m_images[imageIndex];
-        gpu::TextureRecord record{image.width,     image.height,    image.levels,  image.format,
-                                  uint32_t(wrapU), uint32_t(wrapV), filter.bits(), {}};
-        for (uint32_t level = 0; level < image.levels; ++level)
-            record.levelOffset[level] = uint32_t(image.firstWord + image.levelWords[level]);
+        gpu::TextureRecord record{image.width,     image.height,    image.encoded.levels, image.encoded.format,
+                                  uint32_t(wrapU), uint32_t(wrapV), filter.bits(),        {}};
+        for (uint32_t level = 0; level < image.encoded.levels; ++level)
+            record.levelOffset[level] = uint32_t(image.firstWord + image.encoded.levelWords[level]);
         records.push_back(record);
     }
     return records;
@@ -340,13 +460,14 @@ TextureBuffers TextureAtlas::pack(const TextureChunking& chunking) const
     // of padding before its image. So the scene's texel budget keeps them
     // below 2^32; the check stands for an atlas made with a larger budget.
     static_assert(5 * TextureAtlas::kMaxSceneTexels < (uint64_t(1) << 32));
+    settle();
     VKRT_CHECK(m_words <= uint64_t(UINT32_MAX));
     VKRT_CHECK(chunking.count == 1 || ((m_words - 1) >> chunking.shift) + 1 == chunking.count);
     TextureBuffers buffers;
     buffers.texels.reserve(m_words);
     for (const StoredImage& image : m_images) {
         buffers.texels.resize(image.firstWord, 0u); // the padding before a half-float image
-        buffers.texels.insert(buffers.texels.end(), image.words.begin(), image.words.end());
+        buffers.texels.insert(buffers.texels.end(), image.encoded.words.begin(), image.encoded.words.end());
     }
     buffers.records = records();
     buffers.chunking = chunking;

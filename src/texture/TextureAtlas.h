@@ -6,11 +6,13 @@
 // (TextureChunking): a few buffers however many textures, so the texture
 // count never meets a descriptor limit.
 #include "shared/TextureTypes.h"
+#include "texture/TextureCache.h"
 #include "texture/TextureImage.h"
 #include "util/Error.h"
 
 #include <array>
 #include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <map>
 #include <span>
@@ -90,6 +92,13 @@ struct TextureBuffers {
     std::span<const uint32_t> chunk(uint32_t chunk) const;
 };
 
+/// How a scene's images were loaded (vkrt info's start-up split).
+struct TextureLoadStats {
+    double seconds = 0.0;   ///< wall time decoding or reading the cache (in parallel)
+    uint32_t decoded = 0;   ///< images decoded from their files
+    uint32_t fromCache = 0; ///< images read decoded from the texture cache
+};
+
 class TextureAtlas {
 public:
     /// Level-0 texels all of a scene's textures may have together (one
@@ -127,7 +136,17 @@ public:
     /// Distinct images loaded (each with its mip chain).
     size_t imageCount() const { return m_images.size(); }
     /// Bytes of texel storage so far.
-    uint64_t texelBytes() const { return m_words * 4; }
+    uint64_t texelBytes() const
+    {
+        settle();
+        return m_words * 4;
+    }
+    /// Decodes the images added so far (in parallel, through the texture
+    /// cache) and places them in the texel buffer; every accessor below does
+    /// it first. A file that fails to decode throws here, as add would have.
+    void settle() const;
+    /// What loading the images took: decoding, or reading them from the cache.
+    const TextureLoadStats& loadStats() const;
     /// The mean linear RGBA of a record's image (level 0), as Mitsuba's
     /// Texture::mean() gives for a bitmap: what a plastic's sampling weight uses.
     std::array<double, 4> meanOf(uint32_t record) const;
@@ -156,17 +175,25 @@ public:
 private:
     struct StoredImage {
         std::string name;
-        uint32_t width = 0, height = 0, levels = 0, format = 0;
-        uint64_t firstWord = 0;           ///< in the packed buffer
-        std::vector<uint64_t> levelWords; ///< each level's start, relative to firstWord
-        std::vector<uint32_t> words;      ///< every level, encoded
-        std::array<double, 4> mean{};     ///< level 0's mean linear RGBA
+        uint32_t width = 0, height = 0; ///< from the file's header, before it is decoded
+        uint64_t firstWord = 0;         ///< in the packed buffer (once settled)
+        EncodedTexture encoded;         ///< levels, format, words (levelWords relative to firstWord), mean
+    };
+    /// A file's bytes waiting for settle() to decode them into m_images[image].
+    struct PendingImage {
+        size_t image = 0;
+        std::vector<uint8_t> bytes;
+        bool linear = false;
+        SourceLocation where; ///< the scene's `texture` key, for errors (may be empty)
     };
     uint32_t addImage(TextureImage image, const std::string& name);
     /// Counts a texture of `header`'s size against the budget, or refuses it naming `name`.
     void reserveTexels(const TextureHeader& header, const std::string& name);
-    /// Header check, budget, decoding and storing, for a file's bytes.
-    uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear);
+    /// Header check and budget now; decoding and storing at settle().
+    uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
+                        const SourceLocation& where = {});
+    /// A decode failure of a pending image, as a SceneError at `where` when there is one.
+    [[noreturn]] static void rethrowAt(const std::exception_ptr& error, const SourceLocation& where);
     /// What makes a record: its image and how lookups read it.
     struct RecordKey {
         uint32_t image = 0;
@@ -179,10 +206,13 @@ private:
     std::array<double, 4> fetch(const StoredImage& image, uint64_t levelWord, uint32_t width, uint32_t x,
                                 uint32_t y) const;
 
-    std::vector<StoredImage> m_images;
+    mutable std::vector<StoredImage> m_images;
+    mutable std::vector<PendingImage> m_pending;
+    mutable size_t m_placed = 0; ///< images [0, m_placed) have their firstWord
+    mutable TextureLoadStats m_load;
     std::vector<RecordKey> m_records;
     std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile; ///< (canonical path, linear)
-    uint64_t m_words = 0;
+    mutable uint64_t m_words = 0;
     uint64_t m_maxTexels = kMaxSceneTexels;
     uint64_t m_texels = 0; ///< level 0, of every image added
 };
