@@ -314,7 +314,7 @@ JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& 
     json["integrator"] = integratorName(scene.render.integrator);
     json["sampler"] = samplerName(session.sampler());
     json["accel"] = accelName(session.accel());
-    if (std::optional<int> bits = lavapipeVectorBits(device)) json["vectorWidth"] = *bits;
+    json["vectorWidth"] = valueOrNull(lavapipeVectorBits(device)); // null: not lavapipe
     json["kernel"] = {{"variant", renderer.variant().describe()},
                       {"uber", options.uber},
                       {"cacheKey", renderer.kernel().cacheKey},

@@ -84,7 +84,12 @@ std::optional<int> chooseVectorBits(VectorWidthChoice choice, const VectorWidthF
     case VectorWidthChoice::Bits512: checkExplicit512(facts); return 512;
     case VectorWidthChoice::Auto: break;
     }
-    // The user's own $LP_NATIVE_VECTOR_WIDTH stands; so does any device but lavapipe.
+    // The user's own $LP_NATIVE_VECTOR_WIDTH stands (but not into the abort
+    // below); so does any device but lavapipe.
+    if (facts.widthFromEnvironment && facts.runningBits == 512 && facts.driverAccel && mesa26OrLater(facts))
+        throw InputError("$LP_NATIVE_VECTOR_WIDTH=512 with the driver's traversal: lavapipe of Mesa 26 aborts "
+                         "compiling the ray-query kernel at 512 bits (docs/performance.md, \"Round four\"); unset "
+                         "it, or use --accel own");
     if (!facts.runningBits || facts.widthFromEnvironment) return std::nullopt;
     // Measured (docs/performance.md, "Round four"): on Mesa 26.1 512 bits gave
     // 1.2-1.3x samples/s on scenes without meshes and 0.8x with them; on Mesa

@@ -1,9 +1,12 @@
 #include "material/Sheen.h"
 
 #include <algorithm>
-#include <cstdint>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <thread>
+#include <vector>
 
 namespace vkrt {
 
@@ -68,12 +71,22 @@ const std::vector<float>& sheenAlbedoTable()
     static const std::vector<float> table = [] {
         constexpr uint32_t side = kSheenTableSide;
         std::vector<float> entries(size_t(side) * side);
-        for (uint32_t j = 0; j < side; ++j)
-            for (uint32_t i = 0; i < side; ++i) {
-                const double s = double(i) / (side - 1);
-                const double mu = std::max(s * s, 1e-4);
-                entries[size_t(j) * side + i] = float(sheenDirectionalAlbedo(mu, double(j) / (side - 1)));
-            }
+        // 8 million BRDF values: a second of a sheen scene's start-up on one
+        // core, so the rows are shared among the cores (each entry is
+        // computed alone: the table is the same for any number of threads).
+        std::atomic<uint32_t> nextRow{0};
+        auto work = [&] {
+            for (uint32_t j; (j = nextRow++) < side;)
+                for (uint32_t i = 0; i < side; ++i) {
+                    const double s = double(i) / (side - 1);
+                    const double mu = std::max(s * s, 1e-4);
+                    entries[size_t(j) * side + i] = float(sheenDirectionalAlbedo(mu, double(j) / (side - 1)));
+                }
+        };
+        std::vector<std::thread> threads;
+        for (unsigned t = 1; t < std::max(1u, std::thread::hardware_concurrency()); ++t) threads.emplace_back(work);
+        work();
+        for (std::thread& thread : threads) thread.join();
         return entries;
     }();
     return table;

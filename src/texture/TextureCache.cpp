@@ -43,10 +43,12 @@ fs::path TextureCache::defaultDirectory()
 
 std::string TextureCache::keyOf(std::span<const uint8_t> bytes, bool linear)
 {
-    // The commit stands for the decoders, the mip filter and the encoders:
-    // another build never reads this one's entries.
+    // The version and commit stand for the decoders, the mip filter and the
+    // encoders: another build never reads this one's entries (outside a git
+    // clone the commit is "unknown" and the version still differs).
     Fnv1a64 hash;
-    hash.addField("vkrt-texture-cache-v1").addField(VKRT_GIT_COMMIT).addField(linear ? "linear" : "srgb");
+    hash.addField("vkrt-texture-cache-v1").addField(VKRT_VERSION).addField(VKRT_GIT_COMMIT);
+    hash.addField(linear ? "linear" : "srgb");
     hash.addField(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
     return toHex(hash.value()) + "-" + std::to_string(bytes.size());
 }

@@ -336,6 +336,21 @@ TEST_F(Json, InfoReportsTextureMemoryAndItsBuffers)
     EXPECT_EQ(split["kernel"]["defines"]["VKRT_TEXTURE_CHUNKS"], "6");
     EXPECT_EQ(split["kernel"]["defines"]["VKRT_TEXTURE_CHUNK_SHIFT"], "6");
     EXPECT_NE(splitText.find("in 6 buffers\n"), std::string::npos) << splitText;
+    // The start-up split: the image was decoded by the first run (or an
+    // earlier one) and read from the texture cache by the second; the parts
+    // add up to the total.
+    const json& first = one["startup"];
+    EXPECT_EQ(first["texturesDecoded"].get<int>() + first["texturesFromCache"].get<int>(), 1);
+    EXPECT_EQ(split["startup"]["texturesFromCache"], 1);
+    EXPECT_EQ(split["startup"]["texturesDecoded"], 0);
+    double parts = 0.0;
+    for (const char* key : {"parseSeconds", "texturesSeconds", "meshFilesSeconds", "bvhSeconds", "glslangSeconds",
+                            "setupSeconds", "firstFrameSeconds"}) {
+        EXPECT_GE(first[key].get<double>(), 0.0) << key;
+        parts += first[key].get<double>();
+    }
+    EXPECT_NEAR(parts, first["totalSeconds"].get<double>(), 1e-9);
+    EXPECT_NE(oneText.find("start-up:       "), std::string::npos) << oneText;
 }
 
 TEST_F(Json, InfoToStandardOutputMovesTheLinesForPeopleToStderr)

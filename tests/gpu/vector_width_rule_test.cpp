@@ -70,6 +70,11 @@ TEST(VectorWidth, AutoPicks512OnlyWhereItMeasuredFaster)
     VectorWidthFacts userSet = facts;
     userSet.widthFromEnvironment = true;
     EXPECT_EQ(chooseVectorBits(VectorWidthChoice::Auto, userSet), std::nullopt);
+    VectorWidthFacts userSet512 = userSet;
+    userSet512.runningBits = 512;
+    EXPECT_EQ(chooseVectorBits(VectorWidthChoice::Auto, userSet512), std::nullopt);
+    userSet512.driverAccel = true; // into lavapipe's abort: refused
+    EXPECT_THROW(chooseVectorBits(VectorWidthChoice::Auto, userSet512), InputError);
     EXPECT_EQ(chooseVectorBits(VectorWidthChoice::Auto, VectorWidthFacts{}), std::nullopt); // not lavapipe
 }
 
