@@ -1,6 +1,7 @@
 // The render session on a device: its stop rules and the metadata it writes
 // for every command. Its rules that need no device (sampler policy, pacing,
 // Ctrl-C, overrides) are in session_policy_test.cpp (vkrt_cpu_tests).
+#include "gpu/VectorWidth.h"
 #include "render/RenderSession.h"
 #include "shared/Bindings.h"
 #include "support/TestSupport.h"
@@ -106,10 +107,26 @@ TEST_F(RenderSessionTest, RenderMetadataHasEveryField)
     session.run();
     Film film = session.film();
     Metadata m = session.metadata(film);
-    for (const char* key :
-         {"vkrtVersion", "spp", "seed", "renderSeconds", "stoppedBy", "device", "driver", "scene", "sceneHash",
-          "integrator", "kernelVariant", "sampler", "rejectedSamples", "loopCap", "varianceDegreesOfFreedom",
-          "varianceEstimator", "estimatedRmse", "estimatedRelMse", "timeBudgetSeconds", "accel"})
+    for (const char* key : {"vkrtVersion",
+                            "spp",
+                            "seed",
+                            "renderSeconds",
+                            "stoppedBy",
+                            "device",
+                            "driver",
+                            "scene",
+                            "sceneHash",
+                            "integrator",
+                            "kernelVariant",
+                            "sampler",
+                            "rejectedSamples",
+                            "loopCap",
+                            "varianceDegreesOfFreedom",
+                            "varianceEstimator",
+                            "estimatedRmse",
+                            "estimatedRelMse",
+                            "timeBudgetSeconds",
+                            "accel"})
         EXPECT_EQ(m.count(key), 1u) << key;
     EXPECT_EQ(std::get<std::string>(m.at("accel")), "own") << "the backend asked for";
     EXPECT_EQ(m.count("savedBy"), 0u);
@@ -138,6 +155,7 @@ TEST_F(RenderSessionTest, ViewerSaveMetadataAddsSavedByAndFollowsMovesAndResets)
                                       "device",      "driver",        "scene",   "sceneHash",
                                       "integrator",  "kernelVariant", "sampler", "rejectedSamples",
                                       "loopCap",     "savedBy",       "accel"};
+    if (lavapipeVectorBits(gpu().deviceInfo())) expected.insert("vectorWidth"); // lavapipe's SIMD width
     EXPECT_EQ(keysOf(saved), expected);
 
     Camera before = session.scene().camera;
