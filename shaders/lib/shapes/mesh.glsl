@@ -43,7 +43,7 @@ vec3 objectToWorldNormal(Mesh mesh, vec3 n)
 // The packet walk (Wald et al. 2001): the active lanes of the subgroup walk
 // one tree together. The node is subgroup-uniform, so its load is one load
 // for every lane, not a gather per lane: on lavapipe with gallivm's
-// divergence analysis (Mesa >= 25.1) that is 2.8-3.7x cheaper per node
+// divergence analysis (Mesa >= 25.1) that is 3.0-4.8x cheaper per node
 // (tools/load_probe.cpp, docs/performance.md "Round four"). A child is
 // entered when any lane enters its box; of two, the one more lanes enter
 // first is walked first. Each lane keeps its own closest hit and its own
