@@ -13,8 +13,9 @@ NumPy arrays back::
         print(frame.spp, frame.image.mean())
 
 Every render runs the same render session as the command line (one C++ core;
-docs/python.md), so an image equals `vkrt render`'s at the same seed, bit for
-bit. The GIL is released while the device renders; Ctrl-C stops a render
+docs/python.md), so an image equals `vkrt render`'s at the same seed and
+lavapipe vector width, bit for bit (`vkrt render --vector-width auto` may run
+512 bits where this process runs 256: docs/python.md). The GIL is released while the device renders; Ctrl-C stops a render
 between submissions.
 """
 
