@@ -1,9 +1,8 @@
 // libFuzzer target for the mesh path (loadMeshFile, normals, BVH build; a glTF
 // file read as a whole scene: its cameras, lights and material extensions
-// too): the first byte picks the format, the rest is the file. Any outcome but a MeshData or an InputError (another exception,
-// a crash, a sanitizer report, a hang) is a bug. tools/fuzz.sh runs it. The
-// default MeshLoadOptions apply: a glTF's buffer or image URI, or an OBJ's
-// mtllib, that leaves the fuzzer's folder is refused (ReferencePolicy.h), so no
+// too): the first byte picks the format, the rest is the file. Any outcome but a MeshData or an InputError (another
+// exception, a crash, a sanitizer report, a hang) is a bug. tools/fuzz.sh runs it. The default MeshLoadOptions apply: a
+// glTF's buffer or image URI, or an OBJ's mtllib, that leaves the fuzzer's folder is refused (ReferencePolicy.h), so no
 // input makes the target read other files; glTF node depth, JSON nesting, node
 // counts, triangles after instancing and accessor data are bounded before
 // assimp (FileMaterials.h).
@@ -17,6 +16,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -41,6 +41,13 @@ const std::filesystem::path& fuzzDir()
 // leak checker (ASan builds, the fuzzer) must not count that against vkrt.
 // Leaks with any other origin are still reported.
 extern "C" const char* __lsan_default_suppressions() { return "leak:libassimp.so\n"; }
+
+// No texture cache: a glTF input's images would fill the user's cache folder.
+extern "C" int LLVMFuzzerInitialize(int*, char***)
+{
+    setenv("VKRT_TEXTURE_CACHE_DIR", "off", 1);
+    return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
