@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -72,6 +73,19 @@ fs::path testCacheDir()
     static fs::path dir = freshTempDir("spirv-cache");
     return dir;
 }
+
+namespace {
+
+// Tests never fill the user's texture cache (texture/TextureCache.h): theirs
+// is a fresh folder per test process, inherited by the vkrt processes they
+// start; a test that wants another sets its own and restores this one.
+const bool kTestsHaveTheirOwnTextureCache = [] {
+    if (!std::getenv("VKRT_TEXTURE_CACHE_DIR"))
+        setenv("VKRT_TEXTURE_CACHE_DIR", freshTempDir("texture-cache").c_str(), 1);
+    return true;
+}();
+
+} // namespace
 
 RenderOptions pixelCentreOptions()
 {

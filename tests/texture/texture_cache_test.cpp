@@ -11,6 +11,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <random>
 
 namespace fs = std::filesystem;
@@ -18,13 +19,24 @@ namespace fs = std::filesystem;
 namespace vkrt::test {
 namespace {
 
-/// Points the texture cache at `dir` ("off": none) for its lifetime.
+/// Points the texture cache at `dir` ("off": none) for its lifetime, then back.
 class TextureCacheDir {
 public:
-    explicit TextureCacheDir(const std::string& dir) { setenv("VKRT_TEXTURE_CACHE_DIR", dir.c_str(), 1); }
-    ~TextureCacheDir() { unsetenv("VKRT_TEXTURE_CACHE_DIR"); }
+    explicit TextureCacheDir(const std::string& dir)
+    {
+        if (const char* old = std::getenv("VKRT_TEXTURE_CACHE_DIR")) m_previous = old;
+        setenv("VKRT_TEXTURE_CACHE_DIR", dir.c_str(), 1);
+    }
+    ~TextureCacheDir()
+    {
+        if (m_previous) setenv("VKRT_TEXTURE_CACHE_DIR", m_previous->c_str(), 1);
+        else unsetenv("VKRT_TEXTURE_CACHE_DIR");
+    }
     TextureCacheDir(const TextureCacheDir&) = delete;
     TextureCacheDir& operator=(const TextureCacheDir&) = delete;
+
+private:
+    std::optional<std::string> m_previous;
 };
 
 /// A noisy RGBA PNG (every texel different, so a wrong level or order shows).
