@@ -74,6 +74,8 @@ vec4 fetchTexel(uint format, uint offset, uint width, uint x, uint y)
 }
 
 /// Lookup in one mip level: the nearest texel, or bilinear between the four nearest.
+/// The nearest texel is the bilinear's first fetch at its own coordinates, so
+/// that a copy of this function inlines four texel fetches, not five.
 vec4 filterTextureLevel(uint textureIndex, vec2 uv, uint level, bool nearest)
 {
     uint format = textureRecords[textureIndex].format;
@@ -84,19 +86,17 @@ vec4 filterTextureLevel(uint textureIndex, vec2 uv, uint level, bool nearest)
     // Continuous texel coordinates, y down from the top row: texel i spans [i, i + 1).
     vec2 image = vec2(wrapTextureCoordinate(uv.x, wrapU), wrapTextureCoordinate(1.0 - uv.y, wrapV));
     uint w = uint(size.x);
-    if (nearest) {
-        ivec2 i = ivec2(floor(image * vec2(size)));
-        return fetchTexel(format, offset, w, uint(wrapTexelIndex(i.x, size.x, wrapU)),
-                          uint(wrapTexelIndex(i.y, size.y, wrapV)));
-    }
-    // Bilinear: texel centres at integers.
-    vec2 st = image * vec2(size) - 0.5;
+    // Nearest: the texel containing the point. Bilinear: texel centres at integers.
+    vec2 st = nearest ? image * vec2(size) : image * vec2(size) - 0.5;
     vec2 base = floor(st);
-    vec2 f = st - base;
     ivec2 i0 = ivec2(base);
-    uint x0 = uint(wrapTexelIndex(i0.x, size.x, wrapU)), x1 = uint(wrapTexelIndex(i0.x + 1, size.x, wrapU));
-    uint y0 = uint(wrapTexelIndex(i0.y, size.y, wrapV)), y1 = uint(wrapTexelIndex(i0.y + 1, size.y, wrapV));
-    vec4 top = mix(fetchTexel(format, offset, w, x0, y0), fetchTexel(format, offset, w, x1, y0), f.x);
+    uint x0 = uint(wrapTexelIndex(i0.x, size.x, wrapU)), y0 = uint(wrapTexelIndex(i0.y, size.y, wrapV));
+    vec4 topLeft = fetchTexel(format, offset, w, x0, y0);
+    if (nearest)
+        return topLeft;
+    vec2 f = st - base;
+    uint x1 = uint(wrapTexelIndex(i0.x + 1, size.x, wrapU)), y1 = uint(wrapTexelIndex(i0.y + 1, size.y, wrapV));
+    vec4 top = mix(topLeft, fetchTexel(format, offset, w, x1, y0), f.x);
     vec4 bottom = mix(fetchTexel(format, offset, w, x0, y1), fetchTexel(format, offset, w, x1, y1), f.x);
     return mix(top, bottom, f.y);
 }
@@ -116,23 +116,35 @@ vec4 sampleTextureLevel(uint textureIndex, vec2 uv, uint level)
 /// - minified, by default trilinear: levels floor(lod) and floor(lod) + 1
 ///   mixed by the fraction (lod clamped to levels - 1), bilinear or nearest
 ///   within each; or the nearest level (round(lod)) alone; or level 0 alone.
+/// The filters only choose the level(s), the in-level filter and the blend:
+/// filterTextureLevel is called at two sites, not once per filter mode,
+/// because lavapipe inlines every call and each copy of it (four texel
+/// fetches, each decoded by format) costs the driver's compile time.
 vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
 {
     uint filters = textureRecords[textureIndex].filters;
-    if (!(lod > 0.0))
-        return filterTextureLevel(textureIndex, uv, 0u, (filters & TEXTURE_FILTER_MAG_NEAREST) != 0u);
-    bool nearest = (filters & TEXTURE_FILTER_MIN_NEAREST) != 0u;
-    if ((filters & TEXTURE_FILTER_MIP_NONE) != 0u)
-        return filterTextureLevel(textureIndex, uv, 0u, nearest);
-    lod = min(lod, float(textureRecords[textureIndex].levels - 1u));
-    if ((filters & TEXTURE_FILTER_MIP_NEAREST) != 0u)
-        return filterTextureLevel(textureIndex, uv, uint(floor(lod + 0.5)), nearest);
-    float level0 = floor(lod);
-    float t = lod - level0;
-    vec4 fine = filterTextureLevel(textureIndex, uv, uint(level0), nearest);
-    if (t == 0.0)
+    uint level = 0u;
+    float blend = 0.0; // weight of level + 1: nonzero only between two levels of a trilinear lookup
+    bool nearest;
+    if (!(lod > 0.0)) {
+        nearest = (filters & TEXTURE_FILTER_MAG_NEAREST) != 0u;
+    } else {
+        nearest = (filters & TEXTURE_FILTER_MIN_NEAREST) != 0u;
+        if ((filters & TEXTURE_FILTER_MIP_NONE) == 0u) {
+            lod = min(lod, float(textureRecords[textureIndex].levels - 1u));
+            if ((filters & TEXTURE_FILTER_MIP_NEAREST) != 0u) {
+                level = uint(floor(lod + 0.5));
+            } else {
+                float level0 = floor(lod);
+                level = uint(level0);
+                blend = lod - level0;
+            }
+        }
+    }
+    vec4 fine = filterTextureLevel(textureIndex, uv, level, nearest);
+    if (blend == 0.0)
         return fine;
-    return mix(fine, filterTextureLevel(textureIndex, uv, uint(level0) + 1u, nearest), t);
+    return mix(fine, filterTextureLevel(textureIndex, uv, level + 1u, nearest), blend);
 }
 
 /// Mip level from a ray cone (Akenine-Möller et al. 2019, "Texture Level of
