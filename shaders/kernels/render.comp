@@ -153,9 +153,6 @@ bool finishSample(inout AccumPixel sum, uint pixelIndex, uint slot, inout uint f
         return false;
     rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     aovStartSample();
-#ifdef VKRT_HAS_TEXTURES
-    setTextureConeScale(frameIndex);
-#endif
 #ifdef VKRT_HAS_ALPHA
     alphaStartSample(pixelIndex, frameIndex, frame.seed);
 #endif
@@ -178,9 +175,6 @@ void main()
     AccumPixel sum = accum[slot];
     Sampler rng = samplerCreate(pixelIndex, frameIndex, frame.seed);
     aovStartSample();
-#ifdef VKRT_HAS_TEXTURES
-    setTextureConeScale(frameIndex);
-#endif
 #ifdef VKRT_HAS_ALPHA
     alphaStartSample(pixelIndex, frameIndex, frame.seed);
 #endif

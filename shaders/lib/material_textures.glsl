@@ -12,26 +12,27 @@
 // The cone of one pixel is right for one sample per pixel; jittered samples
 // already average over the pixel, and filtering each one over the whole
 // pixel again blurs the converged image by about a pixel (textured test
-// charts came out visibly softer than Cycles'). As pbrt-v4 scales camera ray
-// differentials by 1/sqrt(spp), the cone of the pixel's n-th sample (n from
-// 1) is 1/sqrt(n) of the pixel's: the first samples keep their mip-mapped
-// low noise, and the average converges to the texture's own detail (the
-// filters' added variance, ~ w^2/n, averages to O(log N / N)).
+// charts came out visibly softer than Cycles'). So a jittered sample's cone
+// is 1/8 of the pixel's (pbrt-v4's floor for its scaled camera ray
+// differentials): the converged image keeps the texture's own detail, and
+// every sample of a pixel filters over the same footprint. That last part
+// matters: with a cone that narrowed with the sample's index (1/sqrt(n), as
+// once here), a 64-sample image was the texture filtered wider than a
+// 1024-sample one, an error no variance estimate sees; it was most of the
+// error per sample on textured models (docs/performance.md, round four).
 #ifndef VKRT_MATERIAL_TEXTURES_GLSL
 #define VKRT_MATERIAL_TEXTURES_GLSL
 
 #include "lib/texture.glsl"
 
-// 1/sqrt(n) for the pixel's n-th jittered sample, 1 without jitter (kernels/render.comp sets it per sample).
-float g_textureConeScale = 1.0;
+const float JITTERED_CONE_SCALE = 1.0 / 8.0;
 
-void setTextureConeScale(uint frameIndex)
+// The angle one pixel subtends at the image centre, narrowed for jittered samples (above).
+float pixelSpreadAngle()
 {
-    g_textureConeScale = (u.flags & RENDER_FLAG_JITTER) != 0u ? inversesqrt(float(frameIndex) + 1.0) : 1.0;
+    float scale = (u.flags & RENDER_FLAG_JITTER) != 0u ? JITTERED_CONE_SCALE : 1.0;
+    return scale * 2.0 * length(u.cameraUp) / float(u.height);
 }
-
-// The angle one pixel subtends at the image centre, narrowed for later samples (above).
-float pixelSpreadAngle() { return g_textureConeScale * 2.0 * length(u.cameraUp) / float(u.height); }
 
 // A slot's lookup coordinates of a surface uv: R (uv * scale) + offset
 // (src/render/EmissionPower.cpp: slotUv, the host's copy).

@@ -119,26 +119,31 @@ TEST_F(TextureRender, ImageAppearsUprightOnPlanesBoxesSpheresAndMeshes)
 
 // ----------------------------------------------------------- mip-mapping
 
-std::filesystem::path writeChecker(const std::filesystem::path& dir, uint32_t side)
+/// A black-and-white checker of side x side texels in squares of `block` texels.
+std::filesystem::path writeChecker(const std::filesystem::path& dir, uint32_t side, uint32_t block = 1)
 {
     std::vector<uint8_t> samples;
     for (uint32_t y = 0; y < side; ++y)
-        for (uint32_t x = 0; x < side; ++x) samples.push_back((x + y) % 2 ? 255 : 0);
+        for (uint32_t x = 0; x < side; ++x) samples.push_back((x / block + y / block) % 2 ? 255 : 0);
     return write8BitPng(dir / "checker.png", side, side, 1, samples);
 }
 
 /// A floor under a white sky seen from 1 unit above it, with a one-texel checker at uv scale `scale`.
+std::string checkerFloorText(double scale)
+{
+    return "[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 1, 0]\n"
+           "target = [0, 0.2, -4]\nfov = 40\nwidth = " +
+           std::to_string(kSide) + "\nheight = " + std::to_string(kSide) +
+           "\n[background]\ncolor = [1, 1, 1]\n[materials.floor]\ntype = \"lambert\"\n"
+           "albedo = { texture = \"checker.png\", scale = " +
+           std::to_string(scale) +
+           " }\n[[objects]]\nshape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n"
+           "material = \"floor\"\n";
+}
+
 Image renderCheckerFloor(const std::filesystem::path& dir, double scale)
 {
-    const std::string text = "[render]\nintegrator = \"path\"\nmax_depth = 1\n[camera]\neye = [0, 1, 0]\n"
-                             "target = [0, 0.2, -4]\nfov = 40\nwidth = " +
-                             std::to_string(kSide) + "\nheight = " + std::to_string(kSide) +
-                             "\n[background]\ncolor = [1, 1, 1]\n[materials.floor]\ntype = \"lambert\"\n"
-                             "albedo = { texture = \"checker.png\", scale = " +
-                             std::to_string(scale) +
-                             " }\n[[objects]]\nshape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n"
-                             "material = \"floor\"\n";
-    return renderCentres(parseSceneString(text, (dir / "scene.toml").string()));
+    return renderCentres(parseSceneString(checkerFloorText(scale), (dir / "scene.toml").string()));
 }
 
 TEST_F(TextureRender, DistantCheckerIsFilteredToItsLinearMeanNearOneKeepsItsContrast)
@@ -168,6 +173,57 @@ TEST_F(TextureRender, DistantCheckerIsFilteredToItsLinearMeanNearOneKeepsItsCont
     EXPECT_LT(farMax, 0.55) << "a distant pixel was not filtered (aliasing)";
     EXPECT_LT(nearMin, 0.05) << "the near checker lost its black texels: blurred although magnified";
     EXPECT_GT(nearMax, 0.95) << "the near checker lost its white texels: blurred although magnified";
+}
+
+// Every jittered sample of a pixel filters textures over the same footprint,
+// so the samples are identically distributed: a render of few samples has the
+// expectation of one of many, and its variance estimate covers all of its
+// error. (A footprint narrowing with the sample's index, as once here, made a
+// 64-sample image the texture filtered wider than a 1024-sample one: an error
+// no variance estimate sees, and most of the error per sample on textured
+// models; docs/performance.md, round four.) A checker of one to seven texels
+// per pixel in squares of eight: beside an edge, a wider footprint reaches
+// across it, so where the footprint depends on the sample's index, few and
+// many samples differ there while a pixel's samples barely vary.
+TEST_F(TextureRender, FewJitteredSamplesAverageToTheImageOfManyWithinTheirVariance)
+{
+    const auto dir = freshTempDir("texture-iid");
+    writeChecker(dir, 64, 8);
+    const Scene scene = parseSceneString(checkerFloorText(0.5), (dir / "scene.toml").string());
+    auto render = [&](uint32_t frames, uint32_t seed, Image& varianceOfMean) {
+        Renderer renderer(gpu(), scene, statisticalOptions(seed));
+        renderer.renderFrames(frames);
+        varianceOfMean = renderer.varianceOfMean();
+        return renderer.mean();
+    };
+    constexpr uint32_t kFew = 64, kMany = 1024;
+    Image fewVariance, manyVariance;
+    const Image few = render(kFew, 1, fewVariance);
+    const Image many = render(kMany, 2, manyVariance);
+    double sumSquaredZ = 0;
+    size_t pixels = 0;
+    for (uint32_t y = 0; y < kSide; ++y)
+        for (uint32_t x = 0; x < kSide; ++x) {
+            // One sample's variance from the many samples (64 samples of a
+            // pixel that an edge barely crosses often estimate it as 0).
+            // The floor: the float sums' rounding (a pixel whose samples
+            // all but agree still differs by ~1e-5 between the two means).
+            const double sampleVariance = double(manyVariance.at(x, y)[0]) * kMany;
+            const double variance = sampleVariance / kFew + sampleVariance / kMany + 1e-10;
+            const double difference = double(few.at(x, y)[0]) - double(many.at(x, y)[0]);
+            if (sampleVariance == 0.0 && difference == 0.0) continue; // the sky, or inside a square: exact
+            sumSquaredZ += difference * difference / variance;
+            ++pixels;
+        }
+    ASSERT_GT(pixels, kSide * kSide / 8) << "too few pixels vary to test anything";
+    // With equal expectations E[(few - many)^2] is the variance above, so the
+    // mean of z^2 is 1; over n pixels it spreads by about sqrt(2 / n) (more
+    // for the skewed pixels an edge barely crosses). Five spreads.
+    const double meanSquaredZ = sumSquaredZ / double(pixels);
+    RecordProperty("mean_squared_z", std::to_string(meanSquaredZ));
+    EXPECT_LT(meanSquaredZ, 1.0 + 5.0 * std::sqrt(2.0 / double(pixels)))
+        << "64 samples do not average to 1024 samples' image within their variance: the samples' texture "
+           "footprints differ";
 }
 
 // ------------------------------------------------------------ filters
