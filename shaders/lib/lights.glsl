@@ -62,26 +62,40 @@ vec3 transmittanceTo(vec3 point, vec3 origin, vec3 n, MediumStack media)
     return shadowTransmittance(origin, shadowDir / shadowDist, shadowDist, media);
 }
 
-// Transmittance to a light sample from a surface with geometric normal n
-// and shading normal ns (both on the side the ray arrived from). With
-// shading normals a light above the shading plane can lie behind the
-// geometric one: the surface itself is between them, so it is blocked
-// (where ns == n such a point lies within the surface's error bound and is
-// fully visible, as in transmittanceTo).
-vec3 transmittanceFromSurface(SurfaceHit hit, vec3 n, vec3 ns, vec3 origin, vec3 target, MediumStack media)
+// The shadow ray from a surface with geometric normal n and shading normal
+// ns (both on the side the ray arrived from) to a light sample at `target`,
+// or (false) none, when the sample lies behind the geometric plane: then
+// `visibility` is the whole transmittance. With shading normals a light
+// above the shading plane can lie behind the geometric one: the surface
+// itself is between them, so it is blocked (where ns == n such a point lies
+// within the surface's error bound and is fully visible, as in
+// transmittanceTo).
+bool shadowRayFromSurface(vec3 n, vec3 ns, vec3 origin, vec3 target, out vec3 dir, out float dist, out vec3 visibility)
 {
-    // transmittanceTo, written out so that the extra case stays inside its
-    // rarely taken branch: kernels without it keep their exact arithmetic.
+    // transmittanceTo's test, written out so that the extra case stays inside
+    // its rarely taken branch: kernels without it keep their exact arithmetic.
     vec3 shadowDir = target - origin;
     if (dot(shadowDir, n) <= 0.0) {
+        visibility = vec3(1.0);
 #ifdef VKRT_HAS_SHADING_NORMALS // only vertex normals and normal maps make ns differ from n
         if (ns != n)
-            return vec3(0.0);
+            visibility = vec3(0.0);
 #endif
-        return vec3(1.0);
+        return false;
     }
-    float shadowDist = length(shadowDir);
-    return shadowTransmittance(origin, shadowDir / shadowDist, shadowDist, media);
+    dist = length(shadowDir);
+    dir = shadowDir / dist;
+    return true;
+}
+
+// Transmittance to a light sample from a surface (shadowRayFromSurface).
+vec3 transmittanceFromSurface(SurfaceHit hit, vec3 n, vec3 ns, vec3 origin, vec3 target, MediumStack media)
+{
+    vec3 dir, visibility;
+    float dist;
+    if (!shadowRayFromSurface(n, ns, origin, target, dir, dist, visibility))
+        return visibility;
+    return shadowTransmittance(origin, dir, dist, media);
 }
 
 // A light's contribution to a surface point before visibility, and the point
@@ -294,18 +308,19 @@ vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Medi
 }
 
 // Next-event estimation from every light kind, the emitters and the
-// environment map with one shadow ray (the path integrator). Each light offers its sample as in the
-// Whitted sums above, but only one is tested for visibility: sample i with
-// probability p_i = w_i / W, its unshadowed weight over their total, and
-// scaled by 1 / p_i. The expectation is the sum of every sample times its
-// visibility, so the estimate stays unbiased; where all lights are visible
-// it equals that sum up to the lights' colour differences (no added
-// variance), and under partial occlusion it adds some: measured as a whole,
-// 1.09-1.27x more efficient on the validation scenes (docs/performance.md).
-vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
-                                  inout Sampler rng)
+// environment map with one shadow ray (the path integrator). Each light
+// offers its sample as in the Whitted sums above, but only one is tested for
+// visibility: sample i with probability p_i = w_i / W, its unshadowed weight
+// over their total, and scaled by 1 / p_i. The expectation is the sum of
+// every sample times its visibility, so the estimate stays unbiased; where
+// all lights are visible it equals that sum up to the lights' colour
+// differences (no added variance), and under partial occlusion it adds some:
+// measured as a whole, 1.09-1.27x more efficient on the validation scenes
+// (docs/performance.md). This draws the samples and keeps one; the caller
+// (lib/path.glsl) traces its shadow ray: r.totalWeight == 0 when no light
+// adds anything.
+LightReservoir lightsForOneShadowRay(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng)
 {
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
     LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
 #ifdef VKRT_LIGHT_TABLE
     offerTableSamples(r, m, hit, ns, wo, origin, rng);
@@ -318,10 +333,7 @@ vec3 directFromLightsOneShadowRay(Material m, SurfaceHit hit, vec3 n, vec3 ns, v
     vec4 u4 = sampleNext4D(rng);
     offerLightSample(r, sampleEnvironmentLight(m, ns, wo, origin, true, u4.xyz), u4.w);
 #endif
-    if (r.totalWeight == 0.0)
-        return vec3(0.0);
-    return r.kept.unshadowed * (r.totalWeight / r.keptWeight) *
-           transmittanceFromSurface(hit, n, ns, origin, r.kept.target, media);
+    return r;
 }
 
 #endif

@@ -72,13 +72,49 @@ PathTracer startPath(Ray cameraRay)
     return p;
 }
 
-// Traces the path's next segment, adds what it finds and scatters; false
-// once the path has ended (p.path.radiance is then its sample).
-bool advancePath(inout PathTracer p, inout Sampler rng)
+// The shadow ray of a vertex's next-event estimate, traced after the vertex
+// has scattered (advancePath), and what it adds when nothing blocks it.
+struct ShadowTest {
+    bool pending;
+    Ray ray;
+    float dist;
+    vec3 weight;      // the path's sample weight at the vertex
+    vec3 light;       // the kept light sample over its selection probability
+    vec3 absorption;  // of the medium the shadow ray travels in
+};
+
+#ifdef VKRT_HAS_MATERIALS
+// Adds a non-specular vertex's next-event estimate (lib/lights.glsl:
+// lightsForOneShadowRay) where no ray need be traced, else sets up its
+// shadow ray for advancePath to trace.
+void estimateDirectLight(inout PathTracer p, Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
+                         inout Sampler rng, inout ShadowTest shadow)
 {
-    ++g_loopIterations;
-    SurfaceHit hit;
-    bool missed = !traceClosest(p.ray, FLT_MAX, hit);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightReservoir r = lightsForOneShadowRay(m, hit, ns, wo, origin, rng);
+    vec3 weight = sampleWeight(p.path.throughput, p.path.media);
+    if (r.totalWeight == 0.0) {
+        p.path.radiance += weight * vec3(0.0); // as before: NaN for a NaN weight
+        return;
+    }
+    vec3 light = r.kept.unshadowed * (r.totalWeight / r.keptWeight);
+    vec3 dir, visibility;
+    float dist;
+    if (!shadowRayFromSurface(n, ns, origin, r.kept.target, dir, dist, visibility)) {
+        p.path.radiance += weight * (light * visibility);
+        return;
+    }
+    shadow = ShadowTest(true, Ray(origin, dir), dist, weight, light, mediumAbsorption(p.path.media));
+}
+#endif
+
+// What the path finds at the end of segment p.ray (`hit`, unless `found` is
+// false): adds its emission or the sky's light, then at a surface sets up
+// the next-event estimate's shadow ray and samples the next segment; false
+// once the path has ended.
+bool scatterAtHit(inout PathTracer p, bool found, SurfaceHit hit, inout Sampler rng, inout ShadowTest shadow)
+{
+    bool missed = !found;
     p.path.throughput *= beerLambert(mediumAbsorption(p.path.media), missed ? FLT_MAX : hit.t);
     if (missed) {
         aovEnd();
@@ -112,10 +148,8 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
     m = withInterfaceEta(m, surfaceEta(p.path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
     aovScatter(m, ns);
-    if (!scattersIntoDeltasOnly(m)) {
-        p.path.radiance += sampleWeight(p.path.throughput, p.path.media) *
-                           directFromLightsOneShadowRay(m, hit, n, ns, wo, p.path.media, rng);
-    }
+    if (!scattersIntoDeltasOnly(m))
+        estimateDirectLight(p, m, hit, n, ns, wo, rng, shadow);
     vec4 u4 = sampleNext4D(rng);
     float eta = surfaceEta(p.path.media, hit);
     BsdfSample s = sampleBsdf(m, ns, wo, eta, u4.xyz);
@@ -134,6 +168,43 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
 #else
     return false; // no surfaces: every ray escapes or finds a light above
 #endif
+}
+
+// Traces the path's next segment, adds what it finds and scatters, then
+// traces the vertex's shadow ray and adds its light; false once the path has
+// ended (p.path.radiance is then its sample). Both rays go through the one
+// findHit call of this loop, so a driver that inlines every call compiles
+// the traversal once instead of twice (docs/performance.md, round four;
+// tests/gpu/inline_copies_test.cpp). The shadow ray is traced after the
+// vertex has scattered: it uses no random numbers, and its light is added
+// before anything the next segment finds, so the sample is the same bit for
+// bit as when it was traced first.
+bool advancePath(inout PathTracer p, inout Sampler rng)
+{
+    ++g_loopIterations;
+    ShadowTest shadow;
+    shadow.pending = false;
+    bool tracingShadow = false;
+    bool continues = false;
+    for (;;) {
+        Ray ray = tracingShadow ? shadow.ray : p.ray;
+        HitId id;
+        bool found = findHit(ray, tracingShadow ? shadow.dist : FLT_MAX, tracingShadow, id);
+        if (tracingShadow) {
+            // shadowTransmittance's opaque case (lib/lights.glsl), with the vertex's values.
+            vec3 transmittance = found ? vec3(0.0) : beerLambert(shadow.absorption, shadow.dist);
+            p.path.radiance += shadow.weight * (shadow.light * transmittance);
+            return continues;
+        }
+        SurfaceHit hit;
+        if (found)
+            hit = describeHit(ray, id);
+        continues = scatterAtHit(p, found, hit, rng, shadow);
+        if (!shadow.pending)
+            return continues;
+        tracingShadow = true;
+    }
+    return false; // not reached
 }
 
 #endif

@@ -1,6 +1,6 @@
 // The driver traversal backend (`--accel driver`, VKRT_ACCEL_DRIVER): the
 // device's own acceleration structures, walked with VK_KHR_ray_query, answer
-// findClosest and traceAny (lib/scene.glsl) for every bounded record.
+// findHit (lib/scene.glsl) for every bounded record.
 // render/DriverAccel.cpp builds them:
 //   - one bottom-level structure of opaque triangles per mesh geometry, its
 //     triangles in meshTriangles' order (so the driver's primitive index is

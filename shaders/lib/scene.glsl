@@ -1,7 +1,8 @@
 // The aggregate over every shape and light kind of the registry
 // (shared/Kinds.h): traceClosest for the closest hit, traceAny for shadow
-// rays. Integrators and light sampling call only these two, so an
-// acceleration structure can replace the per-kind loops behind them.
+// rays, and findHit behind both (the path integrator calls it for both kinds
+// of ray from one site). Integrators and light sampling call only these, so
+// an acceleration structure can replace the per-kind loops behind them.
 // Each kind's file supplies the functions lib/surface.glsl lists; everything
 // here is expanded from the registry, so a kind is added there, in its own
 // files and in the includes below (a light kind's file is included again by
@@ -45,28 +46,19 @@ layout(scalar, binding = BINDING_TOP_REFS) readonly buffer TopRefBlock { uint to
 // One record of the top-level BVH, TOP_REF(HIT_Type, index) (shared/SceneTypes.h):
 // every kind of the registry with bounded = 1, as the host builds it
 // (src/render/GpuScene.cpp: buildTopLevel).
-#define VKRT_CLOSEST_RECORD(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
-    if (bounded != 0 && kind == HIT_##Type)                                                 \
-        hitOne##Type(r, tr, i, false, best.t, best);
-#define VKRT_ANY_HIT_RECORD(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
-    if (bounded != 0 && kind == HIT_##Type)                                                 \
-        return hitOne##Type(r, tr, i, true, tMax, unused);
+#define VKRT_HIT_RECORD(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if (bounded != 0 && kind == HIT_##Type)                                             \
+        return hitOne##Type(r, tr, i, anyHit, tMax, best);
 
-void closestRecord(Ray r, TriangleRay tr, uint ref, inout HitId best)
+// Whether the ray hits record `ref` before tMax; without anyHit, best
+// becomes that hit. One call per kind for both kinds of ray: lavapipe
+// inlines each, and a mesh's is its whole BVH walk.
+bool hitRecord(Ray r, TriangleRay tr, uint ref, bool anyHit, float tMax, inout HitId best)
 {
     int kind = int(ref >> TOP_REF_INDEX_BITS);
     uint i = ref & TOP_REF_MAX_INDEX;
-    VKRT_SHAPE_KINDS(VKRT_CLOSEST_RECORD)
-    VKRT_LIGHT_KINDS(VKRT_CLOSEST_RECORD)
-}
-
-bool anyHitRecord(Ray r, TriangleRay tr, uint ref, float tMax)
-{
-    int kind = int(ref >> TOP_REF_INDEX_BITS);
-    uint i = ref & TOP_REF_MAX_INDEX;
-    HitId unused = noHit(tMax);
-    VKRT_SHAPE_KINDS(VKRT_ANY_HIT_RECORD)
-    VKRT_LIGHT_KINDS(VKRT_ANY_HIT_RECORD)
+    VKRT_SHAPE_KINDS(VKRT_HIT_RECORD)
+    VKRT_LIGHT_KINDS(VKRT_HIT_RECORD)
     return false;
 }
 
@@ -86,12 +78,8 @@ bool traverseTop(Ray r, TriangleRay tr, bool anyHit, float tMax, inout HitId bes
             for (uint k = 0u; k < n.count; ++k) {
                 ++g_loopIterations;
                 uint ref = topRefs[n.first + k];
-                if (anyHit) {
-                    if (anyHitRecord(r, tr, ref, tMax))
-                        return true;
-                } else {
-                    closestRecord(r, tr, ref, best);
-                }
+                if (hitRecord(r, tr, ref, anyHit, anyHit ? tMax : best.t, best) && anyHit)
+                    return true;
             }
         } else {
             float limit = anyHit ? tMax : best.t;
@@ -105,28 +93,52 @@ bool traverseTop(Ray r, TriangleRay tr, bool anyHit, float tMax, inout HitId bes
 }
 #endif
 
-// The closest hit over every kind, shapes first, in registry order. With
-// meshes, the top-level BVH replaces the loops over the bounded kinds.
-HitId findClosest(Ray r, float tMax)
+// Whether the ray meets anything (surface or light) before tMax: without
+// anyHit, best is then the closest hit over every kind (shapes first, in
+// registry order); with anyHit the walk stops at the first record found and
+// best says nothing. One function for both kinds of ray, so that the path
+// integrator, which traces both from one call site (lib/path.glsl:
+// advancePath), gets one copy of the traversal where the driver inlines
+// every call (docs/performance.md, round four). With meshes, the top-level
+// BVH replaces the loops over the bounded kinds.
+bool findHit(Ray r, float tMax, bool anyHit, out HitId best)
 {
-    HitId best = noHit(tMax);
+    best = noHit(tMax);
     TriangleRay tr = triangleRaySetup(r);
-#ifdef VKRT_ACCEL_DRIVER
-    VKRT_SHAPE_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
-    VKRT_LIGHT_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
-    traceDriver(r, tr, false, best.t, best);
-    return best;
+#if defined(VKRT_ACCEL_DRIVER) || defined(VKRT_HAS_MESHES)
+#ifndef VKRT_ACCEL_DRIVER
+    if (u.topNodeCount > 0u)
 #endif
-#if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
-    if (u.topNodeCount > 0u) {
-        VKRT_SHAPE_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
-        VKRT_LIGHT_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
-        traverseTop(r, tr, false, tMax, best);
-        return best;
+    {
+        if (anyHit) {
+            VKRT_SHAPE_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
+            VKRT_LIGHT_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
+        } else {
+            VKRT_SHAPE_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
+            VKRT_LIGHT_KINDS(VKRT_CLOSEST_IF_UNBOUNDED)
+        }
+#ifdef VKRT_ACCEL_DRIVER
+        return traceDriver(r, tr, anyHit, best.t, best) || best.shape != SHAPE_NONE;
+#else
+        return traverseTop(r, tr, anyHit, best.t, best) || best.shape != SHAPE_NONE;
+#endif
     }
 #endif
+    if (anyHit) {
+        VKRT_SHAPE_KINDS(VKRT_ANY_HIT_OF_KIND)
+        VKRT_LIGHT_KINDS(VKRT_ANY_HIT_OF_KIND)
+        return false;
+    }
     VKRT_SHAPE_KINDS(VKRT_CLOSEST_OF_KIND)
     VKRT_LIGHT_KINDS(VKRT_CLOSEST_OF_KIND)
+    return best.shape != SHAPE_NONE;
+}
+
+// The closest hit before tMax (shape SHAPE_NONE if there is none).
+HitId findClosest(Ray r, float tMax)
+{
+    HitId best;
+    findHit(r, tMax, false, best);
     return best;
 }
 
@@ -188,24 +200,8 @@ bool traceClosest(Ray r, float tMax, out SurfaceHit hit)
 // interfaces in order with traceClosest instead (lib/lights.glsl).
 bool traceAny(Ray r, float tMax)
 {
-    TriangleRay tr = triangleRaySetup(r);
-#ifdef VKRT_ACCEL_DRIVER
-    VKRT_SHAPE_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
-    VKRT_LIGHT_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
-    HitId unused = noHit(tMax);
-    return traceDriver(r, tr, true, tMax, unused);
-#endif
-#if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
-    if (u.topNodeCount > 0u) {
-        VKRT_SHAPE_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
-        VKRT_LIGHT_KINDS(VKRT_ANY_HIT_IF_UNBOUNDED)
-        HitId unused = noHit(tMax);
-        return traverseTop(r, tr, true, tMax, unused);
-    }
-#endif
-    VKRT_SHAPE_KINDS(VKRT_ANY_HIT_OF_KIND)
-    VKRT_LIGHT_KINDS(VKRT_ANY_HIT_OF_KIND)
-    return false;
+    HitId unused;
+    return findHit(r, tMax, true, unused);
 }
 
 #endif
