@@ -117,9 +117,9 @@ vec4 sampleTextureLevel(uint textureIndex, vec2 uv, uint level)
 ///   mixed by the fraction (lod clamped to levels - 1), bilinear or nearest
 ///   within each; or the nearest level (round(lod)) alone; or level 0 alone.
 /// The filters only choose the level(s), the in-level filter and the blend:
-/// filterTextureLevel is called at two sites, not once per filter mode,
-/// because lavapipe inlines every call and each copy of it (four texel
-/// fetches, each decoded by format) costs the driver's compile time.
+/// filterTextureLevel is called at one site, not once per filter mode or
+/// level, because lavapipe inlines every call and each copy of it (four
+/// texel fetches, each decoded by format) costs the driver's compile time.
 vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
 {
     uint filters = textureRecords[textureIndex].filters;
@@ -141,10 +141,20 @@ vec4 sampleTexture(uint textureIndex, vec2 uv, float lod)
             }
         }
     }
-    vec4 fine = filterTextureLevel(textureIndex, uv, level, nearest);
-    if (blend == 0.0)
-        return fine;
-    return mix(fine, filterTextureLevel(textureIndex, uv, level + 1u, nearest), blend);
+    // The finer level, then (trilinear) the coarser one, from one call site:
+    // a loop whose passes the compiler cannot count, so it keeps one copy.
+    vec4 fine = vec4(0.0);
+    bool coarse = false;
+    for (;;) {
+        vec4 texel = filterTextureLevel(textureIndex, uv, coarse ? level + 1u : level, nearest);
+        if (coarse)
+            return mix(fine, texel, blend);
+        if (blend == 0.0)
+            return texel;
+        fine = texel;
+        coarse = true;
+    }
+    return fine; // not reached
 }
 
 /// Mip level from a ray cone (Akenine-Möller et al. 2019, "Texture Level of
