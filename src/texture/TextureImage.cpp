@@ -137,14 +137,22 @@ TextureImage decodeExr(std::span<const uint8_t> bytes, const std::string& name)
     }
 }
 
-/// Decodes `count` channel values quantized to `maxCode` into linear floats.
+/// Decodes channel values quantized to `maxCode` (8 or 16 bits) into linear
+/// floats. Each code's two values (sRGB colour, linear) are computed once,
+/// exactly as per texel before: a 2048x2048 image no longer calls pow() 12
+/// million times.
 template <typename T>
 void decodeChannels(const T* codes, RgbaImage& image, double maxCode, bool linear)
 {
+    std::vector<float> asColour(size_t(maxCode) + 1), asLinear(size_t(maxCode) + 1);
+    for (size_t code = 0; code < asLinear.size(); ++code) {
+        const double value = double(code) / maxCode;
+        asColour[code] = float(linear ? value : srgbToLinear(value));
+        asLinear[code] = float(value);
+    }
     for (size_t i = 0; i < image.rgba.size(); ++i) {
-        const double value = double(codes[i]) / maxCode;
         const bool colour = i % 4 != 3; // alpha is always linear
-        image.rgba[i] = float(colour && !linear ? srgbToLinear(value) : value);
+        image.rgba[i] = (colour ? asColour : asLinear)[codes[i]];
     }
 }
 
