@@ -170,20 +170,38 @@ bool scatterAtHit(inout PathTracer p, bool found, SurfaceHit hit, inout Sampler 
 #endif
 }
 
+// Adds the light of the vertex's shadow ray, which found something (blocked) or not.
+void addShadowedLight(inout PathTracer p, ShadowTest shadow, bool blocked)
+{
+    // shadowTransmittance's opaque case (lib/lights.glsl), with the vertex's values.
+    vec3 transmittance = blocked ? vec3(0.0) : beerLambert(shadow.absorption, shadow.dist);
+    p.path.radiance += shadow.weight * (shadow.light * transmittance);
+}
+
+// Kernels with meshes trace the segment and the shadow ray from one call site
+// (a loop of one or two passes): a driver that inlines every call, as
+// lavapipe does, then compiles each BVH walk once instead of twice, 0.69-0.83x
+// the cold start of the Khronos models on Mesa 25 (docs/performance.md,
+// round four; tests/gpu/inline_copies_test.cpp). Without meshes the walk is
+// a short loop over the records, and the loop's own cost showed instead:
+// 0.91x the samples/s of diffuse-box on Mesa 26 (0.98x on the mesh-bunny),
+// so those kernels trace each ray at its own site.
+#if defined(VKRT_HAS_MESHES) || defined(VKRT_ACCEL_DRIVER)
+#define VKRT_ONE_TRACE_SITE
+#endif
+
 // Traces the path's next segment, adds what it finds and scatters, then
 // traces the vertex's shadow ray and adds its light; false once the path has
-// ended (p.path.radiance is then its sample). Both rays go through the one
-// findHit call of this loop, so a driver that inlines every call compiles
-// the traversal once instead of twice (docs/performance.md, round four;
-// tests/gpu/inline_copies_test.cpp). The shadow ray is traced after the
-// vertex has scattered: it uses no random numbers, and its light is added
-// before anything the next segment finds, so the sample is the same bit for
-// bit as when it was traced first.
+// ended (p.path.radiance is then its sample). The shadow ray is traced after
+// the vertex has scattered: it uses no random numbers, and its light is
+// added before anything the next segment finds, so the sample is the same
+// bit for bit as when it was traced first.
 bool advancePath(inout PathTracer p, inout Sampler rng)
 {
     ++g_loopIterations;
     ShadowTest shadow;
     shadow.pending = false;
+#ifdef VKRT_ONE_TRACE_SITE
     bool tracingShadow = false;
     bool continues = false;
     for (;;) {
@@ -191,9 +209,7 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
         HitId id;
         bool found = findHit(ray, tracingShadow ? shadow.dist : FLT_MAX, tracingShadow, id);
         if (tracingShadow) {
-            // shadowTransmittance's opaque case (lib/lights.glsl), with the vertex's values.
-            vec3 transmittance = found ? vec3(0.0) : beerLambert(shadow.absorption, shadow.dist);
-            p.path.radiance += shadow.weight * (shadow.light * transmittance);
+            addShadowedLight(p, shadow, found);
             return continues;
         }
         SurfaceHit hit;
@@ -205,6 +221,19 @@ bool advancePath(inout PathTracer p, inout Sampler rng)
         tracingShadow = true;
     }
     return false; // not reached
+#else
+    HitId id;
+    bool found = findHit(p.ray, FLT_MAX, false, id);
+    SurfaceHit hit;
+    if (found)
+        hit = describeHit(p.ray, id);
+    bool continues = scatterAtHit(p, found, hit, rng, shadow);
+    if (shadow.pending) {
+        HitId unused;
+        addShadowedLight(p, shadow, findHit(shadow.ray, shadow.dist, true, unused));
+    }
+    return continues;
+#endif
 }
 
 #endif
