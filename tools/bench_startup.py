@@ -15,6 +15,10 @@ compile of the kernel and one frame).
 
 Needs only Python's standard library (it runs in a Debian 13 chroot to
 measure Mesa 26). --vkrt PATH picks the binary [$VKRT, else build/vkrt].
+--compare A=BINARY[@SHADER_DIR] B=BINARY[@SHADER_DIR] times two builds (or
+shader trees, through VKRT_SHADER_DIR) instead, interleaved: each of --runs
+pairs runs both, in an order that reverses every other pair, and the table
+gives both medians and the median of the pairs' B/A ratios, cold and warm.
 """
 from __future__ import annotations
 
@@ -41,9 +45,11 @@ def model_files(directory: Path) -> list[tuple[str, Path]]:
     return found
 
 
-def run(command: list[str], caches: Path) -> tuple[float, subprocess.CompletedProcess]:
+def run(command: list[str], caches: Path, shaders: str | None = None) -> tuple[float, subprocess.CompletedProcess]:
     env = dict(os.environ, VKRT_CACHE_DIR=str(caches / "spirv"), MESA_SHADER_CACHE_DIR=str(caches / "mesa"))
     env.pop("VKRT_TEXTURE_CACHE_DIR", None)  # inside VKRT_CACHE_DIR
+    if shaders:
+        env["VKRT_SHADER_DIR"] = shaders
     started = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, env=env)
     return time.perf_counter() - started, done
@@ -69,6 +75,55 @@ def bench_model(vkrt: str, model: Path, runs: int, work: Path) -> dict:
     info = json.loads(done.stdout)
     return {"cold": statistics.median(cold), "warm": statistics.median(warm), "cold_runs": cold, "warm_runs": warm,
             "cold_split": info["startup"], "device": info["device"]}
+
+
+def cold_and_warm(binary: str, shaders: str | None, model: Path, work: Path) -> tuple[float, float]:
+    """One cold start (fresh caches) and one warm start after it."""
+    render = [binary, "render", str(model), "--spp", "1", "-o", str(work / "frame.exr")]
+    caches = Path(tempfile.mkdtemp(prefix="cold-", dir=work))
+    seconds = []
+    for _ in ("cold", "warm"):
+        elapsed, done = run(render, caches, shaders)
+        if done.returncode != 0:
+            raise RuntimeError(f"{binary} exited {done.returncode}: {done.stderr.strip()[-800:]}")
+        seconds.append(elapsed)
+    return seconds[0], seconds[1]
+
+
+def compare_model(builds: list, model: Path, runs: int, work: Path) -> dict:
+    times = {name: [] for name, _, _ in builds}
+    for r in range(runs):
+        for name, binary, shaders in builds if r % 2 == 0 else builds[::-1]:
+            times[name].append(cold_and_warm(binary, shaders, model, work))
+    (a, _, _), (b, _, _) = builds
+    row = {"runs": times}
+    for k, kind in enumerate(("cold", "warm")):
+        row[kind] = {name: statistics.median(t[k] for t in times[name]) for name in times}
+        row[kind + "_ratio"] = statistics.median(tb[k] / ta[k] for ta, tb in zip(times[a], times[b]))
+    return row
+
+
+def compare_markdown(rows: list, builds: list) -> str:
+    a, b = builds[0][0], builds[1][0]
+    lines = [f"Start-up of `vkrt render MODEL --spp 1`, whole process, {a} against {b} interleaved: medians and "
+             f"the median of the pairs' {b}/{a} ratios (tools/bench_startup.py --compare).", "",
+             f"| model | cold s, {a} | {b} | ratio | warm s, {a} | {b} | ratio |",
+             "| --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for r in rows:
+        if "error" in r:
+            lines.append(f"| {r['model']} | {r['error'][:100]} | | | | | |")
+            continue
+        lines.append(f"| {r['model']} | {r['cold'][a]:.2f} | {r['cold'][b]:.2f} | {r['cold_ratio']:.2f} | "
+                     f"{r['warm'][a]:.2f} | {r['warm'][b]:.2f} | {r['warm_ratio']:.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def parse_build(spec: str) -> tuple[str, str, str | None]:
+    name, sep, rest = spec.partition("=")
+    if not sep or not name or not rest:
+        raise argparse.ArgumentTypeError(f"--compare {spec}: expected NAME=BINARY or NAME=BINARY@SHADER_DIR")
+    binary, _, shaders = rest.partition("@")
+    return name, binary, shaders or None
 
 
 def markdown(rows: list) -> str:
@@ -98,6 +153,7 @@ def main(argv) -> int:
     p.add_argument("--json")
     p.add_argument("--table")
     p.add_argument("--vkrt", default=os.environ.get("VKRT") or str(REPO / "build" / "vkrt"))
+    p.add_argument("--compare", nargs=2, type=parse_build, metavar="NAME=BINARY[@SHADER_DIR]")
     args = p.parse_args(argv)
     if args.runs < 1:
         p.error("--runs must be at least 1")
@@ -112,12 +168,15 @@ def main(argv) -> int:
         for name, model in models:
             print(f"bench_startup: {name}", file=sys.stderr, flush=True)
             try:
-                rows.append(dict(model=name, **bench_model(args.vkrt, model, args.runs, Path(work))))
+                if args.compare:
+                    rows.append(dict(model=name, **compare_model(args.compare, model, args.runs, Path(work))))
+                else:
+                    rows.append(dict(model=name, **bench_model(args.vkrt, model, args.runs, Path(work))))
             except RuntimeError as error:
                 rows.append({"model": name, "error": str(error)})
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1) + "\n")
-    table = markdown(rows)
+    table = compare_markdown(rows, args.compare) if args.compare else markdown(rows)
     if args.table:
         Path(args.table).write_text(table)
     print(table, end="")
