@@ -97,9 +97,9 @@ bool traverseTop(Ray r, TriangleRay tr, bool anyHit, float tMax, inout HitId bes
 // anyHit, best is then the closest hit over every kind (shapes first, in
 // registry order); with anyHit the walk stops at the first record found and
 // best says nothing. One function for both kinds of ray, so that the path
-// integrator, which traces both from one call site (lib/path.glsl:
-// advancePath), gets one copy of the traversal where the driver inlines
-// every call (docs/performance.md, round four). With meshes, the top-level
+// integrator, which traces both from one call site with vkrt's own BVH
+// (lib/path.glsl: advancePath), gets one copy of the walk where the driver
+// inlines every call (docs/performance.md, round four). With meshes, the top-level
 // BVH replaces the loops over the bounded kinds.
 bool findHit(Ray r, float tMax, bool anyHit, out HitId best)
 {

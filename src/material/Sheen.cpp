@@ -52,8 +52,8 @@ double sheenDirectionalAlbedo(double mu, double roughness)
     constexpr int kT = 64, kPhi = 32;
     // sheenBrdf(mu, cosI, cosH, alpha) term by term, with what does not
     // change along a loop taken out of it: the same operations on the same
-    // values, so the same sum bit for bit (SheenTable test), at a fifth of
-    // the cost (the table is part of a sheen scene's start-up).
+    // values, so the same sum bit for bit (tests/material/sheen_table_test.cpp),
+    // at a quarter of the cost (the table is part of a sheen scene's start-up).
     std::array<double, kPhi> cosPhi, sinPhi;
     for (int b = 0; b < kPhi; ++b) {
         const double phi = std::numbers::pi * (b + 0.5) / kPhi;
@@ -78,33 +78,12 @@ double sheenDirectionalAlbedo(double mu, double roughness)
     return sum * (1.0 / kT) * (2.0 * std::numbers::pi / kPhi);
 }
 
-double sheenDirectionalAlbedoBrdfByBrdf(double mu, double roughness)
-{
-    const double alpha = sheenAlpha(roughness);
-    const double sinO = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-    constexpr int kT = 64, kPhi = 32;
-    double sum = 0.0;
-    for (int a = 0; a < kT; ++a) {
-        const double t = (a + 0.5) / kT;
-        const double cosI = t * t, sinI = std::sqrt(std::max(0.0, 1.0 - cosI * cosI));
-        double ring = 0.0;
-        for (int b = 0; b < kPhi; ++b) {
-            const double phi = std::numbers::pi * (b + 0.5) / kPhi;
-            const double hx = sinO + sinI * std::cos(phi), hy = sinI * std::sin(phi), hz = mu + cosI;
-            const double cosH = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
-            ring += sheenBrdf(mu, cosI, cosH, alpha);
-        }
-        sum += ring * cosI * 2.0 * t;
-    }
-    return sum * (1.0 / kT) * (2.0 * std::numbers::pi / kPhi);
-}
-
 const std::vector<float>& sheenAlbedoTable()
 {
     static const std::vector<float> table = [] {
         constexpr uint32_t side = kSheenTableSide;
         std::vector<float> entries(size_t(side) * side);
-        // 8 million BRDF values: 0.1 s of a sheen scene's start-up on one
+        // 8 million BRDF values: 0.25 s of a sheen scene's start-up on one
         // core, so the rows are shared among the cores (each entry is
         // computed alone: the table is the same for any number of threads).
         std::atomic<uint32_t> nextRow{0};

@@ -26,13 +26,9 @@ double sheenBrdf(double cosO, double cosI, double cosH, double alpha);
 
 /// E(mu) = integral over the hemisphere of sheenBrdf cos(theta_i) for a direction at cosine mu,
 /// by a product midpoint rule in (sqrt(cos theta_i), phi) (nodes clustered at grazing, where the
-/// lobe lives); within 3e-4 of a 16 times finer grid near grazing, 1e-5 elsewhere (0.25 s of one core
-/// for the whole table, once per process).
+/// lobe lives); within 3e-4 of a 16 times finer grid near grazing, 1e-5 elsewhere (0.23-0.25 s of one
+/// core for the whole table, once per process).
 double sheenDirectionalAlbedo(double mu, double roughness);
-
-/// The same sum written with sheenBrdf at every node (five times slower): what
-/// sheenDirectionalAlbedo must equal bit for bit (tests/material/sheen_table_test.cpp).
-double sheenDirectionalAlbedoBrdfByBrdf(double mu, double roughness);
 
 /// The kSheenTableSide^2 entries of the sheen table: E at roughness j / (side - 1) and
 /// cosine (i / (side - 1))^2 (cosine 0 taken as 1e-4), entry j * side + i. Computed once, then cached.

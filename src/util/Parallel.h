@@ -1,6 +1,6 @@
 #pragma once
 // Independent work items spread over the cores, for the CPU parts of a
-// scene's start-up (mesh geometries, tables).
+// scene's start-up (glTF mesh geometries).
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
