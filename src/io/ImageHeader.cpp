@@ -26,8 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void fail(const std::string& name, const std::string& reason) { throw InputError(name + ": " + reason); }
-
 /// OpenEXR's limit on attribute and type names (with long names).
 constexpr size_t kMaxExrNameLength = 255;
 /// Tiles may exceed a small image, but never by more than this a side.
@@ -38,7 +36,7 @@ std::string readExrName(Imf::IStream& stream, const std::string& name)
     std::string text;
     for (char c = 0; stream.read(&c, 1), c != 0;) {
         text += c;
-        if (text.size() > kMaxExrNameLength) fail(name, "not a readable EXR file: a header name is too long");
+        if (text.size() > kMaxExrNameLength) failInFile(name, "not a readable EXR file: a header name is too long");
     }
     return text;
 }
@@ -60,8 +58,8 @@ int skipExrAttributes(Imf::IStream& stream, uint64_t streamBytes, const std::str
         const int64_t size = readLittleEndianInt(stream);
         const uint64_t end = stream.tellg() + uint64_t(std::max<int64_t>(size, 0));
         if (size < 0 || end > streamBytes)
-            fail(name, "not a readable EXR file: header attribute '" + attribute + "' declares " +
-                           std::to_string(size) + " bytes, but the file has " + std::to_string(streamBytes));
+            failInFile(name, "not a readable EXR file: header attribute '" + attribute + "' declares " +
+                                 std::to_string(size) + " bytes, but the file has " + std::to_string(streamBytes));
         stream.seekg(end);
         ++count;
     }
@@ -103,13 +101,13 @@ void checkExrExtent(const Imf::Header& header, const std::string& name)
     const Imath::Box2i window = header.dataWindow();
     const int64_t width = int64_t(window.max.x) - window.min.x + 1, height = int64_t(window.max.y) - window.min.y + 1;
     const std::string size = std::to_string(width) + "x" + std::to_string(height);
-    if (width < 1 || height < 1) fail(name, "the header declares an empty data window (" + size + ")");
+    if (width < 1 || height < 1) failInFile(name, "the header declares an empty data window (" + size + ")");
     if (width > ImageLimits::maxSide || height > ImageLimits::maxSide)
-        fail(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
-                       std::to_string(ImageLimits::maxSide) + " pixels a side");
+        failInFile(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
+                             std::to_string(ImageLimits::maxSide) + " pixels a side");
     if (uint64_t(width * height) > ImageLimits::maxPixels)
-        fail(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
-                       std::to_string(ImageLimits::maxPixels) + " pixels");
+        failInFile(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
+                             std::to_string(ImageLimits::maxPixels) + " pixels");
 }
 
 size_t channelCount(const Imf::Header& header)
@@ -144,8 +142,8 @@ std::pair<uint64_t, uint64_t> exrChunks(const Imf::Header& header, const std::st
     const Imf::TileDescription& tiles = header.tileDescription();
     if (tiles.xSize < 1 || tiles.ySize < 1 || tiles.xSize > std::max<uint64_t>(extent.width, kMaxTileSideBeyondImage) ||
         tiles.ySize > std::max<uint64_t>(extent.height, kMaxTileSideBeyondImage))
-        fail(name, "the header declares " + std::to_string(tiles.xSize) + "x" + std::to_string(tiles.ySize) +
-                       " tiles for a " + extent.str() + " image");
+        failInFile(name, "the header declares " + std::to_string(tiles.xSize) + "x" + std::to_string(tiles.ySize) +
+                             " tiles for a " + extent.str() + " image");
     const uint64_t across = (extent.width + tiles.xSize - 1) / tiles.xSize;
     const uint64_t down = (extent.height + tiles.ySize - 1) / tiles.ySize;
     return {across * down, 20}; // x, y, level x, level y, byte count
@@ -159,10 +157,11 @@ void checkExrLength(const Imf::Header& header, uint64_t headerEnd, uint64_t stre
     const uint64_t ratio = exrMaxCompressionRatio(header.compression());
     const uint64_t smallest = headerEnd + chunks * (8 + chunkHeaderBytes) + (pixelBytes + ratio - 1) / ratio;
     if (streamBytes < smallest)
-        fail(name, "the header declares " + extentOf(header).str() + " pixels of " +
-                       std::to_string(channelCount(header)) + " channels (" + exrCompressionName(header.compression()) +
-                       " compression), which take at least " + std::to_string(smallest) + " bytes, but the file has " +
-                       std::to_string(streamBytes) + ": truncated or damaged");
+        failInFile(name, "the header declares " + extentOf(header).str() + " pixels of " +
+                             std::to_string(channelCount(header)) + " channels (" +
+                             exrCompressionName(header.compression()) + " compression), which take at least " +
+                             std::to_string(smallest) + " bytes, but the file has " + std::to_string(streamBytes) +
+                             ": truncated or damaged");
 }
 
 bool fileStartsWithRadianceSignature(const fs::path& file)
@@ -204,8 +203,8 @@ Imf::Header readCheckedExrHeader(Imf::IStream& stream, uint64_t streamBytes, con
         stream.read(reinterpret_cast<char*>(magic), 4);
         int version = readLittleEndianInt(stream);
         if (!Imf::isImfMagic(reinterpret_cast<const char*>(magic)))
-            fail(name, "not a readable EXR file: no OpenEXR signature");
-        if (Imf::isNonImage(version)) fail(name, "deep EXR images are not supported");
+            failInFile(name, "not a readable EXR file: no OpenEXR signature");
+        if (Imf::isNonImage(version)) failInFile(name, "deep EXR images are not supported");
         const uint64_t headerEnd = checkExrAttributeSizes(stream, streamBytes, version, name);
         stream.seekg(8);
         Imf::Header header;
@@ -217,7 +216,7 @@ Imf::Header readCheckedExrHeader(Imf::IStream& stream, uint64_t streamBytes, con
     } catch (const InputError&) {
         throw;
     } catch (const std::exception& e) {
-        fail(name, std::string("not a readable EXR file: ") + e.what());
+        failInFile(name, std::string("not a readable EXR file: ") + e.what());
     }
 }
 
@@ -238,11 +237,11 @@ bool MemoryExrStream::read(char c[], int n)
 ImageExtent stbImageExtent(std::span<const uint8_t> bytes, const std::string& name)
 {
     if (isRadianceHdr(bytes)) return radianceHdrExtent(bytes, bytes.size(), name);
-    if (bytes.size() > size_t(INT_MAX)) fail(name, "unsupported image: larger than 2 GiB");
+    if (bytes.size() > size_t(INT_MAX)) failInFile(name, "unsupported image: larger than 2 GiB");
     int width = 0, height = 0, channels = 0;
     if (!stbi_info_from_memory(bytes.data(), int(bytes.size()), &width, &height, &channels))
-        fail(name, std::string("no image header stb_image can read (stb_image: ") +
-                       (stbi_failure_reason() ? stbi_failure_reason() : "unknown reason") + ")");
+        failInFile(name, std::string("no image header stb_image can read (stb_image: ") +
+                             (stbi_failure_reason() ? stbi_failure_reason() : "unknown reason") + ")");
     return {uint32_t(width), uint32_t(height)};
 }
 
@@ -251,8 +250,8 @@ ImageExtent stbImageFileExtent(const fs::path& file)
     if (fileStartsWithRadianceSignature(file)) return radianceHdrFileExtent(file);
     int width = 0, height = 0, channels = 0;
     if (!stbi_info(file.c_str(), &width, &height, &channels))
-        fail(file.string(), std::string("no image header stb_image can read (stb_image: ") +
-                                (stbi_failure_reason() ? stbi_failure_reason() : "unknown reason") + ")");
+        failInFile(file.string(), std::string("no image header stb_image can read (stb_image: ") +
+                                      (stbi_failure_reason() ? stbi_failure_reason() : "unknown reason") + ")");
     return {uint32_t(width), uint32_t(height)};
 }
 
@@ -260,8 +259,8 @@ ImageExtent imageFileExtent(const fs::path& file)
 {
     std::error_code error;
     const fs::file_status status = fs::status(file, error);
-    if (!fs::exists(status)) fail(file.string(), "no such file");
-    if (!fs::is_regular_file(status)) fail(file.string(), "is not a regular file");
+    if (!fs::exists(status)) failInFile(file.string(), "no such file");
+    if (!fs::is_regular_file(status)) failInFile(file.string(), "is not a regular file");
     std::string extension = file.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
@@ -272,7 +271,7 @@ ImageExtent imageFileExtent(const fs::path& file)
     } catch (const InputError&) {
         throw;
     } catch (const std::exception& e) {
-        fail(file.string(), std::string("not a readable EXR file: ") + e.what());
+        failInFile(file.string(), std::string("not a readable EXR file: ") + e.what());
     }
 }
 

@@ -12,8 +12,6 @@ namespace vkrt {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& name, const std::string& reason) { throw InputError(name + ": " + reason); }
-
 /// A header longer than this is no image header (real ones are a few hundred bytes).
 constexpr size_t kMaxHeaderBytes = 64 * 1024;
 /// Adaptive RLE is defined for scanlines of 8 to 32767 pixels; others are flat.
@@ -38,9 +36,9 @@ std::string_view nextLine(std::span<const uint8_t> bytes, size_t& at, const std:
         return line;
     }
     if (bytes.size() > kMaxHeaderBytes)
-        fail(name,
-             "not a readable Radiance HDR file: no end of header within " + std::to_string(kMaxHeaderBytes) + " bytes");
-    fail(name, "not a readable Radiance HDR file: the header ends before its resolution line");
+        failInFile(name, "not a readable Radiance HDR file: no end of header within " +
+                             std::to_string(kMaxHeaderBytes) + " bytes");
+    failInFile(name, "not a readable Radiance HDR file: the header ends before its resolution line");
 }
 
 /// A decimal count of at most 9 digits (the limits check it further).
@@ -71,20 +69,21 @@ ImageExtent parseResolution(std::string_view line, const std::string& name)
     std::string_view rest = line;
     const std::string_view yAxis = token(rest), heightText = token(rest), xAxis = token(rest), widthText = token(rest);
     if (!token(rest).empty() || (yAxis != "-Y" && yAxis != "+Y" && yAxis != "-X" && yAxis != "+X"))
-        fail(name, "not a readable Radiance HDR file: the resolution line '" + shown + "' is not '-Y H +X W'");
+        failInFile(name, "not a readable Radiance HDR file: the resolution line '" + shown + "' is not '-Y H +X W'");
     if (yAxis != "-Y" || xAxis != "+X")
-        fail(name, "unsupported Radiance HDR orientation '" + shown + "': vkrt reads '-Y H +X W' (top row first)");
+        failInFile(name,
+                   "unsupported Radiance HDR orientation '" + shown + "': vkrt reads '-Y H +X W' (top row first)");
     ImageExtent extent;
     if (!parseCount(heightText, extent.height) || !parseCount(widthText, extent.width))
-        fail(name, "not a readable Radiance HDR file: the resolution line '" + shown + "' has no size");
+        failInFile(name, "not a readable Radiance HDR file: the resolution line '" + shown + "' has no size");
     const std::string size = extent.str();
-    if (extent.width == 0 || extent.height == 0) fail(name, "the header declares an empty image (" + size + ")");
+    if (extent.width == 0 || extent.height == 0) failInFile(name, "the header declares an empty image (" + size + ")");
     if (extent.width > ImageLimits::maxSide || extent.height > ImageLimits::maxSide)
-        fail(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
-                       std::to_string(ImageLimits::maxSide) + " pixels a side");
+        failInFile(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
+                             std::to_string(ImageLimits::maxSide) + " pixels a side");
     if (extent.pixels() > ImageLimits::maxPixels)
-        fail(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
-                       std::to_string(ImageLimits::maxPixels) + " pixels");
+        failInFile(name, "the header declares " + size + " pixels; vkrt reads images of at most " +
+                             std::to_string(ImageLimits::maxPixels) + " pixels");
     return extent;
 }
 
@@ -103,27 +102,27 @@ uint64_t smallestScanline(uint32_t width)
 /// header's), checked against the file's length `fileBytes`.
 Header readHeader(std::span<const uint8_t> bytes, uint64_t fileBytes, const std::string& name)
 {
-    if (!isRadianceHdr(bytes)) fail(name, "not a Radiance HDR file: no '#?' signature");
+    if (!isRadianceHdr(bytes)) failInFile(name, "not a Radiance HDR file: no '#?' signature");
     size_t at = 0;
     const std::string_view signature = nextLine(bytes, at, name);
     if (!signature.starts_with("#?RADIANCE") && !signature.starts_with("#?RGBE"))
-        fail(name, "not a readable Radiance HDR file: the signature is '" + std::string(signature.substr(0, 32)) +
-                       "', not #?RADIANCE or #?RGBE");
+        failInFile(name, "not a readable Radiance HDR file: the signature is '" + std::string(signature.substr(0, 32)) +
+                             "', not #?RADIANCE or #?RGBE");
     for (std::string_view line = nextLine(bytes, at, name); !line.empty(); line = nextLine(bytes, at, name)) {
         if (!line.starts_with("FORMAT=")) continue;
         const std::string_view format = line.substr(7);
-        if (format == "32-bit_rle_xyze") fail(name, "unsupported Radiance HDR format 32-bit_rle_xyze (CIE XYZ)");
+        if (format == "32-bit_rle_xyze") failInFile(name, "unsupported Radiance HDR format 32-bit_rle_xyze (CIE XYZ)");
         if (format != "32-bit_rle_rgbe")
-            fail(name, "unsupported Radiance HDR format '" + std::string(format.substr(0, 32)) + "'");
+            failInFile(name, "unsupported Radiance HDR format '" + std::string(format.substr(0, 32)) + "'");
     }
     Header header;
     header.extent = parseResolution(nextLine(bytes, at, name), name);
     header.dataOffset = at;
     const uint64_t smallest = at + header.extent.height * smallestScanline(header.extent.width);
     if (fileBytes < smallest)
-        fail(name, "the header declares " + header.extent.str() + " pixels, which take at least " +
-                       std::to_string(smallest) + " bytes, but the file has " + std::to_string(fileBytes) +
-                       ": truncated or damaged");
+        failInFile(name, "the header declares " + header.extent.str() + " pixels, which take at least " +
+                             std::to_string(smallest) + " bytes, but the file has " + std::to_string(fileBytes) +
+                             ": truncated or damaged");
     return header;
 }
 
@@ -154,7 +153,7 @@ private:
 
     [[noreturn]] void bad(const std::string& what) const
     {
-        fail(m_name, "truncated or damaged Radiance HDR: scanline " + std::to_string(m_y) + " " + what);
+        failInFile(m_name, "truncated or damaged Radiance HDR: scanline " + std::to_string(m_y) + " " + what);
     }
 
     void need(uint64_t count, const char* what) const
@@ -206,7 +205,7 @@ ImageExtent radianceHdrExtent(std::span<const uint8_t> bytes, uint64_t fileBytes
 ImageExtent radianceHdrFileExtent(const std::filesystem::path& file)
 {
     std::ifstream in(file, std::ios::binary);
-    if (!in) fail(file.string(), "cannot be opened");
+    if (!in) failInFile(file.string(), "cannot be opened");
     std::vector<uint8_t> head(kMaxHeaderBytes + 1);
     in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size()));
     head.resize(size_t(in.gcount()));

@@ -25,11 +25,6 @@ using namespace gltf_json;
 
 namespace {
 
-[[noreturn]] void fail(const fs::path& file, const std::string& message)
-{
-    throw InputError(file.string() + ": " + message);
-}
-
 /// glTF URIs are RFC 3986: "my%20wood.png" is the file "my wood.png".
 std::string percentDecoded(const std::string& uri)
 {
@@ -103,8 +98,8 @@ std::optional<size_t> findExcessiveNesting(std::string_view text, size_t limit)
 json parseJsonText(const fs::path& file, const std::string& text, bool mustParse)
 {
     if (const auto offset = findExcessiveNesting(text, kMaxGltfJsonNesting))
-        fail(file, "the glTF JSON nests arrays and objects more than " + std::to_string(kMaxGltfJsonNesting) +
-                       " levels deep (at byte " + std::to_string(*offset) + " of the JSON)");
+        failInFile(file, "the glTF JSON nests arrays and objects more than " + std::to_string(kMaxGltfJsonNesting) +
+                             " levels deep (at byte " + std::to_string(*offset) + " of the JSON)");
     std::vector<std::set<std::string>> keys;
     std::string duplicate;
     const json::parser_callback_t noteKeys = [&](int, json::parse_event_t event, json& parsed) {
@@ -117,8 +112,8 @@ json parseJsonText(const fs::path& file, const std::string& text, bool mustParse
     };
     json doc = json::parse(text, noteKeys, /*allow_exceptions=*/false);
     if (!mustParse && doc.is_discarded()) return doc;
-    if (doc.is_discarded() || !doc.is_object()) fail(file, "the glTF JSON cannot be parsed");
-    if (!duplicate.empty()) fail(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
+    if (doc.is_discarded() || !doc.is_object()) failInFile(file, "the glTF JSON cannot be parsed");
+    if (!duplicate.empty()) failInFile(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
     return doc;
 }
 
@@ -177,7 +172,7 @@ std::vector<std::string> materialProblems(const json& material)
 std::string readGltfJson(const fs::path& file)
 {
     std::ifstream in(file, std::ios::binary);
-    if (!in) fail(file, "cannot open the glTF file");
+    if (!in) failInFile(file, "cannot open the glTF file");
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     if (bytes.compare(0, 4, "glTF") != 0) return bytes;
     // .glb: a 12-byte header (magic, version, length), then chunks of (length, type, data); JSON comes first.
@@ -189,7 +184,7 @@ std::string readGltfJson(const fs::path& file)
     constexpr uint32_t kJsonChunk = 0x4E4F534A; // "JSON", little endian
     const uint64_t length = word(12);
     if (bytes.size() < 20 || word(16) != kJsonChunk || 20 + length > bytes.size())
-        fail(file, "the binary glTF's first chunk is not a whole JSON chunk");
+        failInFile(file, "the binary glTF's first chunk is not a whole JSON chunk");
     return bytes.substr(20, size_t(length));
 }
 
@@ -234,8 +229,8 @@ void checkBufferBounds(const fs::path& file, const json& doc)
                 std::min(sizeField(view, "byteOffset", 0), kHuge) + std::min(sizeField(view, "byteLength", 0), kHuge);
             const uint64_t length = sizeField(*buffer, "byteLength", 0);
             if (end > length)
-                fail(file, "bufferView " + std::to_string(v) + " ends at byte " + std::to_string(end) +
-                               " of a buffer of " + std::to_string(length) + " bytes");
+                failInFile(file, "bufferView " + std::to_string(v) + " ends at byte " + std::to_string(end) +
+                                     " of a buffer of " + std::to_string(length) + " bytes");
         }
     }
     const json* accessors = arrayMember(doc, "accessors");
@@ -251,8 +246,9 @@ void checkBufferBounds(const fs::path& file, const json& doc)
         const uint64_t end = std::min(sizeField(accessor, "byteOffset", 0), kHuge) + (count - 1) * stride + bytes;
         const uint64_t length = sizeField(*view, "byteLength", 0);
         if (end > length)
-            fail(file, "accessor " + std::to_string(a) + " needs " + std::to_string(end) + " bytes of bufferView " +
-                           std::to_string(*viewIndex) + ", which has " + std::to_string(length));
+            failInFile(file, "accessor " + std::to_string(a) + " needs " + std::to_string(end) +
+                                 " bytes of bufferView " + std::to_string(*viewIndex) + ", which has " +
+                                 std::to_string(length));
     }
 }
 
@@ -275,14 +271,14 @@ std::vector<uint32_t> nodeParents(const fs::path& file, const json& nodes)
         for (const json& each : *children) {
             const auto child = nodeIndex(each, nodes.size());
             if (!child) continue;
-            if (*child == node) fail(file, "node " + std::to_string(node) + " lists itself among its children");
+            if (*child == node) failInFile(file, "node " + std::to_string(node) + " lists itself among its children");
             if (parent[*child] == node)
-                fail(file, "node " + std::to_string(node) + " lists node " + std::to_string(*child) +
-                               " twice among its children");
+                failInFile(file, "node " + std::to_string(node) + " lists node " + std::to_string(*child) +
+                                     " twice among its children");
             if (parent[*child] != kNoParent)
-                fail(file, "node " + std::to_string(*child) + " is a child of both node " +
-                               std::to_string(parent[*child]) + " and node " + std::to_string(node) +
-                               " (glTF nodes form trees: each has at most one parent)");
+                failInFile(file, "node " + std::to_string(*child) + " is a child of both node " +
+                                     std::to_string(parent[*child]) + " and node " + std::to_string(node) +
+                                     " (glTF nodes form trees: each has at most one parent)");
             parent[*child] = node;
         }
     }
@@ -308,15 +304,15 @@ std::vector<uint32_t> checkNodeHierarchy(const fs::path& file, const json& doc)
             path.push_back(node);
         }
         if (node != kNoParent && onPath[node])
-            fail(file, "node " + std::to_string(node) + " is its own ancestor (its children lists form a cycle)");
+            failInFile(file, "node " + std::to_string(node) + " is its own ancestor (its children lists form a cycle)");
         uint32_t level = node == kNoParent ? 0 : depth[node];
         for (auto it = path.rbegin(); it != path.rend(); ++it) {
             depth[*it] = ++level;
             onPath[*it] = false;
             if (level > kMaxGltfNodeDepth)
-                fail(file, "node " + std::to_string(*it) + " is nested " + std::to_string(level) +
-                               " levels deep in the node hierarchy; vkrt reads at most " +
-                               std::to_string(kMaxGltfNodeDepth) + " levels");
+                failInFile(file, "node " + std::to_string(*it) + " is nested " + std::to_string(level) +
+                                     " levels deep in the node hierarchy; vkrt reads at most " +
+                                     std::to_string(kMaxGltfNodeDepth) + " levels");
         }
     }
     return parent;
@@ -411,8 +407,8 @@ void checkInstancing(const fs::path& file, const json& doc, const std::vector<ui
     const json* nodes = arrayMember(doc, "nodes");
     if (!nodes) return;
     if (nodes->size() > kMaxGltfNodes)
-        fail(file, "the file has " + withThousands(nodes->size()) + " nodes; vkrt reads at most " +
-                       withThousands(kMaxGltfNodes));
+        failInFile(file, "the file has " + withThousands(nodes->size()) + " nodes; vkrt reads at most " +
+                             withThousands(kMaxGltfNodes));
     const std::vector<uint64_t> times = importsPerNode(doc, *nodes, parent);
     const std::vector<uint64_t> triangles = meshTriangles(doc);
     // Every mesh a node names counts, in whichever scene: --scene may choose any.
@@ -426,13 +422,13 @@ void checkInstancing(const fs::path& file, const json& doc, const std::vector<ui
         meshInstances = saturatingAdd(meshInstances, times[node]);
     }
     if (importedNodes > kMaxGltfNodes)
-        fail(file, "the scene reaches " + withThousands(importedNodes) +
-                       " nodes (a node listed more than once among its roots is reached each time, with its "
-                       "children); vkrt reads at most " +
-                       withThousands(kMaxGltfNodes));
+        failInFile(file, "the scene reaches " + withThousands(importedNodes) +
+                             " nodes (a node listed more than once among its roots is reached each time, with its "
+                             "children); vkrt reads at most " +
+                             withThousands(kMaxGltfNodes));
     if (meshInstances > kMaxGltfInstances)
-        fail(file, "the node hierarchy places meshes " + withThousands(meshInstances) + " times; vkrt reads at most " +
-                       withThousands(kMaxGltfInstances) + " instances");
+        failInFile(file, "the node hierarchy places meshes " + withThousands(meshInstances) +
+                             " times; vkrt reads at most " + withThousands(kMaxGltfInstances) + " instances");
     uint64_t total = 0;
     size_t largest = 0;
     for (size_t m = 0; m < triangles.size(); ++m) {
@@ -441,9 +437,9 @@ void checkInstancing(const fs::path& file, const json& doc, const std::vector<ui
         if (triangles[m] > triangles[largest] || !placed[largest]) largest = m;
     }
     if (total > kMaxGltfTriangles)
-        fail(file, "the meshes the scene places hold " + withThousands(total) + " triangles (mesh " +
-                       std::to_string(largest) + ": " + withThousands(triangles[largest]) + "); vkrt reads at most " +
-                       withThousands(kMaxGltfTriangles));
+        failInFile(file, "the meshes the scene places hold " + withThousands(total) + " triangles (mesh " +
+                             std::to_string(largest) + ": " + withThousands(triangles[largest]) +
+                             "); vkrt reads at most " + withThousands(kMaxGltfTriangles));
 }
 
 /// The bytes of accessor data one reference asks the reader for: count x
@@ -507,10 +503,10 @@ void checkAccessorUse(const fs::path& file, const json& doc)
     const uint64_t bytes =
         saturatingAdd(meshAccessorBytes(doc, accessors), skinAndAnimationAccessorBytes(doc, accessors));
     if (bytes > kMaxGltfAccessorBytes)
-        fail(file, "the meshes, morph targets, skins and animations use " + withThousands(bytes) +
-                       " bytes of accessor data (each use counted, an accessor without a bufferView twice); vkrt "
-                       "reads at most " +
-                       withThousands(kMaxGltfAccessorBytes));
+        failInFile(file, "the meshes, morph targets, skins and animations use " + withThousands(bytes) +
+                             " bytes of accessor data (each use counted, an accessor without a bufferView twice); vkrt "
+                             "reads at most " +
+                             withThousands(kMaxGltfAccessorBytes));
 }
 
 /// Every buffer and image the JSON names by a file URI (data: URIs need no file) must be one the policy allows.
@@ -556,8 +552,8 @@ float extensionNumber(const fs::path& file, const json& extension, const char* e
     const json* value = member(extension, key);
     if (!value) return fallback;
     if (!value->is_number() || !(value->get<double>() >= low && value->get<double>() <= high))
-        fail(file, std::string(extensionName) + "." + key + ": must be a number in [" + std::to_string(low) + ", " +
-                       std::to_string(high) + "]");
+        failInFile(file, std::string(extensionName) + "." + key + ": must be a number in [" + std::to_string(low) +
+                             ", " + std::to_string(high) + "]");
     return float(value->get<double>());
 }
 
@@ -575,16 +571,16 @@ void readTextureTransform(const fs::path& file, const json* info, const char* sl
         if (!value->is_array() || value->size() != 2 || !(*value)[0].is_number() || !(*value)[1].is_number() ||
             !(std::abs((*value)[0].get<double>()) <= kMaxKernelMagnitude) ||
             !(std::abs((*value)[1].get<double>()) <= kMaxKernelMagnitude))
-            fail(file, where + "." + key +
-                           ": expected two numbers of magnitude at most 1e18 (the kernel's float32 "
-                           "texture coordinates)");
+            failInFile(file, where + "." + key +
+                                 ": expected two numbers of magnitude at most 1e18 (the kernel's float32 "
+                                 "texture coordinates)");
         return glm::dvec2((*value)[0].get<double>(), (*value)[1].get<double>());
     };
     texture->offset = pair("offset", glm::dvec2(0.0));
     texture->scale = pair("scale", glm::dvec2(1.0));
     if (const json* rotation = member(*transform, "rotation")) {
         if (!rotation->is_number() || !std::isfinite(rotation->get<double>()))
-            fail(file, where + ".rotation: expected a finite number");
+            failInFile(file, where + ".rotation: expected a finite number");
         texture->rotation = rotation->get<double>();
     }
 }
@@ -612,11 +608,11 @@ void readHonouredExtensions(const fs::path& file, const json& material, FileMate
     if (const json* e = member(*extensions, "KHR_materials_ior")) {
         out.ior = extensionNumber(file, *e, "KHR_materials_ior", "ior", 1.5f, 0.0f, 1e30f);
         if (out.ior != 0.0f && out.ior < 1.0f)
-            fail(file, "KHR_materials_ior.ior: must be 0 or at least 1, got " + std::to_string(out.ior));
+            failInFile(file, "KHR_materials_ior.ior: must be 0 or at least 1, got " + std::to_string(out.ior));
         if (out.ior == 0.0f) out.ior = 1.5f; // glTF: 0 means the default dielectric; vkrt has no ideal metal here
     }
     if (!std::isfinite(out.emissiveFactor.r + out.emissiveFactor.g + out.emissiveFactor.b))
-        fail(file, "emissiveFactor x KHR_materials_emissive_strength is beyond 32-bit float range");
+        failInFile(file, "emissiveFactor x KHR_materials_emissive_strength is beyond 32-bit float range");
 }
 
 } // namespace
@@ -641,7 +637,10 @@ struct MaterialReader {
     const GltfViewBytes& viewBytes;
     std::string materialName; ///< for messages
 
-    [[noreturn]] void malformed(const std::string& what) const { fail(file, "material " + materialName + ": " + what); }
+    [[noreturn]] void malformed(const std::string& what) const
+    {
+        failInFile(file, "material " + materialName + ": " + what);
+    }
 
     float unitFactor(const json* owner, const char* key, float fallback) const
     {

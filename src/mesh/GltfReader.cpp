@@ -31,8 +31,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace gltf_json;
 
-[[noreturn]] void fail(const fs::path& file, const std::string& what) { throw InputError(file.string() + ": " + what); }
-
 std::string indexed(const char* array, uint64_t index)
 {
     return std::string(array) + "[" + std::to_string(index) + "]";
@@ -74,14 +72,14 @@ std::optional<std::string> glbBinaryChunk(const fs::path& file)
     const std::string bytes = readBytes(file);
     if (word(bytes, 0) != kGlbMagic) return std::nullopt;
     const uint64_t jsonLength = word(bytes, 12);
-    if (word(bytes, 16) != kGlbJsonChunk) fail(file, "the binary glTF's first chunk is not JSON");
+    if (word(bytes, 16) != kGlbJsonChunk) failInFile(file, "the binary glTF's first chunk is not JSON");
     const uint64_t next = 20 + jsonLength;
     if (next + 8 > bytes.size()) return std::nullopt;
     const uint64_t length = word(bytes, size_t(next));
     if (word(bytes, size_t(next) + 4) != kGlbBinChunk) return std::nullopt;
     if (next + 8 + length > bytes.size())
-        fail(file, "the binary glTF's BIN chunk says " + std::to_string(length) + " bytes, but the file ends after " +
-                       std::to_string(bytes.size() - next - 8));
+        failInFile(file, "the binary glTF's BIN chunk says " + std::to_string(length) +
+                             " bytes, but the file ends after " + std::to_string(bytes.size() - next - 8));
     return bytes.substr(size_t(next) + 8, size_t(length));
 }
 
@@ -108,7 +106,7 @@ struct Document {
     {
         const json* list = array(key);
         if (!list || index >= list->size() || !(*list)[index].is_object())
-            fail(file, where + " names " + indexed(key, index) + ", which the file does not have");
+            failInFile(file, where + " names " + indexed(key, index) + ", which the file does not have");
         return (*list)[index];
     }
 
@@ -117,15 +115,15 @@ struct Document {
     {
         const json& v = element("bufferViews", view, where);
         const auto buffer = uintMember(v, "buffer");
-        if (!buffer || *buffer >= buffers.size()) fail(file, indexed("bufferViews", view) + ": no such buffer");
+        if (!buffer || *buffer >= buffers.size()) failInFile(file, indexed("bufferViews", view) + ": no such buffer");
         const uint64_t viewOffset = uintMember(v, "byteOffset").value_or(0);
         const uint64_t viewLength = uintMember(v, "byteLength").value_or(0);
         const std::string& bytes = buffers[*buffer];
         if (offset > viewLength || length > viewLength - offset || viewOffset > bytes.size() ||
             viewOffset + viewLength > bytes.size())
-            fail(file, where + " reads bytes " + std::to_string(offset) + " to " + std::to_string(offset + length) +
-                           " of " + indexed("bufferViews", view) + " (" + std::to_string(viewLength) +
-                           " bytes), beyond its buffer's data");
+            failInFile(file, where + " reads bytes " + std::to_string(offset) + " to " +
+                                 std::to_string(offset + length) + " of " + indexed("bufferViews", view) + " (" +
+                                 std::to_string(viewLength) + " bytes), beyond its buffer's data");
         return bytes.data() + viewOffset + offset;
     }
 };
@@ -135,15 +133,15 @@ std::string loadBuffer(const Document& d, size_t index, const std::optional<std:
     const json& buffer = (*d.array("buffers"))[index];
     const std::string where = indexed("buffers", index);
     const auto length = member(buffer, "byteLength") ? uintMember(buffer, "byteLength") : std::nullopt;
-    if (!length) fail(d.file, where + ": byteLength must be an integer from 1 to 2^32 - 1");
+    if (!length) failInFile(d.file, where + ": byteLength must be an integer from 1 to 2^32 - 1");
     std::string bytes;
     const std::string uri = stringMember(buffer, "uri");
     if (!member(buffer, "uri")) {
-        if (index != 0 || !glbChunk) fail(d.file, where + " has no uri and is not a binary glTF's BIN chunk");
+        if (index != 0 || !glbChunk) failInFile(d.file, where + " has no uri and is not a binary glTF's BIN chunk");
         bytes = *glbChunk;
     } else if (uri.rfind("data:", 0) == 0) {
         const auto decoded = dataUriBytes(uri);
-        if (!decoded) fail(d.file, where + ": its data: URI is not base64 data vkrt can decode");
+        if (!decoded) failInFile(d.file, where + ": its data: URI is not base64 data vkrt can decode");
         bytes = *decoded;
     } else {
         const fs::path path = d.file.parent_path() / gltfUriPath(uri);
@@ -151,12 +149,12 @@ std::string loadBuffer(const Document& d, size_t index, const std::optional<std:
         try {
             bytes = readBytes(path);
         } catch (const InputError& error) {
-            fail(d.file, "the referenced file '" + uri + "' cannot be read: " + error.what());
+            failInFile(d.file, "the referenced file '" + uri + "' cannot be read: " + error.what());
         }
     }
     if (bytes.size() < *length)
-        fail(d.file, where + " holds " + std::to_string(bytes.size()) + " bytes, but its byteLength is " +
-                         std::to_string(*length));
+        failInFile(d.file, where + " holds " + std::to_string(bytes.size()) + " bytes, but its byteLength is " +
+                               std::to_string(*length));
     bytes.resize(*length);
     return bytes;
 }
@@ -166,8 +164,8 @@ Document openDocument(const fs::path& file, const MeshLoadOptions& options)
     Document d{file, checkedGltfDocument(file, ReferencePolicy(file, options)), ReferencePolicy(file, options), {}};
     const std::string version = member(d.doc, "asset") ? stringMember(d.doc["asset"], "version") : "";
     if (version.rfind("2.", 0) != 0)
-        fail(file, "asset.version is " + (version.empty() ? std::string("missing") : "'" + version + "'") +
-                       ": vkrt reads glTF 2.0");
+        failInFile(file, "asset.version is " + (version.empty() ? std::string("missing") : "'" + version + "'") +
+                             ": vkrt reads glTF 2.0");
     if (const json* buffers = d.array("buffers")) {
         const std::optional<std::string> chunk = glbBinaryChunk(file);
         for (size_t i = 0; i < buffers->size(); ++i) d.buffers.push_back(loadBuffer(d, i, chunk));
@@ -229,7 +227,7 @@ void readElements(const Document& d, uint64_t view, uint64_t offset, uint64_t co
                   uint64_t stride, const std::string& where, T* out)
 {
     if (stride > 252) // glTF's bound; it keeps (count - 1) * stride far from overflow
-        fail(d.file, where + ": its bufferView's byteStride " + std::to_string(stride) + " is over glTF's 252");
+        failInFile(d.file, where + ": its bufferView's byteStride " + std::to_string(stride) + " is over glTF's 252");
     const uint64_t size = uint64_t(componentBytes(type.componentType)) * type.components;
     if (count == 0) return;
     const char* bytes = d.viewBytes(view, offset, (count - 1) * stride + size, where);
@@ -272,14 +270,14 @@ Accessor<T> readAccessor(const Document& d, uint64_t index, std::initializer_lis
     type.componentType = uintMember(a, "componentType").value_or(0);
     type.normalized = member(a, "normalized") && a["normalized"].is_boolean() && a["normalized"].get<bool>();
     if (std::find(allowed.begin(), allowed.end(), type.components) == allowed.end())
-        fail(d.file, where + " uses " + name + " of type '" + stringMember(a, "type") + "', which it cannot be");
+        failInFile(d.file, where + " uses " + name + " of type '" + stringMember(a, "type") + "', which it cannot be");
     const uint32_t size = componentBytes(type.componentType);
-    if (size == 0) fail(d.file, name + ": unknown componentType");
+    if (size == 0) failInFile(d.file, name + ": unknown componentType");
     const auto count = uintMember(a, "count");
-    if (!count || *count == 0) fail(d.file, name + ": count must be at least 1");
+    if (!count || *count == 0) failInFile(d.file, name + ": count must be at least 1");
     if (uint64_t(*count) * type.components > kMaxAccessorValues)
-        fail(d.file, name + ": " + std::to_string(*count) + " elements; vkrt reads at most " +
-                         std::to_string(kMaxAccessorValues / type.components) + " of this type");
+        failInFile(d.file, name + ": " + std::to_string(*count) + " elements; vkrt reads at most " +
+                               std::to_string(kMaxAccessorValues / type.components) + " of this type");
     Accessor<T> out;
     out.count = *count;
     out.components = type.components;
@@ -298,13 +296,13 @@ Accessor<T> readAccessor(const Document& d, uint64_t index, std::initializer_lis
     const json* indices = member(*sparse, "indices");
     const json* values = member(*sparse, "values");
     if (!sparseCount || *sparseCount == 0 || *sparseCount > *count || !indices || !values)
-        fail(d.file, sparseName + ": needs a count from 1 to the accessor's count, indices and values");
+        failInFile(d.file, sparseName + ": needs a count from 1 to the accessor's count, indices and values");
     ElementType indexType{1, uintMember(*indices, "componentType").value_or(0), false};
     if (indexType.componentType != 5121 && indexType.componentType != 5123 && indexType.componentType != 5125)
-        fail(d.file, sparseName + ".indices: componentType must be an unsigned byte, short or int");
+        failInFile(d.file, sparseName + ".indices: componentType must be an unsigned byte, short or int");
     const auto indexView = uintMember(*indices, "bufferView");
     const auto valueView = uintMember(*values, "bufferView");
-    if (!indexView || !valueView) fail(d.file, sparseName + ": indices and values need a bufferView");
+    if (!indexView || !valueView) failInFile(d.file, sparseName + ": indices and values need a bufferView");
     std::vector<uint32_t> where_(*sparseCount);
     std::vector<T> substitutes(size_t(*sparseCount) * type.components);
     readElements(d, *indexView, uintMember(*indices, "byteOffset").value_or(0), *sparseCount, indexType,
@@ -314,8 +312,8 @@ Accessor<T> readAccessor(const Document& d, uint64_t index, std::initializer_lis
     for (uint64_t i = 0; i < *sparseCount; ++i) {
         const uint64_t target = where_[i];
         if (target >= *count)
-            fail(d.file, sparseName + ".indices[" + std::to_string(i) + "] is " + std::to_string(target) +
-                             ", beyond the accessor's " + std::to_string(*count) + " elements");
+            failInFile(d.file, sparseName + ".indices[" + std::to_string(i) + "] is " + std::to_string(target) +
+                                   ", beyond the accessor's " + std::to_string(*count) + " elements");
         std::copy_n(substitutes.begin() + long(i * type.components), type.components,
                     out.values.begin() + long(target * type.components));
     }
@@ -355,7 +353,7 @@ uint32_t primitiveMaterial(const Document& d, const json& primitive, size_t mate
 {
     const auto own = uintMember(primitive, "material");
     if (member(primitive, "material") && (!own || *own + 1 >= materialCount))
-        fail(d.file, where + ".material names a material the file does not have");
+        failInFile(d.file, where + ".material names a material the file does not have");
     uint32_t chosen = own.value_or(uint32_t(materialCount - 1));
     const json* extensions = member(primitive, "extensions");
     const json* variants = extensions ? member(*extensions, "KHR_materials_variants") : nullptr;
@@ -367,8 +365,8 @@ uint32_t primitiveMaterial(const Document& d, const json& primitive, size_t mate
                 if (v.is_number_unsigned() && v.get<uint64_t>() == *variant) {
                     const auto material = uintMember(mapping, "material");
                     if (!material || *material + 1 >= materialCount)
-                        fail(d.file, where + ".extensions.KHR_materials_variants: a mapping names a material the "
-                                             "file does not have");
+                        failInFile(d.file, where + ".extensions.KHR_materials_variants: a mapping names a material the "
+                                                   "file does not have");
                     chosen = *material;
                 }
     return chosen;
@@ -398,8 +396,8 @@ struct MeshBuilder {
     void checkCount(const Accessor<>& a, uint64_t count, const std::string& where, const char* name) const
     {
         if (a.count != count)
-            fail(d.file, where + ": " + name + " has " + std::to_string(a.count) + " elements, POSITION " +
-                             std::to_string(count));
+            failInFile(d.file, where + ": " + name + " has " + std::to_string(a.count) + " elements, POSITION " +
+                                   std::to_string(count));
     }
 
     /// A primitive's TEXCOORD_n attribute; a set its material's textures read must be there.
@@ -410,8 +408,9 @@ struct MeshBuilder {
         const std::string name = "TEXCOORD_" + std::to_string(set);
         std::optional<Accessor<>> uvs = optional(name.c_str());
         if (!uvs && texCoordSets(material).count(set))
-            fail(d.file, where + ": its material (" + (material.name.empty() ? "unnamed" : "'" + material.name + "'") +
-                             ") samples textures through " + name + ", which the primitive does not have");
+            failInFile(d.file, where + ": its material (" +
+                                   (material.name.empty() ? "unnamed" : "'" + material.name + "'") +
+                                   ") samples textures through " + name + ", which the primitive does not have");
         return uvs;
     }
 
@@ -435,7 +434,7 @@ struct MeshBuilder {
         glm::vec2 uv(0.0f);
         if (uvs) {
             if (!finite(*uvs, i))
-                fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite texture coordinate");
+                failInFile(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite texture coordinate");
             uv = glm::vec2(float(uvs->at(i, 0)), float(1.0 - uvs->at(i, 1)));
         }
         to.push_back(uv);
@@ -444,14 +443,14 @@ struct MeshBuilder {
     void addPrimitive(const json& primitive, const std::string& where)
     {
         const uint32_t mode = uintMember(primitive, "mode").value_or(kTriangles);
-        if (mode > kFan) fail(d.file, where + ".mode: " + std::to_string(mode) + " is not a glTF primitive mode");
+        if (mode > kFan) failInFile(d.file, where + ".mode: " + std::to_string(mode) + " is not a glTF primitive mode");
         if (mode < kTriangles) {
             warnOnce("points and lines (primitive modes 0-3) are not rendered");
             return;
         }
         const json* attributes = member(primitive, "attributes");
         const auto position = attributes ? uintMember(*attributes, "POSITION") : std::nullopt;
-        if (!position) fail(d.file, where + ": a triangle primitive needs a POSITION attribute");
+        if (!position) failInFile(d.file, where + ": a triangle primitive needs a POSITION attribute");
         const Accessor<> positions = readAccessor(d, *position, {3}, where + ".attributes.POSITION");
         const uint64_t count = positions.count;
         const uint32_t materialIndex = primitiveMaterial(d, primitive, materials.size(), variant, where);
@@ -479,14 +478,14 @@ struct MeshBuilder {
             const uint32_t type = uintMember(indexAccessor, "componentType").value_or(0);
             const json* normalized = member(indexAccessor, "normalized");
             if ((type != 5121 && type != 5123 && type != 5125) || (normalized && *normalized == true))
-                fail(d.file, where + ".indices: accessor " + std::to_string(*indices) +
-                                 " must hold unsigned bytes, shorts or ints, not normalized");
+                failInFile(d.file, where + ".indices: accessor " + std::to_string(*indices) +
+                                       " must hold unsigned bytes, shorts or ints, not normalized");
             const Accessor<uint32_t> a = readAccessor<uint32_t>(d, *indices, {1}, where + ".indices");
             sequence.resize(a.count);
             for (uint64_t i = 0; i < a.count; ++i) {
                 if (a.values[i] >= count)
-                    fail(d.file, where + ".indices[" + std::to_string(i) + "] is " + std::to_string(a.values[i]) +
-                                     ", beyond the " + std::to_string(count) + " vertices");
+                    failInFile(d.file, where + ".indices[" + std::to_string(i) + "] is " + std::to_string(a.values[i]) +
+                                           ", beyond the " + std::to_string(count) + " vertices");
                 sequence[i] = a.values[i];
             }
         } else {
@@ -495,18 +494,18 @@ struct MeshBuilder {
         // glTF 3.7.2.1: TRIANGLES' vertex count is a multiple of 3; a stray
         // index or two would otherwise be dropped without a word.
         if (mode == kTriangles && sequence.size() % 3 != 0)
-            fail(d.file, where + ": a TRIANGLES primitive of " + std::to_string(sequence.size()) + " " +
-                             (member(primitive, "indices") ? "indices" : "vertices") + ", not a multiple of 3");
-        if (out.positions.size() + count > UINT32_MAX) fail(d.file, "a mesh has more than 2^32 vertices");
+            failInFile(d.file, where + ": a TRIANGLES primitive of " + std::to_string(sequence.size()) + " " +
+                                   (member(primitive, "indices") ? "indices" : "vertices") + ", not a multiple of 3");
+        if (out.positions.size() + count > UINT32_MAX) failInFile(d.file, "a mesh has more than 2^32 vertices");
         const auto base = uint32_t(out.positions.size());
         for (uint64_t i = 0; i < count; ++i) {
             if (!finite(positions, i))
-                fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite position");
+                failInFile(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite position");
             out.positions.emplace_back(positions.at(i, 0), positions.at(i, 1), positions.at(i, 2));
             glm::vec3 n(0.0f);
             if (normals) {
                 if (!finite(*normals, i))
-                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite normal");
+                    failInFile(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite normal");
                 const glm::dvec3 v(normals->at(i, 0), normals->at(i, 1), normals->at(i, 2));
                 const double length = glm::length(v);
                 if (length > 0.0) n = glm::vec3(v / length);
@@ -515,7 +514,7 @@ struct MeshBuilder {
             glm::vec4 t(0.0f);
             if (tangents) {
                 if (!finite(*tangents, i))
-                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite tangent");
+                    failInFile(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite tangent");
                 const glm::dvec3 v(tangents->at(i, 0), tangents->at(i, 1), tangents->at(i, 2));
                 const double length = glm::length(v);
                 // glTF's bitangent w cross(n, t) runs along decreasing file v (MikkTSpace's
@@ -532,7 +531,7 @@ struct MeshBuilder {
             glm::vec4 color(1.0f);
             if (colors) {
                 if (!finite(*colors, i))
-                    fail(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite colour");
+                    failInFile(d.file, where + ": vertex " + std::to_string(i) + " has a non-finite colour");
                 for (uint32_t c = 0; c < colors->components; ++c) color[int(c)] = float(colors->at(i, c));
             }
             out.colors.push_back(color);
@@ -567,7 +566,7 @@ MeshData readMesh(const Document& d, uint32_t index, const std::vector<FileMater
     const json& mesh = (*d.array("meshes"))[index];
     const std::string where = indexed("meshes", index);
     const json* primitives = arrayMember(mesh, "primitives");
-    if (!primitives || primitives->empty()) fail(d.file, where + ": a mesh needs at least one primitive");
+    if (!primitives || primitives->empty()) failInFile(d.file, where + ": a mesh needs at least one primitive");
     MeshBuilder builder{d, materials, warnings, variant, {}};
     for (size_t p = 0; p < primitives->size(); ++p)
         builder.addPrimitive((*primitives)[p], where + ".primitives[" + std::to_string(p) + "]");
@@ -581,7 +580,8 @@ MeshData readMesh(const Document& d, uint32_t index, const std::vector<FileMater
 
 double finiteNumber(const fs::path& file, const json& value, const std::string& where)
 {
-    if (!value.is_number() || !std::isfinite(value.get<double>())) fail(file, where + ": expected finite numbers");
+    if (!value.is_number() || !std::isfinite(value.get<double>()))
+        failInFile(file, where + ": expected finite numbers");
     return value.get<double>();
 }
 
@@ -590,7 +590,7 @@ glm::dvec3 numbers3(const fs::path& file, const json& node, const char* key, glm
 {
     const json* value = member(node, key);
     if (!value) return fallback;
-    if (!value->is_array() || value->size() != 3) fail(file, where + "." + key + ": expected 3 numbers");
+    if (!value->is_array() || value->size() != 3) failInFile(file, where + "." + key + ": expected 3 numbers");
     glm::dvec3 out;
     for (int i = 0; i < 3; ++i) out[i] = finiteNumber(file, (*value)[size_t(i)], where + "." + key);
     return out;
@@ -605,7 +605,7 @@ glm::dmat4 trs(const glm::dvec3& t, const glm::dquat& r, const glm::dvec3& s)
 glm::dquat unitQuaternion(const fs::path& file, const glm::dvec4& q, const std::string& where)
 {
     const double length = glm::length(q);
-    if (!(length > 0.0) || !std::isfinite(length)) fail(file, where + ": a rotation quaternion must not be zero");
+    if (!(length > 0.0) || !std::isfinite(length)) failInFile(file, where + ": a rotation quaternion must not be zero");
     return glm::dquat(q.w / length, q.x / length, q.y / length, q.z / length);
 }
 
@@ -613,14 +613,14 @@ glm::dquat unitQuaternion(const fs::path& file, const glm::dvec4& q, const std::
 glm::dmat4 localTransform(const fs::path& file, const json& node, const std::string& where)
 {
     if (const json* m = member(node, "matrix")) {
-        if (!m->is_array() || m->size() != 16) fail(file, where + ".matrix: expected 16 numbers");
+        if (!m->is_array() || m->size() != 16) failInFile(file, where + ".matrix: expected 16 numbers");
         glm::dmat4 matrix;
         for (int i = 0; i < 16; ++i) matrix[i / 4][i % 4] = finiteNumber(file, (*m)[size_t(i)], where + ".matrix");
         return matrix;
     }
     glm::dvec4 q(0.0, 0.0, 0.0, 1.0);
     if (const json* r = member(node, "rotation")) {
-        if (!r->is_array() || r->size() != 4) fail(file, where + ".rotation: expected a quaternion of 4 numbers");
+        if (!r->is_array() || r->size() != 4) failInFile(file, where + ".rotation: expected a quaternion of 4 numbers");
         for (int i = 0; i < 4; ++i) q[i] = finiteNumber(file, (*r)[size_t(i)], where + ".rotation");
     }
     return trs(numbers3(file, node, "translation", glm::dvec3(0.0), where),
@@ -641,11 +641,11 @@ std::vector<glm::dmat4> instanceTransforms(const Document& d, const json& node, 
         if (const auto index = uintMember(*attributes, key)) {
             const uint64_t declared = uintMember(d.element("accessors", *index, name), "count").value_or(0);
             if (declared > kMaxGltfInstances)
-                fail(d.file, name + "." + key + ": " + std::to_string(declared) + " instances; vkrt reads at most " +
-                                 std::to_string(kMaxGltfInstances));
+                failInFile(d.file, name + "." + key + ": " + std::to_string(declared) +
+                                       " instances; vkrt reads at most " + std::to_string(kMaxGltfInstances));
             into = readAccessor(d, *index, {size}, name + "." + key);
             if (count != 0 && into->count != count)
-                fail(d.file, name + ": TRANSLATION, ROTATION and SCALE must have the same count");
+                failInFile(d.file, name + ": TRANSLATION, ROTATION and SCALE must have the same count");
             count = into->count;
         }
     };
@@ -654,8 +654,8 @@ std::vector<glm::dmat4> instanceTransforms(const Document& d, const json& node, 
     read("SCALE", 3, s);
     if (count == 0) return {glm::dmat4(1.0)};
     if (count > kMaxGltfInstances)
-        fail(d.file, name + ": " + std::to_string(count) + " instances; vkrt reads at most " +
-                         std::to_string(kMaxGltfInstances));
+        failInFile(d.file, name + ": " + std::to_string(count) + " instances; vkrt reads at most " +
+                               std::to_string(kMaxGltfInstances));
     std::vector<glm::dmat4> out;
     out.reserve(count);
     for (uint64_t i = 0; i < count; ++i) {
@@ -664,7 +664,7 @@ std::vector<glm::dmat4> instanceTransforms(const Document& d, const json& node, 
             r ? glm::dvec4(r->at(i, 0), r->at(i, 1), r->at(i, 2), r->at(i, 3)) : glm::dvec4(0, 0, 0, 1);
         const glm::dvec3 scale = s ? glm::dvec3(s->at(i, 0), s->at(i, 1), s->at(i, 2)) : glm::dvec3(1.0);
         if (!std::isfinite(glm::dot(translation, translation) + glm::dot(scale, scale)))
-            fail(d.file, name + ": instance " + std::to_string(i) + " has a non-finite transform");
+            failInFile(d.file, name + ": instance " + std::to_string(i) + " has a non-finite transform");
         out.push_back(
             trs(translation, unitQuaternion(d.file, q, name + ".ROTATION[" + std::to_string(i) + "]"), scale));
     }
@@ -679,7 +679,8 @@ std::optional<uint32_t> chosenScene(const Document& d, const std::optional<std::
     if (!choice) {
         if (count == 0) return std::nullopt;
         const uint32_t index = uintMember(d.doc, "scene").value_or(0);
-        if (index >= count) fail(d.file, "scene: " + std::to_string(index) + " names a scene the file does not have");
+        if (index >= count)
+            failInFile(d.file, "scene: " + std::to_string(index) + " names a scene the file does not have");
         return index;
     }
     const std::string& text = *choice;
@@ -724,7 +725,7 @@ std::vector<uint32_t> rootNodes(const Document& d, std::optional<uint32_t> scene
         if (const json* list = arrayMember((*d.array("scenes"))[*scene], "nodes"))
             for (const json& n : *list) {
                 if (!n.is_number_unsigned() || n.get<uint64_t>() >= nodeCount)
-                    fail(d.file, indexed("scenes", *scene) + ".nodes names a node the file does not have");
+                    failInFile(d.file, indexed("scenes", *scene) + ".nodes names a node the file does not have");
                 roots.push_back(uint32_t(n.get<uint64_t>()));
             }
         return roots;
@@ -759,16 +760,17 @@ void walkNodes(const Document& d, GltfModel& model, std::optional<uint32_t> scen
         const Visit visit = stack.back();
         stack.pop_back();
         if (++visits > kMaxGltfNodes)
-            fail(d.file, "the scene reaches more than " + withThousands(kMaxGltfNodes) +
-                             " nodes (a node listed more than once among its roots is reached each time, with its "
-                             "children); vkrt reads at most that many");
+            failInFile(d.file,
+                       "the scene reaches more than " + withThousands(kMaxGltfNodes) +
+                           " nodes (a node listed more than once among its roots is reached each time, with its "
+                           "children); vkrt reads at most that many");
         const std::string where = indexed("nodes", visit.node);
         const json& node = (*nodes)[visit.node];
-        if (!node.is_object()) fail(d.file, where + ": expected an object");
+        if (!node.is_object()) failInFile(d.file, where + ": expected an object");
         const glm::dmat4 world = visit.parent * localTransform(d.file, node, where);
         const std::string name = stringMember(node, "name");
         if (const auto mesh = uintMember(node, "mesh")) {
-            if (*mesh >= meshCount) fail(d.file, where + ".mesh names a mesh the file does not have");
+            if (*mesh >= meshCount) failInFile(d.file, where + ".mesh names a mesh the file does not have");
             for (const glm::dmat4& instance : instanceTransforms(d, node, where)) {
                 const glm::dmat4 placed = world * instance;
                 const double det = glm::determinant(glm::dmat3(placed));
@@ -779,8 +781,8 @@ void walkNodes(const Document& d, GltfModel& model, std::optional<uint32_t> scen
                 model.instances.push_back({*mesh, placed, name});
             }
             if (model.instances.size() > kMaxGltfInstances)
-                fail(d.file, "the scene places meshes more than " + std::to_string(kMaxGltfInstances) +
-                                 " times; vkrt reads at most that many instances");
+                failInFile(d.file, "the scene places meshes more than " + std::to_string(kMaxGltfInstances) +
+                                       " times; vkrt reads at most that many instances");
         }
         if (const auto camera = uintMember(node, "camera")) model.cameras.push_back({*camera, visit.node, name, world});
         if (const json* extensions = member(node, "extensions"))
@@ -803,7 +805,7 @@ double number(const fs::path& file, const json& object, const char* key, double 
     const json* value = member(object, key);
     if (!value) return fallback;
     if (!value->is_number() || !std::isfinite(value->get<double>()))
-        fail(file, where + "." + key + ": expected a finite number");
+        failInFile(file, where + "." + key + ": expected a finite number");
     return value->get<double>();
 }
 
@@ -814,42 +816,42 @@ GltfCamera readCamera(const fs::path& file, const json& camera, const std::strin
     const std::string type = stringMember(camera, "type");
     if (type == "orthographic") {
         const json* o = member(camera, "orthographic");
-        if (!o || !o->is_object()) fail(file, where + ": an orthographic camera needs its `orthographic` object");
+        if (!o || !o->is_object()) failInFile(file, where + ": an orthographic camera needs its `orthographic` object");
         c.orthographic = true;
         c.xmag = number(file, *o, "xmag", 0.0, where + ".orthographic");
         c.ymag = number(file, *o, "ymag", 0.0, where + ".orthographic");
         if (c.xmag == 0.0 || c.ymag == 0.0)
-            fail(file, where + ".orthographic: xmag and ymag must be given and not zero");
+            failInFile(file, where + ".orthographic: xmag and ymag must be given and not zero");
         return c;
     }
     if (type != "perspective")
-        fail(file, where + ".type: must be \"perspective\" or \"orthographic\", got '" + type + "'");
+        failInFile(file, where + ".type: must be \"perspective\" or \"orthographic\", got '" + type + "'");
     const json* p = member(camera, "perspective");
-    if (!p || !p->is_object()) fail(file, where + ": a perspective camera needs its `perspective` object");
+    if (!p || !p->is_object()) failInFile(file, where + ": a perspective camera needs its `perspective` object");
     c.yfov = number(file, *p, "yfov", 0.0, where + ".perspective");
     if (!(c.yfov > 0.0 && c.yfov < 3.141592653589793))
-        fail(file, where + ".perspective.yfov: must be strictly between 0 and pi radians");
+        failInFile(file, where + ".perspective.yfov: must be strictly between 0 and pi radians");
     if (member(*p, "aspectRatio")) {
         c.aspectRatio = number(file, *p, "aspectRatio", 1.0, where + ".perspective");
-        if (!(*c.aspectRatio > 0.0)) fail(file, where + ".perspective.aspectRatio: must be > 0");
+        if (!(*c.aspectRatio > 0.0)) failInFile(file, where + ".perspective.aspectRatio: must be > 0");
     }
     return c;
 }
 
 GltfLight readLight(const fs::path& file, const json& light, const std::string& where)
 {
-    if (!light.is_object()) fail(file, where + ": expected an object with a `type`");
+    if (!light.is_object()) failInFile(file, where + ": expected an object with a `type`");
     GltfLight l;
     l.name = stringMember(light, "name");
     l.type = stringMember(light, "type");
     if (l.type != "point" && l.type != "spot" && l.type != "directional")
-        fail(file, where + ".type: unknown light type '" + l.type + "' (point, spot, directional)");
+        failInFile(file, where + ".type: unknown light type '" + l.type + "' (point, spot, directional)");
     l.color = numbers3(file, light, "color", glm::dvec3(1.0), where);
     l.intensity = number(file, light, "intensity", 1.0, where);
     if (!(l.intensity >= 0.0) || glm::any(glm::lessThan(l.color, glm::dvec3(0.0))))
-        fail(file, where + ": color and intensity must be >= 0");
+        failInFile(file, where + ": color and intensity must be >= 0");
     if (std::max({l.color.r, l.color.g, l.color.b}) * l.intensity > std::numeric_limits<float>::max())
-        fail(file, where + ": color x intensity is beyond 32-bit float range");
+        failInFile(file, where + ": color x intensity is beyond 32-bit float range");
     l.hasRange = member(light, "range") != nullptr;
     if (l.type == "spot") {
         const json* spot = member(light, "spot");
@@ -859,7 +861,8 @@ GltfLight readLight(const fs::path& file, const json& light, const std::string& 
         l.outerConeAngle = number(file, s, "outerConeAngle", l.outerConeAngle, where + ".spot");
         if (!(l.outerConeAngle > 0.0 && l.outerConeAngle <= 3.141592653589793 / 2.0) ||
             !(l.innerConeAngle >= 0.0 && l.innerConeAngle <= l.outerConeAngle))
-            fail(file, where + ".spot: needs 0 <= innerConeAngle <= outerConeAngle <= pi/2 and outerConeAngle > 0");
+            failInFile(file,
+                       where + ".spot: needs 0 <= innerConeAngle <= outerConeAngle <= pi/2 and outerConeAngle > 0");
     }
     return l;
 }
@@ -877,10 +880,10 @@ void readCamerasAndLights(const Document& d, GltfModel& model)
                 readLight(d.file, (*lights)[i], "extensions.KHR_lights_punctual." + indexed("lights", i)));
     for (const GltfPlaced& c : model.cameras)
         if (c.index >= model.cameraDefinitions.size())
-            fail(d.file, indexed("nodes", c.node) + ".camera names a camera the file does not have");
+            failInFile(d.file, indexed("nodes", c.node) + ".camera names a camera the file does not have");
     for (const GltfPlaced& l : model.lights)
         if (l.index >= model.lightDefinitions.size())
-            fail(d.file, indexed("nodes", l.node) + " names a KHR_lights_punctual light the file does not have");
+            failInFile(d.file, indexed("nodes", l.node) + " names a KHR_lights_punctual light the file does not have");
 }
 
 // --------------------------------------------------------------- extensions
@@ -894,8 +897,8 @@ void checkExtensions(const Document& d, GltfModel& model)
     if (const json* required = d.array("extensionsRequired"))
         for (const json& name : *required)
             if (name.is_string() && !known(name.get<std::string>()))
-                fail(d.file, "extensionsRequired names " + name.get<std::string>() +
-                                 ", which vkrt does not implement (the file cannot be rendered without it)");
+                failInFile(d.file, "extensionsRequired names " + name.get<std::string>() +
+                                       ", which vkrt does not implement (the file cannot be rendered without it)");
     if (const json* used = d.array("extensionsUsed"))
         for (const json& name : *used)
             if (name.is_string() && !known(name.get<std::string>()))
@@ -999,14 +1002,15 @@ MeshData flattenGltfModel(GltfModel model)
         vertices += model.meshes[i.mesh].positions.size();
     }
     if (triangles == 0)
-        fail(model.file, "no triangles in " + model.file.string() + " (its scene places no triangle mesh)");
+        failInFile(model.file, "no triangles in " + model.file.string() + " (its scene places no triangle mesh)");
     if (triangles > kMaxGltfTriangles)
-        fail(model.file, "the node hierarchy instances meshes " + withThousands(model.instances.size()) + " times, " +
-                             withThousands(triangles) + " triangles in all; vkrt reads at most " +
-                             withThousands(kMaxGltfTriangles) +
-                             " triangles after instancing into one mesh (a glTF scene keeps its instances instead: "
-                             "render the file itself, or `[import] gltf` it)");
-    if (vertices > UINT32_MAX) fail(model.file, "more than 2^32 vertices after instancing");
+        failInFile(model.file,
+                   "the node hierarchy instances meshes " + withThousands(model.instances.size()) + " times, " +
+                       withThousands(triangles) + " triangles in all; vkrt reads at most " +
+                       withThousands(kMaxGltfTriangles) +
+                       " triangles after instancing into one mesh (a glTF scene keeps its instances instead: "
+                       "render the file itself, or `[import] gltf` it)");
+    if (vertices > UINT32_MAX) failInFile(model.file, "more than 2^32 vertices after instancing");
     // Attributes are all or nothing in MeshData: a mesh without one gets neutral values.
     auto any = [&](auto member) {
         return std::any_of(model.instances.begin(), model.instances.end(),

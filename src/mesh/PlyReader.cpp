@@ -82,7 +82,7 @@ bool isInteger(Scalar type) { return type != Scalar::Float32 && type != Scalar::
 
 struct Property {
     std::string name;
-    Scalar type = Scalar::Float32; ///< of the value, or of a list's entries
+    Scalar type = Scalar::Float32;   ///< of the value, or of a list's entries
     std::optional<Scalar> countType; ///< set for a list
 };
 
@@ -221,7 +221,11 @@ private:
 class BodyReader {
 public:
     BodyReader(const fs::path& file, const std::string& data, const Header& header)
-        : m_file(file), m_data(data), m_format(header.format), m_at(header.bytes), m_line(header.lines)
+        : m_file(file),
+          m_data(data),
+          m_format(header.format),
+          m_at(header.bytes),
+          m_line(header.lines)
     {
     }
 
@@ -264,10 +268,7 @@ public:
         fail(m_file, 0, "byte " + std::to_string(m_instanceStart) + ": " + message);
     }
 
-    std::string where() const
-    {
-        return m_element->name + " " + std::to_string(m_index) + " (counting from 0)";
-    }
+    std::string where() const { return m_element->name + " " + std::to_string(m_index) + " (counting from 0)"; }
 
 private:
     double asciiValue(Scalar type)
@@ -278,8 +279,8 @@ private:
         const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
         if (error != std::errc() || end != word.data() + word.size()) {
             // from_chars reports out-of-range values as errors: name them apart from non-numbers.
-            if (error == std::errc::result_out_of_range) failHere(where() + " has a value out of range: '" +
-                                                                  std::string(word) + "'");
+            if (error == std::errc::result_out_of_range)
+                failHere(where() + " has a value out of range: '" + std::string(word) + "'");
             failHere(where() + " has '" + std::string(word) + "', not a number");
         }
         if (isInteger(type) && value != std::floor(value)) {
@@ -355,7 +356,8 @@ VertexLayout vertexLayout(const fs::path& file, const Element& vertex)
     const char* axes[3] = {"x", "y", "z"};
     for (int a = 0; a < 3; ++a) {
         const std::optional<size_t> found = findProperty(vertex, {axes[a]});
-        if (!found) fail(file, vertex.line, "PLY element 'vertex' has no scalar property '" + std::string(axes[a]) + "'");
+        if (!found)
+            fail(file, vertex.line, "PLY element 'vertex' has no scalar property '" + std::string(axes[a]) + "'");
         layout.position[a] = *found;
     }
     const auto nx = findProperty(vertex, {"nx"}), ny = findProperty(vertex, {"ny"}), nz = findProperty(vertex, {"nz"});
@@ -418,16 +420,16 @@ std::string readWholeFile(const fs::path& file)
 // ---------------------------------------------------------------------------
 // Reading the body into a MeshData.
 
-std::string describe(const glm::vec3& v)
+std::string describeVertex(const glm::vec3& v)
 {
     std::ostringstream text;
     text << "(" << v.x << ", " << v.y << ", " << v.z << ")";
     return text.str();
 }
 
-class MeshBuilder {
+class PlyMeshBuilder {
 public:
-    MeshBuilder(const fs::path& file, BodyReader& body) : m_file(file), m_body(body) {}
+    PlyMeshBuilder(const fs::path& file, BodyReader& body) : m_file(file), m_body(body) {}
 
     void readVertices(const Element& element)
     {
@@ -441,11 +443,12 @@ public:
             for (size_t p = 0; p < element.properties.size(); ++p) values[p] = readProperty(element.properties[p]);
             m_body.endInstance();
             const glm::vec3 position = pick3(values, layout.position);
-            if (!allFinite(position)) m_body.failHere(m_body.where() + " has a non-finite coordinate " + describe(position));
+            if (!allFinite(position))
+                m_body.failHere(m_body.where() + " has a non-finite coordinate " + describeVertex(position));
             m_mesh.positions.push_back(position);
             if (layout.normal) {
                 const glm::vec3 n = pick3(values, *layout.normal);
-                if (!allFinite(n)) m_body.failHere(m_body.where() + " has a non-finite normal " + describe(n));
+                if (!allFinite(n)) m_body.failHere(m_body.where() + " has a non-finite normal " + describeVertex(n));
                 const float length = glm::length(n);
                 m_mesh.normals.push_back(length > 0.0f && std::isfinite(length) ? n / length : glm::vec3(0.0f));
             }
@@ -475,7 +478,8 @@ public:
             }
             m_body.endInstance();
             // A fan: what assimp's Triangulate gave for the convex polygons of real files.
-            for (size_t c = 2; c < corners.size(); ++c) m_mesh.triangles.emplace_back(corners[0], corners[c - 1], corners[c]);
+            for (size_t c = 2; c < corners.size(); ++c)
+                m_mesh.triangles.emplace_back(corners[0], corners[c - 1], corners[c]);
         }
     }
 
@@ -543,7 +547,7 @@ MeshData readPlyFile(const fs::path& file)
     if (vertex == header.elements.end()) fail(file, header.lines, "the PLY header declares no 'vertex' element");
     if (vertex->count > std::numeric_limits<uint32_t>::max()) fail(file, vertex->line, "more than 2^32 vertices");
     BodyReader body(file, data, header);
-    MeshBuilder builder(file, body);
+    PlyMeshBuilder builder(file, body);
     for (const Element& element : header.elements) {
         if (&element == &*vertex) {
             builder.readVertices(element);
@@ -554,7 +558,8 @@ MeshData readPlyFile(const fs::path& file)
         }
     }
     MeshData mesh = builder.take();
-    if (mesh.triangles.empty()) fail(file, 0, "no triangles in " + file.string() + " (it has no faces of 3 or more vertices)");
+    if (mesh.triangles.empty())
+        fail(file, 0, "no triangles in " + file.string() + " (it has no faces of 3 or more vertices)");
     return mesh;
 }
 

@@ -27,8 +27,6 @@ constexpr double kTimeoutWithoutBaseline = 600.0; // seconds: a case that says n
 constexpr auto kPollInterval = std::chrono::milliseconds(20);
 constexpr size_t kLogTailBytes = size_t(1) << 20; // a child's output kept in --report-dir: its last MiB
 
-bool interrupted() { return interruptFlag().load(); }
-
 /// The last `limit` bytes of a file ("" if it cannot be read).
 std::string fileTail(const fs::path& path, size_t limit)
 {
@@ -82,7 +80,6 @@ std::string seconds(double value)
 }
 
 } // namespace
-
 
 TemporaryFolder::TemporaryFolder()
 {

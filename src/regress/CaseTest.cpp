@@ -22,9 +22,6 @@ namespace vkrt {
 
 namespace {
 
-/// Ctrl-C (the caller holds an InterruptGuard): renders stop between submissions.
-bool interrupted() { return interruptFlag().load(); }
-
 // ---------------------------------------------------------------- references
 
 std::string makeHint(const RegressionCase& c)

@@ -34,9 +34,6 @@ namespace {
 
 constexpr uint32_t kReferenceSeed = 0x5eed5eed; // never a test seed
 
-/// Ctrl-C (runRegression holds an InterruptGuard): renders stop between submissions.
-bool interrupted() { return interruptFlag().load(); }
-
 void writeText(const fs::path& path, const std::string& text)
 {
     writeBytesAtomically(path, text); // every write checked: an unchecked ofstream's last flush can fail silently

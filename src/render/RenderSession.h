@@ -160,4 +160,7 @@ private:
 /// between submissions.
 const std::atomic<bool>& interruptFlag();
 
+/// Whether Ctrl-C has asked the running command to stop (interruptFlag()).
+inline bool interrupted() { return interruptFlag().load(); }
+
 } // namespace vkrt

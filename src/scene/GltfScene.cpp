@@ -13,6 +13,7 @@
 #include "scene/TomlReader.h"
 #include "scene/kinds/Kinds.h"
 #include "texture/TextureAtlas.h"
+#include "util/Error.h"
 #include "util/Hash.h"
 #include "util/Parallel.h"
 
@@ -28,8 +29,6 @@ namespace vkrt {
 namespace {
 
 namespace fs = std::filesystem;
-
-[[noreturn]] void fail(const fs::path& file, const std::string& what) { throw InputError(file.string() + ": " + what); }
 
 glm::dvec3 pointOf(const glm::dmat4& m) { return glm::dvec3(m * glm::dvec4(0, 0, 0, 1)); }
 glm::dvec3 axisOf(const glm::dmat4& m, const glm::dvec3& local) { return glm::dvec3(m * glm::dvec4(local, 0.0)); }
@@ -81,7 +80,7 @@ Camera cameraFrom(const GltfModel& model, const GltfPlaced& placed, const Aabb& 
     const std::optional<glm::dvec3> forward = normalized(axisOf(placed.world, {0, 0, -1}));
     const std::optional<glm::dvec3> up = normalized(axisOf(placed.world, {0, 1, 0}));
     if (!forward || !up || isParallel(*forward, *up))
-        fail(model.file, where + ": its node's transform collapses the camera's axes");
+        failInFile(model.file, where + ": its node's transform collapses the camera's axes");
     // The target sets where the viewer orbits and the default focus: the
     // point of the view axis nearest the scene's centre, at least a little ahead.
     const double ahead = bounds.empty() ? 1.0 : glm::dot(bounds.centre() - c.eye, *forward);
@@ -105,12 +104,13 @@ Camera cameraFrom(const GltfModel& model, const GltfPlaced& placed, const Aabb& 
     const double longer = 640.0;
     const double shorter = aspect >= 1.0 ? longer / aspect : longer * aspect;
     if (!(shorter >= 0.5))
-        fail(model.file, where + ": the aspect ratio " + formatNumber(aspect) + " leaves an image of " +
-                             std::to_string(int(longer)) + " pixels less than one pixel " +
-                             (aspect >= 1.0 ? "high" : "wide") + " (vkrt renders aspect ratios from 1:640 to 640:1)");
+        failInFile(model.file, where + ": the aspect ratio " + formatNumber(aspect) + " leaves an image of " +
+                                   std::to_string(int(longer)) + " pixels less than one pixel " +
+                                   (aspect >= 1.0 ? "high" : "wide") +
+                                   " (vkrt renders aspect ratios from 1:640 to 640:1)");
     c.width = uint32_t(aspect >= 1.0 ? longer : std::lround(shorter));
     c.height = uint32_t(aspect >= 1.0 ? std::lround(shorter) : longer);
-    if (auto problem = cameraProblem(c)) fail(model.file, where + ": " + *problem);
+    if (auto problem = cameraProblem(c)) failInFile(model.file, where + ": " + *problem);
     return c;
 }
 
@@ -144,7 +144,7 @@ void addLight(const GltfModel& model, const GltfPlaced& placed, Scene& scene)
         scene.pointLights.push_back({position, power});
         return;
     }
-    if (!direction) fail(model.file, where + ": its node's transform collapses the light's direction");
+    if (!direction) failInFile(model.file, where + ": its node's transform collapses the light's direction");
     if (light.type == "directional") {
         scene.directionalLights.push_back({*direction, power, 0.0});
         return;
@@ -233,7 +233,7 @@ void importGltf(const fs::path& file, const GltfSceneOptions& options, bool take
     read.scene = options.scene;
     read.variant = options.variant;
     GltfModel model = readGltfModel(file, read);
-    if (model.instances.empty()) fail(file, "its scene places no triangle mesh: nothing to render");
+    if (model.instances.empty()) failInFile(file, "its scene places no triangle mesh: nothing to render");
     for (const std::string& warning : model.warnings) scene.warnings.push_back(file.string() + ": " + warning);
     const Aabb bounds = addMeshes(model, context);
     for (const GltfPlaced& light : model.lights) addLight(model, light, scene);

@@ -39,22 +39,18 @@ double linearToSrgb(double linear)
 namespace {
 
 /// Every message starts with the file, or the name an in-memory image was given.
-[[noreturn]] void fail(const std::string& name, const std::string& reason) { throw InputError(name + ": " + reason); }
-
-[[noreturn]] void fail(const fs::path& file, const std::string& reason) { fail(file.string(), reason); }
-
 std::vector<uint8_t> readBytes(const fs::path& file)
 {
     std::error_code error;
     const fs::file_status status = fs::status(file, error);
-    if (!fs::exists(status)) fail(file, "texture file not found");
-    if (fs::is_directory(status)) fail(file, "is a directory, not an image file");
+    if (!fs::exists(status)) failInFile(file, "texture file not found");
+    if (fs::is_directory(status)) failInFile(file, "is a directory, not an image file");
     // A device or pipe (/dev/zero, a FIFO) could block or never end.
-    if (!fs::is_regular_file(status)) fail(file, "is not a regular file");
+    if (!fs::is_regular_file(status)) failInFile(file, "is not a regular file");
     std::ifstream in(file, std::ios::binary);
-    if (!in) fail(file, "cannot open texture file");
+    if (!in) failInFile(file, "cannot open texture file");
     std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    if (bytes.empty()) fail(file, "empty file, not an image");
+    if (bytes.empty()) failInFile(file, "empty file, not an image");
     return bytes;
 }
 
@@ -66,11 +62,11 @@ bool isExr(std::span<const uint8_t> bytes)
 void checkSize(const std::string& file, uint64_t width, uint64_t height)
 {
     if (width == 0 || height == 0)
-        fail(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) + " pixels");
+        failInFile(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) + " pixels");
     if (width > gpu::TEXTURE_MAX_SIZE || height > gpu::TEXTURE_MAX_SIZE)
-        fail(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) +
-                       " pixels (textures may have at most " + std::to_string(gpu::TEXTURE_MAX_SIZE) +
-                       " pixels a side)");
+        failInFile(file, "unsupported image: " + std::to_string(width) + "x" + std::to_string(height) +
+                             " pixels (textures may have at most " + std::to_string(gpu::TEXTURE_MAX_SIZE) +
+                             " pixels a side)");
 }
 
 std::string stbReason()
@@ -94,9 +90,9 @@ TextureImage exrTexture(const Image& rgb, const std::string& file)
             float* out = texture.pixels.at(x, y);
             for (int c = 0; c < 3; ++c) {
                 if (!std::isfinite(in[c]))
-                    fail(file, "non-finite texel (" + std::string(std::isnan(in[c]) ? "NaN" : "infinity") +
-                                   ") at pixel x=" + std::to_string(x) + ", y=" + std::to_string(y) +
-                                   " (from the top left)");
+                    failInFile(file, "non-finite texel (" + std::string(std::isnan(in[c]) ? "NaN" : "infinity") +
+                                         ") at pixel x=" + std::to_string(x) + ", y=" + std::to_string(y) +
+                                         " (from the top left)");
                 out[c] = in[c];
             }
             out[3] = 1.0f;
@@ -121,7 +117,7 @@ TextureImage decodeExr(std::span<const uint8_t> bytes, const std::string& name)
         const char* const channels[3] = {"R", "G", "B"};
         for (int c = 0; c < 3; ++c) {
             if (!file.header().channels().findChannel(channels[c]))
-                fail(name, "no channel '" + std::string(channels[c]) + "'");
+                failInFile(name, "no channel '" + std::string(channels[c]) + "'");
             char* base =
                 reinterpret_cast<char*>(rgb.rgb.data() + c) -
                 (int64_t(window.min.x) + int64_t(window.min.y) * int64_t(rgb.width)) * int64_t(sizeof(float) * 3);
@@ -133,7 +129,7 @@ TextureImage decodeExr(std::span<const uint8_t> bytes, const std::string& name)
     } catch (const InputError&) {
         throw;
     } catch (const std::exception& e) {
-        fail(name, std::string("not a readable EXR file: ") + e.what());
+        failInFile(name, std::string("not a readable EXR file: ") + e.what());
     }
 }
 
@@ -162,7 +158,7 @@ ImageExtent stbHeader(std::span<const uint8_t> bytes, const std::string& file)
     const auto* data = bytes.data();
     const int length = int(bytes.size());
     int width = 0, height = 0, channels = 0;
-    if (bytes.size() > size_t(INT32_MAX)) fail(file, "unsupported image: larger than 2 GiB");
+    if (bytes.size() > size_t(INT32_MAX)) failInFile(file, "unsupported image: larger than 2 GiB");
     if (!stbi_info_from_memory(data, length, &width, &height, &channels)) {
         // stbi_info tries every format in turn and reports the last one's
         // complaint ("unknown image type"); a decode attempt stops at the
@@ -170,8 +166,8 @@ ImageExtent stbHeader(std::span<const uint8_t> bytes, const std::string& file)
         // (Only a header stb_image cannot parse gets here: no size to believe.)
         StbPixels<stbi_uc> pixels(stbi_load_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
         const std::string reason = pixels ? "its header cannot be read" : stbReason();
-        if (reason == "unknown image type") fail(file, "not an image file (stb_image: " + reason + ")");
-        fail(file, "unsupported or damaged image (stb_image: " + reason + ")");
+        if (reason == "unknown image type") failInFile(file, "not an image file (stb_image: " + reason + ")");
+        failInFile(file, "unsupported or damaged image (stb_image: " + reason + ")");
     }
     checkSize(file, uint64_t(width), uint64_t(height));
     return {uint32_t(width), uint32_t(height)};
@@ -207,16 +203,16 @@ TextureImage decodeStb(std::span<const uint8_t> bytes, const std::string& file, 
     // Four channels requested: grey becomes (g, g, g, 1), grey + alpha (g, g, g, a), RGB gets alpha 1.
     if (stbi_is_hdr_from_memory(data, length)) {
         StbPixels<float> pixels(stbi_loadf_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
-        if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
+        if (!pixels) failInFile(file, "cannot decode image (stb_image: " + stbReason() + ")");
         std::copy_n(pixels.get(), texture.pixels.rgba.size(), texture.pixels.rgba.begin());
     } else if (stbi_is_16_bit_from_memory(data, length)) {
         StbPixels<stbi_us> pixels(stbi_load_16_from_memory(data, length, &width, &height, &channels, 4),
                                   stbi_image_free);
-        if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
+        if (!pixels) failInFile(file, "cannot decode image (stb_image: " + stbReason() + ")");
         decodeChannels(pixels.get(), texture.pixels, 65535.0, linear);
     } else {
         StbPixels<stbi_uc> pixels(stbi_load_from_memory(data, length, &width, &height, &channels, 4), stbi_image_free);
-        if (!pixels) fail(file, "cannot decode image (stb_image: " + stbReason() + ")");
+        if (!pixels) failInFile(file, "cannot decode image (stb_image: " + stbReason() + ")");
         decodeChannels(pixels.get(), texture.pixels, 255.0, linear);
     }
     return texture;
@@ -228,7 +224,7 @@ std::vector<uint8_t> readTextureFile(const fs::path& file) { return readBytes(fi
 
 TextureHeader readTextureHeader(std::span<const uint8_t> bytes, const std::string& name, bool linear)
 {
-    if (bytes.empty()) fail(name, "empty file, not an image");
+    if (bytes.empty()) failInFile(name, "empty file, not an image");
     if (isExr(bytes)) {
         MemoryExrStream stream(bytes, name);
         const ImageExtent extent = extentOf(readCheckedExrHeader(stream, bytes.size(), name));
@@ -251,7 +247,7 @@ TextureImage loadTextureImage(const fs::path& file, bool linear)
 
 TextureImage decodeTextureImage(std::span<const uint8_t> bytes, const std::string& name, bool linear)
 {
-    if (bytes.empty()) fail(name, "empty file, not an image");
+    if (bytes.empty()) failInFile(name, "empty file, not an image");
     if (isExr(bytes)) return decodeExr(bytes, name);         // EXR is linear whatever `linear` says
     if (isRadianceHdr(bytes)) return decodeHdr(bytes, name); // so is HDR
     return decodeStb(bytes, name, linear);

@@ -8,4 +8,6 @@ void failCheck(const char* expression, const char* file, int line)
                         std::to_string(line));
 }
 
+void failInFile(const std::string& file, const std::string& message) { throw InputError(file + ": " + message); }
+
 } // namespace vkrt

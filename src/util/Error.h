@@ -58,6 +58,10 @@ public:
 
 [[noreturn]] void failCheck(const char* expression, const char* file, int line);
 
+/// Throws InputError("file: message"): what a reader says of a file it
+/// cannot use where no line is known (binary formats, JSON documents).
+[[noreturn]] void failInFile(const std::string& file, const std::string& message);
+
 } // namespace vkrt
 
 /// Checks an internal invariant; throws InternalError naming the source line.

@@ -103,6 +103,9 @@ const char* viewerHelp()
            "  H                  this list                 Esc     quit\n";
 }
 
+// In the file's own namespace, as the window types it holds are.
+namespace {
+
 /// All state of one viewer session. Members are declared in creation order.
 class Viewer {
 public:
@@ -163,6 +166,8 @@ private:
     void runScript(const std::vector<ViewerCommand>& commands);
     void runInteractive();
 };
+
+} // namespace
 
 SessionConfig sessionConfig(const ViewOptions& options, const Scene& scene)
 {

@@ -18,8 +18,6 @@ using nlohmann::json;
 namespace vkrt::test {
 namespace {
 
-const std::string kDefaultScene = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/default.toml";
-
 std::string readText(const fs::path& path)
 {
     std::ifstream in(path, std::ios::binary);

@@ -21,8 +21,6 @@ namespace fs = std::filesystem;
 namespace vkrt::test {
 namespace {
 
-const std::string kDefaultScene = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/default.toml";
-
 class NewUserCli : public ::testing::Test {
 protected:
     void SetUp() override

@@ -35,6 +35,9 @@ private:
 /// A fresh, empty directory removed at process exit is not guaranteed: tests use unique names.
 std::filesystem::path freshTempDir(const std::string& name);
 
+/// scenes/default.toml of the source tree: the scene `vkrt render` renders by default.
+inline const std::string kDefaultScene = std::string(VKRT_TEST_SOURCE_DIR) + "/scenes/default.toml";
+
 /// SPIR-V cache directory private to this test process.
 std::filesystem::path testCacheDir();
 
