@@ -239,6 +239,8 @@ float lightSelection(int kind, uint i)
     offer##Type##Samples(r, m, hit, ns, wo, origin, rng);
 
 #ifdef VKRT_ENVIRONMENT_SAMPLING
+bool constantEnvironment() { return (u.flags & RENDER_FLAG_CONSTANT_ENVIRONMENT) != 0u; }
+
 // One direction drawn from the environment map and its light at a surface
 // before visibility, MIS-weighted against BSDF sampling (which finds the same
 // light when a ray escapes: environmentOnEscape) when `bsdfFollows`; false at
@@ -247,6 +249,11 @@ float lightSelection(int kind, uint i)
 // direction (FAR_LIGHT_DISTANCE).
 LightSample sampleEnvironmentLight(Material m, vec3 ns, vec3 wo, vec3 origin, bool bsdfFollows, vec3 rnd)
 {
+    // A constant map is left to BSDF sampling where a BSDF ray follows: its
+    // light samples, uniform over the sphere, only add variance there (a
+    // smooth dielectric in a white map: 70x a sample's variance; docs/performance.md).
+    if (bsdfFollows && constantEnvironment())
+        return LightSample(vec3(0.0), origin);
     float pdf;
     vec3 wi = sampleEnvironment(rnd, pdf);
     vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
@@ -282,7 +289,7 @@ vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf)
 {
     vec3 le = environmentRadiance(dir);
 #ifdef VKRT_ENVIRONMENT_SAMPLING
-    if (!specular)
+    if (!specular && !constantEnvironment())
         le *= powerHeuristic(bsdfPdf, environmentPdf(dir));
 #endif
     return le;

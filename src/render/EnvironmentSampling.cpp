@@ -6,6 +6,18 @@
 
 namespace vkrt {
 
+bool isConstantEnvironment(std::span<const Image> images)
+{
+    const float* first = nullptr;
+    for (const Image& image : images) {
+        for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
+            if (!first) first = &image.rgb[i];
+            else if (!std::equal(first, first + 3, &image.rgb[i])) return false;
+        }
+    }
+    return true;
+}
+
 std::vector<float> environmentCdf(const std::array<Image, 6>& faces)
 {
     const uint32_t n = faces[0].width;
@@ -37,7 +49,6 @@ std::vector<float> environmentCdf(const std::array<Image, 6>& faces)
     cdf.back() = 1.0f;
     return cdf;
 }
-
 
 namespace {
 

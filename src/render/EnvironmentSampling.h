@@ -5,6 +5,7 @@
 #include "io/Image.h"
 
 #include <array>
+#include <span>
 #include <vector>
 
 namespace vkrt {
@@ -14,7 +15,6 @@ namespace vkrt {
 /// solid angle (4 / (N^2 r^3) at its centre). A black environment gets a
 /// uniform distribution (it is never worth sampling, but must stay valid).
 std::vector<float> environmentCdf(const std::array<Image, 6>& faces);
-
 
 /// The lat-long map's sampling distribution (shaders/lib/environment.glsl):
 /// a grid over (s, v), s = u - 0.5 / W (mod 1), so that its lines fall on
@@ -31,6 +31,12 @@ struct LatLongDistribution {
     /// conditional entries from 0 to 1.
     std::vector<float> cdf;
 };
+
+/// Whether every texel of the images has the same RGB (one image: a lat-long
+/// map; six: a cubemap). Such an environment is found by BSDF sampling alone
+/// with less variance than by its light samples, which are uniform over the
+/// sphere (RENDER_FLAG_CONSTANT_ENVIRONMENT, docs/performance.md).
+bool isConstantEnvironment(std::span<const Image> images);
 
 /// 8 Mi cells: a 4096 x 2049 map at full resolution, 32 MiB of CDF.
 constexpr uint64_t kMaxLatLongCells = uint64_t(1) << 23;

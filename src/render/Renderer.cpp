@@ -413,6 +413,7 @@ void Renderer::bindCubemap()
     m_environment.emplace(m_context, faces);
     m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
     m_environmentSizes.cubeSize = faces[0].width;
+    m_environmentSizes.constant = isConstantEnvironment(faces);
     if (m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) {
         m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), kStorage));
         m_kernel.bind(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
@@ -425,6 +426,7 @@ void Renderer::bindLatLongMap()
     m_environment.emplace(m_context, map);
     m_kernel.bind(gpu::BINDING_ENVIRONMENT, m_environment->view(), m_environment->sampler());
     m_environmentSizes.latLongExtent = {map.width, map.height};
+    m_environmentSizes.constant = isConstantEnvironment(std::span(&map, 1));
     if (!m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) return;
     const LatLongDistribution distribution = latLongDistribution(map);
     m_environmentSizes.latLongGrid = {distribution.columns, distribution.rows};
@@ -447,6 +449,7 @@ void Renderer::uploadSceneBuffers()
     m_data.uniforms.environmentExtent = m_environmentSizes.latLongExtent;
     m_data.uniforms.environmentGrid = m_environmentSizes.latLongGrid;
     m_data.uniforms.environmentBlock = m_environmentSizes.latLongBlock;
+    if (m_environmentSizes.constant) m_data.uniforms.flags |= gpu::RENDER_FLAG_CONSTANT_ENVIRONMENT;
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
 #define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \

@@ -148,6 +148,7 @@ private:
         uint32_t cubeSize = 0;
         glm::uvec2 latLongExtent{0}, latLongGrid{0};
         uint32_t latLongBlock = 1;
+        bool constant = false; ///< every texel equal: RENDER_FLAG_CONSTANT_ENVIRONMENT
     } m_environmentSizes;
     uint32_t m_frames = 0;
 

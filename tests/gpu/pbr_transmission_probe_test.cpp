@@ -178,7 +178,9 @@ glm::dvec4 lobeProbabilities(const TransmissionCase& tc, double cosO)
     // Transmission keeps a tenth of its share where Fd(cosO) reaches 1 (past
     // the critical angle, leaving a volume), where tilted microfacets still transmit.
     const double transmitted = below * tc.transmission * std::max(1.0 - fd, 0.1);
-    const double cosine = below * (1.0 - fd) * (1.0 - tc.transmission);
+    // The diffuse weighed by its mean 1 - F(V.H) over its lobe (diffuseMeanHalfCosineFit).
+    const double fdDiffuse = std::min(max3(dielectricFresnel(tc, diffuseMeanHalfCosineFit(cosO))), fd);
+    const double cosine = below * (1.0 - fdDiffuse) * (1.0 - tc.transmission);
     const double total = specular + cosine + transmitted;
     if (!(total > 0.0)) return {coat, 1.0 - coat, 0.0, 0.0};
     return {coat, (1.0 - coat) * specular / total, (1.0 - coat) * cosine / total, (1.0 - coat) * transmitted / total};

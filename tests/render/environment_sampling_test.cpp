@@ -6,6 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <span>
+
 namespace vkrt {
 namespace {
 
@@ -60,6 +64,26 @@ TEST(LatLongDistribution, ABlackMapIsSampledUniformly)
     const LatLongDistribution d = latLongDistribution(Image(4, 3));
     EXPECT_FLOAT_EQ(d.cdf[1], 0.5f);
     EXPECT_FLOAT_EQ(d.cdf[3 + 1], 0.25f);
+}
+
+TEST(ConstantEnvironment, IsOneWhoseTexelsAreAllEqual)
+{
+    Image map(6, 4);
+    for (size_t i = 0; i < map.rgb.size(); i += 3) {
+        map.rgb[i] = 0.25f;
+        map.rgb[i + 1] = 2.0f;
+        map.rgb[i + 2] = 1.0f;
+    }
+    EXPECT_TRUE(isConstantEnvironment(std::span(&map, 1)));
+    map.at(5, 3)[1] = 2.0001f; // the last texel's green alone
+    EXPECT_FALSE(isConstantEnvironment(std::span(&map, 1)));
+
+    std::array<Image, 6> faces;
+    faces.fill(Image(2, 2));
+    for (Image& face : faces) std::fill(face.rgb.begin(), face.rgb.end(), 0.5f);
+    EXPECT_TRUE(isConstantEnvironment(faces));
+    faces[4].rgb[0] = 0.0f; // one face's first red
+    EXPECT_FALSE(isConstantEnvironment(faces));
 }
 
 TEST(LatLongDistribution, LargeMapsGroupCellsIntoBlocks)

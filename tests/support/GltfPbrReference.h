@@ -75,4 +75,15 @@ double sheenDirectionalAlbedoUncached(double mu, double sheenRoughness, int refi
 double charlieD(double cosH, double sheenRoughness);
 double charlieVisibility(double cosV, double cosL, double sheenRoughness);
 
+/// The cosine at which the samplers take the Fresnel that weighs a pbr
+/// material's diffuse lobe when they choose a lobe, where F there is below
+/// F(N.V) (lib/bsdf.glsl's diffuseMeanHalfCosine, docs/scene-format.md): a fit of the cosine whose
+/// (1 - c)^5 is the mean of (1 - V.H)^5 over the cosine lobe's directions,
+/// checked against quadrature by PbrLobeChoice.* (tests/gpu/microfacet_probe_test.cpp).
+inline double diffuseMeanHalfCosineFit(double cosO)
+{
+    const double c = cosO < 0.0 ? 0.0 : (cosO > 1.0 ? 1.0 : cosO);
+    return 0.5147 + c * (0.2320 + 0.0879 * c);
+}
+
 } // namespace vkrt::test
