@@ -241,7 +241,16 @@ float lightSelection(int kind, uint i)
 #ifdef VKRT_ENVIRONMENT_SAMPLING
 bool constantEnvironment() { return (u.flags & RENDER_FLAG_CONSTANT_ENVIRONMENT) != 0u; }
 
-// One direction drawn from the environment map and its light at a surface
+// A constant map's light samples follow the cosine lobe about the shading
+// normal, the map times the cosine, rather than the map's own distribution
+// (uniform over the sphere for it): a diffuse surface in the open then gets
+// the same value from every sample, where uniform directions gave a smooth
+// dielectric 70x a sample's variance, and an occluded one still gets a second
+// visibility sample beside its BSDF ray (docs/performance.md).
+float constantEnvironmentPdf(vec3 ns, vec3 dir) { return max(dot(ns, dir), 0.0) * INV_PI; }
+
+// One direction drawn from the environment map (a constant one: from the
+// cosine lobe about ns, constantEnvironmentPdf) and its light at a surface
 // before visibility, MIS-weighted against BSDF sampling (which finds the same
 // light when a ray escapes: environmentOnEscape) when `bsdfFollows`; false at
 // a vertex no ray leaves (the Whitted integrator's last), where the light
@@ -249,13 +258,14 @@ bool constantEnvironment() { return (u.flags & RENDER_FLAG_CONSTANT_ENVIRONMENT)
 // direction (FAR_LIGHT_DISTANCE).
 LightSample sampleEnvironmentLight(Material m, vec3 ns, vec3 wo, vec3 origin, bool bsdfFollows, vec3 rnd)
 {
-    // A constant map is left to BSDF sampling where a BSDF ray follows: its
-    // light samples, uniform over the sphere, only add variance there (a
-    // smooth dielectric in a white map: 70x a sample's variance; docs/performance.md).
-    if (bsdfFollows && constantEnvironment())
-        return LightSample(vec3(0.0), origin);
     float pdf;
-    vec3 wi = sampleEnvironment(rnd, pdf);
+    vec3 wi;
+    if (constantEnvironment()) {
+        wi = sampleCosineHemisphere(ns, rnd.xy);
+        pdf = constantEnvironmentPdf(ns, wi);
+    } else {
+        wi = sampleEnvironment(rnd, pdf);
+    }
     vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
     float cosI = dot(ns, wi);
     if (pdf <= 0.0 || cosI <= 0.0)
@@ -284,13 +294,15 @@ vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
 
 // Environment radiance found by a ray that escaped after a scattering of
 // solid-angle density bsdfPdf (`specular`: a delta event, or the camera),
-// MIS-weighted when the environment is also sampled directly.
-vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf)
+// MIS-weighted when the environment is also sampled directly; cosinePdf is
+// the direction's density in the cosine lobe about the scattering vertex's
+// shading normal (constantEnvironmentPdf), how a constant map is sampled.
+vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf, float cosinePdf)
 {
     vec3 le = environmentRadiance(dir);
 #ifdef VKRT_ENVIRONMENT_SAMPLING
-    if (!specular && !constantEnvironment())
-        le *= powerHeuristic(bsdfPdf, environmentPdf(dir));
+    if (!specular)
+        le *= powerHeuristic(bsdfPdf, constantEnvironment() ? cosinePdf : environmentPdf(dir));
 #endif
     return le;
 }

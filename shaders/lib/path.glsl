@@ -19,6 +19,7 @@ struct PathVertexState {
     MediumStack media;     // the dielectrics the ray travels in
     bool specular;         // the last scattering was a delta event (or the camera)
     float bsdfPdf;         // solid-angle pdf of the last BSDF sample
+    float cosinePdf;       // ... and its density in the cosine lobe about that vertex's shading normal
 };
 
 vec3 emitterOnHit(PathVertexState path, Ray ray, SurfaceHit hit)
@@ -63,7 +64,7 @@ struct PathTracer {
 PathTracer startPath(Ray cameraRay)
 {
     PathTracer p;
-    p.path = PathVertexState(vec3(0.0), vec3(1.0), cameraMedia(), true, 0.0);
+    p.path = PathVertexState(vec3(0.0), vec3(1.0), cameraMedia(), true, 0.0, 0.0);
     p.ray = cameraRay;
     p.depth = 1u;
 #ifdef VKRT_HAS_TEXTURES
@@ -119,7 +120,7 @@ bool scatterAtHit(inout PathTracer p, bool found, SurfaceHit hit, inout Sampler 
     if (missed) {
         aovEnd();
         p.path.radiance += sampleWeight(p.path.throughput, p.path.media) *
-                           (environmentOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf) +
+                           (environmentOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf, p.path.cosinePdf) +
                             directionalOnEscape(p.ray.dir, p.path.specular, p.path.bsdfPdf));
         return false;
     }
@@ -158,6 +159,7 @@ bool scatterAtHit(inout PathTracer p, bool found, SurfaceHit hit, inout Sampler 
     p.path.throughput *= s.weight;
     p.path.specular = s.specular;
     p.path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
+    p.path.cosinePdf = max(dot(ns, s.dir), 0.0) * INV_PI;
     if (s.transmitted && boundsMedium(m))
         p.path.media = refractThrough(p.path.media, hit);
     if (!survivesRoulette(p.path, p.depth, u4.w))

@@ -21,6 +21,7 @@ struct PathState {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     bool specular;     // the last scattering was a delta event (or the camera)
     float bsdfPdf;     // solid-angle pdf of the last BSDF sample
+    float cosinePdf;   // ... and its density in the cosine lobe about that vertex's shading normal
 #endif
 };
 
@@ -39,7 +40,7 @@ void addEmitterRadiance(inout PathState path, Ray ray, SurfaceHit hit)
 vec3 traceWhitted(Ray ray, inout Sampler rng)
 {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
-    PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true, true, 0.0);
+    PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true, true, 0.0, 0.0);
 #else
     PathState path = PathState(vec3(0.0), vec3(1.0), cameraMedia(), true);
 #endif
@@ -56,7 +57,8 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
             aovEnd();
 #ifdef VKRT_ENVIRONMENT_SAMPLING
             // The map is also sampled at every vertex: MIS as in the path integrator.
-            path.radiance += path.throughput * environmentOnEscape(ray.dir, path.specular, path.bsdfPdf);
+            path.radiance +=
+                path.throughput * environmentOnEscape(ray.dir, path.specular, path.bsdfPdf, path.cosinePdf);
 #else
             path.radiance += path.throughput * environmentRadiance(ray.dir);
 #endif
@@ -104,6 +106,7 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
 #ifdef VKRT_ENVIRONMENT_SAMPLING
         path.specular = s.specular;
         path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
+        path.cosinePdf = max(dot(ns, s.dir), 0.0) * INV_PI;
 #endif
         if (s.transmitted && boundsMedium(m))
             path.media = crossInterface(path.media, hit.material, hit.front);

@@ -317,9 +317,9 @@ VKRT_CONSTANT(uint, TOP_REF_MAX_INDEX, 16777215)
 VKRT_CONSTANT(uint, RENDER_FLAG_JITTER, 1)
 // The camera projects orthographically (kernels with VKRT_ORTHOGRAPHIC, lib/camera.glsl).
 VKRT_CONSTANT(uint, RENDER_FLAG_ORTHOGRAPHIC, 2)
-// The environment's texels are all equal (render/EnvironmentSampling.h): the
-// path integrator finds its light by BSDF sampling alone, without light
-// samples of it or MIS weights on escape (lib/lights.glsl).
+// The environment's texels are all equal (render/EnvironmentSampling.h): its
+// light samples follow the cosine lobe about the shading normal instead of
+// the map's distribution (lib/lights.glsl: constantEnvironmentPdf).
 VKRT_CONSTANT(uint, RENDER_FLAG_CONSTANT_ENVIRONMENT, 4)
 
 /// Per-render constants. Camera ray for pixel coordinate (x, y) in [0,w]x[0,h]:

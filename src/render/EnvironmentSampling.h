@@ -33,9 +33,9 @@ struct LatLongDistribution {
 };
 
 /// Whether every texel of the images has the same RGB (one image: a lat-long
-/// map; six: a cubemap). Such an environment is found by BSDF sampling alone
-/// with less variance than by its light samples, which are uniform over the
-/// sphere (RENDER_FLAG_CONSTANT_ENVIRONMENT, docs/performance.md).
+/// map; six: a cubemap). Such an environment's light samples follow the
+/// cosine lobe about the shading normal rather than its own distribution,
+/// uniform over the sphere (RENDER_FLAG_CONSTANT_ENVIRONMENT, docs/performance.md).
 bool isConstantEnvironment(std::span<const Image> images);
 
 /// 8 Mi cells: a 4096 x 2049 map at full resolution, 32 MiB of CDF.
