@@ -447,9 +447,10 @@ VKRT_ABSENT_MATERIAL(Plastic)
 // a quadratic fit, within 0.013, of its NumPy quadrature over N.V in [0, 1].
 // Lobe probabilities weigh the diffuse with F at this cosine (or at N.V
 // where that is smaller), so a smooth dielectric seen at grazing is not
-// sampled as if it were mostly mirror: a sample's variance, smooth and pink
-// under a constant map, is 4x lower at N.V = 0.3, 20x at 0.15 and 110x at
-// 0.05 (docs/performance.md).
+// sampled as if it were mostly mirror: the variance of a smooth pink
+// dielectric's BSDF-sample weights is 4x lower at N.V = 0.3, 20x at 0.15 and
+// 110x at 0.05 (a NumPy model of this sampler; the probe test
+// MicrofacetProbe.ASmoothDielectricSeenAtGrazingHasSteadyWeights measures it).
 float diffuseMeanHalfCosine(float cosO)
 {
     float c = clamp(cosO, 0.0, 1.0);
