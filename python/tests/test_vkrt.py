@@ -98,6 +98,10 @@ def test_bad_arguments_raise_value_errors_naming_them(scene, arguments, words):
     (lambda s: vkrt.render(s, spp=True, **SMALL), "spp: expected an integer, got bool"),
     (lambda s: vkrt.render(s, time_budget="1", **SMALL), "time_budget: expected a number or None"),
     (lambda s: next(vkrt.progressive(s, batches="3", **SMALL)), "batches: expected an integer, got str"),
+    # bool('no') is True: a flag takes True or False alone.
+    (lambda s: vkrt.render(s, variance="no", **SMALL), "variance: expected True or False, got str 'no'"),
+    (lambda s: vkrt.render(s, variance=0, **SMALL), "variance: expected True or False, got int 0"),
+    (lambda s: next(vkrt.progressive(s, variance=None, **SMALL)), "variance: expected True or False, got NoneType"),
 ])
 def test_wrong_types_raise_type_errors_naming_the_argument(scene, call, words):
     with pytest.raises(TypeError) as caught:
@@ -123,6 +127,25 @@ def test_a_result_is_not_saved_over_the_scene_it_rendered(tmp_path):
     with pytest.raises(Exception, match="the scene file"):
         result.save(scene_file)
     assert scene_file.read_bytes() == before
+
+
+def test_a_result_is_not_saved_over_a_buffer_the_scenes_gltf_read(tmp_path):
+    # The buffer has an image's name: save() through a link to it overwrote it before.
+    import struct
+    (tmp_path / "x.exr").write_bytes(struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0))
+    (tmp_path / "model.gltf").write_text(
+        '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],'
+        ' "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],'
+        ' "buffers": [{"uri": "x.exr", "byteLength": 36}], "bufferViews": [{"buffer": 0, "byteLength": 36}],'
+        ' "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",'
+        ' "min": [0, 0, 0], "max": [1, 1, 0]}]}')
+    (tmp_path / "link.exr").symlink_to(tmp_path / "x.exr")
+    before = (tmp_path / "x.exr").read_bytes()
+    result = vkrt.render(vkrt.Scene.load(tmp_path / "model.gltf"), spp=1, **SMALL)
+    for path in (tmp_path / "x.exr", tmp_path / "link.exr"):
+        with pytest.raises(Exception, match="a glTF file the scene imports, or a buffer it reads"):
+            result.save(path)
+    assert (tmp_path / "x.exr").read_bytes() == before
 
 
 def test_a_material_is_checked_where_the_scene_uses_it():

@@ -240,6 +240,14 @@ def _real(name, value):
     return float(value)
 
 
+def _flag(name, value):
+    """`value` as a bool: TypeError for anything else. bool() would take any
+    object, so variance='no' (a non-empty string) would mean True."""
+    if isinstance(value, bool) or type(value).__name__ == "bool_":  # NumPy's bool too
+        return bool(value)
+    raise TypeError(f"{name}: expected True or False, got {type(value).__name__} {value!r}")
+
+
 def _text(name, value, allowed=None):
     if not isinstance(value, str):
         what = f"one of {', '.join(repr(a) for a in allowed)}" if allowed else "a string"
@@ -278,7 +286,7 @@ def _session(scene, spp, width, height, seed, sampler, integrator, device, time_
     device = _text("device", device)
     accel = _text("accel", accel, ("auto", "own", "driver"))
     return _vkrt.Session(scene._native, spp, width, height, seed, sampler, integrator, device,
-                         _real("time_budget", time_budget), _real("target_error", target_error), bool(variance),
+                         _real("time_budget", time_budget), _real("target_error", target_error), _flag("variance", variance),
                          _aov_list(aovs), accel)
 
 

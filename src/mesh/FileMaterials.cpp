@@ -1,4 +1,5 @@
 #include "mesh/FileMaterials.h"
+#include "mesh/GltfSchema.h"
 
 #include "mesh/GltfJson.h"
 #include "util/Error.h"
@@ -13,6 +14,8 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string_view>
@@ -92,6 +95,41 @@ std::optional<size_t> findExcessiveNesting(std::string_view text, size_t limit)
     return std::nullopt;
 }
 
+/// The first key a JSON text has twice in one object, found by a SAX pass
+/// in time linear in the text. (nlohmann's parser with a callback, used for
+/// this before, scans an array's elements at the end of each object in it:
+/// 300,000 empty nodes took 26 s.)
+struct DuplicateKeyFinder : nlohmann::json_sax<json> {
+    std::vector<std::set<std::string>> keys; ///< one set per open object
+    std::string duplicate;
+
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t) override { return true; }
+    bool number_unsigned(number_unsigned_t) override { return true; }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool start_object(std::size_t) override
+    {
+        keys.emplace_back();
+        return true;
+    }
+    bool key(string_t& name) override
+    {
+        if (!keys.back().insert(name).second && duplicate.empty()) duplicate = name;
+        return true;
+    }
+    bool end_object() override
+    {
+        keys.pop_back();
+        return true;
+    }
+    bool start_array(std::size_t) override { return true; }
+    bool end_array() override { return true; }
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
+};
+
 /// The file's JSON. Duplicate keys are refused: parsers differ in which one
 /// they keep (the first or the last), and a file that means two things to
 /// two readers is no file to trust.
@@ -100,20 +138,13 @@ json parseJsonText(const fs::path& file, const std::string& text, bool mustParse
     if (const auto offset = findExcessiveNesting(text, kMaxGltfJsonNesting))
         failInFile(file, "the glTF JSON nests arrays and objects more than " + std::to_string(kMaxGltfJsonNesting) +
                              " levels deep (at byte " + std::to_string(*offset) + " of the JSON)");
-    std::vector<std::set<std::string>> keys;
-    std::string duplicate;
-    const json::parser_callback_t noteKeys = [&](int, json::parse_event_t event, json& parsed) {
-        if (event == json::parse_event_t::object_start) keys.emplace_back();
-        if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
-        if (event == json::parse_event_t::key && !keys.empty() && parsed.is_string() &&
-            !keys.back().insert(parsed.get<std::string>()).second && duplicate.empty())
-            duplicate = parsed.get<std::string>();
-        return true;
-    };
-    json doc = json::parse(text, noteKeys, /*allow_exceptions=*/false);
+    json doc = json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (!mustParse && doc.is_discarded()) return doc;
     if (doc.is_discarded() || !doc.is_object()) failInFile(file, "the glTF JSON cannot be parsed");
-    if (!duplicate.empty()) failInFile(file, "the glTF JSON has the key '" + duplicate + "' twice in one object");
+    DuplicateKeyFinder finder;
+    json::sax_parse(text, &finder);
+    if (!finder.duplicate.empty())
+        failInFile(file, "the glTF JSON has the key '" + finder.duplicate + "' twice in one object");
     return doc;
 }
 
@@ -182,9 +213,18 @@ std::string readGltfJson(const fs::path& file)
         return value;
     };
     constexpr uint32_t kJsonChunk = 0x4E4F534A; // "JSON", little endian
+    // glTF 2.0, 4.4: version 2; the header's length is the file's; chunks start and end 4-byte aligned.
+    if (bytes.size() < 12 || word(4) != 2)
+        failInFile(file, "a binary glTF of container version " + std::to_string(word(4)) + ": vkrt reads version 2");
+    if (word(8) != bytes.size())
+        failInFile(file, "the binary glTF's header gives its length as " + std::to_string(word(8)) +
+                             " bytes, but the file has " + std::to_string(bytes.size()));
     const uint64_t length = word(12);
     if (bytes.size() < 20 || word(16) != kJsonChunk || 20 + length > bytes.size())
         failInFile(file, "the binary glTF's first chunk is not a whole JSON chunk");
+    if (length % 4 != 0)
+        failInFile(file, "the binary glTF's JSON chunk is " + std::to_string(length) +
+                             " bytes long, not a multiple of 4 (glTF pads it with spaces)");
     return bytes.substr(20, size_t(length));
 }
 
@@ -531,6 +571,7 @@ void checkFileReferences(const fs::path& file, const json& doc, const ReferenceP
 json checkedGltfDocument(const fs::path& file, const ReferencePolicy& references)
 {
     json doc = parseJson(file);
+    checkGltfSchema(file, doc); // first: the checks below read wrongly typed fields as absent
     checkBufferBounds(file, doc);
     checkInstancing(file, doc, checkNodeHierarchy(file, doc));
     checkAccessorUse(file, doc);
@@ -630,12 +671,18 @@ TextureWrap wrapMode(uint32_t mode)
     return TextureWrap::Repeat; // 10497, glTF's default
 }
 
+/// Each embedded image's bytes, read once per file and shared by every
+/// texture slot that names the image (15,000 slots naming one 197 KB PNG
+/// made 15,000 copies, 2.9 GB, before).
+using EmbeddedImages = std::map<uint32_t, std::shared_ptr<const std::vector<uint8_t>>>;
+
 struct MaterialReader {
     const json& doc;
     const fs::path& file;
     const ReferencePolicy& references;
     const GltfViewBytes& viewBytes;
     std::string materialName; ///< for messages
+    EmbeddedImages& embeddedImages;
 
     [[noreturn]] void malformed(const std::string& what) const
     {
@@ -733,20 +780,26 @@ struct MaterialReader {
             texture.name = texture.file.string();
             return;
         }
-        const std::string what = file.string() + " (embedded image " + std::to_string(index) + ")";
+        texture.name = file.string() + " (embedded image " + std::to_string(index) + ")";
+        std::shared_ptr<const std::vector<uint8_t>>& bytes = embeddedImages[index];
+        if (!bytes) bytes = std::make_shared<const std::vector<uint8_t>>(embeddedBytes(*image, uri, index));
+        texture.embedded = bytes;
+    }
+
+    /// An embedded image's bytes: a base64 data: URI's, or its bufferView's.
+    std::vector<uint8_t> embeddedBytes(const json& image, const json* uri, uint32_t index) const
+    {
         if (uri && uri->is_string()) {
             const std::string text = uri->get<std::string>();
             const size_t comma = text.find(',');
             if (comma == std::string::npos || comma < 7 || text.compare(comma - 7, 7, ";base64") != 0)
                 malformed("image " + std::to_string(index) + "'s data: URI is not base64");
-            texture.embedded = decodeBase64(std::string_view(text).substr(comma + 1));
-            if (texture.embedded.empty()) malformed("image " + std::to_string(index) + "'s base64 data is malformed");
-        } else if (const auto view = uintMember(*image, "bufferView")) {
-            texture.embedded = viewBytes(*view, "images[" + std::to_string(index) + "]");
-        } else {
-            malformed("image " + std::to_string(index) + " has neither a uri nor a bufferView");
+            std::vector<uint8_t> decoded = decodeBase64(std::string_view(text).substr(comma + 1));
+            if (decoded.empty()) malformed("image " + std::to_string(index) + "'s base64 data is malformed");
+            return decoded;
         }
-        texture.name = what;
+        if (const auto view = uintMember(image, "bufferView")) return viewBytes(*view, "images[" + std::to_string(index) + "]");
+        malformed("image " + std::to_string(index) + " has neither a uri nor a bufferView");
     }
 
     std::optional<FileTexture> texture(const json* info, const char* slot) const
@@ -792,8 +845,9 @@ struct MaterialReader {
         const json* normal = member(m, "normalTexture");
         out.normalTexture = texture(normal, "normalTexture");
         if (const json* scale = normal ? member(*normal, "scale") : nullptr) {
-            if (!scale->is_number() || !std::isfinite(scale->get<double>()))
-                malformed("normalTexture.scale must be a finite number");
+            // The kernel scales the map's X and Y in float32: 1e39 became infinite there (no normal map at all).
+            if (!scale->is_number() || !(std::abs(scale->get<double>()) <= kMaxKernelMagnitude))
+                malformed("normalTexture.scale must be a number of magnitude at most 1e18");
             out.normalScale = float(scale->get<double>());
         }
         out.emissiveFactor = glm::vec3(colour(&m, "emissiveFactor", glm::vec4(0.0f), 3, true));
@@ -868,8 +922,11 @@ struct MaterialReader {
             out.clearcoatRoughnessFactor = unitFactor(e, "clearcoatRoughnessFactor", out.clearcoatRoughnessFactor);
             out.clearcoatRoughnessTexture = layerTexture(*e, "clearcoatRoughnessTexture");
             out.clearcoatNormalTexture = layerTexture(*e, "clearcoatNormalTexture");
-            if (const json* normal = member(*e, "clearcoatNormalTexture"))
+            if (const json* normal = member(*e, "clearcoatNormalTexture")) {
                 out.clearcoatNormalScale = finiteNumber(*normal, "scale", "clearcoatNormalTexture", 1.0f);
+                if (!(std::abs(out.clearcoatNormalScale) <= kMaxKernelMagnitude))
+                    malformed("clearcoatNormalTexture.scale must be a number of magnitude at most 1e18");
+            }
         }
         if (const json* e = member(extensions, "KHR_materials_anisotropy")) {
             out.anisotropyStrength = unitFactor(e, "anisotropyStrength", out.anisotropyStrength);
@@ -932,10 +989,11 @@ std::vector<FileMaterial> readGltfMaterials(const json& doc, const fs::path& fil
                                             const GltfViewBytes& viewBytes)
 {
     std::vector<FileMaterial> materials;
+    EmbeddedImages embeddedImages;
     if (const json* list = arrayMember(doc, "materials")) {
         for (size_t i = 0; i < list->size(); ++i) {
             const json& source = (*list)[i];
-            const MaterialReader reader{doc, file, references, viewBytes, describeMaterial(i, source)};
+            const MaterialReader reader{doc, file, references, viewBytes, describeMaterial(i, source), embeddedImages};
             FileMaterial material = reader.convert(source);
             material.fileIndex = int(i);
             material.unsupported = materialProblems(source);

@@ -106,6 +106,8 @@ struct GltfModel {
     std::string sceneName;      ///< its name, "" when it has none
     /// What vkrt cannot honour, each once per file, in order (phrases without the file's name).
     std::vector<std::string> warnings;
+    /// The buffer files it read (not data: URIs nor the .glb's own chunk).
+    std::vector<std::filesystem::path> referencedFiles;
 };
 
 /// Reads `file` (.gltf or .glb). Throws InputError naming the file and the

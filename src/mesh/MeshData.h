@@ -16,6 +16,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct MeshData {
     std::vector<uint32_t> triangleMaterials;
     /// The file's materials that its triangles use (glTF 2.0 only; OBJ and PLY leave it empty).
     std::vector<FileMaterial> materials;
+    /// The files besides the mesh file that loading it read (glTF buffers, an
+    /// OBJ's material library): inputs that no output may replace.
+    std::vector<std::filesystem::path> referencedFiles;
 };
 
 /// The texture coordinates the tangents belong to (MeshData::tangentUvSet).

@@ -230,7 +230,7 @@ void checkReferences(const fs::path& file, const std::string& extension, const R
 }
 
 const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, const std::string& extension,
-                           const ReferencePolicy& policy)
+                           const ReferencePolicy& policy, std::vector<fs::path>& opened)
 {
     // Points and lines are dropped by SortByPType; an all-lines file then has no meshes, reported below.
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -245,6 +245,7 @@ const aiScene* importScene(Assimp::Importer& importer, const fs::path& file, con
         failImport(file, extension, error.what());
     }
     checkReferences(file, extension, policy, log);
+    opened = log.opened;
     if (scene) return scene;
     const std::string reason = importer.GetErrorString();
     if (reason.find("No meshes remaining") != std::string::npos ||
@@ -463,9 +464,11 @@ MeshData loadMeshFile(const fs::path& file, const MeshLoadOptions& options)
     }
     const ReferencePolicy policy(file, options);
     Assimp::Importer importer;
-    const aiScene* scene = importScene(importer, file, extension, policy);
+    std::vector<fs::path> opened;
+    const aiScene* scene = importScene(importer, file, extension, policy, opened);
     MeshData mesh = convertScene(*scene, MeshCheck{file, extension});
     if (extension == ".obj") joinIdenticalCorners(mesh);
+    mesh.referencedFiles = std::move(opened);
     return mesh;
 }
 

@@ -72,6 +72,7 @@ public:
         }
         Assimp::IOStream* stream = DefaultIOSystem::Open(target.c_str(), mode);
         if (!stream) noteMissing(file, "cannot be opened (" + std::string(std::strerror(errno)) + ")");
+        else m_log.opened.push_back(target);
         return stream;
     }
 

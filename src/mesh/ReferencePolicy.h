@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace Assimp {
 class IOSystem;
@@ -59,6 +60,7 @@ struct ReferenceLog {
     std::optional<std::string> refused; ///< the first path the policy refused to open
     std::optional<std::string> missing; ///< the first path that could not be opened
     std::string missingReason;          ///< why ("no such file", "is a directory", ...)
+    std::vector<std::filesystem::path> opened; ///< every file besides the mesh file that was opened
 };
 
 /// A new assimp file system (Importer::SetIOHandler takes ownership) that

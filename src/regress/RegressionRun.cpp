@@ -8,6 +8,8 @@
 #include "regress/Expectations.h"
 #include "regress/Reports.h"
 #include "regress/Suite.h"
+#include "io/OutputPaths.h"
+#include "scene/SceneInputs.h"
 #include "render/RenderSession.h"
 #include "util/ChildProcess.h"
 #include "util/Error.h"
@@ -115,9 +117,26 @@ bool updateReference(const VulkanContext& context, const RegressionSuite& suite,
     return true;
 }
 
+/// The files --update writes for a case: none may be one its scene reads
+/// (a texture kept in the reference's own folder), nor the scene or suite.
+void refuseReferencesThatAreInputs(const RegressionSuite& suite, const RegressionCase& c)
+{
+    const Scene scene = caseScene(suite, c);
+    std::vector<NamedFile> inputs = filesTheSceneRead(scene);
+    inputs.push_back({"the scene file of case " + c.name, c.scene});
+    inputs.push_back({"the suite file", suite.path});
+    const std::string role = "the reference of case " + c.name;
+    refuseOverlappingFiles(inputs, {{role + " (mean)", c.referenceDir / "mean.exr"},
+                                    {role + " (variance)", c.referenceDir / "variance.exr"},
+                                    {role + " (its README)", c.referenceDir / "README.md"}});
+}
+
 Outcome updateReferences(const VulkanContext& context, const RegressionSuite& suite,
                          const std::vector<RegressionCase>& cases, const RegressOptions& options)
 {
+    // Every case is checked before the first is rendered: a refusal leaves every reference as it was.
+    for (const RegressionCase& c : cases)
+        if (c.source != ReferenceSource::Mitsuba) refuseReferencesThatAreInputs(suite, c);
     std::set<fs::path> updated;
     for (const RegressionCase& c : cases) {
         if (c.source == ReferenceSource::Mitsuba) {

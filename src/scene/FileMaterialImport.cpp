@@ -17,7 +17,7 @@ uint32_t addFileTexture(const FileTexture& texture, bool linear, const std::file
     try {
         // Embedded bytes go through the same header check and budget as a
         // file, before they are decoded: a small .glb may hold a PNG bomb.
-        if (!texture.embedded.empty())
+        if (texture.embedded)
             return atlas.addEncoded(texture.embedded, texture.name, linear, texture.wrapU, texture.wrapV,
                                     texture.filter);
         return atlas.add(TextureRequest{texture.file, linear, texture.wrapU, texture.wrapV, texture.filter});

@@ -233,6 +233,8 @@ void importGltf(const fs::path& file, const GltfSceneOptions& options, bool take
     read.scene = options.scene;
     read.variant = options.variant;
     GltfModel model = readGltfModel(file, read);
+    scene.importedFiles.push_back(file);
+    scene.importedFiles.insert(scene.importedFiles.end(), model.referencedFiles.begin(), model.referencedFiles.end());
     if (model.instances.empty()) failInFile(file, "its scene places no triangle mesh: nothing to render");
     for (const std::string& warning : model.warnings) scene.warnings.push_back(file.string() + ": " + warning);
     const Aabb bounds = addMeshes(model, context);

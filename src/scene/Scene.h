@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -407,6 +408,9 @@ struct Background {
 
 struct Scene {
     std::string path;      ///< the file it came from ("<string>" for text)
+    /// The glTF files it imports (`[import] gltf`) and the buffer files they
+    /// read: inputs that no output may replace (SceneInputs.h).
+    std::vector<std::filesystem::path> importedFiles;
     uint64_t fileHash = 0; ///< FNV-1a 64 of the file's bytes
     RenderSettings render;
     Camera camera;

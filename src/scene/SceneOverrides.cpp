@@ -49,8 +49,9 @@ std::optional<std::string> lensProblem(const Camera& camera)
     if (camera.thinLens() && !(camera.resolvedFocusDistance() <= kMaxKernelMagnitude))
         return "focus_distance: the distance from eye to target, " + formatNumber(camera.resolvedFocusDistance()) +
                ", is too far to focus at" + range + "; set focus_distance";
-    if (!(camera.orthographicHeight >= 0 && std::isfinite(camera.orthographicHeight)))
-        return "orthographic height: must be finite and at least 0, got " + formatNumber(camera.orthographicHeight);
+    if (!(camera.orthographicHeight >= 0 && camera.orthographicHeight <= kMaxKernelMagnitude))
+        return "orthographic height: must be between 0 and " + formatNumber(kMaxKernelMagnitude) + ", got " +
+               formatNumber(camera.orthographicHeight) + range;
     if (camera.orthographic() && camera.thinLens())
         return std::string("aperture_radius: an orthographic camera has no lens");
     return std::nullopt;

@@ -114,10 +114,10 @@ void TextureAtlas::reserveTexels(const TextureHeader& header, const std::string&
     m_texels += header.texels();
 }
 
-uint32_t TextureAtlas::addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
-                                  const SourceLocation& where)
+uint32_t TextureAtlas::addDecoded(std::shared_ptr<const std::vector<uint8_t>> bytes, const std::string& name,
+                                  bool linear, const SourceLocation& where)
 {
-    const TextureHeader header = readTextureHeader(bytes, name, linear);
+    const TextureHeader header = readTextureHeader(*bytes, name, linear);
     reserveTexels(header, name);
     // Decoded later, with the scene's other images, in parallel (settle).
     StoredImage stored;
@@ -125,7 +125,7 @@ uint32_t TextureAtlas::addDecoded(std::span<const uint8_t> bytes, const std::str
     stored.width = header.width;
     stored.height = header.height;
     m_images.push_back(std::move(stored));
-    m_pending.push_back({m_images.size() - 1, std::vector<uint8_t>(bytes.begin(), bytes.end()), linear, where});
+    m_pending.push_back({m_images.size() - 1, std::move(bytes), linear, where});
     return uint32_t(m_images.size() - 1);
 }
 
@@ -184,7 +184,7 @@ void TextureAtlas::settle() const
             for (size_t i; (i = next++) < m_pending.size();) {
                 const PendingImage& job = m_pending[i];
                 const StoredImage& image = m_images[job.image];
-                outcomes[i] = decodeThroughCache(cache, job.bytes, image.name, job.linear, image.width, image.height);
+                outcomes[i] = decodeThroughCache(cache, *job.bytes, image.name, job.linear, image.width, image.height);
             }
         };
         const size_t workers = std::min<size_t>(m_pending.size(), std::max(1u, std::thread::hardware_concurrency()));
@@ -192,6 +192,8 @@ void TextureAtlas::settle() const
         for (size_t w = 1; w < workers; ++w) threads.emplace_back(work);
         work();
         for (std::thread& thread : threads) thread.join();
+        if (std::any_of(outcomes.begin(), outcomes.end(), [](const DecodeOutcome& o) { return !o.fromCache; }))
+            cache.evictBeyondLimit();
         std::vector<PendingImage> pending = std::move(m_pending);
         m_pending.clear();
         m_load.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -371,7 +373,8 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
     if (found == m_imageByFile.end()) {
         uint32_t image = 0;
         try {
-            image = addDecoded(readTextureFile(request.file), request.file.string(), request.linear, where);
+            image = addDecoded(std::make_shared<const std::vector<uint8_t>>(readTextureFile(request.file)),
+                               request.file.string(), request.linear, where);
         } catch (const SceneError&) {
             throw;
         } catch (const InputError& error) {
@@ -383,10 +386,16 @@ uint32_t TextureAtlas::add(const TextureRequest& request, const SourceLocation& 
     return addRecord({found->second, request.wrapU, request.wrapV, request.filter});
 }
 
-uint32_t TextureAtlas::addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
-                                  TextureWrap wrapU, TextureWrap wrapV, const TextureFilter& filter)
+uint32_t TextureAtlas::addEncoded(const std::shared_ptr<const std::vector<uint8_t>>& bytes, const std::string& name,
+                                  bool linear, TextureWrap wrapU, TextureWrap wrapV, const TextureFilter& filter)
 {
-    return addRecord({addDecoded(bytes, name, linear), wrapU, wrapV, filter});
+    VKRT_CHECK(bytes != nullptr);
+    auto& [kept, image] = m_imageByBytes[{bytes.get(), linear}];
+    if (kept.lock() != bytes) {
+        image = addDecoded(bytes, name, linear);
+        kept = bytes;
+    }
+    return addRecord({image, wrapU, wrapV, filter});
 }
 
 uint32_t TextureAtlas::add(const TextureImage& image, const std::string& name, TextureWrap wrapU, TextureWrap wrapV,

@@ -15,6 +15,7 @@
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -124,7 +125,7 @@ public:
 
     /// An image file's bytes already in memory (embedded in a .glb, a data:
     /// URI): its header checked against the budget before it is decoded.
-    uint32_t addEncoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
+    uint32_t addEncoded(const std::shared_ptr<const std::vector<uint8_t>>& bytes, const std::string& name, bool linear,
                         TextureWrap wrapU = TextureWrap::Repeat, TextureWrap wrapV = TextureWrap::Repeat,
                         const TextureFilter& filter = {});
 
@@ -182,7 +183,7 @@ private:
     /// A file's bytes waiting for settle() to decode them into m_images[image].
     struct PendingImage {
         size_t image = 0;
-        std::vector<uint8_t> bytes;
+        std::shared_ptr<const std::vector<uint8_t>> bytes;
         bool linear = false;
         SourceLocation where; ///< the scene's `texture` key, for errors (may be empty)
     };
@@ -190,7 +191,7 @@ private:
     /// Counts a texture of `header`'s size against the budget, or refuses it naming `name`.
     void reserveTexels(const TextureHeader& header, const std::string& name);
     /// Header check and budget now; decoding and storing at settle().
-    uint32_t addDecoded(std::span<const uint8_t> bytes, const std::string& name, bool linear,
+    uint32_t addDecoded(std::shared_ptr<const std::vector<uint8_t>> bytes, const std::string& name, bool linear,
                         const SourceLocation& where = {});
     /// A decode failure of a pending image, as a SceneError at `where` when there is one.
     [[noreturn]] static void rethrowAt(const std::exception_ptr& error, const SourceLocation& where);
@@ -212,6 +213,12 @@ private:
     mutable TextureLoadStats m_load;
     std::vector<RecordKey> m_records;
     std::map<std::pair<std::string, bool>, uint32_t> m_imageByFile; ///< (canonical path, linear)
+    /// Embedded images by (their bytes' address, linear): a file's image named
+    /// by many slots shares one set of bytes (FileTexture::embedded), and is
+    /// decoded and counted against the budget once. The weak pointer tells a
+    /// freed address that was reused from the same bytes.
+    std::map<std::pair<const void*, bool>, std::pair<std::weak_ptr<const std::vector<uint8_t>>, uint32_t>>
+        m_imageByBytes;
     mutable uint64_t m_words = 0;
     uint64_t m_maxTexels = kMaxSceneTexels;
     uint64_t m_texels = 0; ///< level 0, of every image added

@@ -111,7 +111,6 @@ void TextureCache::store(const std::string& key, const EncodedTexture& texture) 
     }
     fs::rename(temporary, pathFor(key), error);
     if (error) fs::remove(temporary, error);
-    evictBeyondLimit();
 }
 
 void TextureCache::evictBeyondLimit() const

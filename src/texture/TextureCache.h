@@ -41,13 +41,17 @@ public:
     static std::string keyOf(std::span<const uint8_t> bytes, bool linear);
     std::optional<EncodedTexture> load(const std::string& key) const;
     /// Best effort: a cache that cannot be written is skipped, never an error.
+    /// Call evictBeyondLimit() once after a batch of stores.
     void store(const std::string& key, const EncodedTexture& texture) const;
+    /// Removes the least recently used entries beyond kMaxBytes. It lists the
+    /// whole folder, so it runs once per batch: once per store, a scene of
+    /// 5,000 new textures listed it 5,000 times (past 30 s).
+    void evictBeyondLimit() const;
     const std::filesystem::path& directory() const { return m_directory; }
 
 private:
     std::filesystem::path m_directory;
     std::filesystem::path pathFor(const std::string& key) const;
-    void evictBeyondLimit() const;
 };
 
 } // namespace vkrt

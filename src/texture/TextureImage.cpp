@@ -1,5 +1,7 @@
 #include "texture/TextureImage.h"
 
+#include "texture/JpegStructure.h"
+
 #include "io/ExrFile.h"
 #include "io/ImageHeader.h"
 #include "io/RadianceHdr.h"
@@ -170,6 +172,9 @@ ImageExtent stbHeader(std::span<const uint8_t> bytes, const std::string& file)
         failInFile(file, "unsupported or damaged image (stb_image: " + reason + ")");
     }
     checkSize(file, uint64_t(width), uint64_t(height));
+    // stb_image decodes a JPEG cut short as if the rest were zeros: its structure is checked first.
+    if (isJpeg(bytes))
+        if (const auto problem = jpegStructureProblem(bytes)) failInFile(file, "damaged JPEG image: " + *problem);
     return {uint32_t(width), uint32_t(height)};
 }
 

@@ -225,6 +225,65 @@ TEST_F(OutputSafety, RegressAndViewRefuseToOverwriteTheirInputs)
     EXPECT_EQ(readAll(m_scene), kSphereScene);
 }
 
+/// A one-triangle glTF whose buffer is the file `bufferName` beside it (any
+/// name: a glTF's URIs need no extension); returns the glTF's path.
+fs::path gltfWithBufferFile(const fs::path& dir, const std::string& bufferName)
+{
+    std::string buffer;
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) buffer.append(reinterpret_cast<char*>(&v), 4);
+    writeText(dir / bufferName, buffer);
+    writeText(dir / "model.gltf", R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "buffers": [{"uri": ")" + bufferName + R"(", "byteLength": 36}],
+  "bufferViews": [{"buffer": 0, "byteLength": 36}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]}]})");
+    return dir / "model.gltf";
+}
+
+// Every file a scene read is an input: a glTF's buffer named like an output
+// was overwritten (exit 0), and the scene no longer loaded.
+TEST_F(OutputSafety, NoOutputReplacesAFileTheScenesMeshesRead)
+{
+    const fs::path gltf = gltfWithBufferFile(m_dir, "x.exr");
+    const std::string buffer = readAll(m_dir / "x.exr");
+    fs::create_symlink(m_dir / "x.exr", m_dir / "link.exr");
+    fs::create_symlink(gltf, m_dir / "gltf-link.png");
+    writeText(m_dir / "imports.toml", "[import]\ngltf = \"model.gltf\"\n");
+    writeText(m_dir / "mesh.toml", std::string(kSphereScene) +
+                                       "[[objects]]\nshape = \"mesh\"\nfile = \"model.gltf\"\nmaterial = \"white\"\n");
+    const fs::path out = m_dir / "out.exr";
+    struct Case {
+        fs::path scene;
+        std::vector<std::string> args;
+        std::string expected;
+    } cases[] = {
+        {gltf, {"-o", (m_dir / "x.exr").string()}, "x.exr: -o is the same file as a glTF file the scene imports"},
+        {gltf, {"-o", (m_dir / "link.exr").string()}, "link.exr: -o is the same file as"},
+        {gltf, {"-o", out.string(), "--json", (m_dir / "x.exr").string()}, "x.exr: --json is the same file as"},
+        {gltf, {"-o", out.string(), "--report", (m_dir / "x.exr").string()}, "x.exr: --report is the same file as"},
+        {m_dir / "imports.toml", {"-o", (m_dir / "link.exr").string()}, "link.exr: -o is the same file as"},
+        {m_dir / "imports.toml", {"-o", out.string(), "--png", (m_dir / "gltf-link.png").string()},
+         "gltf-link.png: --png is the same file as a glTF file the scene imports"},
+        {m_dir / "mesh.toml", {"-o", (m_dir / "x.exr").string()}, "x.exr: -o is the same file as a file a mesh"},
+    };
+    for (const Case& c : cases) {
+        std::vector<std::string> args = {"render", c.scene.string(), "--spp", "1"};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        for (const std::string& a : deviceArgs()) args.push_back(a);
+        const ProcessResult r = runVkrt(args);
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_TRUE(contains(r.output, c.expected)) << c.expected << "\n" << r.output;
+        EXPECT_EQ(readAll(m_dir / "x.exr"), buffer) << "the glTF's buffer was overwritten";
+        EXPECT_FALSE(fs::exists(out));
+    }
+    EXPECT_TRUE(fs::is_symlink(m_dir / "link.exr"));
+    const ProcessResult info =
+        runVkrt({"info", gltf.string(), "--json", (m_dir / "link.exr").string()});
+    EXPECT_EQ(info.exitCode, 2) << info.output;
+    EXPECT_EQ(readAll(m_dir / "x.exr"), buffer);
+}
+
 // ---------------------------------------------------------------- 1: what is at the output path
 
 TEST_F(OutputSafety, DevicesFifosAndDirectoriesAreRefusedNotReplaced)

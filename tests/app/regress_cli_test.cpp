@@ -490,6 +490,46 @@ TEST_F(RegressCli, UpdateMakesReferencesTheSuiteAccepts)
     EXPECT_EQ(run.exitCode, 0) << run.output;
 }
 
+// A case whose scene reads a texture from its own reference folder: --update
+// overwrote the texture with the new reference (exit 0). Refused now, naming
+// both, before any case is rendered.
+TEST_F(RegressCli, UpdateRefusesAReferenceThatIsAnInputOfItsCase)
+{
+    fs::create_directories(m_dir / "ref");
+    Image texture(2, 2);
+    for (float& v : texture.rgb) v = 0.5f;
+    writeExr(m_dir / "ref" / "mean.exr", texture, {});
+    const std::string before = readFile(m_dir / "ref" / "mean.exr");
+    writeText(m_dir / "textured.toml", R"([camera]
+eye = [0, 0, 4]
+target = [0, 0, 0]
+fov = 40
+width = 16
+height = 12
+[materials.wood]
+type = "lambert"
+albedo = { texture = "ref/mean.exr" }
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "wood"
+[[lights]]
+type = "point"
+position = [0, 3, 3]
+intensity = [10, 10, 10]
+)");
+    ManifestCase first = shipped("extreme/kappa-shadow", 16, "width = 32\nheight = 24");
+    first.reference = m_dir / "made";
+    const ManifestCase textured{"textured", m_dir / "textured.toml", m_dir / "ref", 16, 4};
+    const fs::path suite = writeManifest({first, textured});
+    expectInputError(regress({"--suite", suite.string(), "--update"}),
+                     {(m_dir / "ref" / "mean.exr").string() + ": the reference of case textured (mean) is the same "
+                                                               "file as a texture the scene loads"});
+    EXPECT_EQ(readFile(m_dir / "ref" / "mean.exr"), before) << "the texture was overwritten";
+    EXPECT_FALSE(fs::exists(first.reference)) << "a case was rendered before the refusal";
+}
+
 // ------------------------------------------------------------ Ctrl-C
 
 /// Processes whose command line mentions `text` (the children of a run name its suite).

@@ -92,7 +92,7 @@ TEST(MeshFileMaterials, CubeHasOneTexturedMetallicRoughnessMaterial)
     EXPECT_EQ(m.fileIndex, 0);
     ASSERT_TRUE(m.baseColorTexture);
     EXPECT_TRUE(fs::equivalent(m.baseColorTexture->file, cubeDir() / "Cube_BaseColor.png"));
-    EXPECT_TRUE(m.baseColorTexture->embedded.empty());
+    EXPECT_FALSE(m.baseColorTexture->embedded);
     ASSERT_TRUE(m.metallicRoughnessTexture);
     EXPECT_TRUE(fs::equivalent(m.metallicRoughnessTexture->file, cubeDir() / "Cube_MetallicRoughness.png"));
     // Cube.gltf states no factors: glTF's defaults, 1.
@@ -174,9 +174,10 @@ TEST(MeshFileMaterials, FactorsSamplersImagesAndEveryUnsupportedFeature)
     ASSERT_TRUE(m.normalTexture);
     EXPECT_EQ(m.normalScale, 0.5f);
     EXPECT_TRUE(m.normalTexture->file.empty());
-    EXPECT_EQ(m.normalTexture->embedded, bytesOf(png));
+    ASSERT_TRUE(m.normalTexture->embedded);
+    EXPECT_EQ(*m.normalTexture->embedded, bytesOf(png));
     EXPECT_EQ(m.normalTexture->wrapU, TextureWrap::Repeat);
-    const TextureImage decoded = decodeTextureImage(m.normalTexture->embedded, m.normalTexture->name, true);
+    const TextureImage decoded = decodeTextureImage(*m.normalTexture->embedded, m.normalTexture->name, true);
     EXPECT_EQ(decoded.pixels.rgba, loadTextureImage(cubeDir() / "Cube_MetallicRoughness.png", true).pixels.rgba);
     // KHR_texture_transform is read (scene/FileMaterialImport.cpp turns it into vkrt's uv space).
     EXPECT_EQ(m.baseColorTexture->scale, glm::dvec2(2.0, 3.0));
@@ -358,7 +359,8 @@ TEST(MeshFileMaterials, EmbeddedImageInAGlb)
     ASSERT_EQ(mesh.materials.size(), 1u);
     ASSERT_TRUE(mesh.materials[0].metallicRoughnessTexture);
     const FileTexture& texture = *mesh.materials[0].metallicRoughnessTexture;
-    EXPECT_EQ(texture.embedded, bytesOf(png));
+    ASSERT_TRUE(texture.embedded);
+    EXPECT_EQ(*texture.embedded, bytesOf(png));
     EXPECT_EQ(texture.name.rfind(file.string(), 0), 0u) << texture.name; // messages start with the file
 }
 

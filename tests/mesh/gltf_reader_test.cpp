@@ -31,77 +31,6 @@ fs::path testDir()
     return dir;
 }
 
-/// A glTF 2.0 document built in memory, its one buffer inline as a data: URI.
-class GltfBuilder {
-public:
-    GltfBuilder()
-    {
-        m_doc = {{"asset", {{"version", "2.0"}}},
-                 {"bufferViews", json::array()},
-                 {"accessors", json::array()},
-                 {"meshes", json::array()},
-                 {"nodes", json::array()}};
-    }
-
-    /// An accessor over tightly packed values of one component type.
-    template <typename T>
-    uint32_t accessor(const std::vector<T>& values, const char* type, uint32_t componentType, bool normalized = false)
-    {
-        const uint32_t components = std::string(type) == "SCALAR" ? 1 : uint32_t(type[3] - '0');
-        align();
-        const size_t offset = m_bin.size();
-        for (T v : values) put(m_bin, v);
-        m_doc["bufferViews"].push_back(
-            {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
-        json a = {{"bufferView", m_doc["bufferViews"].size() - 1},
-                  {"componentType", componentType},
-                  {"count", values.size() / components},
-                  {"type", type}};
-        if (normalized) a["normalized"] = true;
-        m_doc["accessors"].push_back(a);
-        return uint32_t(m_doc["accessors"].size() - 1);
-    }
-    uint32_t floats(const std::vector<float>& v, const char* type) { return accessor(v, type, 5126); }
-    uint32_t indices(const std::vector<uint32_t>& v) { return accessor(v, "SCALAR", 5125); }
-
-    /// A mesh of one primitive with the given attributes; returns its index.
-    uint32_t mesh(json attributes, std::optional<uint32_t> indexAccessor = {}, uint32_t mode = 4,
-                  std::optional<uint32_t> material = {})
-    {
-        json primitive = {{"attributes", attributes}, {"mode", mode}};
-        if (indexAccessor) primitive["indices"] = *indexAccessor;
-        if (material) primitive["material"] = *material;
-        m_doc["meshes"].push_back({{"primitives", json::array({primitive})}});
-        return uint32_t(m_doc["meshes"].size() - 1);
-    }
-
-    uint32_t node(json node)
-    {
-        m_doc["nodes"].push_back(node);
-        return uint32_t(m_doc["nodes"].size() - 1);
-    }
-
-    json& doc() { return m_doc; }
-
-    fs::path write(const std::string& name)
-    {
-        json doc = m_doc;
-        doc["buffers"] =
-            json::array({{{"byteLength", m_bin.size()}, {"uri", dataUri("application/octet-stream", m_bin)}}});
-        const fs::path path = testDir() / name;
-        std::ofstream(path) << doc.dump();
-        return path;
-    }
-
-private:
-    void align()
-    {
-        while (m_bin.size() % 4) m_bin.push_back('\0');
-    }
-    json m_doc;
-    std::string m_bin;
-};
-
 /// One triangle in the z = 0 plane: (0,0,0) (1,0,0) (0,1,0), with an optional uv set.
 uint32_t triangleMesh(GltfBuilder& b, bool uvs = false, std::optional<uint32_t> material = {})
 {
@@ -127,11 +56,11 @@ TEST(GltfReader, SmallNodeTranslationsArePlacedExactly)
     const uint32_t mesh = triangleMesh(b);
     b.node({{"mesh", mesh}, {"translation", {0.001, -0.004, 0.0}}});
     b.node({{"mesh", mesh}, {"translation", {1e-7, 0.0, 0.0}}});
-    const GltfModel model = readGltfModel(b.write("small.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "small.gltf"));
     ASSERT_EQ(model.instances.size(), 2u);
     EXPECT_EQ(model.instances[0].world[3], glm::dvec4(0.001, -0.004, 0.0, 1.0));
     EXPECT_EQ(model.instances[1].world[3], glm::dvec4(1e-7, 0.0, 0.0, 1.0));
-    const MeshData flat = loadMeshFile(b.write("small2.gltf"));
+    const MeshData flat = loadMeshFile(b.write(testDir() / "small2.gltf"));
     ASSERT_EQ(flat.triangles.size(), 2u);
     EXPECT_FLOAT_EQ(flat.positions[flat.triangles[0].x].x, 0.001f);
     EXPECT_FLOAT_EQ(flat.positions[flat.triangles[0].x].y, -0.004f);
@@ -151,7 +80,7 @@ TEST(GltfReader, AMeshPlacedTwiceAndByGpuInstancingIsOneMeshWithInstances)
              {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", translations}, {"SCALE", scales}}}}}}}});
     b.doc()["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
     b.doc()["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
-    const GltfModel model = readGltfModel(b.write("instanced.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "instanced.gltf"));
     ASSERT_EQ(model.meshes.size(), 1u);
     EXPECT_EQ(model.meshes[0].triangles.size(), 1u);
     ASSERT_EQ(model.instances.size(), 4u);
@@ -160,7 +89,7 @@ TEST(GltfReader, AMeshPlacedTwiceAndByGpuInstancingIsOneMeshWithInstances)
     EXPECT_EQ(model.instances[3].world[0][0], 3.0);
     EXPECT_TRUE(model.warnings.empty());
     // The scene keeps them as instances sharing one geometry.
-    const Scene scene = parseGltfScene(b.write("instanced-scene.gltf").string());
+    const Scene scene = parseGltfScene(b.write(testDir() / "instanced-scene.gltf").string());
     ASSERT_EQ(scene.meshes.size(), 4u);
     for (const Mesh& m : scene.meshes) EXPECT_EQ(m.geometry, scene.meshes[0].geometry);
 }
@@ -177,7 +106,7 @@ TEST(GltfReader, PrimitivesWithAndWithoutTextureCoordinatesShareAFile)
     const uint32_t plain = triangleMesh(b, false, 1);
     b.node({{"mesh", textured}});
     b.node({{"mesh", plain}, {"translation", {2.0, 0.0, 0.0}}});
-    const GltfModel model = readGltfModel(b.write("mixed.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "mixed.gltf"));
     ASSERT_EQ(model.instances.size(), 2u);
     EXPECT_EQ(model.meshes[0].uvs.size(), 3u);
     EXPECT_TRUE(model.meshes[1].uvs.empty());
@@ -191,7 +120,7 @@ TEST(GltfReader, PrimitivesWithAndWithoutTextureCoordinatesShareAFile)
     bad.doc()["textures"] = b.doc()["textures"];
     bad.doc()["images"] = b.doc()["images"];
     bad.node({{"mesh", triangleMesh(bad, false, 0)}});
-    const std::string error = errorOf([&] { readGltfModel(bad.write("bad-uvs.gltf")); });
+    const std::string error = errorOf([&] { readGltfModel(bad.write(testDir() / "bad-uvs.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
     EXPECT_NE(error.find("TEXCOORD_0"), std::string::npos) << error;
 }
@@ -217,7 +146,7 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
     };
     b.node({{"mesh", twoSets(0)}});
     b.node({{"mesh", twoSets(1)}});
-    const GltfModel model = readGltfModel(b.write("second-set.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "second-set.gltf"));
     ASSERT_EQ(model.meshes.size(), 2u);
     const MeshData& second = model.meshes[0];
     ASSERT_EQ(second.uvs1.size(), 3u);
@@ -249,13 +178,13 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
         return builder.mesh(attributes, std::nullopt, 4, 0);
     };
     carried.node({{"mesh", uvTriangle(carried, true)}});
-    const MeshData fromFile = readGltfModel(carried.write("carried.gltf")).meshes.at(0);
+    const MeshData fromFile = readGltfModel(carried.write(testDir() / "carried.gltf")).meshes.at(0);
     GltfBuilder computed;
     computed.doc()["materials"] = carried.doc()["materials"];
     computed.doc()["textures"] = b.doc()["textures"];
     computed.doc()["images"] = b.doc()["images"];
     computed.node({{"mesh", uvTriangle(computed, false)}});
-    const auto computedGeometry = makeMeshGeometry(readGltfModel(computed.write("computed.gltf")).meshes.at(0),
+    const auto computedGeometry = makeMeshGeometry(readGltfModel(computed.write(testDir() / "computed.gltf")).meshes.at(0),
                                                    NormalMode::File, "computed.gltf");
     ASSERT_EQ(fromFile.tangents.size(), 3u);
     ASSERT_EQ(computedGeometry->data.tangents.size(), 3u);
@@ -271,7 +200,7 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
     bad.doc()["textures"] = b.doc()["textures"];
     bad.doc()["images"] = b.doc()["images"];
     bad.node({{"mesh", triangleMesh(bad, true, 0)}});
-    const std::string error = errorOf([&] { readGltfModel(bad.write("bad-uv1.gltf")); });
+    const std::string error = errorOf([&] { readGltfModel(bad.write(testDir() / "bad-uv1.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
     EXPECT_NE(error.find("TEXCOORD_1"), std::string::npos) << error;
 }
@@ -298,7 +227,7 @@ TEST(GltfReader, PbrExtensionLayersAreReadWithTheirTextures)
                              {"TEXCOORD_0", b.floats({0, 0, 1, 0, 0, 1}, "VEC2")},
                              {"TEXCOORD_1", b.floats({0, 0, 1, 0, 0, 1}, "VEC2")}},
                             std::nullopt, 4, 0)}});
-    const GltfModel model = readGltfModel(b.write("layers.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "layers.gltf"));
     EXPECT_TRUE(model.warnings.empty()) << model.warnings.front();
     const FileMaterial& m = model.materials.at(0);
     EXPECT_EQ(m.specularFactor, 0.5f);
@@ -318,7 +247,7 @@ TEST(GltfReader, PbrExtensionLayersAreReadWithTheirTextures)
     GltfBuilder bad;
     bad.doc()["materials"] = json::parse(R"([{"extensions": {"KHR_materials_sheen": {"sheenRoughnessFactor": 2}}}])");
     bad.node({{"mesh", triangleMesh(bad, false, 0)}});
-    const std::string error = errorOf([&] { readGltfModel(bad.write("bad-sheen.gltf")); });
+    const std::string error = errorOf([&] { readGltfModel(bad.write(testDir() / "bad-sheen.gltf")); });
     EXPECT_NE(error.find("bad-sheen.gltf"), std::string::npos) << error;
     EXPECT_NE(error.find("sheenRoughnessFactor"), std::string::npos) << error;
 }
@@ -333,7 +262,7 @@ TEST(GltfReader, StripsAndFansBecomeTrianglesWithTheirWinding)
     b.node({{"mesh", strip}});
     b.node({{"mesh", fan}});
     b.node({{"mesh", lines}});
-    const GltfModel model = readGltfModel(b.write("modes.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "modes.gltf"));
     // glTF 3.7.2.1: strip triangle i = {i, i + 1 + i % 2, i + 2 - i % 2}; fan = {i, i + 1, 0}.
     ASSERT_EQ(model.meshes[0].triangles.size(), 3u);
     EXPECT_EQ(model.meshes[0].triangles[1], glm::uvec3(1, 3, 2));
@@ -366,7 +295,7 @@ TEST(GltfReader, SparseInterleavedAndNormalizedAccessors)
     const uint32_t colors = b.accessor(std::vector<uint8_t>{255, 51, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255}, "VEC4",
                                        5121, /*normalized=*/true);
     b.node({{"mesh", b.mesh({{"POSITION", positions}, {"COLOR_0", colors}})}});
-    const GltfModel model = readGltfModel(b.write("sparse.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "sparse.gltf"));
     const MeshData& mesh = model.meshes[0];
     ASSERT_EQ(mesh.positions.size(), 3u);
     EXPECT_EQ(mesh.positions[0], glm::vec3(0.0f));
@@ -388,7 +317,7 @@ TEST(GltfReader, SparseInterleavedAndNormalizedAccessors)
     normal["byteOffset"] = 12;
     i.doc()["accessors"].push_back(normal);
     i.node({{"mesh", i.mesh({{"POSITION", both}, {"NORMAL", 1}})}});
-    const MeshData interleaved = readGltfModel(i.write("interleaved.gltf")).meshes[0];
+    const MeshData interleaved = readGltfModel(i.write(testDir() / "interleaved.gltf")).meshes[0];
     EXPECT_EQ(interleaved.positions[2], glm::vec3(0, 1, 0));
     EXPECT_EQ(interleaved.normals[1], glm::vec3(0, 0, 1));
 }
@@ -402,7 +331,7 @@ TEST(GltfReader, ANegativeScaleKeepsTheFrontSide)
     const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
     const uint32_t normals = b.floats({0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
     b.node({{"mesh", b.mesh({{"POSITION", positions}, {"NORMAL", normals}})}, {"scale", {-1.0, 1.0, 1.0}}});
-    const MeshData flat = loadMeshFile(b.write("mirror.gltf"));
+    const MeshData flat = loadMeshFile(b.write(testDir() / "mirror.gltf"));
     const glm::uvec3 t = flat.triangles[0];
     const glm::vec3 winding =
         glm::cross(flat.positions[t.y] - flat.positions[t.x], flat.positions[t.z] - flat.positions[t.x]);
@@ -418,7 +347,7 @@ TEST(GltfReader, ScenesAreChosenByNameOrIndex)
     b.node({{"mesh", mesh}, {"translation", {3, 0, 0}}});
     b.doc()["scenes"] = {{{"name", "left"}, {"nodes", {0}}}, {{"name", "both"}, {"nodes", {0, 1}}}};
     b.doc()["scene"] = 1;
-    const fs::path file = b.write("scenes.gltf");
+    const fs::path file = b.write(testDir() / "scenes.gltf");
     EXPECT_EQ(readGltfModel(file).instances.size(), 2u);
     GltfReadOptions options;
     options.scene = "left";
@@ -436,11 +365,11 @@ TEST(GltfReader, RequiredExtensionsMustBeImplementedUsedOnesAreNamedOnce)
     GltfBuilder b;
     b.node({{"mesh", triangleMesh(b)}});
     b.doc()["extensionsUsed"] = {"KHR_materials_diffuse_transmission", "KHR_lights_punctual"};
-    const GltfModel model = readGltfModel(b.write("used.gltf"));
+    const GltfModel model = readGltfModel(b.write(testDir() / "used.gltf"));
     ASSERT_EQ(model.warnings.size(), 1u);
     EXPECT_NE(model.warnings[0].find("KHR_materials_diffuse_transmission"), std::string::npos);
     b.doc()["extensionsRequired"] = {"KHR_draco_mesh_compression"};
-    const std::string error = errorOf([&] { readGltfModel(b.write("required.gltf")); });
+    const std::string error = errorOf([&] { readGltfModel(b.write(testDir() / "required.gltf")); });
     EXPECT_NE(error.find("extensionsRequired names KHR_draco_mesh_compression"), std::string::npos) << error;
 }
 
@@ -456,7 +385,7 @@ TEST(GltfReader, AMaterialVariantReplacesTheMaterialsItMaps)
     const json mappings = json::array({{{"material", 1}, {"variants", {0}}}, {{"material", 2}, {"variants", {1}}}});
     b.doc()["meshes"][mesh]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"] = mappings;
     b.node({{"mesh", mesh}});
-    const fs::path file = b.write("variants.gltf");
+    const fs::path file = b.write(testDir() / "variants.gltf");
     const GltfModel plain = readGltfModel(file);
     EXPECT_EQ(plain.meshes[0].triangleMaterials[0], 0u);
     EXPECT_TRUE(plain.warnings.empty()); // the extension is implemented
@@ -476,10 +405,10 @@ TEST(GltfReader, BadAccessorsAndIndicesAreNamed)
     GltfBuilder b;
     const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
     b.node({{"mesh", b.mesh({{"POSITION", positions}}, b.indices({0, 1, 7}))}});
-    std::string error = errorOf([&] { readGltfModel(b.write("index.gltf")); });
+    std::string error = errorOf([&] { readGltfModel(b.write(testDir() / "index.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0].indices[2] is 7"), std::string::npos) << error;
     b.doc()["accessors"][positions]["count"] = 4; // past its bufferView
-    error = errorOf([&] { readGltfModel(b.write("count.gltf")); });
+    error = errorOf([&] { readGltfModel(b.write(testDir() / "count.gltf")); });
     EXPECT_NE(error.find("accessor 0"), std::string::npos) << error;
 }
 
@@ -490,7 +419,7 @@ TEST(GltfReader, TrianglesOfAnIndexCountNotAMultipleOfThreeAreRefused)
     GltfBuilder b;
     const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
     b.node({{"mesh", b.mesh({{"POSITION", positions}}, b.indices({0, 1, 2, 1, 3, 2, 0, 1}))}});
-    const std::string error = errorOf([&] { readGltfModel(b.write("eight.gltf")); });
+    const std::string error = errorOf([&] { readGltfModel(b.write(testDir() / "eight.gltf")); });
     EXPECT_NE(error.find(
                   "eight.gltf: meshes[0].primitives[0]: a TRIANGLES primitive of 8 indices, not a multiple of 3"),
               std::string::npos)
@@ -498,7 +427,7 @@ TEST(GltfReader, TrianglesOfAnIndexCountNotAMultipleOfThreeAreRefused)
     GltfBuilder unindexed;
     const uint32_t four = unindexed.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
     unindexed.node({{"mesh", unindexed.mesh({{"POSITION", four}})}});
-    const std::string second = errorOf([&] { readGltfModel(unindexed.write("four.gltf")); });
+    const std::string second = errorOf([&] { readGltfModel(unindexed.write(testDir() / "four.gltf")); });
     EXPECT_NE(second.find("a TRIANGLES primitive of 4 vertices, not a multiple of 3"), std::string::npos) << second;
 }
 

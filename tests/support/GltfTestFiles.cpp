@@ -1,6 +1,7 @@
 #include "support/GltfTestFiles.h"
 
 #include <algorithm>
+#include <fstream>
 
 namespace vkrt::test {
 
@@ -97,6 +98,73 @@ std::string quadsGltf(const std::vector<GltfQuad>& quads, const std::string& res
                    : "") +
            R"(],
   )" + rest + "}";
+}
+
+GltfBuilder::GltfBuilder()
+{
+    m_doc = {{"asset", {{"version", "2.0"}}},
+             {"bufferViews", json::array()},
+             {"accessors", json::array()},
+             {"meshes", json::array()},
+             {"nodes", json::array()}};
+}
+
+uint32_t GltfBuilder::bufferView(const std::string& bytes)
+{
+    while (m_bin.size() % 4) m_bin.push_back('\0');
+    m_doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", m_bin.size()}, {"byteLength", bytes.size()}});
+    m_bin += bytes;
+    return uint32_t(m_doc["bufferViews"].size() - 1);
+}
+
+uint32_t GltfBuilder::mesh(json attributes, std::optional<uint32_t> indexAccessor, uint32_t mode,
+                           std::optional<uint32_t> material)
+{
+    json primitive = {{"attributes", attributes}, {"mode", mode}};
+    if (indexAccessor) primitive["indices"] = *indexAccessor;
+    if (material) primitive["material"] = *material;
+    m_doc["meshes"].push_back({{"primitives", json::array({primitive})}});
+    return uint32_t(m_doc["meshes"].size() - 1);
+}
+
+uint32_t GltfBuilder::node(json node)
+{
+    m_doc["nodes"].push_back(node);
+    return uint32_t(m_doc["nodes"].size() - 1);
+}
+
+std::filesystem::path GltfBuilder::write(const std::filesystem::path& path) const
+{
+    json doc = m_doc;
+    doc["buffers"] = json::array({{{"byteLength", m_bin.size()}, {"uri", dataUri("application/octet-stream", m_bin)}}});
+    std::ofstream(path, std::ios::binary) << doc.dump();
+    return path;
+}
+
+std::filesystem::path GltfBuilder::writeGlb(const std::filesystem::path& path) const
+{
+    json doc = m_doc;
+    std::string bin = m_bin;
+    while (bin.size() % 4) bin.push_back('\0');
+    doc["buffers"] = json::array({{{"byteLength", m_bin.size()}}});
+    std::ofstream(path, std::ios::binary) << glbBytes(doc.dump(), bin);
+    return path;
+}
+
+std::string glbBytes(const std::string& json, const std::string& bin, uint32_t version, bool padJson)
+{
+    std::string text = json;
+    while (padJson && text.size() % 4) text.push_back(' ');
+    std::string out = "glTF";
+    put(out, version);
+    put(out, uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
+    put(out, uint32_t(text.size()));
+    out += "JSON" + text;
+    if (!bin.empty()) {
+        put(out, uint32_t(bin.size()));
+        out += std::string("BIN\0", 4) + bin;
+    }
+    return out;
 }
 
 } // namespace vkrt::test

@@ -126,6 +126,48 @@ TEST(TextureImage, JpegIsDecodedAsSrgb)
     EXPECT_NEAR(image.pixels.at(3, 3)[0], srgbReference(128 / 255.0), 0.01); // JPEG is lossy
 }
 
+/// The bytes of an 8x8 JPEG stb_image_write makes (baseline: one scan, then the end-of-image marker).
+std::string eightByEightJpeg()
+{
+    const fs::path file = textureTestDir() / "whole.jpg";
+    std::vector<uint8_t> rgb(8 * 8 * 3);
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t(i * 37);
+    EXPECT_TRUE(stbi_write_jpg(file.c_str(), 8, 8, 3, rgb.data(), 95));
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// stb_image decodes a JPEG cut short as though the missing data were zeros:
+// the sweep's 8x8 JPEG with its headers and no scan data became a texture
+// without a word. Refused now, naming the file.
+TEST(TextureImage, ATruncatedJpegIsRefusedNamingTheFile)
+{
+    const std::string whole = eightByEightJpeg();
+    const size_t scan = whole.find("\xFF\xDA");
+    ASSERT_NE(scan, std::string::npos);
+    const size_t scanHeader = (static_cast<size_t>(static_cast<uint8_t>(whole[scan + 2])) << 8 |
+                               static_cast<uint8_t>(whole[scan + 3])) + 2;
+    const std::vector<std::pair<std::string, std::string>> cuts = {
+        {"no-scan.jpg", whole.substr(0, scan)},                           // the headers alone
+        {"empty-scan.jpg", whole.substr(0, scan + scanHeader) + "\xFF\xD9"}, // a scan header, no data
+        {"half-scan.jpg", whole.substr(0, (scan + scanHeader + whole.size()) / 2)},
+        {"no-end.jpg", whole.substr(0, whole.size() - 2)}, // without its end-of-image marker
+    };
+    for (const auto& [name, bytes] : cuts) {
+        const fs::path file = writeBytes(textureTestDir() / name, bytes);
+        const std::string error = errorOf([&] { loadTextureImage(file, false); });
+        EXPECT_EQ(error.rfind(file.string() + ": damaged JPEG image: ", 0), 0u) << error;
+        const std::vector<uint8_t> data(bytes.begin(), bytes.end());
+        EXPECT_EQ(errorOf([&] { readTextureHeader(data, name, false); }).rfind(name + ": damaged JPEG image", 0), 0u);
+    }
+    EXPECT_NE(errorOf([&] { loadTextureImage(writeBytes(textureTestDir() / "n.jpg", cuts[0].second), false); })
+                  .find("no start-of-scan"),
+              std::string::npos);
+    // The whole file, and one with bytes after its end-of-image marker (allowed), decode.
+    const fs::path good = writeBytes(textureTestDir() / "trailing.jpg", whole + "trailing bytes");
+    EXPECT_EQ(loadTextureImage(good, false).pixels.width, 8u);
+}
+
 TEST(TextureImage, ExrRoundTripIsLinearAndExact)
 {
     Image rgb(3, 2);
