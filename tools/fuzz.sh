@@ -143,6 +143,71 @@ doc = {"asset": {"version": "2.0"}, "scene": 1,
 open(sys.argv[1], "w").write(json.dumps(doc))
 PY
 seed 2 "$work/features.gltf"
+# What the third sweep found (issue 58, tests/mesh/gltf_input_rules_test.cpp):
+# integer properties written as floats, strings and negatives; sparse indices
+# repeated and decreasing; a byteStride under the element; 15,000 nodes (the
+# JSON pass was quadratic in a list's length); 70 materials whose 15 texture
+# slots each name one embedded PNG; 4,096 instancing copies in one place.
+python3 - "$work" <<'PY'
+import base64, json, struct, sys, zlib
+out = sys.argv[1]
+tri = struct.pack("<9f", 0,0,0, 1,0,0, 0,1,0)
+def doc(extra_bin=b"", **more):
+    b = tri + extra_bin
+    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+         "buffers": [{"uri": "data:application/octet-stream;base64," + base64.b64encode(b).decode(), "byteLength": len(b)}],
+         "bufferViews": [{"buffer": 0, "byteLength": 36}],
+         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}]}
+    d.update(more)
+    return d
+def write(name, d):
+    open(f"{out}/{name}.gltf", "w").write(json.dumps(d))
+for i, (path, value) in enumerate([(("accessors", 0, "byteOffset"), 0.0), (("accessors", 0, "bufferView"), "0"),
+                                   (("nodes", 0, "mesh"), -1), (("scene",), 0.0)]):
+    d = doc()
+    target = d
+    for key in path[:-1]: target = target[key]
+    target[path[-1]] = value
+    write(f"integer-{i}", d)
+d = doc(); d["nodes"] = [{"children": [1.0]}, {"mesh": 0, "extensions": {"KHR_lights_punctual": {"light": 0.0}}}]
+write("integer-children", d)
+for name, targets in [("sparse-repeated", (1, 1)), ("sparse-decreasing", (2, 0))]:
+    extra = struct.pack("<2H", *targets) + struct.pack("<6f", 1,0,0, 0,1,0)
+    d = doc(extra)
+    d["bufferViews"] += [{"buffer": 0, "byteOffset": 36, "byteLength": 4}, {"buffer": 0, "byteOffset": 40, "byteLength": 24}]
+    d["accessors"].append({"componentType": 5126, "count": 3, "type": "VEC3", "sparse": {"count": 2,
+        "indices": {"bufferView": 1, "componentType": 5123}, "values": {"bufferView": 2}}})
+    d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 1
+    write(name, d)
+d = doc(); d["bufferViews"][0]["byteStride"] = 4; write("stride", d)
+d = doc(); d["nodes"] += [{} for _ in range(15000)]; write("many-nodes", d)
+raw = b"".join(b"\0" + bytes(range(i, i + 12)) for i in range(4))
+def chunk(kind, data): return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 4, 4, 8, 2, 0, 0, 0)) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+slot = {"index": 0}
+material = {"pbrMetallicRoughness": {"baseColorTexture": slot, "metallicRoughnessTexture": slot},
+            "normalTexture": slot, "emissiveTexture": slot, "extensions": {
+            "KHR_materials_sheen": {"sheenColorTexture": slot, "sheenRoughnessTexture": slot},
+            "KHR_materials_clearcoat": {"clearcoatTexture": slot, "clearcoatRoughnessTexture": slot, "clearcoatNormalTexture": slot},
+            "KHR_materials_specular": {"specularTexture": slot, "specularColorTexture": slot},
+            "KHR_materials_transmission": {"transmissionTexture": slot},
+            "KHR_materials_iridescence": {"iridescenceTexture": slot, "iridescenceThicknessTexture": slot},
+            "KHR_materials_anisotropy": {"anisotropyTexture": slot}}}
+d = doc(images=[{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}], textures=[{"source": 0}],
+        materials=[material] * 70)
+d["accessors"].append({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC2"})
+d["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 1
+d["meshes"][0]["primitives"][0]["material"] = 0
+write("one-image-many-slots", d)
+d = doc(); d["accessors"].append({"componentType": 5126, "count": 4096, "type": "VEC3"})
+d["nodes"][0]["extensions"] = {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 1}}}
+write("copies", d)
+PY
+for file in "$work"/integer-*.gltf "$work"/sparse-*.gltf "$work"/stride.gltf "$work"/many-nodes.gltf \
+  "$work"/one-image-many-slots.gltf "$work"/copies.gltf; do
+  seed 2 "$file"
+done
 find "$root/scenes" -name '*.toml' -exec cp {} "$work/scene/" \;
 # Nesting at the parser's bound (kMaxTomlNesting, 128 levels) and one past it,
 # as a header, a dotted key and inline tables, so mutations explore both sides.
@@ -174,6 +239,17 @@ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 8192\n' | run_seed 0 hd
 for file in "$root"/scenes/validation/textures/*.png; do
   if [[ -f $file && $(stat -c %s "$file") -le 65536 ]]; then run_seed 0 "$(basename "$file")" <"$file"; fi
 done
+# An 8x8 JPEG's headers (quantization, frame, Huffman and scan headers) and
+# no scan data: stb_image decoded it as black (issue 58).
+python3 -c '
+import struct, sys
+def segment(marker, body): return b"\xff" + bytes([marker]) + struct.pack(">H", len(body) + 2) + body
+jpeg = (b"\xff\xd8" + segment(0xDB, b"\x00" + b"\x01" * 64)
+        + segment(0xC0, b"\x08\x00\x08\x00\x08\x01\x01\x11\x00")
+        + segment(0xC4, b"\x00" + b"\x01" + b"\x00" * 15 + b"\x00")
+        + segment(0xC4, b"\x10" + b"\x01" + b"\x00" * 15 + b"\x00")
+        + segment(0xDA, b"\x01\x01\x00\x00\x3f\x00") + b"\xff\xd9")
+sys.stdout.buffer.write(jpeg)' | run_seed 0 jpeg-headers-only
 printf '# known failures\nextreme/tir,Fail\nseed/glass,Crash,1.5\nvalidation/x,Timeout\n' | run_seed 1 baseline
 printf 'kappa-\n^seed/glass$\nvalidation/.*texture\n^(.*.*.*.*.*.*.*.*.*.*)*Q$\n' | run_seed 2 patterns
 run_seed 3 suite <"$root/tests/regress/suite.toml"
