@@ -13,7 +13,8 @@
 #     built as it is (NAME: the tree's folder name), or
 #   - a Debian source version of the `mesa` package, e.g. 26.1.6-1~bpo13+1
 #     (trixie-backports) or 25.0.7-2~bpo12+1 (bookworm-backports), whose .dsc,
-#     orig and debian tarballs are downloaded from deb.debian.org's pool and
+#     orig and debian tarballs are downloaded from the pool of the Debian
+#     archive in the host's apt sources (or DEBIAN_MIRROR) and
 #     unpacked with dpkg-source (which applies Debian's own patches, nothing
 #     else) into build/lavapipe-REF/src (NAME: REF).
 #
@@ -40,7 +41,10 @@
 set -euo pipefail
 
 prog='build-lavapipe.sh'
-mirror=${DEBIAN_MIRROR:-https://deb.debian.org/debian}
+# shellcheck source=tools/apt-sources.sh
+. "$(dirname "${BASH_SOURCE[0]}")/apt-sources.sh"
+# The host's own archive, as apt is set up (tools/apt-sources.sh); DEBIAN_MIRROR overrides it.
+mirror=${DEBIAN_MIRROR:-$(host_debian_archive)}
 # Suites whose Sources indices name the versions a bad REF could have meant.
 suites=(trixie-backports bookworm-backports trixie bookworm forky sid experimental)
 
@@ -53,7 +57,7 @@ repository and prints the path of its installed ICD manifest, for
 'vkrt regress --driver MANIFEST' or VK_DRIVER_FILES=MANIFEST.
 
 REF   a Mesa source tree (git checkout or unpacked tarball; NAME is its
-      folder's name), or a Debian source version of mesa on deb.debian.org,
+      folder's name), or a Debian source version of mesa in the Debian archive,
       e.g. 26.1.6-1~bpo13+1 (trixie-backports) or 25.0.7-2~bpo12+1
       (bookworm-backports), downloaded and unpacked with dpkg-source
       (Debian's patches applied; NAME is REF).
@@ -64,7 +68,8 @@ REF   a Mesa source tree (git checkout or unpacked tarball; NAME is its
   -v          show meson's and ninja's output (default: only in logs/)
   -h, --help  this text
 
-Environment: DEBIAN_MIRROR (default https://deb.debian.org/debian).
+Environment: DEBIAN_MIRROR (default: the first Debian archive of the host's
+apt sources that is not a security archive).
 Missing build dependencies are installed with apt-get; a meson too old for
 the tree is installed from PyPI into build/lavapipe-NAME/venv, not
 system-wide. Re-running with the same REF reuses the download and the build.
@@ -197,7 +202,7 @@ explain_missing_version() { # VERSION HTTPCODE URL
     say "mesa $version is listed in the Sources of ${found[*]}, but $url could not be downloaded (HTTP $code): this mirror does not serve it"
     exit 1
   fi
-  say "$version: not a Mesa source tree nor a mesa source version found on deb.debian.org"
+  say "$version: not a Mesa source tree nor a mesa source version found in the Debian archive at ${mirror:-(none)}"
   if ((${#listed[@]})); then
     say "mesa source versions there:"
     printf '  %s\n' "${listed[@]}" >&2
@@ -207,14 +212,14 @@ explain_missing_version() { # VERSION HTTPCODE URL
 
 if [[ -d $ref ]]; then
   src=$(cd "$ref" && pwd -P)
-  is_mesa_tree "$src" || { say "$ref: not a Mesa source tree nor a mesa source version found on deb.debian.org"; exit 2; }
+  is_mesa_tree "$src" || { say "$ref: not a Mesa source tree nor a mesa source version found in the Debian archive at ${mirror:-(none)}"; exit 2; }
   name=$(basename "$src")
   mode=tree
 elif [[ $ref =~ ^([0-9]+:)?[0-9][A-Za-z0-9.+~-]*$ && $ref != */* ]]; then
   name=${ref//:/_}
   mode=debian
 else
-  say "$ref: not a Mesa source tree nor a mesa source version found on deb.debian.org"
+  say "$ref: not a Mesa source tree nor a mesa source version found in the Debian archive at ${mirror:-(none)}"
   exit 2
 fi
 out=$root/build/lavapipe-$name
@@ -225,6 +230,7 @@ if [[ $mode == debian ]]; then
   apt_install curl ca-certificates xz-utils dpkg-dev
   version=${ref#*:}
   dsc_name=mesa_$version.dsc
+  [[ -n $mirror ]] || die "no Debian archive in the host's apt sources to download mesa $version from; set DEBIAN_MIRROR to one"
   pool=$mirror/pool/main/m/mesa
   src=$out/src
   if [[ ! -f $src/.unpacked ]]; then

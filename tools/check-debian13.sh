@@ -74,36 +74,9 @@ head=$(git -C "$repo" rev-parse HEAD)
 
 host_codename=$(. /etc/os-release 2>/dev/null && echo "${VERSION_CODENAME:-}")
 
-# Prints "URI SUITE" for every enabled source of the host, one per line, from
-# both the one-line format (*.list) and the deb822 format (*.sources).
-host_apt_sources() {
-  local file
-  for file in /etc/apt/sources.list /etc/apt/sources.list.d/*.list; do
-    [[ -f $file ]] || continue
-    # deb [options] URI SUITE COMPONENTS...
-    sed -e 's/#.*//' -e 's/\[[^]]*\]//' "$file" | awk '$1 == "deb" { print $2, $3 }'
-  done
-  for file in /etc/apt/sources.list.d/*.sources; do
-    [[ -f $file ]] || continue
-    awk '
-      function flush() {
-        if (enabled && types ~ /(^| )deb( |$)/)
-          for (u = 1; u <= nu; u++) for (s = 1; s <= ns; s++) print uris[u], suites[s]
-        types = ""; nu = ns = 0; enabled = 1
-      }
-      BEGIN { enabled = 1 }
-      /^[[:space:]]*#/ { next }
-      /^[[:space:]]*$/ { flush(); next }
-      {
-        key = tolower($1); sub(/:$/, "", key)
-        if (key == "types") { types = ""; for (i = 2; i <= NF; i++) types = types " " $i; types = types " " }
-        else if (key == "uris") for (i = 2; i <= NF; i++) uris[++nu] = $i
-        else if (key == "suites") for (i = 2; i <= NF; i++) suites[++ns] = $i
-        else if (key == "enabled" && tolower($2) == "no") enabled = 0
-      }
-      END { flush() }' "$file"
-  done
-}
+# host_apt_sources: "URI SUITE" for every enabled source of the host (tools/apt-sources.sh).
+# shellcheck source=tools/apt-sources.sh
+. "$(dirname "${BASH_SOURCE[0]}")/apt-sources.sh"
 
 # The archive is the source that serves the host's own release (its suite is
 # exactly the host's codename); the security archive serves CODENAME-security.

@@ -255,6 +255,11 @@ void printSummary(const RenderFacts& facts)
                      "warning: %llu pixels overflowed float32 (radiance too large for its sum over the samples): "
                      "they are inf in the image\n",
                      static_cast<unsigned long long>(facts.counters.overflowedPixels));
+    if (facts.counters.miscountedPixels)
+        std::fprintf(stderr,
+                     "warning: %llu pixels counted more samples than were rendered: the device miscounted (a driver "
+                     "fault); the image cannot be trusted\n",
+                     static_cast<unsigned long long>(facts.counters.miscountedPixels));
     if (facts.counters.budgetExceeded && facts.loopCapped)
         std::fprintf(stderr, "warning: %u invocations reached the device's loop cap; the image may be wrong\n",
                      facts.counters.budgetExceeded);
@@ -330,6 +335,7 @@ JsonObject renderJson(const RenderCommandOptions& options, const RenderSession& 
     json["samplesPerSecond"] = facts.samplesPerSecond;
     json["rejectedSamples"] = facts.counters.rejectedSamples;
     json["overflowedPixels"] = facts.counters.overflowedPixels;
+    json["miscountedPixels"] = facts.counters.miscountedPixels;
     json["loopCap"] = {{"capped", facts.loopCapped},
                        {"budget", valueOrNull(session.context().loopCap().budget)},
                        {"invocationsAtCap", facts.counters.budgetExceeded}};

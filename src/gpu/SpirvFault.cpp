@@ -3,6 +3,7 @@
 #include "util/Error.h"
 
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -110,8 +111,10 @@ double epsilonOf(const std::string& spec, const std::string& text)
 {
     const std::string rule = " (EPS must be a finite number with |EPS| < 1, e.g. 0.01 or -1e-3)";
     char* end = nullptr;
+    // strtod skips leading white space: 'scale:FMul: 0.1' must be refused as written, not read as 0.1.
+    const bool spaced = !text.empty() && std::isspace(static_cast<unsigned char>(text.front()));
     const double eps = text.empty() ? NAN : std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(eps))
+    if (text.empty() || spaced || end != text.c_str() + text.size() || !std::isfinite(eps))
         badSpec(spec, "EPS '" + text + "' is not a finite number" + rule);
     if (std::abs(eps) >= 1.0) badSpec(spec, "EPS " + text + " is out of range" + rule);
     return eps;

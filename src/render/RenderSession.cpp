@@ -243,6 +243,7 @@ Metadata RenderSession::metadata(const Film& film, const std::string& savedBy) c
     };
     // Said wherever the image goes: an inf pixel is never written without it.
     if (counters.overflowedPixels) metadata["overflowedPixels"] = int64_t(counters.overflowedPixels);
+    if (counters.miscountedPixels) metadata["miscountedPixels"] = int64_t(counters.miscountedPixels);
     // lavapipe's SIMD width (vkrt render --vector-width).
     if (std::optional<int> bits = lavapipeVectorBits(m_context.deviceInfo())) metadata["vectorWidth"] = int64_t(*bits);
     // Whether the device may have cut loops short (docs/platform.md).

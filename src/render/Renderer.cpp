@@ -703,7 +703,8 @@ RenderCounters Renderer::counters() const
     RenderCounters counters;
     size_t pixelCount = size_t(width()) * height();
     for (size_t i = 0; i < pixelCount; ++i) {
-        counters.rejectedSamples += m_frames - pixels[i].count;
+        if (pixels[i].count <= m_frames) counters.rejectedSamples += m_frames - pixels[i].count;
+        else ++counters.miscountedPixels;
         const glm::vec3 sum = pixels[i].sum;
         if (!std::isfinite(sum.x) || !std::isfinite(sum.y) || !std::isfinite(sum.z)) ++counters.overflowedPixels;
     }

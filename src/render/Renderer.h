@@ -66,6 +66,10 @@ struct RenderCounters {
     /// Pixels whose accumulated sum is not finite although every sample was:
     /// radiance so large that its sum overflowed float32. Their mean is inf.
     uint64_t overflowedPixels = 0;
+    /// Pixels that counted more samples than frames were rendered: only a
+    /// faulty device (or an injected fault, `--inject neighbour-load`) does
+    /// that. They add nothing to rejectedSamples (which once wrapped to 1.8e11).
+    uint64_t miscountedPixels = 0;
     uint32_t maxLoopIterations = 0; ///< largest loop count of one sample seen
     uint32_t budgetExceeded = 0;    ///< invocations that reached lavapipe's loop budget
 };

@@ -133,6 +133,23 @@ intensity = 30
 
 // ---------------------------------------------------------------- render
 
+// A device that miscounts (here an injected fault: every storage-buffer load
+// reads the next element) gave pixels more samples than frames; the
+// difference wrapped, and 1,536 samples reported about 1.8e11 rejected ones.
+TEST_F(Json, APixelCountingMoreSamplesThanRenderedIsReportedNotWrapped)
+{
+    const fs::path file = m_dir / "faulty.json";
+    const ProcessResult r = runVkrt(withDevice({"render", kDefaultScene, "-o", (m_dir / "f.exr").string(), "--width",
+                                                "32", "--height", "24", "--spp", "2", "--inject", "neighbour-load",
+                                                "--json", file.string()}));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const json doc = parseJson(readText(file));
+    EXPECT_LE(doc["rejectedSamples"].get<uint64_t>(), 32u * 24u * 2u);
+    EXPECT_GT(doc["miscountedPixels"].get<uint64_t>(), 0u) << r.output;
+    EXPECT_NE(r.output.find("pixels counted more samples than were rendered"), std::string::npos) << r.output;
+    EXPECT_EQ(doc["miscountedPixels"], attribute<int64_t>(readExr(m_dir / "f.exr").metadata, "miscountedPixels"));
+}
+
 TEST_F(Json, RenderWritesTheFactsOfTheRenderItDid)
 {
     const fs::path file = m_dir / "run.json";

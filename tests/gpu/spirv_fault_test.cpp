@@ -109,6 +109,8 @@ TEST(SpirvFaultSpec, RefusalsNameTheProblemAndTheChoices)
     expectSpecError("scale:FMul:-1.5", {"out of range"});
     expectSpecError("scale:FMul:inf", {"EPS 'inf'", "finite"});
     expectSpecError("scale:FMul:0.1x", {"EPS '0.1x'"});
+    expectSpecError("scale:FMul: 0.1", {"EPS ' 0.1' is not a finite number"}); // strtod skipped the space
+    expectSpecError("scale:FMul:\t0.1", {"is not a finite number"});
     expectSpecError("compare", {"compare:lt-le", "compare:gt-ge"});
     expectSpecError("compare:lt-ge", {"'lt-ge'", "compare:lt-le", "compare:gt-ge"});
     expectSpecError("nan-minmax:1", {"no arguments"});
