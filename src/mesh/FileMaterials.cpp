@@ -798,7 +798,8 @@ struct MaterialReader {
             if (decoded.empty()) malformed("image " + std::to_string(index) + "'s base64 data is malformed");
             return decoded;
         }
-        if (const auto view = uintMember(image, "bufferView")) return viewBytes(*view, "images[" + std::to_string(index) + "]");
+        if (const auto view = uintMember(image, "bufferView"))
+            return viewBytes(*view, "images[" + std::to_string(index) + "]");
         malformed("image " + std::to_string(index) + " has neither a uri nor a bufferView");
     }
 

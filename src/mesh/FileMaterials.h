@@ -42,12 +42,12 @@ namespace vkrt {
 
 /// An image a material names: a file beside the glTF, or bytes inside it.
 struct FileTexture {
-    std::filesystem::path file;    ///< resolved against the glTF's folder; empty when embedded
+    std::filesystem::path file; ///< resolved against the glTF's folder; empty when embedded
     /// Bytes of an embedded image (.glb, data: URIs), else null; one copy per
     /// image, shared by every slot that names it (TextureAtlas decodes it once).
     std::shared_ptr<const std::vector<uint8_t>> embedded;
-    std::string name;              ///< for messages: the URI, or "embedded image N of FILE"
-    uint32_t texCoord = 0;         ///< the TEXCOORD_n set it reads (KHR_texture_transform's override applied)
+    std::string name;      ///< for messages: the URI, or "embedded image N of FILE"
+    uint32_t texCoord = 0; ///< the TEXCOORD_n set it reads (KHR_texture_transform's override applied)
     TextureWrap wrapU = TextureWrap::Repeat;
     TextureWrap wrapV = TextureWrap::Repeat;
     TextureFilter filter; ///< the sampler's magFilter and minFilter (absent: vkrt's trilinear default)

@@ -23,8 +23,8 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <unordered_set>
 #include <sstream>
+#include <unordered_set>
 
 namespace vkrt {
 

@@ -42,9 +42,9 @@ namespace vkrt {
 /// One placement of a glTF mesh (a node, or one of a node's
 /// EXT_mesh_gpu_instancing copies) with its world transform.
 struct GltfInstance {
-    uint32_t mesh = 0;        ///< index into GltfModel::meshes
-    glm::dmat4 world{1.0};    ///< node world transform (instancing's TRS applied last)
-    std::string nodeName;     ///< "" when the node has none
+    uint32_t mesh = 0;     ///< index into GltfModel::meshes
+    glm::dmat4 world{1.0}; ///< node world transform (instancing's TRS applied last)
+    std::string nodeName;  ///< "" when the node has none
 };
 
 /// A camera or light and the world transform of the node that carries it.
@@ -102,8 +102,8 @@ struct GltfModel {
     std::vector<GltfPlaced> lights;
     std::vector<GltfCamera> cameraDefinitions; ///< the file's `cameras`, by index
     std::vector<GltfLight> lightDefinitions;   ///< KHR_lights_punctual's `lights`, by index
-    uint32_t sceneIndex = 0;    ///< the scene read (0 when the file has none)
-    std::string sceneName;      ///< its name, "" when it has none
+    uint32_t sceneIndex = 0;                   ///< the scene read (0 when the file has none)
+    std::string sceneName;                     ///< its name, "" when it has none
     /// What vkrt cannot honour, each once per file, in order (phrases without the file's name).
     std::vector<std::string> warnings;
     /// The buffer files it read (not data: URIs nor the .glb's own chunk).

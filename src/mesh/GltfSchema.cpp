@@ -20,14 +20,14 @@ using nlohmann::json;
 
 /// What a property must be.
 enum class Want {
-    Index,    ///< an integer from 0 to 2^32 - 1 (indices, offsets)
-    Count,    ///< an integer from 1 to 2^32 - 1 (counts, lengths)
-    Stride,   ///< a byteStride: an integer from 4 to 252, a multiple of 4
-    OneOf,    ///< one of `values`
-    Array,    ///< an array
-    Object,   ///< an object
-    String,   ///< a string
-    Boolean,  ///< true or false
+    Index,   ///< an integer from 0 to 2^32 - 1 (indices, offsets)
+    Count,   ///< an integer from 1 to 2^32 - 1 (counts, lengths)
+    Stride,  ///< a byteStride: an integer from 4 to 252, a multiple of 4
+    OneOf,   ///< one of `values`
+    Array,   ///< an array
+    Object,  ///< an object
+    String,  ///< a string
+    Boolean, ///< true or false
 };
 
 /// One rule: a path pattern and what the properties it matches must be.
@@ -46,18 +46,34 @@ const std::vector<Rule>& rules()
 {
     static const std::vector<Rule> list = {
         // The top level's arrays.
-        {"accessors", Want::Array}, {"animations", Want::Array}, {"buffers", Want::Array},
-        {"bufferViews", Want::Array}, {"cameras", Want::Array}, {"images", Want::Array},
-        {"materials", Want::Array}, {"meshes", Want::Array}, {"nodes", Want::Array},
-        {"samplers", Want::Array}, {"scenes", Want::Array}, {"skins", Want::Array},
-        {"textures", Want::Array}, {"extensionsUsed", Want::Array}, {"extensionsRequired", Want::Array},
-        {"extensionsUsed[]", Want::String}, {"extensionsRequired[]", Want::String},
-        {"asset", Want::Object}, {"asset.version", Want::String},
+        {"accessors", Want::Array},
+        {"animations", Want::Array},
+        {"buffers", Want::Array},
+        {"bufferViews", Want::Array},
+        {"cameras", Want::Array},
+        {"images", Want::Array},
+        {"materials", Want::Array},
+        {"meshes", Want::Array},
+        {"nodes", Want::Array},
+        {"samplers", Want::Array},
+        {"scenes", Want::Array},
+        {"skins", Want::Array},
+        {"textures", Want::Array},
+        {"extensionsUsed", Want::Array},
+        {"extensionsRequired", Want::Array},
+        {"extensionsUsed[]", Want::String},
+        {"extensionsRequired[]", Want::String},
+        {"asset", Want::Object},
+        {"asset.version", Want::String},
         {"scene", Want::Index},
-        {"scenes[].nodes", Want::Array}, {"scenes[].nodes[]", Want::Index},
+        {"scenes[].nodes", Want::Array},
+        {"scenes[].nodes[]", Want::Index},
         // Nodes.
-        {"nodes[].camera", Want::Index}, {"nodes[].skin", Want::Index}, {"nodes[].mesh", Want::Index},
-        {"nodes[].children", Want::Array}, {"nodes[].children[]", Want::Index},
+        {"nodes[].camera", Want::Index},
+        {"nodes[].skin", Want::Index},
+        {"nodes[].mesh", Want::Index},
+        {"nodes[].children", Want::Array},
+        {"nodes[].children[]", Want::Index},
         {"nodes[].extensions.KHR_lights_punctual", Want::Object},
         {"nodes[].extensions.KHR_lights_punctual.light", Want::Index},
         {"nodes[].extensions.EXT_mesh_gpu_instancing.attributes", Want::Object},
@@ -78,7 +94,9 @@ const std::vector<Rule>& rules()
         // Accessors, buffer views, buffers.
         {"accessors[].bufferView", Want::Index},
         {"accessors[].byteOffset", Want::Index},
-        {"accessors[].componentType", Want::OneOf, {5120, 5121, 5122, 5123, 5125, 5126},
+        {"accessors[].componentType",
+         Want::OneOf,
+         {5120, 5121, 5122, 5123, 5125, 5126},
          "a component type (5120, 5121, 5122, 5123, 5125 or 5126)"},
         {"accessors[].normalized", Want::Boolean},
         {"accessors[].count", Want::Count},
@@ -88,7 +106,9 @@ const std::vector<Rule>& rules()
         {"accessors[].sparse.indices", Want::Object},
         {"accessors[].sparse.indices.bufferView", Want::Index},
         {"accessors[].sparse.indices.byteOffset", Want::Index},
-        {"accessors[].sparse.indices.componentType", Want::OneOf, {5121, 5123, 5125},
+        {"accessors[].sparse.indices.componentType",
+         Want::OneOf,
+         {5121, 5123, 5125},
          "an unsigned index type (5121, 5123 or 5125)"},
         {"accessors[].sparse.values", Want::Object},
         {"accessors[].sparse.values.bufferView", Want::Index},
@@ -108,7 +128,9 @@ const std::vector<Rule>& rules()
         {"textures[].source", Want::Index},
         {"textures[].extensions.*.source", Want::Index},
         {"samplers[].magFilter", Want::OneOf, {9728, 9729}, "a magnification filter (9728 or 9729)"},
-        {"samplers[].minFilter", Want::OneOf, {9728, 9729, 9984, 9985, 9986, 9987},
+        {"samplers[].minFilter",
+         Want::OneOf,
+         {9728, 9729, 9984, 9985, 9986, 9987},
          "a minification filter (9728, 9729 or 9984 to 9987)"},
         {"samplers[].wrapS", Want::OneOf, {33071, 33648, 10497}, "a wrap mode (33071, 33648 or 10497)"},
         {"samplers[].wrapT", Want::OneOf, {33071, 33648, 10497}, "a wrap mode (33071, 33648 or 10497)"},
@@ -144,8 +166,8 @@ std::string shown(const json& value)
 
 bool isInteger(const json& value, int64_t low, int64_t high)
 {
-    if (value.is_number_unsigned()) return value.get<uint64_t>() >= uint64_t(std::max<int64_t>(low, 0)) &&
-                                             value.get<uint64_t>() <= uint64_t(high);
+    if (value.is_number_unsigned())
+        return value.get<uint64_t>() >= uint64_t(std::max<int64_t>(low, 0)) && value.get<uint64_t>() <= uint64_t(high);
     if (value.is_number_integer()) return value.get<int64_t>() >= low && value.get<int64_t>() <= high;
     return false; // 84.0 is a float here: glTF's integers are written without a fraction
 }
@@ -221,7 +243,8 @@ void visit(const fs::path& file, const json& value, std::string_view path, const
             if (key != "extras" && endsWith(key, suffix)) step(key, member);
         return;
     }
-    if (const json* member = gltf_json::member(value, std::string(segment).c_str())) step(std::string(segment), *member);
+    if (const json* member = gltf_json::member(value, std::string(segment).c_str()))
+        step(std::string(segment), *member);
 }
 
 /// Every `extensions` must be an object (an array hid its extensions from every reader).

@@ -57,9 +57,9 @@ private:
 
 /// What the importer tried to open beyond the mesh file, for the error message.
 struct ReferenceLog {
-    std::optional<std::string> refused; ///< the first path the policy refused to open
-    std::optional<std::string> missing; ///< the first path that could not be opened
-    std::string missingReason;          ///< why ("no such file", "is a directory", ...)
+    std::optional<std::string> refused;        ///< the first path the policy refused to open
+    std::optional<std::string> missing;        ///< the first path that could not be opened
+    std::string missingReason;                 ///< why ("no such file", "is a directory", ...)
     std::vector<std::filesystem::path> opened; ///< every file besides the mesh file that was opened
 };
 

@@ -2,15 +2,15 @@
 
 #include "io/AtomicFile.h"
 #include "io/ExrFile.h"
+#include "io/OutputPaths.h"
 #include "regress/AttemptPool.h"
 #include "regress/CaseTest.h"
 #include "regress/CompareDrivers.h"
 #include "regress/Expectations.h"
 #include "regress/Reports.h"
 #include "regress/Suite.h"
-#include "io/OutputPaths.h"
-#include "scene/SceneInputs.h"
 #include "render/RenderSession.h"
+#include "scene/SceneInputs.h"
 #include "util/ChildProcess.h"
 #include "util/Error.h"
 

@@ -407,7 +407,7 @@ struct Background {
 };
 
 struct Scene {
-    std::string path;      ///< the file it came from ("<string>" for text)
+    std::string path; ///< the file it came from ("<string>" for text)
     /// The glTF files it imports (`[import] gltf`) and the buffer files they
     /// read: inputs that no output may replace (SceneInputs.h).
     std::vector<std::filesystem::path> importedFiles;

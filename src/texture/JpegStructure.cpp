@@ -5,10 +5,7 @@ namespace vkrt {
 namespace {
 
 // ITU-T T.81, table B.1: the markers that carry no length field.
-bool isStandalone(uint8_t marker)
-{
-    return marker == 0x01 || (marker >= 0xD0 && marker <= 0xD9);
-}
+bool isStandalone(uint8_t marker) { return marker == 0x01 || (marker >= 0xD0 && marker <= 0xD9); }
 
 // SOF0-SOF15 less DHT (C4), JPG (C8) and DAC (CC).
 bool isFrameHeader(uint8_t marker)
@@ -68,7 +65,8 @@ std::optional<std::string> jpegStructureProblem(std::span<const uint8_t> bytes)
         if (!frame) return "a scan (start-of-scan marker) comes before any frame header";
         const size_t end = endOfEntropyData(bytes, at);
         if (end == at) return "the scan at byte " + std::to_string(at - length - 2) + " holds no image data";
-        if (end == bytes.size()) return "it is truncated: the file ends inside its image data, before the end-of-image marker";
+        if (end == bytes.size())
+            return "it is truncated: the file ends inside its image data, before the end-of-image marker";
         scan = true;
         at = end;
     }

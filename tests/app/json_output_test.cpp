@@ -139,9 +139,9 @@ intensity = 30
 TEST_F(Json, APixelCountingMoreSamplesThanRenderedIsReportedNotWrapped)
 {
     const fs::path file = m_dir / "faulty.json";
-    const ProcessResult r = runVkrt(withDevice({"render", kDefaultScene, "-o", (m_dir / "f.exr").string(), "--width",
-                                                "32", "--height", "24", "--spp", "2", "--inject", "neighbour-load",
-                                                "--json", file.string()}));
+    const ProcessResult r =
+        runVkrt(withDevice({"render", kDefaultScene, "-o", (m_dir / "f.exr").string(), "--width", "32", "--height",
+                            "24", "--spp", "2", "--inject", "neighbour-load", "--json", file.string()}));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const json doc = parseJson(readText(file));
     EXPECT_LE(doc["rejectedSamples"].get<uint64_t>(), 32u * 24u * 2u);

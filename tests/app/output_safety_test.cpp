@@ -234,7 +234,8 @@ fs::path gltfWithBufferFile(const fs::path& dir, const std::string& bufferName)
     writeText(dir / bufferName, buffer);
     writeText(dir / "model.gltf", R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
   "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-  "buffers": [{"uri": ")" + bufferName + R"(", "byteLength": 36}],
+  "buffers": [{"uri": ")" + bufferName +
+                                      R"(", "byteLength": 36}],
   "bufferViews": [{"buffer": 0, "byteLength": 36}],
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
                  "min": [0, 0, 0], "max": [1, 1, 0]}]})");
@@ -263,7 +264,8 @@ TEST_F(OutputSafety, NoOutputReplacesAFileTheScenesMeshesRead)
         {gltf, {"-o", out.string(), "--json", (m_dir / "x.exr").string()}, "x.exr: --json is the same file as"},
         {gltf, {"-o", out.string(), "--report", (m_dir / "x.exr").string()}, "x.exr: --report is the same file as"},
         {m_dir / "imports.toml", {"-o", (m_dir / "link.exr").string()}, "link.exr: -o is the same file as"},
-        {m_dir / "imports.toml", {"-o", out.string(), "--png", (m_dir / "gltf-link.png").string()},
+        {m_dir / "imports.toml",
+         {"-o", out.string(), "--png", (m_dir / "gltf-link.png").string()},
          "gltf-link.png: --png is the same file as a glTF file the scene imports"},
         {m_dir / "mesh.toml", {"-o", (m_dir / "x.exr").string()}, "x.exr: -o is the same file as a file a mesh"},
     };
@@ -278,8 +280,7 @@ TEST_F(OutputSafety, NoOutputReplacesAFileTheScenesMeshesRead)
         EXPECT_FALSE(fs::exists(out));
     }
     EXPECT_TRUE(fs::is_symlink(m_dir / "link.exr"));
-    const ProcessResult info =
-        runVkrt({"info", gltf.string(), "--json", (m_dir / "link.exr").string()});
+    const ProcessResult info = runVkrt({"info", gltf.string(), "--json", (m_dir / "link.exr").string()});
     EXPECT_EQ(info.exitCode, 2) << info.output;
     EXPECT_EQ(readAll(m_dir / "x.exr"), buffer);
 }

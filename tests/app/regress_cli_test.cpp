@@ -525,7 +525,7 @@ intensity = [10, 10, 10]
     const fs::path suite = writeManifest({first, textured});
     expectInputError(regress({"--suite", suite.string(), "--update"}),
                      {(m_dir / "ref" / "mean.exr").string() + ": the reference of case textured (mean) is the same "
-                                                               "file as a texture the scene loads"});
+                                                              "file as a texture the scene loads"});
     EXPECT_EQ(readFile(m_dir / "ref" / "mean.exr"), before) << "the texture was overwritten";
     EXPECT_FALSE(fs::exists(first.reference)) << "a case was rendered before the refusal";
 }

@@ -158,13 +158,17 @@ TEST(GltfInputRules, ExtensionListsHoldNamesAndExtensionsAreObjects)
                   "extensionsUsed: expected an array");
     expectRefusal(errorAfter("node-extensions.gltf", [](json& d) { d["nodes"][0]["extensions"] = json::array(); }),
                   "nodes[0].extensions: expected an object, got []");
-    expectRefusal(errorAfter("deep-extensions.gltf",
-                             [](json& d) {
-                                 d["materials"] = json::array({{{"extensions", {{"KHR_materials_ior", {{"extensions", 1}}}}}}});
-                             }),
-                  "materials[0].extensions.KHR_materials_ior.extensions: expected an object");
+    expectRefusal(
+        errorAfter("deep-extensions.gltf",
+                   [](json& d) {
+                       d["materials"] = json::array({{{"extensions", {{"KHR_materials_ior", {{"extensions", 1}}}}}}});
+                   }),
+        "materials[0].extensions.KHR_materials_ior.extensions: expected an object");
     // extras is the application's own: anything goes there.
-    EXPECT_EQ(errorAfter("extras.gltf", [](json& d) { d["nodes"][0]["extras"] = {{"extensions", json::array()}}; }),
+    EXPECT_EQ(errorAfter("extras.gltf",
+                         [](json& d) {
+                             d["nodes"][0]["extras"] = {{"extensions", json::array()}};
+                         }),
               "");
 }
 
@@ -242,9 +246,9 @@ TEST(GltfInputRules, AnOrthographicViewBeyondTheKernelsFloatsIsRefused)
 {
     const auto orthographic = [](double mag) {
         return [=](json& d) {
-            d["cameras"] = json::array(
-                {{{"type", "orthographic"},
-                  {"orthographic", {{"xmag", mag}, {"ymag", mag}, {"znear", 0.1}, {"zfar", 100.0}}}}});
+            d["cameras"] =
+                json::array({{{"type", "orthographic"},
+                              {"orthographic", {{"xmag", mag}, {"ymag", mag}, {"znear", 0.1}, {"zfar", 100.0}}}}});
             d["nodes"].push_back({{"camera", 0}, {"translation", {0.3, 0.3, 2.0}}});
             d["scenes"][0]["nodes"].push_back(1);
         };
@@ -279,8 +283,8 @@ double secondsFor(const std::function<void()>& f)
 // Refused in linear time now (well under a second for these on one core).
 TEST(GltfInputRules, ANodeCountBeyondTheLimitIsRefusedInLinearTime)
 {
-    for (const auto& [count, node] : {std::pair<size_t, json>{300000, json::object()},
-                                      std::pair<size_t, json>{1000000, json{{"mesh", 0}}}}) {
+    for (const auto& [count, node] :
+         {std::pair<size_t, json>{300000, json::object()}, std::pair<size_t, json>{1000000, json{{"mesh", 0}}}}) {
         GltfBuilder b = triangleFile();
         json& nodes = b.doc()["nodes"];
         for (size_t i = 1; i < count; ++i) nodes.push_back(node);
@@ -345,23 +349,24 @@ fs::path manySlotsGlb(const std::string& name, size_t materials, size_t used)
     const json slot = {{"index", 0}};
     json list = json::array();
     for (size_t m = 0; m < materials; ++m)
-        list.push_back({{"pbrMetallicRoughness", {{"baseColorTexture", slot}, {"metallicRoughnessTexture", slot}}},
-                        {"normalTexture", slot},
-                        {"emissiveTexture", slot},
-                        {"emissiveFactor", {1, 1, 1}},
-                        {"extensions",
-                         {{"KHR_materials_sheen", {{"sheenColorTexture", slot}, {"sheenRoughnessTexture", slot}}},
-                          {"KHR_materials_clearcoat",
-                           {{"clearcoatTexture", slot}, {"clearcoatRoughnessTexture", slot}, {"clearcoatNormalTexture", slot}}},
-                          {"KHR_materials_specular", {{"specularTexture", slot}, {"specularColorTexture", slot}}},
-                          {"KHR_materials_transmission", {{"transmissionTexture", slot}}},
-                          {"KHR_materials_iridescence", {{"iridescenceTexture", slot}, {"iridescenceThicknessTexture", slot}}},
-                          {"KHR_materials_anisotropy", {{"anisotropyTexture", slot}}}}}});
+        list.push_back(
+            {{"pbrMetallicRoughness", {{"baseColorTexture", slot}, {"metallicRoughnessTexture", slot}}},
+             {"normalTexture", slot},
+             {"emissiveTexture", slot},
+             {"emissiveFactor", {1, 1, 1}},
+             {"extensions",
+              {{"KHR_materials_sheen", {{"sheenColorTexture", slot}, {"sheenRoughnessTexture", slot}}},
+               {"KHR_materials_clearcoat",
+                {{"clearcoatTexture", slot}, {"clearcoatRoughnessTexture", slot}, {"clearcoatNormalTexture", slot}}},
+               {"KHR_materials_specular", {{"specularTexture", slot}, {"specularColorTexture", slot}}},
+               {"KHR_materials_transmission", {{"transmissionTexture", slot}}},
+               {"KHR_materials_iridescence", {{"iridescenceTexture", slot}, {"iridescenceThicknessTexture", slot}}},
+               {"KHR_materials_anisotropy", {{"anisotropyTexture", slot}}}}}});
     b.doc()["materials"] = list;
     json primitives = json::array();
     for (size_t m = 0; m < used; ++m)
-        primitives.push_back({{"attributes", {{"POSITION", positions}, {"NORMAL", normals}, {"TEXCOORD_0", uvs}}},
-                              {"material", m}});
+        primitives.push_back(
+            {{"attributes", {{"POSITION", positions}, {"NORMAL", normals}, {"TEXCOORD_0", uvs}}}, {"material", m}});
     b.doc()["meshes"] = json::array({{{"primitives", primitives}}});
     b.node({{"mesh", 0}});
     return b.writeGlb(testDir() / name);

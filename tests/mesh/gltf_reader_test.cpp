@@ -184,8 +184,9 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
     computed.doc()["textures"] = b.doc()["textures"];
     computed.doc()["images"] = b.doc()["images"];
     computed.node({{"mesh", uvTriangle(computed, false)}});
-    const auto computedGeometry = makeMeshGeometry(readGltfModel(computed.write(testDir() / "computed.gltf")).meshes.at(0),
-                                                   NormalMode::File, "computed.gltf");
+    const auto computedGeometry =
+        makeMeshGeometry(readGltfModel(computed.write(testDir() / "computed.gltf")).meshes.at(0), NormalMode::File,
+                         "computed.gltf");
     ASSERT_EQ(fromFile.tangents.size(), 3u);
     ASSERT_EQ(computedGeometry->data.tangents.size(), 3u);
     for (size_t v = 0; v < 3; ++v) {

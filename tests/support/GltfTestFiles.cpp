@@ -29,7 +29,7 @@ std::string triangleBuffer()
     for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(bytes, v); // 0: 36 bytes
     for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) put(bytes, v);                // 36: 24 bytes
     for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) put(bytes, v);                // 60: 24 bytes
-    for (uint16_t i : {0, 1, 2}) put(bytes, i);                                   // 84: 6 bytes
+    for (uint16_t i : {0, 1, 2}) put(bytes, i);                                  // 84: 6 bytes
     bytes.append(2, '\0');
     return bytes;
 }
@@ -48,7 +48,8 @@ std::string triangleGltf(const std::string& rest, const std::string& material)
     {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
     {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"},
     {"bufferView": 3, "componentType": 5123, "count": 3, "type": "SCALAR"}],
-  )" + rest + "}";
+  )" + rest +
+           "}";
 }
 
 std::string quadsGltf(const std::vector<GltfQuad>& quads, const std::string& rest)
@@ -97,7 +98,8 @@ std::string quadsGltf(const std::vector<GltfQuad>& quads, const std::string& res
            (second ? R"(, {"bufferView": 3, "componentType": 5126, "count": )" + number(n) + R"(, "type": "VEC2"})"
                    : "") +
            R"(],
-  )" + rest + "}";
+  )" + rest +
+           "}";
 }
 
 GltfBuilder::GltfBuilder()

@@ -67,7 +67,9 @@ public:
     {
         const uint32_t components = std::string(type) == "SCALAR" ? 1 : uint32_t(type[3] - '0');
         const uint32_t view = bufferView(valueBytes(values));
-        json a = {{"bufferView", view}, {"componentType", componentType}, {"count", values.size() / components},
+        json a = {{"bufferView", view},
+                  {"componentType", componentType},
+                  {"count", values.size() / components},
                   {"type", type}};
         if (normalized) a["normalized"] = true;
         m_doc["accessors"].push_back(a);

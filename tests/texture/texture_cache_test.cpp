@@ -151,7 +151,7 @@ TEST(TextureCache, ManyNewImagesBesideAFullCacheAreStoredInTimeLinearInTheImages
     for (int i = 0; i < 40000; ++i) std::ofstream(dir / ("old" + std::to_string(i) + ".vtex")) << "entry";
     const TextureCacheDir cache(dir.string());
     std::vector<fs::path> files;
-    for (unsigned i = 0; i < 2000; ++i)  files.push_back(noisyPng(folder, "tiny" + std::to_string(i) + ".png", 2, i));
+    for (unsigned i = 0; i < 2000; ++i) files.push_back(noisyPng(folder, "tiny" + std::to_string(i) + ".png", 2, i));
     TextureLoadStats stats;
     const auto start = std::chrono::steady_clock::now();
     packAll(files, &stats);

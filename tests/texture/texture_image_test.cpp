@@ -145,10 +145,10 @@ TEST(TextureImage, ATruncatedJpegIsRefusedNamingTheFile)
     const std::string whole = eightByEightJpeg();
     const size_t scan = whole.find("\xFF\xDA");
     ASSERT_NE(scan, std::string::npos);
-    const size_t scanHeader = (static_cast<size_t>(static_cast<uint8_t>(whole[scan + 2])) << 8 |
-                               static_cast<uint8_t>(whole[scan + 3])) + 2;
+    const size_t scanHeader =
+        (static_cast<size_t>(static_cast<uint8_t>(whole[scan + 2])) << 8 | static_cast<uint8_t>(whole[scan + 3])) + 2;
     const std::vector<std::pair<std::string, std::string>> cuts = {
-        {"no-scan.jpg", whole.substr(0, scan)},                           // the headers alone
+        {"no-scan.jpg", whole.substr(0, scan)},                              // the headers alone
         {"empty-scan.jpg", whole.substr(0, scan + scanHeader) + "\xFF\xD9"}, // a scan header, no data
         {"half-scan.jpg", whole.substr(0, (scan + scanHeader + whole.size()) / 2)},
         {"no-end.jpg", whole.substr(0, whole.size() - 2)}, // without its end-of-image marker
@@ -160,8 +160,9 @@ TEST(TextureImage, ATruncatedJpegIsRefusedNamingTheFile)
         const std::vector<uint8_t> data(bytes.begin(), bytes.end());
         EXPECT_EQ(errorOf([&] { readTextureHeader(data, name, false); }).rfind(name + ": damaged JPEG image", 0), 0u);
     }
-    EXPECT_NE(errorOf([&] { loadTextureImage(writeBytes(textureTestDir() / "n.jpg", cuts[0].second), false); })
-                  .find("no start-of-scan"),
+    EXPECT_NE(errorOf([&] {
+                  loadTextureImage(writeBytes(textureTestDir() / "n.jpg", cuts[0].second), false);
+              }).find("no start-of-scan"),
               std::string::npos);
     // The whole file, and one with bytes after its end-of-image marker (allowed), decode.
     const fs::path good = writeBytes(textureTestDir() / "trailing.jpg", whole + "trailing bytes");
