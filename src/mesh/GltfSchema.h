@@ -4,7 +4,7 @@
 // an index written 84.0, -84 or "84" is an error naming its path in the
 // file (nodes[3].children[0]), not a property quietly taken as absent (a
 // child, light or camera dropped, a byteOffset read as 0); enumerations
-// (primitive modes, component types, sampler filters and wraps) hold only
+// (primitive modes, component types, sampler wraps; the material reader checks filters) hold only
 // their listed values; every `extensions` is an object, every name in
 // extensionsUsed and extensionsRequired a string.
 #include <nlohmann/json_fwd.hpp>
