@@ -1,10 +1,12 @@
 #include "view/Viewer.h"
 
 #include "io/ExrFile.h"
+#include "io/OutputPaths.h"
 #include "io/PngFile.h"
 #include "render/ErrorMetrics.h"
 #include "render/Progress.h"
 #include "render/RenderSession.h"
+#include "scene/SceneInputs.h"
 #include "util/Error.h"
 #include "view/CameraControl.h"
 #include "view/DisplayPass.h"
@@ -106,10 +108,30 @@ const char* viewerHelp()
 // In the file's own namespace, as the window types it holds are.
 namespace {
 
+/// The scene file and every file the scene read: what no file the viewer writes may replace.
+std::vector<NamedFile> inputsOf(const Scene& scene)
+{
+    std::vector<NamedFile> inputs = filesTheSceneRead(scene);
+    inputs.push_back({"the scene file", scene.path});
+    return inputs;
+}
+
+/// The scene of `options`, refused before any window opens when one of the
+/// session's `outputs` (--screenshot, a script's save and screenshot paths)
+/// would replace a file it read: a texture, a glTF buffer, a mesh.
+Scene loadSceneWritingNoInput(const ViewOptions& options, const std::vector<NamedFile>& outputs)
+{
+    Scene scene = loadScene(options.scenePath, {options.width, options.height}, options.gltf);
+    const std::vector<NamedFile> inputs = inputsOf(scene);
+    for (const NamedFile& output : outputs) refuseOverlappingFiles(inputs, {output}); // a script may write one file twice
+    return scene;
+}
+
 /// All state of one viewer session. Members are declared in creation order.
 class Viewer {
 public:
-    explicit Viewer(const ViewOptions& options);
+    /// `outputs`: the files the session's script will write (checked against the scene's inputs).
+    Viewer(const ViewOptions& options, const std::vector<NamedFile>& outputs);
     /// Runs `script` if it has commands, else the interactive loop.
     void run(const std::vector<ViewerCommand>& script);
     std::vector<std::string> validationMessages() const { return m_context.validationMessages(); }
@@ -182,9 +204,9 @@ SessionConfig sessionConfig(const ViewOptions& options, const Scene& scene)
     return config;
 }
 
-Viewer::Viewer(const ViewOptions& options)
+Viewer::Viewer(const ViewOptions& options, const std::vector<NamedFile>& outputs)
     : m_options(options),
-      m_parsed(loadScene(options.scenePath, {options.width, options.height}, options.gltf)),
+      m_parsed(loadSceneWritingNoInput(options, outputs)),
       m_window(m_parsed.camera.width, m_parsed.camera.height, "vkrt view - " + options.scenePath),
       m_context(ContextOptions{options.device, options.validation, presentationFor(m_window.get())}),
       m_exposure(options.exposure),
@@ -429,12 +451,14 @@ void Viewer::updateTitle(bool force)
 
 void Viewer::save(const std::string& exrPath)
 {
+    std::filesystem::path png = std::filesystem::path(exrPath).replace_extension(".png");
+    // The scene may have changed since the start (a file dropped on the window): checked again here.
+    refuseOverlappingFiles(inputsOf(scene()), {{"the saved EXR", exrPath}, {"the saved PNG", png}});
     m_context.device().waitIdle();
     Film film = m_session->film();
     std::map<std::string, Image> layers;
     if (film.variance) layers["variance"] = *film.variance;
     writeExr(exrPath, film.mean, m_session->metadata(film, "vkrt view"), layers);
-    std::filesystem::path png = std::filesystem::path(exrPath).replace_extension(".png");
     screenshot(png.string());
     std::printf("saved %s (%u spp) and %s\n", exrPath.c_str(), renderer().completedFrames(), png.c_str());
     std::fflush(stdout);
@@ -442,6 +466,7 @@ void Viewer::save(const std::string& exrPath)
 
 void Viewer::screenshot(const std::string& pngPath)
 {
+    refuseOverlappingFiles(inputsOf(scene()), {{"the screenshot", pngPath}});
     m_context.device().waitIdle();
     writePngPixels(pngPath, renderer().width(), renderer().height(), m_display->readPixels());
 }
@@ -491,7 +516,11 @@ void Viewer::runInteractive()
         while (!m_keys.empty()) {
             std::string key = m_keys.front();
             m_keys.pop_front();
-            if (!flying()) handleKey(key);
+            try {
+                if (!flying()) handleKey(key);
+            } catch (const InputError& e) { // S over one of the scene's files: say so, keep the session
+                std::fprintf(stderr, "vkrt view: %s\n", e.what());
+            }
         }
         renderAndPresent(m_paused ? 0 : m_pacer.nextFrames());
         if (m_paused) glfwWaitEventsTimeout(0.05);
@@ -518,10 +547,24 @@ std::vector<ViewerCommand> scriptFor(const ViewOptions& options)
     return commands;
 }
 
+/// The files a script writes: each `save` (its EXR and the PNG beside it) and `screenshot`.
+std::vector<NamedFile> scriptOutputs(const std::vector<ViewerCommand>& script)
+{
+    std::vector<NamedFile> outputs;
+    for (const ViewerCommand& c : script) {
+        if (c.name == "save") {
+            outputs.push_back({"a saved EXR", c.text});
+            outputs.push_back({"a saved PNG", std::filesystem::path(c.text).replace_extension(".png")});
+        }
+        if (c.name == "screenshot") outputs.push_back({"a screenshot", c.text});
+    }
+    return outputs;
+}
+
 Outcome runViewer(const ViewOptions& options)
 {
     std::vector<ViewerCommand> script = scriptFor(options); // mistakes surface before any window opens
-    Viewer viewer(options);
+    Viewer viewer(options, scriptOutputs(script));
     viewer.run(script);
     return withValidation(Outcome::passed(), viewer.validationMessages());
 }

@@ -282,6 +282,16 @@ TEST_F(OutputSafety, NoOutputReplacesAFileTheScenesMeshesRead)
     EXPECT_TRUE(fs::is_symlink(m_dir / "link.exr"));
     const ProcessResult info = runVkrt({"info", gltf.string(), "--json", (m_dir / "link.exr").string()});
     EXPECT_EQ(info.exitCode, 2) << info.output;
+    // The viewer's --screenshot and a script's save (its EXR and the PNG beside it): refused before any window opens.
+    fs::create_symlink(m_dir / "x.exr", m_dir / "link.png");
+    const ProcessResult view = runVkrt({"view", gltf.string(), "--screenshot", (m_dir / "link.png").string()});
+    EXPECT_EQ(view.exitCode, 2) << view.output;
+    EXPECT_TRUE(contains(view.output, "link.png: a screenshot is the same file as a glTF file the scene imports"))
+        << view.output;
+    writeText(m_dir / "session.txt", "frames 1\nsave " + (m_dir / "link.exr").string() + "\n");
+    const ProcessResult script = runVkrt({"view", gltf.string(), "--script", (m_dir / "session.txt").string()});
+    EXPECT_EQ(script.exitCode, 2) << script.output;
+    EXPECT_TRUE(contains(script.output, "link.exr: a saved EXR is the same file as")) << script.output;
     EXPECT_EQ(readAll(m_dir / "x.exr"), buffer);
 }
 
