@@ -123,7 +123,8 @@ Scene loadSceneWritingNoInput(const ViewOptions& options, const std::vector<Name
 {
     Scene scene = loadScene(options.scenePath, {options.width, options.height}, options.gltf);
     const std::vector<NamedFile> inputs = inputsOf(scene);
-    for (const NamedFile& output : outputs) refuseOverlappingFiles(inputs, {output}); // a script may write one file twice
+    for (const NamedFile& output : outputs)
+        refuseOverlappingFiles(inputs, {output}); // a script may write one file twice
     return scene;
 }
 
