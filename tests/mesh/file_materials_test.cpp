@@ -344,17 +344,7 @@ TEST(MeshFileMaterials, EmbeddedImageInAGlb)
     {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
     {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"},
     {"bufferView": 3, "componentType": 5123, "count": 3, "type": "SCALAR"}]})";
-    json.append((4 - json.size() % 4) % 4, ' ');
-    std::string glb = "glTF";
-    put<uint32_t>(glb, 2);
-    put<uint32_t>(glb, uint32_t(12 + 8 + json.size() + 8 + bin.size()));
-    put<uint32_t>(glb, uint32_t(json.size()));
-    put<uint32_t>(glb, 0x4E4F534Au); // JSON
-    glb += json;
-    put<uint32_t>(glb, uint32_t(bin.size()));
-    put<uint32_t>(glb, 0x004E4942u); // BIN
-    glb += bin;
-    const fs::path file = writeFile(testDir() / "embedded.glb", glb);
+    const fs::path file = writeFile(testDir() / "embedded.glb", vkrt::test::glbBytes(json, bin));
     const MeshData mesh = loadMeshFile(file);
     ASSERT_EQ(mesh.materials.size(), 1u);
     ASSERT_TRUE(mesh.materials[0].metallicRoughnessTexture);

@@ -336,20 +336,7 @@ TEST(MeshReferences, DeeplyNestedJsonIsRefusedWithItsByte)
 }
 
 /// A .glb: the JSON chunk `json` (padded with spaces), then the binary chunk triangleBytes(1).
-std::string glb(std::string json)
-{
-    json.append((4 - json.size() % 4) % 4, ' ');
-    const std::string binary = triangleBytes(1.0f);
-    std::string out = "glTF";
-    put(out, uint32_t(2));
-    put(out, uint32_t(12 + 8 + json.size() + 8 + binary.size()));
-    put(out, uint32_t(json.size()));
-    put(out, uint32_t(0x4E4F534A)); // "JSON"
-    out += json;
-    put(out, uint32_t(binary.size()));
-    put(out, uint32_t(0x004E4942)); // "BIN"
-    return out + binary;
-}
+std::string glb(const std::string& json) { return glbBytes(json, triangleBytes(1.0f)); }
 
 TEST(MeshReferences, GlbJsonChunkIsCheckedToo)
 {
