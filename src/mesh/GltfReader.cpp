@@ -789,7 +789,11 @@ private:
     struct Key {
         uint32_t mesh;
         std::array<double, 16> matrix;
-        bool operator==(const Key& other) const { return mesh == other.mesh && matrix == other.matrix; }
+        /// Bit for bit, as the hash reads them (0.0 and -0.0 differ; a NaN is no transform here).
+        bool operator==(const Key& other) const
+        {
+            return mesh == other.mesh && std::memcmp(matrix.data(), other.matrix.data(), sizeof matrix) == 0;
+        }
     };
     struct KeyHash {
         size_t operator()(const Key& key) const

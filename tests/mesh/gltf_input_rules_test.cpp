@@ -35,16 +35,6 @@ fs::path testDir()
     return dir;
 }
 
-std::string errorOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 /// A one-triangle file (indexed, with uvs) whose node 0 places mesh 0.
 GltfBuilder triangleFile()
 {
@@ -63,7 +53,7 @@ std::string errorAfter(const std::string& name, const std::function<void(json&)>
     GltfBuilder b = triangleFile();
     change(b.doc());
     const fs::path file = b.write(testDir() / name);
-    return errorOf([&] { readGltfModel(file); });
+    return inputErrorOf([&] { readGltfModel(file); });
 }
 
 void expectRefusal(const std::string& error, const std::string& words)
@@ -206,7 +196,7 @@ std::string sparseError(const std::string& name, const std::vector<uint16_t>& ta
     accessors.push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"sparse", sparse}});
     b.node({{"mesh", b.mesh({{"POSITION", accessors.size() - 1}})}});
     const fs::path file = b.write(testDir() / name);
-    return errorOf([&] { readGltfModel(file); });
+    return inputErrorOf([&] { readGltfModel(file); });
 }
 
 TEST(GltfInputRules, SparseIndicesMustStrictlyIncrease)
@@ -223,7 +213,7 @@ TEST(GltfInputRules, BinaryGltfHeadersAreCheckedAsTheSpecificationSays)
 {
     const GltfBuilder b = triangleFile();
     const fs::path good = b.writeGlb(testDir() / "good.glb");
-    EXPECT_EQ(errorOf([&] { readGltfModel(good); }), "");
+    EXPECT_EQ(inputErrorOf([&] { readGltfModel(good); }), "");
     std::ifstream in(good, std::ios::binary);
     const std::string bytes{std::istreambuf_iterator<char>(in), {}};
     const uint32_t jsonLength = uint32_t(bytes[12] & 0xff) | uint32_t(bytes[13] & 0xff) << 8;
@@ -231,13 +221,13 @@ TEST(GltfInputRules, BinaryGltfHeadersAreCheckedAsTheSpecificationSays)
     const std::string bin = bytes.substr(20 + jsonLength + 8);
 
     const fs::path version1 = writeBytes(testDir() / "version1.glb", glbBytes(text, bin, 1));
-    expectRefusal(errorOf([&] { readGltfModel(version1); }), "a binary glTF of container version 1");
+    expectRefusal(inputErrorOf([&] { readGltfModel(version1); }), "a binary glTF of container version 1");
     std::string unpaddedText = text;
     while (unpaddedText.size() % 4 != 1) unpaddedText.pop_back(); // trailing spaces only
     const fs::path unpadded = writeBytes(testDir() / "unpadded.glb", glbBytes(unpaddedText + " ", bin, 2, false));
-    expectRefusal(errorOf([&] { readGltfModel(unpadded); }), "not a multiple of 4");
+    expectRefusal(inputErrorOf([&] { readGltfModel(unpadded); }), "not a multiple of 4");
     const fs::path longer = writeBytes(testDir() / "longer.glb", bytes + std::string(8, '\0'));
-    expectRefusal(errorOf([&] { readGltfModel(longer); }), "header gives its length as");
+    expectRefusal(inputErrorOf([&] { readGltfModel(longer); }), "header gives its length as");
 }
 
 // ---------------------------------------------------------------- cameras
@@ -291,7 +281,7 @@ TEST(GltfInputRules, ANodeCountBeyondTheLimitIsRefusedInLinearTime)
         for (size_t i = 1; i < count; ++i) nodes.push_back(node);
         const fs::path file = b.write(testDir() / ("nodes" + std::to_string(node.size()) + ".gltf"));
         std::string error;
-        const double seconds = secondsFor([&] { error = errorOf([&] { readGltfModel(file); }); });
+        const double seconds = secondsFor([&] { error = inputErrorOf([&] { readGltfModel(file); }); });
         expectRefusal(error, "nodes; vkrt reads at most 65,536");
         EXPECT_LT(seconds, 20.0) << node.dump() << " x " << count;
     }

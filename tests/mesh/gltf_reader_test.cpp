@@ -39,16 +39,6 @@ uint32_t triangleMesh(GltfBuilder& b, bool uvs = false, std::optional<uint32_t> 
     return b.mesh(attributes, std::nullopt, 4, material);
 }
 
-std::string errorOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 TEST(GltfReader, SmallNodeTranslationsArePlacedExactly)
 {
     // assimp's identity test (tolerance 1e-2) dropped translations like these.
@@ -120,7 +110,7 @@ TEST(GltfReader, PrimitivesWithAndWithoutTextureCoordinatesShareAFile)
     bad.doc()["textures"] = b.doc()["textures"];
     bad.doc()["images"] = b.doc()["images"];
     bad.node({{"mesh", triangleMesh(bad, false, 0)}});
-    const std::string error = errorOf([&] { readGltfModel(bad.write(testDir() / "bad-uvs.gltf")); });
+    const std::string error = inputErrorOf([&] { readGltfModel(bad.write(testDir() / "bad-uvs.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
     EXPECT_NE(error.find("TEXCOORD_0"), std::string::npos) << error;
 }
@@ -201,7 +191,7 @@ TEST(GltfReader, TheSecondUvSetIsReadWhereATextureReadsIt)
     bad.doc()["textures"] = b.doc()["textures"];
     bad.doc()["images"] = b.doc()["images"];
     bad.node({{"mesh", triangleMesh(bad, true, 0)}});
-    const std::string error = errorOf([&] { readGltfModel(bad.write(testDir() / "bad-uv1.gltf")); });
+    const std::string error = inputErrorOf([&] { readGltfModel(bad.write(testDir() / "bad-uv1.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0]"), std::string::npos) << error;
     EXPECT_NE(error.find("TEXCOORD_1"), std::string::npos) << error;
 }
@@ -248,7 +238,7 @@ TEST(GltfReader, PbrExtensionLayersAreReadWithTheirTextures)
     GltfBuilder bad;
     bad.doc()["materials"] = json::parse(R"([{"extensions": {"KHR_materials_sheen": {"sheenRoughnessFactor": 2}}}])");
     bad.node({{"mesh", triangleMesh(bad, false, 0)}});
-    const std::string error = errorOf([&] { readGltfModel(bad.write(testDir() / "bad-sheen.gltf")); });
+    const std::string error = inputErrorOf([&] { readGltfModel(bad.write(testDir() / "bad-sheen.gltf")); });
     EXPECT_NE(error.find("bad-sheen.gltf"), std::string::npos) << error;
     EXPECT_NE(error.find("sheenRoughnessFactor"), std::string::npos) << error;
 }
@@ -356,7 +346,7 @@ TEST(GltfReader, ScenesAreChosenByNameOrIndex)
     options.scene = "0";
     EXPECT_EQ(readGltfModel(file, options).sceneName, "left");
     options.scene = "right";
-    const std::string error = errorOf([&] { readGltfModel(file, options); });
+    const std::string error = inputErrorOf([&] { readGltfModel(file, options); });
     EXPECT_NE(error.find("--scene right"), std::string::npos) << error;
     EXPECT_NE(error.find("1 ('both')"), std::string::npos) << error;
 }
@@ -370,7 +360,7 @@ TEST(GltfReader, RequiredExtensionsMustBeImplementedUsedOnesAreNamedOnce)
     ASSERT_EQ(model.warnings.size(), 1u);
     EXPECT_NE(model.warnings[0].find("KHR_materials_diffuse_transmission"), std::string::npos);
     b.doc()["extensionsRequired"] = {"KHR_draco_mesh_compression"};
-    const std::string error = errorOf([&] { readGltfModel(b.write(testDir() / "required.gltf")); });
+    const std::string error = inputErrorOf([&] { readGltfModel(b.write(testDir() / "required.gltf")); });
     EXPECT_NE(error.find("extensionsRequired names KHR_draco_mesh_compression"), std::string::npos) << error;
 }
 
@@ -396,7 +386,7 @@ TEST(GltfReader, AMaterialVariantReplacesTheMaterialsItMaps)
     options.variant = "0";
     EXPECT_EQ(readGltfModel(file, options).meshes[0].triangleMaterials[0], 1u);
     options.variant = "Green";
-    const std::string error = errorOf([&] { readGltfModel(file, options); });
+    const std::string error = inputErrorOf([&] { readGltfModel(file, options); });
     EXPECT_NE(error.find("--variant Green"), std::string::npos) << error;
     EXPECT_NE(error.find("1 ('Blue')"), std::string::npos) << error;
 }
@@ -406,10 +396,10 @@ TEST(GltfReader, BadAccessorsAndIndicesAreNamed)
     GltfBuilder b;
     const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
     b.node({{"mesh", b.mesh({{"POSITION", positions}}, b.indices({0, 1, 7}))}});
-    std::string error = errorOf([&] { readGltfModel(b.write(testDir() / "index.gltf")); });
+    std::string error = inputErrorOf([&] { readGltfModel(b.write(testDir() / "index.gltf")); });
     EXPECT_NE(error.find("meshes[0].primitives[0].indices[2] is 7"), std::string::npos) << error;
     b.doc()["accessors"][positions]["count"] = 4; // past its bufferView
-    error = errorOf([&] { readGltfModel(b.write(testDir() / "count.gltf")); });
+    error = inputErrorOf([&] { readGltfModel(b.write(testDir() / "count.gltf")); });
     EXPECT_NE(error.find("accessor 0"), std::string::npos) << error;
 }
 
@@ -420,7 +410,7 @@ TEST(GltfReader, TrianglesOfAnIndexCountNotAMultipleOfThreeAreRefused)
     GltfBuilder b;
     const uint32_t positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
     b.node({{"mesh", b.mesh({{"POSITION", positions}}, b.indices({0, 1, 2, 1, 3, 2, 0, 1}))}});
-    const std::string error = errorOf([&] { readGltfModel(b.write(testDir() / "eight.gltf")); });
+    const std::string error = inputErrorOf([&] { readGltfModel(b.write(testDir() / "eight.gltf")); });
     EXPECT_NE(error.find(
                   "eight.gltf: meshes[0].primitives[0]: a TRIANGLES primitive of 8 indices, not a multiple of 3"),
               std::string::npos)
@@ -428,7 +418,7 @@ TEST(GltfReader, TrianglesOfAnIndexCountNotAMultipleOfThreeAreRefused)
     GltfBuilder unindexed;
     const uint32_t four = unindexed.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
     unindexed.node({{"mesh", unindexed.mesh({{"POSITION", four}})}});
-    const std::string second = errorOf([&] { readGltfModel(unindexed.write(testDir() / "four.gltf")); });
+    const std::string second = inputErrorOf([&] { readGltfModel(unindexed.write(testDir() / "four.gltf")); });
     EXPECT_NE(second.find("a TRIANGLES primitive of 4 vertices, not a multiple of 3"), std::string::npos) << second;
 }
 

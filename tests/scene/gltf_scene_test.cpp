@@ -29,16 +29,6 @@ void expectNear(const glm::dvec3& a, const glm::dvec3& b, double tolerance, cons
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(a[i], b[i], tolerance) << what << "[" << i << "]";
 }
 
-std::string errorOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 TEST(GltfScene, CameraAndLightsAreThoseTheNodesPlace)
 {
     const Scene gltf = parseGltfScene((kSource / "scenes/gltf/lights-camera.gltf").string());
@@ -86,7 +76,7 @@ TEST(GltfScene, AnotherCameraByIndexOrNameAndAClearErrorForNone)
     const std::string file = (kSource / "scenes/gltf/lights-camera.gltf").string();
     const Scene byIndex = parseGltfScene(file, {std::string("0"), std::nullopt});
     EXPECT_GT(byIndex.camera.fovY, 0.0);
-    const std::string error = errorOf([&] { parseGltfScene(file, {std::string("7"), std::nullopt}); });
+    const std::string error = inputErrorOf([&] { parseGltfScene(file, {std::string("7"), std::nullopt}); });
     EXPECT_NE(error.find("--camera 7: "), std::string::npos) << error;
     EXPECT_NE(error.find("has no such camera"), std::string::npos) << error;
 }
@@ -125,7 +115,7 @@ TEST(GltfScene, BadCamerasAndLightsNameTheFile)
                       R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}])",
                       R"("scenes": [{"nodes": [0, 1]}],
         "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}])");
-    std::string error = errorOf([&] { parseGltfScene(a.string()); });
+    std::string error = inputErrorOf([&] { parseGltfScene(a.string()); });
     EXPECT_NE(error.find(a.string() + ": cameras[0].perspective.yfov: must be strictly between 0 and pi"),
               std::string::npos)
         << error;
@@ -134,14 +124,14 @@ TEST(GltfScene, BadCamerasAndLightsNameTheFile)
         "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": -1}]}})",
                                      R"("scenes": [{"nodes": [0, 1]}],
         "nodes": [{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 0}}}])");
-    error = errorOf([&] { parseGltfScene(b.string()); });
+    error = inputErrorOf([&] { parseGltfScene(b.string()); });
     EXPECT_NE(error.find(b.string() + ": extensions.KHR_lights_punctual.lights[0]: color and intensity must be >= 0"),
               std::string::npos)
         << error;
 
     const fs::path c = freshTempDir("gltf-broken") / "broken.gltf";
     writeText(c, "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [");
-    error = errorOf([&] { parseGltfScene(c.string()); });
+    error = inputErrorOf([&] { parseGltfScene(c.string()); });
     EXPECT_NE(error.find("broken.gltf"), std::string::npos) << error;
 }
 
@@ -164,7 +154,7 @@ TEST(GltfScene, ExtremeAspectRatiosGiveSmallImagesOrAnError)
     EXPECT_EQ(wide.camera.height, 320u);
     for (const char* aspect : {"1e-300", "1e300"}) {
         const fs::path file = writeTriangle("gltf-thin", cameraWithAspect(aspect), nodes);
-        const std::string error = errorOf([&] { parseGltfScene(file.string()); });
+        const std::string error = inputErrorOf([&] { parseGltfScene(file.string()); });
         EXPECT_NE(error.find(file.string() + ": cameras[0]"), std::string::npos) << error;
         EXPECT_NE(error.find("less than one pixel"), std::string::npos) << error;
     }
@@ -172,7 +162,7 @@ TEST(GltfScene, ExtremeAspectRatiosGiveSmallImagesOrAnError)
     const fs::path zero = writeTriangle(
         "gltf-zero-rotation", cameraWithAspect("1.5"),
         R"("scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"camera": 0, "rotation": [0, 0, 0, 0]}])");
-    const std::string error = errorOf([&] { parseGltfScene(zero.string()); });
+    const std::string error = inputErrorOf([&] { parseGltfScene(zero.string()); });
     EXPECT_NE(error.find("nodes[1].rotation: a rotation quaternion must not be zero"), std::string::npos) << error;
 }
 
@@ -211,7 +201,7 @@ TEST(GltfScene, CamerasAreListedInFileOrderAndOrthographicOnesKeepTheirView)
                                            {"camera": 2, "translation": [0, 0, 5]},
                                            {"camera": 1, "translation": [0, 0, 6]},
                                            {"camera": 0, "translation": [0, 0, 7]}])");
-    const std::string error = errorOf([&] { parseGltfScene(file.string(), {std::string("top"), std::nullopt}); });
+    const std::string error = inputErrorOf([&] { parseGltfScene(file.string(), {std::string("top"), std::nullopt}); });
     EXPECT_NE(error.find("its cameras: 0 ('front'), 1 ('side'), 2 ('plan')"), std::string::npos) << error;
     const Scene plan = parseGltfScene(file.string(), {std::string("plan"), std::nullopt});
     EXPECT_EQ(plan.camera.orthographicHeight, 3.0);
@@ -262,7 +252,7 @@ TEST(GltfScene, ImportedIntoATomlSceneKeepsTheTomlCameraAndAddsLights)
     EXPECT_EQ(own.camera.eye, gltf.camera.eye);
     // A missing file is the scene's error, located at the key.
     const std::string error =
-        errorOf([&] { parseSceneString("[import]\ngltf = \"missing.glb\"\n", (dir / "import.toml").string()); });
+        inputErrorOf([&] { parseSceneString("[import]\ngltf = \"missing.glb\"\n", (dir / "import.toml").string()); });
     EXPECT_NE(error.find("import.toml:2:8: import.gltf: file"), std::string::npos) << error;
 }
 

@@ -201,4 +201,14 @@ double channelMean(const Image& image, int channel)
     return sum / double(image.pixelCount());
 }
 
+std::string inputErrorOf(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
 } // namespace vkrt::test

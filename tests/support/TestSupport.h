@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,9 @@ ProcessResult runShell(const std::string& command);
 
 /// Single-quotes a string for the shell.
 std::string shellQuote(const std::string& arg);
+
+/// The message of the InputError `f` throws, or "" when it throws none.
+std::string inputErrorOf(const std::function<void()>& f);
 
 /// Writes text to a file (creating parent directories).
 void writeText(const std::filesystem::path& path, const std::string& text);
