@@ -159,6 +159,24 @@ bool finishSample(inout AccumPixel sum, uint pixelIndex, uint slot, inout uint f
     return true;
 }
 
+#ifdef VKRT_STAGE
+#include "lib/stages.glsl"
+
+// A staged kernel (VKRT_STAGE 1: trace, 2: shade) works on its pixel's lane.
+void main()
+{
+    uvec2 pixel = scatteredPixel();
+    if (pixel.x >= u.width || pixel.y >= u.height)
+        return;
+    uint pixelIndex = pixel.y * u.width + pixel.x;
+    uint slot = pixelIndex - bandFirstTileRow() * WORKGROUP_SIZE_Y * u.width;
+#if VKRT_STAGE == 1
+    traceStage(pixelIndex, slot);
+#else
+    shadeStage(pixel, pixelIndex, slot);
+#endif
+}
+#else
 // One invocation adds frames [frameIndex, frameEnd) of its pixel (FrameRun),
 // in order, so the sums are the same as one frame per dispatch would give.
 void main()
@@ -203,3 +221,4 @@ void main()
     accum[slot] = sum;
     reportLoopIterations(g_longestSample);
 }
+#endif

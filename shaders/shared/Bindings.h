@@ -65,11 +65,22 @@ VKRT_CONSTANT(uint, BINDING_MESH_COLORS, BINDING_ENVIRONMENT + 20)
 VKRT_CONSTANT(uint, BINDING_MESH_UVS1, BINDING_ENVIRONMENT + 21)
 // LightPick[]: the light table of scenes with many lights (VKRT_LIGHT_TABLE).
 VKRT_CONSTANT(uint, BINDING_LIGHT_TABLE, BINDING_ENVIRONMENT + 22)
+// The staged kernels' lanes (lib/stages.glsl: StagedLane per pixel, after a
+// header of 4 words), in variants with VKRT_STAGE only.
+#if defined(__cplusplus) || defined(VKRT_STAGE)
+VKRT_CONSTANT(uint, BINDING_STAGED_LANES, BINDING_ENVIRONMENT + 23)
+#endif
+#ifdef __cplusplus
+// The bytes the host gives each lane and the header before them
+// (tests/render/staged_kernels_test.cpp checks StagedLane's compiled size).
+VKRT_CONSTANT(uint, STAGED_LANE_BYTES, 320)
+VKRT_CONSTANT(uint, STAGED_HEADER_BYTES, 16)
+#endif
 // Host only: a GLSL constant of a new value is emitted into every variant's
 // SPIR-V (glslang keeps folded constants), so a binding added for one feature
 // would change every kernel; the kernels never need the count.
 #ifdef __cplusplus
-VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 23)
+VKRT_CONSTANT(uint, BINDING_COUNT, BINDING_ENVIRONMENT + 24)
 #endif
 
 // BVH traversal keeps a stack of this many nodes per level (top and mesh);

@@ -26,6 +26,7 @@ struct InfoOptions {
     std::string scenePath;
     std::string device;
     bool uber = false;
+    bool staged = false;
     AccelChoice accel = AccelChoice::Auto;
     std::string json;                  ///< --json FILE, or "-" for standard output
     std::string sceneJson;             ///< --scene-json FILE, or "-" for standard output
@@ -414,6 +415,7 @@ int runInfo(const InfoOptions& options)
     VulkanContext context({options.device, false});
     SessionConfig config;
     config.uber = options.uber;
+    config.staged = options.staged;
     config.accel = options.accel;
     config.warmUp = false; // the first frame's time is what info measures
     config.maxTextureChunkBytes = options.maxTextureChunkBytes;
@@ -443,6 +445,7 @@ CommandRunner addInfoCommand(CLI::App& app)
     cmd->add_option("scene", options->scenePath, "Scene file")->required();
     cmd->add_option("--device", options->device, "Vulkan device index or name");
     cmd->add_flag("--uber", options->uber, "Describe the all-features kernel instead");
+    cmd->add_flag("--staged", options->staged, "Describe the staged kernels (trace and shade) instead");
     addAccelOption(*cmd, options->accel);
     cmd->add_option("--json", options->json,
                     "Also write these facts as one JSON object to FILE, or to standard output for - (the lines "

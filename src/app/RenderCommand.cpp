@@ -50,6 +50,7 @@ struct RenderCommandOptions {
     bool filmic = false;
     bool validation = false;
     bool uber = false;
+    bool staged = false;
     bool pixelCenters = false;
     bool variance = false;
     std::optional<double> timeBudget;
@@ -148,6 +149,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
     if (shard) config.firstFrame = shard->begin;
     config.jitter = !options.pixelCenters;
     config.uber = options.uber;
+    config.staged = options.staged;
     config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
     config.accel = options.accel;
     config.variance = options.varianceNeeds();
@@ -547,6 +549,8 @@ CommandRunner addRenderCommand(CLI::App& app)
     cmd->add_flag("--validation", options->validation,
                   "Enable Vulkan validation; any message makes the exit status 3 (also VKRT_VALIDATION=1)");
     cmd->add_flag("--uber", options->uber, "Use the all-features kernel instead of the scene's variant");
+    cmd->add_flag("--staged", options->staged,
+                  "Run the path integrator as two kernels, trace and shade, that take turns (the same image)");
     cmd->add_flag("--pixel-centers", options->pixelCenters, "Sample pixel centres only (no anti-aliasing jitter)");
     cmd->add_option("--time-budget", options->timeBudget, "Stop after this many seconds of rendering")
         ->check(positiveFiniteNumber("seconds"));

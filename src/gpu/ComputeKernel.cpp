@@ -27,20 +27,18 @@ std::vector<KernelBinding> renderKernelBindings(const std::vector<uint32_t>& ind
 
 ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv,
                              std::vector<KernelBinding> bindings, uint32_t pushConstantSize, uint32_t setCount)
+    : ComputeKernel(context, std::vector<std::span<const uint32_t>>{spirv}, std::move(bindings), pushConstantSize,
+                    setCount)
+{
+}
+
+ComputeKernel::ComputeKernel(const VulkanContext& context, const std::vector<std::span<const uint32_t>>& stages,
+                             std::vector<KernelBinding> bindings, uint32_t pushConstantSize, uint32_t setCount)
     : m_context(context),
       m_bindings(std::move(bindings)),
       m_pushConstantSize(pushConstantSize)
 {
     const auto& device = context.device();
-    // The fault injector (gpu/SpirvFault.h) changes only what the driver
-    // runs: the SPIR-V cache keeps the kernel as compiled.
-    std::vector<uint32_t> faulty;
-    if (std::optional<SpirvFault> fault = spirvFaultFromEnvironment()) {
-        faulty = injectSpirvFault(spirv, *fault);
-        spirv = faulty;
-    }
-    m_module = vk::raii::ShaderModule(device, vk::ShaderModuleCreateInfo({}, spirv.size_bytes(), spirv.data()));
-
     std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
     std::vector<vk::DescriptorPoolSize> poolSizes;
     for (const KernelBinding& binding : m_bindings) {
@@ -55,10 +53,21 @@ ComputeKernel::ComputeKernel(const VulkanContext& context, std::span<const uint3
     if (pushConstantSize == 0) layoutInfo.setPushConstantRanges({});
     m_pipelineLayout = vk::raii::PipelineLayout(device, layoutInfo);
 
-    vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *m_module, "main");
-    m_pipeline = vk::raii::Pipeline(device, nullptr,
-                                    vk::ComputePipelineCreateInfo(vk::PipelineCreateFlagBits::eDispatchBase, stage,
-                                                                  *m_pipelineLayout));
+    VKRT_CHECK(!stages.empty());
+    for (std::span<const uint32_t> spirv : stages) {
+        // The fault injector (gpu/SpirvFault.h) changes only what the driver
+        // runs: the SPIR-V cache keeps the kernel as compiled.
+        std::vector<uint32_t> faulty;
+        if (std::optional<SpirvFault> fault = spirvFaultFromEnvironment()) {
+            faulty = injectSpirvFault(spirv, *fault);
+            spirv = faulty;
+        }
+        vk::raii::ShaderModule module(device, vk::ShaderModuleCreateInfo({}, spirv.size_bytes(), spirv.data()));
+        vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *module, "main");
+        m_pipelines.emplace_back(device, nullptr,
+                                 vk::ComputePipelineCreateInfo(vk::PipelineCreateFlagBits::eDispatchBase, stage,
+                                                               *m_pipelineLayout));
+    }
 
     VKRT_CHECK(setCount > 0);
     m_pool = vk::raii::DescriptorPool(device,
@@ -139,14 +148,20 @@ void ComputeKernel::bindStorageImage(uint32_t binding, vk::ImageView view)
     }
 }
 
-void ComputeKernel::recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, uint32_t set) const
+void ComputeKernel::recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, uint32_t set,
+                               uint32_t stage) const
 {
     VKRT_CHECK(pushConstants.size() == m_pushConstantSize);
-    cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *m_pipeline);
+    recordBindStage(cmd, stage);
     cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *m_pipelineLayout, 0, *m_sets.at(set), nullptr);
     if (!pushConstants.empty())
         cmd.pushConstants(*m_pipelineLayout, vk::ShaderStageFlagBits::eCompute, 0, uint32_t(pushConstants.size()),
                           pushConstants.data());
+}
+
+void ComputeKernel::recordBindStage(vk::CommandBuffer cmd, uint32_t stage) const
+{
+    cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *m_pipelines.at(stage));
 }
 
 void ComputeKernel::recordDispatch(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants,

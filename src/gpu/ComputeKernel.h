@@ -27,6 +27,10 @@ public:
     /// `pushConstantSize` in bytes (0: no push constants); `setCount` descriptor sets.
     ComputeKernel(const VulkanContext& context, std::span<const uint32_t> spirv, std::vector<KernelBinding> bindings,
                   uint32_t pushConstantSize, uint32_t setCount = 1);
+    /// Several pipelines (stages) of one layout and one set of descriptors:
+    /// recordBind's `stage` picks one; a binding made once serves them all.
+    ComputeKernel(const VulkanContext& context, const std::vector<std::span<const uint32_t>>& stages,
+                  std::vector<KernelBinding> bindings, uint32_t pushConstantSize, uint32_t setCount = 1);
 
     /// Points `binding` at `buffer` (the whole buffer) in every set.
     void bind(uint32_t binding, const Buffer& buffer);
@@ -45,7 +49,10 @@ public:
     /// Binds the pipeline, descriptor set and push constants once, for a run
     /// of recordDispatchAt calls (lavapipe re-specializes the kernel each time
     /// push constants or bindings change).
-    void recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, uint32_t set = 0) const;
+    void recordBind(vk::CommandBuffer cmd, std::span<const std::byte> pushConstants, uint32_t set = 0,
+                    uint32_t stage = 0) const;
+    /// Binds stage `stage`'s pipeline alone (the set and push constants stay bound).
+    void recordBindStage(vk::CommandBuffer cmd, uint32_t stage) const;
     /// A dispatch of `groups` workgroups whose ids start at (base.x, base.y, baseZ).
     void recordDispatchAt(vk::CommandBuffer cmd, vk::Offset2D base, uint32_t baseZ, vk::Extent2D groups) const;
     bool uses(uint32_t binding) const;
@@ -57,10 +64,9 @@ private:
     const VulkanContext& m_context;
     std::vector<KernelBinding> m_bindings;
     uint32_t m_pushConstantSize;
-    vk::raii::ShaderModule m_module = nullptr;
     vk::raii::DescriptorSetLayout m_setLayout = nullptr;
     vk::raii::PipelineLayout m_pipelineLayout = nullptr;
-    vk::raii::Pipeline m_pipeline = nullptr;
+    std::vector<vk::raii::Pipeline> m_pipelines; ///< one per stage
     vk::raii::DescriptorPool m_pool = nullptr;
     std::vector<vk::raii::DescriptorSet> m_sets;
 };

@@ -161,6 +161,7 @@ std::vector<uint32_t> KernelVariant::bindings() const
     if (features.anyPrimitive()) result.push_back(gpu::BINDING_MATERIALS);
     for (const auto& feature : optionalFeatures(*this))
         if (feature.on && feature.binding >= 0) result.push_back(uint32_t(feature.binding));
+    if (staged) result.push_back(gpu::BINDING_STAGED_LANES);
     return result;
 }
 
@@ -174,6 +175,7 @@ std::string KernelVariant::describe() const
     for (MaterialType type : kAllMaterialTypes)
         if (features.has(type)) text += " " + materialTypeName(type);
     text += uniformScene ? "; uniform-scene" : "; storage-scene";
+    if (staged) text += "; staged";
     return text;
 }
 

@@ -42,6 +42,9 @@ struct KernelVariant {
     /// TextureChunking). 1 (every scene whose texels fit one buffer) adds
     /// nothing, so those kernels are what they were; more adds
     /// VKRT_TEXTURE_CHUNKS and VKRT_TEXTURE_CHUNK_SHIFT (lib/texture_bindings.glsl).
+    /// The path integrator in two kernels, trace and shade (lib/stages.glsl;
+    /// render --staged): the same defines, each stage compiled with VKRT_STAGE.
+    bool staged = false;
     uint32_t textureChunks = 1;
     uint32_t textureChunkShift = 0; ///< log2 of the words of each chunk, with several
 

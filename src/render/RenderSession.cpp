@@ -102,6 +102,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     options.samplesPerInvocation = config.samplesPerInvocation;
     options.jitter = config.jitter;
     options.uber = config.uber;
+    options.staged = config.staged;
     options.variance = config.variance.any();
     options.aov = config.aov;
     options.extraDefines = config.extraDefines;

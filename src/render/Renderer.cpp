@@ -129,6 +129,10 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
                          "(its batch count is VARIANCE_BATCHES)");
     variant.uniformScene = sceneFitsUniformBuffers(scene) && !options.storageScene;
     variant.groupLoopCount = context.loopCap().capped() && !scene.meshes.empty();
+    if (options.staged && variant.features.integrator != Integrator::Path)
+        throw InputError(scene.path + ": --staged runs the path integrator only; the scene's integrator is " +
+                         integratorName(variant.features.integrator));
+    variant.staged = options.staged;
     chooseTextureChunks(context, scene, options, variant);
     return variant;
 }
@@ -179,9 +183,11 @@ Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records
     return makeBufferFrom(context, records, vk::BufferUsageFlagBits::eUniformBuffer);
 }
 
-CompiledKernel compileVariant(const KernelVariant& variant, const RenderOptions& options)
+/// The variant's kernel; with staged kernels, stage `stage` (1 trace, 2 shade; lib/stages.glsl).
+CompiledKernel compileVariant(const KernelVariant& variant, const RenderOptions& options, int stage = 2)
 {
     KernelSource source{options.shaderRoot, "kernels/render.comp", variant.defines()};
+    if (variant.staged) source.defines.emplace_back("VKRT_STAGE", std::to_string(stage));
     source.defines.insert(source.defines.end(), options.extraDefines.begin(), options.extraDefines.end());
     return compileKernelCached(source, SpirvCache(options.cacheDirectory));
 }
@@ -308,14 +314,24 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
                                   TextureChunking{m_variant.textureChunks, m_variant.textureChunkShift})),
       m_data(convertScene(scene, frameSettings(), m_static)),
       m_compiled(compileVariant(m_variant, m_options)),
+      m_traceCompiled(m_variant.staged ? compileVariant(m_variant, m_options, 1) : CompiledKernel{}),
       m_accumulation(context, m_bands, sizeof(gpu::AccumPixel), scene.path, "the accumulation buffer"),
       m_stats(context, sizeof(gpu::RenderStats),
               kStorage | vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eTransferSrc,
               MemoryUse::Device),
       m_frameRun(context, sizeof(gpu::FrameRun), kStorage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Device),
-      m_kernel(context, m_compiled.spirv, checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants),
+      m_kernel(context, kernelStages(), checkedKernelBindings(context, scene, m_variant), sizeof(gpu::FrameConstants),
                m_bands.count)
 {
+    if (m_variant.staged) {
+        if (m_bands.count > 1)
+            throw InputError(scene.path + ": --staged renders images of one band only (" +
+                             std::to_string(m_bands.count) + " bands here)");
+        m_lanes.emplace(context, gpu::STAGED_HEADER_BYTES + vk::DeviceSize(gpu::STAGED_LANE_BYTES) * width() * height(),
+                        kStorage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Readback);
+        m_lanes->clear(context);
+        m_kernel.bind(gpu::BINDING_STAGED_LANES, *m_lanes);
+    }
     m_accumulation.clear(context);
     m_stats.clear(context);
     if (m_variant.variance) {
@@ -469,9 +485,16 @@ void Renderer::uploadSceneBuffers()
     addStorage(gpu::BINDING_MATERIAL_TABLES, m_static.materialTables);
 }
 
+std::vector<std::span<const uint32_t>> Renderer::kernelStages() const
+{
+    if (!m_variant.staged) return {m_compiled.spirv};
+    return {m_traceCompiled.spirv, m_compiled.spirv};
+}
+
 void Renderer::reset()
 {
     m_frames = 0;
+    if (m_lanes) m_lanes->clear(m_context);
     m_accumulation.clear(m_context);
     m_stats.clear(m_context);
     if (m_moments) m_moments->clear(m_context);
@@ -543,10 +566,14 @@ void Renderer::renderFrames(uint32_t frames)
     // Base z + 1 stays within maxComputeWorkGroupCount[2], which Vulkan
     // guarantees to be at least 65,535.
     constexpr uint32_t maxRun = 4096;
-    m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+    if (m_variant.staged) {
         for (uint32_t done = 0; done < frames; done += maxRun)
-            recordFrames(cmd, m_options.firstFrame + m_frames + done, std::min(maxRun, frames - done));
-    });
+            renderStagedRun(m_options.firstFrame + m_frames + done, std::min(maxRun, frames - done));
+    } else
+        m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+            for (uint32_t done = 0; done < frames; done += maxRun)
+                recordFrames(cmd, m_options.firstFrame + m_frames + done, std::min(maxRun, frames - done));
+        });
     m_frames += frames;
     if (m_variant.groupLoopCount && counters().budgetExceeded)
         throw InputError(m_scene.path + ": " + std::to_string(counters().budgetExceeded) +
@@ -557,9 +584,69 @@ void Renderer::renderFrames(uint32_t frames)
                          "not written. Use Mesa 25's lavapipe, which has no such cap, or simpler meshes");
 }
 
+// The staged kernels take turns, shade then trace, a few rounds per
+// submission, until the last shade leaves no lane work (lib/stages.glsl).
+void Renderer::renderStagedRun(uint32_t firstFrame, uint32_t count)
+{
+    constexpr uint32_t roundsPerSubmit = 8;
+    const gpu::FrameConstants constants{firstFrame, m_options.seed};
+    const uint32_t tilesX = (width() + gpu::WORKGROUP_SIZE_X - 1) / gpu::WORKGROUP_SIZE_X;
+    const vk::Extent2D groups(tilesX, m_bands.tileRowsPerBand());
+    auto* header = static_cast<volatile uint32_t*>(m_lanes->mapped());
+    VKRT_CHECK(header != nullptr);
+    bool first = true;
+    for (;;) {
+        m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+            if (first) recordFrameRun(cmd, gpu::FrameRun{count, firstFrame + count});
+            m_kernel.recordBind(cmd, bytesOf(constants), 0, 1);
+            vk::MemoryBarrier shaderToShader(vk::AccessFlagBits::eShaderWrite,
+                                             vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+            vk::MemoryBarrier transferToShader(vk::AccessFlagBits::eTransferWrite,
+                                               vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+            for (uint32_t round = 0; round < roundsPerSubmit; ++round) {
+                if (round + 1 == roundsPerSubmit) {
+                    // Only the last shade's verdict counts.
+                    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer,
+                                        {},
+                                        vk::MemoryBarrier(vk::AccessFlagBits::eShaderWrite,
+                                                          vk::AccessFlagBits::eTransferWrite),
+                                        nullptr, nullptr);
+                    cmd.fillBuffer(m_lanes->handle(), 0, 4, 0);
+                    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader,
+                                        {}, transferToShader, nullptr, nullptr);
+                }
+                for (uint32_t stage : {1u, 0u}) {
+                    m_kernel.recordBindStage(cmd, stage);
+                    m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, 0), 0, groups);
+                    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader,
+                                        vk::PipelineStageFlagBits::eComputeShader, {}, shaderToShader, nullptr,
+                                        nullptr);
+                }
+            }
+            cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {},
+                                vk::MemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead),
+                                nullptr, nullptr);
+        });
+        first = false;
+        if (header[0] == 0) return;
+    }
+}
+
 void Renderer::warmUp()
 {
     VKRT_CHECK(m_frames == 0);
+    if (m_variant.staged) {
+        // One workgroup of each stage: lavapipe compiles each at its first dispatch.
+        m_context.submitAndWait([&](vk::CommandBuffer cmd) {
+            recordFrameRun(cmd, gpu::FrameRun{1, 1});
+            for (uint32_t stage : {1u, 0u}) {
+                m_kernel.recordBind(cmd, bytesOf(gpu::FrameConstants{0, m_options.seed}), 0, stage);
+                m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, 0), 0, vk::Extent2D(1, 1));
+            }
+        });
+        reset();
+        return;
+    }
     // One workgroup is enough to make lavapipe compile the kernel.
     m_context.submitAndWait([&](vk::CommandBuffer cmd) {
         recordFrameRun(cmd, gpu::FrameRun{1, 1});

@@ -29,6 +29,9 @@ struct RenderOptions {
     bool storageScene = false; ///< scene arrays in storage buffers even when they fit uniform ones
     bool driverAccel =
         false; ///< the driver's traversal (VK_KHR_ray_query) instead of vkrt's BVH (a kernel-variant flag)
+    /// The path integrator as two kernels (trace, shade) that take turns
+    /// (KernelVariant::staged); the same image bit for bit.
+    bool staged = false;
     uint32_t firstFrame = 0; ///< index of the first frame (sample) rendered: a shard's start
     /// Frames one invocation runs back to back per dispatch (path
     /// regeneration); 0: the device's default (samplesPerInvocationFor).
@@ -118,6 +121,8 @@ public:
 
     const KernelVariant& variant() const { return m_variant; }
     const CompiledKernel& kernel() const { return m_compiled; }
+    /// Staged kernels: the trace stage (kernel() is then the shade stage).
+    const CompiledKernel& traceStage() const { return m_traceCompiled; }
     /// The scene's mesh data as uploaded (empty for a scene without meshes).
     const GpuSceneStatic& meshData() const { return m_static; }
     /// The driver backend's structures (null with vkrt's own traversal).
@@ -133,7 +138,8 @@ private:
     ImageBands m_bands;      ///< before m_data, whose tile count is per band
     GpuSceneStatic m_static; ///< mesh geometry and the top-level topology: uploaded once
     GpuSceneData m_data;
-    CompiledKernel m_compiled;
+    CompiledKernel m_compiled;      ///< the kernel, or with staged kernels the shade stage
+    CompiledKernel m_traceCompiled; ///< staged kernels: the trace stage (else empty)
     std::vector<Buffer> m_meshBuffers;
     std::vector<Buffer> m_textureChunks; ///< the texel words, one buffer per chunk (TextureChunking)
     std::vector<Buffer> m_sceneBuffers;
@@ -143,6 +149,7 @@ private:
     std::optional<BandedBuffer> m_moments;
     std::optional<BandedBuffer> m_aovs;
     ComputeKernel m_kernel;
+    std::optional<Buffer> m_lanes;           ///< staged kernels: every pixel's path between stages
     const Buffer* m_meshTriangles = nullptr; ///< in m_meshBuffers, for the driver backend's builds
     std::optional<DriverAccel> m_driverAccel;
     std::optional<EnvironmentTexture> m_environment;
@@ -167,6 +174,8 @@ private:
     void uploadMeshBuffers();
     void uploadTextureChunks();
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
+    void renderStagedRun(uint32_t firstFrame, uint32_t count);
+    std::vector<std::span<const uint32_t>> kernelStages() const;
     void bindPerPixelBuffers();
     void recordFrameRun(vk::CommandBuffer cmd, const gpu::FrameRun& run) const;
 };
