@@ -9,7 +9,10 @@
 #      (`vkrt regress --compare-accel`), its JSON report kept;
 #   4. the benchmark tables on the GPU: tools/bench_backends.py (samples/s of
 #      both backends on the suite's scenes), the default scene's samples/s at
-#      640x480, and the same figure on lavapipe for the ratio.
+#      640x480, and the same figure on lavapipe for the ratio;
+#   5. both kernel designs on the GPU: the megakernel and the staged kernels
+#      (`render --staged`, trace and shade taking turns), samples/s of each on
+#      three validation scenes and `vkrt compare` of their images.
 # Every step has its own time limit and writes its output under OUT (default
 # gpu-check-out/, or $OUT when set, as on the device machine); a step that
 # fails is reported and the next one still runs. Exit status: 0 when every
@@ -90,6 +93,24 @@ default_scene_rate() {
   done
 }
 step bench-default-gpu 90 default_scene_rate "$gpu" 1024 5
+# samples/s of both kernel designs, warm, and how far apart their images are.
+both_kernel_designs() {
+  local device=$1 scene name design
+  for scene in scenes/validation/diffuse-box.toml scenes/validation/mesh-bunny-glass.toml \
+    scenes/validation/textured.toml; do
+    name=$(basename "$scene" .toml)
+    for design in megakernel staged; do
+      local flag=()
+      [[ $design == staged ]] && flag=(--staged)
+      "$vkrt" render "$scene" --device "$device" --spp 1 "${flag[@]}" -o "$out/warm.exr" >/dev/null || return 1
+      "$vkrt" render "$scene" --device "$device" --spp 1024 --width 640 "${flag[@]}" -o "$out/$name-$design.exr" \
+        --json - 2>/dev/null | python3 -c 'import json, sys; d = json.load(sys.stdin); print(sys.argv[1], sys.argv[2], d["samplesPerSecond"])' "$name" "$design" ||
+        return 1
+    done
+    "$vkrt" compare "$out/$name-megakernel.exr" "$out/$name-staged.exr" | head -n 3 || return 1
+  done
+}
+step kernel-designs 240 both_kernel_designs "$gpu"
 step bench-default-lavapipe 150 default_scene_rate llvmpipe 64 3
 
 log "finished $(date -u +%Y-%m-%dT%H:%M:%SZ); outputs in $out"

@@ -69,12 +69,8 @@ VKRT_CONSTANT(uint, BINDING_LIGHT_TABLE, BINDING_ENVIRONMENT + 22)
 // header of 4 words), in variants with VKRT_STAGE only.
 #if defined(__cplusplus) || defined(VKRT_STAGE)
 VKRT_CONSTANT(uint, BINDING_STAGED_LANES, BINDING_ENVIRONMENT + 23)
-#endif
-#ifdef __cplusplus
-// The bytes the host gives each lane and the header before them
-// (tests/render/staged_kernels_test.cpp checks StagedLane's compiled size).
-VKRT_CONSTANT(uint, STAGED_LANE_BYTES, 320)
-VKRT_CONSTANT(uint, STAGED_HEADER_BYTES, 16)
+// 16-byte words per lane (lib/stages.glsl lists them), after one word of header.
+VKRT_CONSTANT(uint, STAGED_LANE_VEC4S, 18)
 #endif
 // Host only: a GLSL constant of a new value is emitted into every variant's
 // SPIR-V (glslang keeps folded constants), so a binding added for one feature

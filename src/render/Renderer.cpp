@@ -327,7 +327,7 @@ Renderer::Renderer(const VulkanContext& context, const Scene& scene, RenderOptio
         if (m_bands.count > 1)
             throw InputError(scene.path + ": --staged renders images of one band only (" +
                              std::to_string(m_bands.count) + " bands here)");
-        m_lanes.emplace(context, gpu::STAGED_HEADER_BYTES + vk::DeviceSize(gpu::STAGED_LANE_BYTES) * width() * height(),
+        m_lanes.emplace(context, 16 * (1 + vk::DeviceSize(gpu::STAGED_LANE_VEC4S) * width() * height()),
                         kStorage | vk::BufferUsageFlagBits::eTransferDst, MemoryUse::Readback);
         m_lanes->clear(context);
         m_kernel.bind(gpu::BINDING_STAGED_LANES, *m_lanes);
