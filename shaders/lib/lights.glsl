@@ -153,6 +153,39 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 #include "lights/directional.glsl"
 #include "lights/spot.glsl"
 
+// The loops every kind of light sampled one by one shares (point, spot and
+// directional lights; triangle lights have none of their own: they are
+// emitters). A kind gives tableEntries<Type> (how many), whittedSample<Type>
+// and candidate<Type> (lib/lights/*.glsl); forgetting one fails the build.
+// directFrom<Type>: every light of the kind, each with its shadow ray (the
+// Whitted integrator). offer<Type>Samples: every light of the kind as a
+// candidate of the path integrator's one shadow ray.
+#define VKRT_LIGHT_LOOPS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded)                             \
+    vec3 directFrom##Type(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng) \
+    {                                                                                                                 \
+        vec3 radiance = vec3(0.0);                                                                                    \
+        vec3 origin = offsetRayOrigin(hit.position, hit.error, n);                                                    \
+        for (uint i = 0u; i < tableEntries##Type(); ++i) {                                                            \
+            ++g_loopIterations;                                                                                       \
+            LightSample s = whittedSample##Type(i, m, hit, ns, wo, origin, rng);                                      \
+            if (s.unshadowed != vec3(0.0))                                                                            \
+                radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);             \
+        }                                                                                                             \
+        return radiance;                                                                                              \
+    }                                                                                                                 \
+    void offer##Type##Samples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,      \
+                              inout Sampler rng)                                                                      \
+    {                                                                                                                 \
+        for (uint i = 0u; i < tableEntries##Type(); ++i) {                                                            \
+            ++g_loopIterations;                                                                                       \
+            float pick;                                                                                               \
+            LightSample s = candidate##Type(i, m, hit, ns, wo, origin, rng, pick);                                    \
+            offerLightSample(r, s, pick);                                                                             \
+        }                                                                                                             \
+    }
+VKRT_LIGHT_KINDS(VKRT_LIGHT_LOOPS)
+#undef VKRT_LIGHT_LOOPS
+
 // ------------------------------------------------------------ the light table
 // Scenes with more point, spot and directional lights than the host lets the
 // kernel test one by one (src/render/LightTable.h) get VKRT_LIGHT_TABLE: every

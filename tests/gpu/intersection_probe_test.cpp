@@ -389,7 +389,7 @@ class IntersectionProbeSelfIntersection : public GpuTest {};
 //  - bounce: a random direction into the hemisphere the primary ray came from
 //    (a quarter of them grazing, cos theta from 1e-4 to 0.1),
 //  - transmit: the same into the other hemisphere,
-//  - shadow: towards a point light above, as directFromPointLights does.
+//  - shadow: towards a point light above, as directFromPointLight does.
 // A convex shape must not be hit again by a bounce or shadow ray; a plane or
 // triangle by none; a ray transmitted into a sphere or box must reach the far side.
 // The side each primary hit reports (front/back) must agree with the exact geometry,

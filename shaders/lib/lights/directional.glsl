@@ -97,33 +97,29 @@ LightSample sampleTableDirectionalLight(uint i, float selection, Material m, Sur
 // The density of having chosen light i of a kind (lib/lights.glsl).
 float lightSelection(int kind, uint i);
 
-// Every sun, each with its shadow ray (the Whitted integrator).
-vec3 directFromDirectionalLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
-                                inout Sampler rng)
+// Sun i for the Whitted integrator (its cone sampled with 2 numbers) and as
+// a candidate of the path integrator's one shadow ray (4 numbers: the cone's
+// 2 and the reservoir's; lib/lights.glsl: VKRT_LIGHT_LOOPS).
+LightSample whittedSampleDirectionalLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                          inout Sampler rng)
 {
-    vec3 radiance = vec3(0.0);
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    for (uint i = 0u; i < u.directionalLightCount; ++i) {
-        ++g_loopIterations;
-        LightSample s = sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, sampleNext2D(rng));
-        if (s.unshadowed != vec3(0.0))
-            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
-    }
+    return sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, sampleNext2D(rng));
+#else
+    return LightSample(vec3(0.0), origin);
 #endif
-    return radiance;
 }
 
-// Every sun as a candidate of the path integrator's one shadow ray.
-void offerDirectionalLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                  inout Sampler rng)
+LightSample candidateDirectionalLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                      inout Sampler rng, out float pick)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    for (uint i = 0u; i < u.directionalLightCount; ++i) {
-        ++g_loopIterations;
-        vec4 u4 = sampleNext4D(rng);
-        offerLightSample(r, sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, u4.xy), u4.z);
-    }
+    vec4 u4 = sampleNext4D(rng);
+    pick = u4.z;
+    return sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, u4.xy);
+#else
+    pick = 0.0;
+    return LightSample(vec3(0.0), origin);
 #endif
 }
 

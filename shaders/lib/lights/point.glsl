@@ -36,22 +36,6 @@ LightSample samplePointLight(PointLight light, Material m, SurfaceHit hit, vec3 
 }
 #endif
 
-// Every point light, each with its shadow ray (the Whitted integrator).
-vec3 directFromPointLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
-{
-    vec3 radiance = vec3(0.0);
-#ifdef VKRT_HAS_POINT_LIGHTS
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    for (uint i = 0u; i < u.pointLightCount; ++i) {
-        ++g_loopIterations;
-        LightSample s = samplePointLight(pointLights[i], m, hit, ns, wo);
-        if (s.unshadowed != vec3(0.0))
-            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
-    }
-#endif
-    return radiance;
-}
-
 // The point lights' entries in the light table (VKRT_LIGHT_TABLE): one each.
 uint tableEntriesPointLight()
 {
@@ -76,16 +60,24 @@ LightSample sampleTablePointLight(uint i, float selection, Material m, SurfaceHi
 #endif
 }
 
-// Every point light as a candidate of the path integrator's one shadow ray.
-void offerPointLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                            inout Sampler rng)
+// Point light i as the Whitted integrator samples it (its own shadow ray)
+// and as a candidate of the path integrator's one shadow ray, with the
+// reservoir's number `pick` (lib/lights.glsl: VKRT_LIGHT_LOOPS).
+LightSample whittedSamplePointLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_POINT_LIGHTS
-    for (uint i = 0u; i < u.pointLightCount; ++i) {
-        ++g_loopIterations;
-        offerLightSample(r, samplePointLight(pointLights[i], m, hit, ns, wo), sampleNext1D(rng));
-    }
+    return samplePointLight(pointLights[i], m, hit, ns, wo);
+#else
+    return LightSample(vec3(0.0), origin);
 #endif
+}
+
+LightSample candidatePointLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng,
+                                out float pick)
+{
+    LightSample s = whittedSamplePointLight(i, m, hit, ns, wo, origin, rng);
+    pick = sampleNext1D(rng);
+    return s;
 }
 
 #endif

@@ -46,22 +46,6 @@ LightSample sampleSpotLight(SpotLight light, Material m, SurfaceHit hit, vec3 ns
 }
 #endif
 
-// Every spot light, each with its shadow ray (the Whitted integrator).
-vec3 directFromSpotLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
-{
-    vec3 radiance = vec3(0.0);
-#ifdef VKRT_HAS_SPOT_LIGHTS
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    for (uint i = 0u; i < u.spotLightCount; ++i) {
-        ++g_loopIterations;
-        LightSample s = sampleSpotLight(spotLights[i], m, hit, ns, wo);
-        if (s.unshadowed != vec3(0.0))
-            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
-    }
-#endif
-    return radiance;
-}
-
 // The spot lights' entries in the light table (VKRT_LIGHT_TABLE): one each.
 uint tableEntriesSpotLight()
 {
@@ -85,16 +69,23 @@ LightSample sampleTableSpotLight(uint i, float selection, Material m, SurfaceHit
 #endif
 }
 
-// Every spot light as a candidate of the path integrator's one shadow ray.
-void offerSpotLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                           inout Sampler rng)
+// Spot light i for the Whitted integrator and as a candidate of the path
+// integrator's one shadow ray (lib/lights.glsl: VKRT_LIGHT_LOOPS).
+LightSample whittedSampleSpotLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_SPOT_LIGHTS
-    for (uint i = 0u; i < u.spotLightCount; ++i) {
-        ++g_loopIterations;
-        offerLightSample(r, sampleSpotLight(spotLights[i], m, hit, ns, wo), sampleNext1D(rng));
-    }
+    return sampleSpotLight(spotLights[i], m, hit, ns, wo);
+#else
+    return LightSample(vec3(0.0), origin);
 #endif
+}
+
+LightSample candidateSpotLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng,
+                               out float pick)
+{
+    LightSample s = whittedSampleSpotLight(i, m, hit, ns, wo, origin, rng);
+    pick = sampleNext1D(rng);
+    return s;
 }
 
 #endif

@@ -47,11 +47,19 @@ void describeTriangleLight(Ray r, HitId id, inout SurfaceHit hit)
 #if defined(VKRT_LIGHT_SAMPLING) && !defined(VKRT_LIGHT_TRIANGLE_SAMPLING)
 #define VKRT_LIGHT_TRIANGLE_SAMPLING
 
-// Sampled with every emitter (lib/emitters.glsl), not on their own.
-vec3 directFromTriangleLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media,
-                             inout Sampler rng)
+// Sampled with every emitter (lib/emitters.glsl), not on their own: no
+// lights of their own to loop over (tableEntriesTriangleLight is 0).
+LightSample whittedSampleTriangleLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                       inout Sampler rng)
 {
-    return vec3(0.0);
+    return LightSample(vec3(0.0), origin);
+}
+
+LightSample candidateTriangleLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
+                                   inout Sampler rng, out float pick)
+{
+    pick = 0.0;
+    return LightSample(vec3(0.0), origin);
 }
 
 // No entries of their own in the light table: its last entry is every emitter.
@@ -63,9 +71,5 @@ LightSample sampleTableTriangleLight(uint i, float selection, Material m, Surfac
     return LightSample(vec3(0.0), origin);
 }
 
-void offerTriangleLightSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                               inout Sampler rng)
-{
-}
 
 #endif

@@ -7,7 +7,7 @@
 // the frame of the side the new ray leaves into, mode (0: bounce to the side
 // the primary ray came from, 1: transmission to the other side, 2: shadow ray
 // towards a point light at hit + distance * direction, as
-// directFromPointLights does), light distance.
+// directFromPointLight does), light distance.
 // outputs[15i ..] = primary hit flag, second hit flag, second t, new ray
 // origin, new ray direction, dot(direction, side normal), surface point,
 // front-face flag, traceAny's answer for the second ray (it must agree
