@@ -229,7 +229,8 @@ StartupSplit startupSplit(const RenderSession& session, const InfoTimes& times)
         topBuild = facts.topBuildSeconds;
     }
     split.parse = std::max(0.0, times.parse - split.textures - split.meshLoad - (split.bvh - topBuild));
-    split.glslang = session.renderer().kernel().compileSeconds;
+    // Both stages' glslang time with staged kernels (the trace stage's is 0 otherwise).
+    split.glslang = session.renderer().kernel().compileSeconds + session.renderer().traceStage().compileSeconds;
     split.setup = std::max(0.0, times.setup - split.glslang - topBuild);
     split.firstFrame = std::max(0.0, times.firstFrame - times.setup);
     return split;
@@ -354,6 +355,17 @@ JsonObject featuresJson(const KernelVariant& variant)
             {"fileMaterials", features.fileMaterials}};
 }
 
+/// Staged kernels (--staged): the trace stage's SPIR-V (`kernel` itself is the shade stage); null otherwise.
+JsonObject traceStageJson(const Renderer& renderer)
+{
+    if (!renderer.variant().staged) return nullptr;
+    const CompiledKernel& trace = renderer.traceStage();
+    return {{"cacheKey", trace.cacheKey},
+            {"spirvBytes", trace.spirv.size() * sizeof(uint32_t)},
+            {"fromCache", trace.fromCache},
+            {"compileSeconds", trace.compileSeconds}};
+}
+
 JsonObject kernelJson(const RenderSession& session, const InfoOptions& options)
 {
     const KernelVariant& variant = session.renderer().variant();
@@ -367,7 +379,9 @@ JsonObject kernelJson(const RenderSession& session, const InfoOptions& options)
             {"spirvBytes", kernel.spirv.size() * sizeof(uint32_t)},
             {"fromCache", kernel.fromCache},
             {"compileSeconds", kernel.compileSeconds},
-            {"cacheDirectory", session.renderOptions().cacheDirectory.string()}};
+            {"cacheDirectory", session.renderOptions().cacheDirectory.string()},
+            {"staged", variant.staged},
+            {"traceStage", traceStageJson(session.renderer())}};
 }
 
 JsonObject infoJson(const RenderSession& session, const InfoOptions& options, const InfoTimes& times)

@@ -324,6 +324,35 @@ TEST_F(Json, InfoCountsWhatTheSceneHolds)
     EXPECT_NE(r.output.find("variant:        " + doc["kernel"]["cacheKey"].get<std::string>()), std::string::npos);
 }
 
+// With --staged the kernel is the shade stage and traceStage the other
+// (null without); a Whitted scene is refused, naming the option.
+TEST_F(Json, InfoDescribesBothStagedKernels)
+{
+    const fs::path scene = fs::path(VKRT_TEST_SOURCE_DIR) / "scenes" / "validation" / "diffuse-box.toml";
+    const fs::path file = m_dir / "staged.json";
+    ProcessResult plain = runVkrt(withDevice({"info", scene.string(), "--json", file.string()}));
+    ASSERT_EQ(plain.exitCode, 0) << plain.output;
+    const json megakernel = parseJson(readText(file));
+    EXPECT_EQ(megakernel["kernel"]["staged"], false);
+    EXPECT_TRUE(megakernel["kernel"]["traceStage"].is_null());
+
+    ProcessResult staged = runVkrt(withDevice({"info", scene.string(), "--staged", "--json", file.string()}));
+    ASSERT_EQ(staged.exitCode, 0) << staged.output;
+    const json doc = parseJson(readText(file));
+    EXPECT_EQ(doc["kernel"]["staged"], true);
+    const json& trace = doc["kernel"]["traceStage"];
+    ASSERT_TRUE(trace.is_object()) << doc["kernel"].dump();
+    EXPECT_GT(trace["spirvBytes"].get<int64_t>(), 0);
+    EXPECT_NE(trace["cacheKey"], doc["kernel"]["cacheKey"]);
+    EXPECT_NE(doc["kernel"]["cacheKey"], megakernel["kernel"]["cacheKey"]);
+
+    ProcessResult whitted =
+        runVkrt(withDevice({"render", kDefaultScene, "--staged", "--spp", "1", "-o", (m_dir / "w.exr").string()}));
+    EXPECT_EQ(whitted.exitCode, 2) << whitted.output;
+    EXPECT_NE(whitted.output.find("--staged runs the path integrator only"), std::string::npos) << whitted.output;
+    EXPECT_FALSE(fs::exists(m_dir / "w.exr"));
+}
+
 // Texture memory: its bytes and the storage buffers they take, one unless
 // they exceed a buffer (here forced by the hidden --max-texture-chunk-bytes).
 TEST_F(Json, InfoReportsTextureMemoryAndItsBuffers)
