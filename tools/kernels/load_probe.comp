@@ -11,15 +11,23 @@
 //   LOAD_MODE 2  one lane loads (subgroupElect) and broadcasts the node,
 //                for a compiler that does not know uniform loads;
 //   LOAD_MODE 3  as 1, plus the one cross-lane sum per node a packet walk
-//                needs to decide which children to enter.
+//                needs to decide which children to enter;
+//   LOAD_MODE 4  as 0, but through the buffer's device address
+//                (GL_EXT_buffer_reference): llvmpipe gathers such a load,
+//                where it loops over the lanes for a storage buffer's.
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#if LOAD_MODE == 4
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer NodeArray { vec4 v[]; };
+#endif
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Nodes { vec4 nodes[]; };
 layout(std430, binding = 1) readonly buffer Starts { uint starts[]; };
 layout(std430, binding = 2) writeonly buffer Sums { float sums[]; };
-layout(push_constant) uniform Push { uint steps; uint nodeCount; };
+layout(push_constant) uniform Push { uint steps; uint nodeCount; uvec2 nodesAddress; };
 
 uint chainIndex(uint index)
 {
@@ -47,6 +55,9 @@ void main()
         }
         lower = subgroupBroadcastFirst(lower);
         upper = subgroupBroadcastFirst(upper);
+#elif LOAD_MODE == 4
+        vec4 lower = NodeArray(nodesAddress).v[2u * node];
+        vec4 upper = NodeArray(nodesAddress).v[2u * node + 1u];
 #else
         vec4 lower = nodes[2u * node];
         vec4 upper = nodes[2u * node + 1u];
