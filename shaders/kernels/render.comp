@@ -16,6 +16,11 @@
 #endif
 #ifdef VKRT_TEXTURE_CHUNKS
 #extension GL_EXT_nonuniform_qualifier : require
+#elif defined(VKRT_HAS_TEXTURES)
+// The texels read through their buffer's device address (lib/texture_bindings.glsl).
+#define VKRT_TEXEL_ADDRESS
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
 #endif
 
 #include "lib/bindings.glsl"

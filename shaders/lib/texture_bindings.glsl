@@ -28,8 +28,19 @@ uint textureWord(uint word)
 }
 #else
 layout(scalar, binding = BINDING_TEXTURE_TEXELS) readonly buffer TextureTexelBlock { uint textureTexels[]; };
+#ifdef VKRT_TEXEL_ADDRESS
+// The render kernels read the words through the buffer's device address
+// (SceneUniforms::texelAddress): lavapipe compiles a storage-buffer load
+// whose offset differs between lanes into a loop over the lanes with a
+// bounds check, a device-address load into one gather. ClearCoatTest's
+// cold start on Mesa 25: 20.1 -> 14.8 s (docs/performance.md, "Staged
+// kernels"). The probe kernels keep the storage buffer.
+layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer TexelWords { uint words[]; };
+#define textureWord(word) TexelWords(u.texelAddress).words[word]
+#else
 // A macro, not a function: the one-buffer kernels' SPIR-V stays what it was.
 #define textureWord(word) textureTexels[word]
+#endif
 #endif
 layout(scalar, binding = BINDING_TEXTURE_RECORDS) readonly buffer TextureRecordBlock
 {

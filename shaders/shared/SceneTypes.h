@@ -371,6 +371,9 @@ struct SceneUniforms {
     // shadow ray (lib/lights.glsl).
     uint lightTableCount;
     uint lightCandidates;
+    // The texel words' device address, low word first (lib/texture_bindings.glsl:
+    // read through it, not the storage buffer, when the texels are one buffer).
+    uvec2 texelAddress;
 };
 
 /// Per-batch values (push constants), pushed once per submission: lavapipe

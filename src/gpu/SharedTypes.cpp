@@ -54,7 +54,7 @@ constexpr bool bindingsDistinct()
     return true;
 }
 static_assert(bindingsDistinct(), "shared/Bindings.h: every scene array needs its own binding below BINDING_COUNT");
-static_assert(sizeof(SceneUniforms) == 180 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
+static_assert(sizeof(SceneUniforms) == 188 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
               "SceneUniforms holds one count per shape and light kind");
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);

@@ -407,7 +407,8 @@ void Renderer::uploadTextureChunks()
     VKRT_CHECK(textures.chunking.count == m_kernel.countOf(gpu::BINDING_TEXTURE_TEXELS));
     m_textureChunks.reserve(textures.chunking.count); // bind() keeps references: no reallocation
     for (uint32_t chunk = 0; chunk < textures.chunking.count; ++chunk)
-        m_textureChunks.push_back(makeBufferFrom(m_context, textures.chunk(chunk), kStorage));
+        m_textureChunks.push_back(
+            makeBufferFrom(m_context, textures.chunk(chunk), kStorage | vk::BufferUsageFlagBits::eShaderDeviceAddress));
     if (m_textureChunks.size() == 1) m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, m_textureChunks.front());
     else m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, std::span<const Buffer>(m_textureChunks));
 }
@@ -466,6 +467,10 @@ void Renderer::uploadSceneBuffers()
     m_data.uniforms.environmentGrid = m_environmentSizes.latLongGrid;
     m_data.uniforms.environmentBlock = m_environmentSizes.latLongBlock;
     if (m_environmentSizes.constant) m_data.uniforms.flags |= gpu::RENDER_FLAG_CONSTANT_ENVIRONMENT;
+    if (m_textureChunks.size() == 1) {
+        const vk::DeviceAddress texels = m_textureChunks.front().address(m_context);
+        m_data.uniforms.texelAddress = glm::uvec2(uint32_t(texels), uint32_t(texels >> 32));
+    }
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
 #define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \

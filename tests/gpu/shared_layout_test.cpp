@@ -160,6 +160,7 @@ std::vector<Member> expectedMembers()
         BLOCK_MEMBER(u, SceneUniforms, softDirectionalLightCount),
         BLOCK_MEMBER(u, SceneUniforms, lightTableCount),
         BLOCK_MEMBER(u, SceneUniforms, lightCandidates),
+        BLOCK_MEMBER(u, SceneUniforms, texelAddress),
         ARRAY_MEMBER(lightTable, LightPick, pdf),
         ARRAY_MEMBER(lightTable, LightPick, aliasThreshold),
         ARRAY_MEMBER(lightTable, LightPick, alias),
@@ -190,7 +191,7 @@ TEST(SharedLayout, LastMemberEndsTheStruct)
     EXPECT_EQ(offsets.at("spheres[0].material") + 4, int(sizeof(gpu::Sphere)));
     EXPECT_EQ(offsets.at("materials[0].clearcoatNormal") + 12, int(sizeof(gpu::Material)));
     EXPECT_EQ(offsets.at("triangleLights[0].v2") + 12, int(sizeof(gpu::TriangleLight)));
-    EXPECT_EQ(offsets.at("u.lightCandidates") + 4, int(sizeof(gpu::SceneUniforms)));
+    EXPECT_EQ(offsets.at("u.texelAddress") + 8, int(sizeof(gpu::SceneUniforms)));
     EXPECT_EQ(offsets.at("lightTable[0].alias") + 4, int(sizeof(gpu::LightPick)));
     EXPECT_EQ(offsets.at("directionalLights[0].sin2Alpha") + 4, int(sizeof(gpu::DirectionalLight)));
     EXPECT_EQ(offsets.at("spotLights[0].axis") + 12, int(sizeof(gpu::SpotLight)));
