@@ -183,6 +183,10 @@ Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records
     return makeBufferFrom(context, records, vk::BufferUsageFlagBits::eUniformBuffer);
 }
 
+/// The staged kernels' pipelines in ComputeKernel (kernelStages' order).
+constexpr uint32_t kTraceStage = 0;
+constexpr uint32_t kShadeStage = 1;
+
 /// The variant's kernel; with staged kernels, stage `stage` (1 trace, 2 shade; lib/stages.glsl).
 CompiledKernel compileVariant(const KernelVariant& variant, const RenderOptions& options, int stage = 2)
 {
@@ -599,11 +603,18 @@ void Renderer::renderStagedRun(uint32_t firstFrame, uint32_t count)
     const vk::Extent2D groups(tilesX, m_bands.tileRowsPerBand());
     auto* header = static_cast<volatile uint32_t*>(m_lanes->mapped());
     VKRT_CHECK(header != nullptr);
+    // A round advances every lane by one segment or its last shadow ray: a
+    // sample takes at most max_depth + 3 rounds (start, segments, shadow), so
+    // a lane still busy after that many is a fault, not a long path.
+    const uint64_t roundLimit = uint64_t(count) * (m_data.uniforms.maxDepth + 3) + roundsPerSubmit;
     bool first = true;
-    for (;;) {
+    for (uint64_t rounds = 0;; rounds += roundsPerSubmit) {
+        if (rounds > roundLimit)
+            throw GpuError("the staged kernels' lanes still had work after " + std::to_string(rounds) + " rounds for " +
+                           std::to_string(count) + " samples: the device lost track of them");
         m_context.submitAndWait([&](vk::CommandBuffer cmd) {
             if (first) recordFrameRun(cmd, gpu::FrameRun{count, firstFrame + count});
-            m_kernel.recordBind(cmd, bytesOf(constants), 0, 1);
+            m_kernel.recordBind(cmd, bytesOf(constants), 0, kShadeStage);
             vk::MemoryBarrier shaderToShader(vk::AccessFlagBits::eShaderWrite,
                                              vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
             vk::MemoryBarrier transferToShader(vk::AccessFlagBits::eTransferWrite,
@@ -620,7 +631,7 @@ void Renderer::renderStagedRun(uint32_t firstFrame, uint32_t count)
                     cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader,
                                         {}, transferToShader, nullptr, nullptr);
                 }
-                for (uint32_t stage : {1u, 0u}) {
+                for (uint32_t stage : {kShadeStage, kTraceStage}) {
                     m_kernel.recordBindStage(cmd, stage);
                     m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, 0), 0, groups);
                     cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader,
@@ -644,7 +655,7 @@ void Renderer::warmUp()
         // One workgroup of each stage: lavapipe compiles each at its first dispatch.
         m_context.submitAndWait([&](vk::CommandBuffer cmd) {
             recordFrameRun(cmd, gpu::FrameRun{1, 1});
-            for (uint32_t stage : {1u, 0u}) {
+            for (uint32_t stage : {kShadeStage, kTraceStage}) {
                 m_kernel.recordBind(cmd, bytesOf(gpu::FrameConstants{0, m_options.seed}), 0, stage);
                 m_kernel.recordDispatchAt(cmd, vk::Offset2D(0, 0), 0, vk::Extent2D(1, 1));
             }
