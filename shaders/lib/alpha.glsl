@@ -31,7 +31,8 @@
 #include "lib/texture.glsl"
 #endif
 
-layout(scalar, binding = BINDING_MATERIAL_ALPHA) readonly buffer MaterialAlphaBlock { MaterialAlpha materialAlpha[]; };
+VKRT_READ_BUFFER(BINDING_MATERIAL_ALPHA, MaterialAlphaBlock, MaterialAlpha, materialAlpha)
+#define materialAlpha VKRT_READ_ITEMS(BINDING_MATERIAL_ALPHA, MaterialAlphaBlock, materialAlpha)
 
 // The sample's part of every BLEND coin (render.comp sets it per sample).
 uint g_alphaSample = 0u;

@@ -29,46 +29,45 @@ layout(scalar, binding = BINDING_AOVS) buffer AovBlock { AovPixel aovs[]; };
 #endif
 
 // Scene arrays: fixed-size uniform blocks in the uniform-scene variant,
-// runtime-sized storage buffers otherwise (shared/SceneTypes.h). Each shape
-// and light kind declares its own array in its file (lib/shapes/*.glsl,
+// read buffers otherwise (shared/SceneTypes.h, lib/scene_buffers.glsl). Each
+// shape and light kind declares its own array in its file (lib/shapes/*.glsl,
 // lib/lights/*.glsl); the top-level BVH is declared by lib/scene.glsl and the
 // emitters by lib/emitters.glsl.
-#ifdef VKRT_UNIFORM_SCENE
-#define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity) \
-    layout(scalar, binding = binding_) uniform Block { Type name[capacity]; };
-#else
-#define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity) \
-    layout(scalar, binding = binding_) readonly buffer Block { Type name[]; };
-#endif
+#include "lib/scene_buffers.glsl"
 
 #ifdef VKRT_HAS_MATERIALS
 VKRT_SCENE_ARRAY(BINDING_MATERIALS, MaterialBlock, Material, materials, UNIFORM_MATERIALS)
+#define materials VKRT_SCENE_ITEMS(BINDING_MATERIALS, MaterialBlock, materials)
 #endif
 #ifdef VKRT_HAS_MESHES
 #ifndef VKRT_ACCEL_DRIVER // the driver backend walks its own structures instead
-layout(scalar, binding = BINDING_MESH_NODES) readonly buffer MeshNodeBlock { BvhNode meshNodes[]; };
+VKRT_READ_BUFFER(BINDING_MESH_NODES, MeshNodeBlock, BvhNode, meshNodes)
+#define meshNodes VKRT_READ_ITEMS(BINDING_MESH_NODES, MeshNodeBlock, meshNodes)
 #endif
-layout(scalar, binding = BINDING_MESH_TRIANGLES) readonly buffer MeshTriangleBlock { MeshTriangle meshTriangles[]; };
+VKRT_READ_BUFFER(BINDING_MESH_TRIANGLES, MeshTriangleBlock, MeshTriangle, meshTriangles)
+#define meshTriangles VKRT_READ_ITEMS(BINDING_MESH_TRIANGLES, MeshTriangleBlock, meshTriangles)
 #endif
 #ifdef VKRT_HAS_MESH_NORMALS
-layout(scalar, binding = BINDING_MESH_NORMALS) readonly buffer MeshNormalBlock { MeshNormals meshNormals[]; };
+VKRT_READ_BUFFER(BINDING_MESH_NORMALS, MeshNormalBlock, MeshNormals, meshNormals)
+#define meshNormals VKRT_READ_ITEMS(BINDING_MESH_NORMALS, MeshNormalBlock, meshNormals)
 #endif
 #ifdef VKRT_HAS_MATERIAL_TABLES
-layout(scalar, binding = BINDING_MATERIAL_TABLES) readonly buffer MaterialTableBlock { float materialTables[]; };
+VKRT_READ_BUFFER(BINDING_MATERIAL_TABLES, MaterialTableBlock, float, materialTables)
+#define materialTables VKRT_READ_ITEMS(BINDING_MATERIAL_TABLES, MaterialTableBlock, materialTables)
 #endif
 #ifdef VKRT_HAS_TEXTURES
 // The texel and record buffers are declared by lib/texture_bindings.glsl.
 #include "shared/TextureTypes.h"
-layout(scalar, binding = BINDING_MATERIAL_TEXTURES) readonly buffer MaterialTextureBlock
-{
-    MaterialTextures materialTextures[];
-};
+VKRT_READ_BUFFER(BINDING_MATERIAL_TEXTURES, MaterialTextureBlock, MaterialTextures, materialTextures)
+#define materialTextures VKRT_READ_ITEMS(BINDING_MATERIAL_TEXTURES, MaterialTextureBlock, materialTextures)
 #endif
 #ifdef VKRT_HAS_MESH_UVS
-layout(scalar, binding = BINDING_MESH_UVS) readonly buffer MeshUvBlock { MeshUvs meshUvs[]; };
+VKRT_READ_BUFFER(BINDING_MESH_UVS, MeshUvBlock, MeshUvs, meshUvs)
+#define meshUvs VKRT_READ_ITEMS(BINDING_MESH_UVS, MeshUvBlock, meshUvs)
 #endif
 #ifdef VKRT_HAS_MESH_UVS1
-layout(scalar, binding = BINDING_MESH_UVS1) readonly buffer MeshUv1Block { MeshUvs meshUvs1[]; };
+VKRT_READ_BUFFER(BINDING_MESH_UVS1, MeshUv1Block, MeshUvs, meshUvs1)
+#define meshUvs1 VKRT_READ_ITEMS(BINDING_MESH_UVS1, MeshUv1Block, meshUvs1)
 #endif
 #ifdef VKRT_HAS_MESH_UVS
 // Mesh triangle `index`'s uv of set `set` (TextureSlot::texCoord) at
@@ -84,13 +83,16 @@ vec2 meshTriangleUv(uint index, uint set, vec3 b)
 }
 #endif
 #ifdef VKRT_HAS_MESH_TANGENTS
-layout(scalar, binding = BINDING_MESH_TANGENTS) readonly buffer MeshTangentBlock { MeshTangents meshTangents[]; };
+VKRT_READ_BUFFER(BINDING_MESH_TANGENTS, MeshTangentBlock, MeshTangents, meshTangents)
+#define meshTangents VKRT_READ_ITEMS(BINDING_MESH_TANGENTS, MeshTangentBlock, meshTangents)
 #endif
 #ifdef VKRT_HAS_MESH_MATERIALS
-layout(scalar, binding = BINDING_MESH_MATERIALS) readonly buffer MeshMaterialBlock { uint meshMaterials[]; };
+VKRT_READ_BUFFER(BINDING_MESH_MATERIALS, MeshMaterialBlock, uint, meshMaterials)
+#define meshMaterials VKRT_READ_ITEMS(BINDING_MESH_MATERIALS, MeshMaterialBlock, meshMaterials)
 #endif
 #ifdef VKRT_HAS_MESH_COLORS
-layout(scalar, binding = BINDING_MESH_COLORS) readonly buffer MeshColorBlock { MeshColors meshColors[]; };
+VKRT_READ_BUFFER(BINDING_MESH_COLORS, MeshColorBlock, MeshColors, meshColors)
+#define meshColors VKRT_READ_ITEMS(BINDING_MESH_COLORS, MeshColorBlock, meshColors)
 #endif
 // Shading normals differ from geometric ones with meshes' vertex normals or normal maps.
 #if defined(VKRT_HAS_MESH_NORMALS) || defined(VKRT_HAS_NORMAL_MAPS)
@@ -102,7 +104,8 @@ layout(binding = BINDING_ENVIRONMENT) uniform sampler2D environmentLatLong;
 layout(binding = BINDING_ENVIRONMENT) uniform samplerCube environmentMap;
 #endif
 #ifdef VKRT_ENVIRONMENT_SAMPLING
-layout(scalar, binding = BINDING_ENVIRONMENT_CDF) readonly buffer EnvironmentCdfBlock { float environmentCdf[]; };
+VKRT_READ_BUFFER(BINDING_ENVIRONMENT_CDF, EnvironmentCdfBlock, float, environmentCdf)
+#define environmentCdf VKRT_READ_ITEMS(BINDING_ENVIRONMENT_CDF, EnvironmentCdfBlock, environmentCdf)
 #endif
 
 #endif

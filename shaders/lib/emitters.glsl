@@ -6,7 +6,8 @@
 #define VKRT_EMITTERS_GLSL
 
 #ifdef VKRT_HAS_EMITTERS
-layout(scalar, binding = BINDING_EMITTERS) readonly buffer EmitterBlock { Emitter emitters[]; };
+VKRT_READ_BUFFER(BINDING_EMITTERS, EmitterBlock, Emitter, emitters)
+#define emitters VKRT_READ_ITEMS(BINDING_EMITTERS, EmitterBlock, emitters)
 
 // Unit normal of an emitter: its counter-clockwise side.
 vec3 emitterNormal(Emitter e) { return normalize(cross(e.v1 - e.v0, e.v2 - e.v0)); }

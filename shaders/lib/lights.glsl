@@ -199,7 +199,8 @@ VKRT_LIGHT_KINDS(VKRT_LIGHT_LOOPS)
 // the same M-times density: the host scales every emitter's pdf by M times
 // the emitters' entry (LightTable.cpp), so emitterOnHit needs no change.
 #ifdef VKRT_LIGHT_TABLE
-layout(scalar, binding = BINDING_LIGHT_TABLE) readonly buffer LightTableBlock { LightPick lightTable[]; };
+VKRT_READ_BUFFER(BINDING_LIGHT_TABLE, LightTableBlock, LightPick, lightTable)
+#define lightTable VKRT_READ_ITEMS(BINDING_LIGHT_TABLE, LightTableBlock, lightTable)
 
 // The density of choosing one entry among the candidates: M times its probability.
 float tableSelection(uint entry) { return float(u.lightCandidates) * lightTable[entry].pdf; }

@@ -11,7 +11,7 @@
 
 struct MediumStack {
     uint count;
-    uvec4 materials; // MEDIUM_STACK_DEPTH entries
+    uvec4 interiors; // MEDIUM_STACK_DEPTH entries: the materials, innermost last
     // The products of n_incident (x) and n_transmitted (y) over the
     // refractions that brought the ray here. Radiance scales by
     // (n_incident / n_transmitted)^2 at a refraction (the beam's solid angle
@@ -26,11 +26,11 @@ MediumStack cameraMedia()
 }
 
 #if defined(VKRT_MATERIAL_DIELECTRIC) || defined(VKRT_MATERIAL_ROUGH_DIELECTRIC) || defined(VKRT_PBR_TRANSMISSION)
-float mediumIor(MediumStack s) { return s.count == 0u ? 1.0 : materials[s.materials[s.count - 1u]].ior; }
+float mediumIor(MediumStack s) { return s.count == 0u ? 1.0 : materials[s.interiors[s.count - 1u]].ior; }
 
 vec3 mediumAbsorption(MediumStack s)
 {
-    return s.count == 0u ? vec3(0.0) : materials[s.materials[s.count - 1u]].absorption;
+    return s.count == 0u ? vec3(0.0) : materials[s.interiors[s.count - 1u]].absorption;
 }
 
 // The stack on the far side of an interface of `material`. A full stack
@@ -40,7 +40,7 @@ MediumStack crossInterface(MediumStack s, uint material, bool entering)
 {
     if (entering) {
         if (s.count < MEDIUM_STACK_DEPTH) {
-            s.materials[s.count] = material;
+            s.interiors[s.count] = material;
             s.count += 1u;
         }
         return s;
@@ -48,23 +48,23 @@ MediumStack crossInterface(MediumStack s, uint material, bool entering)
     // Remove the innermost entry of `material`, written out over the fixed
     // depth so no loop counts against lavapipe's loop budget.
     int found = -1;
-    if (s.count > 0u && s.materials[0] == material) found = 0;
-    if (s.count > 1u && s.materials[1] == material) found = 1;
-    if (s.count > 2u && s.materials[2] == material) found = 2;
-    if (s.count > 3u && s.materials[3] == material) found = 3;
+    if (s.count > 0u && s.interiors[0] == material) found = 0;
+    if (s.count > 1u && s.interiors[1] == material) found = 1;
+    if (s.count > 2u && s.interiors[2] == material) found = 2;
+    if (s.count > 3u && s.interiors[3] == material) found = 3;
     if (found < 0)
         return s;
-    if (found <= 0) s.materials[0] = s.materials[1];
-    if (found <= 1) s.materials[1] = s.materials[2];
-    if (found <= 2) s.materials[2] = s.materials[3];
+    if (found <= 0) s.interiors[0] = s.interiors[1];
+    if (found <= 1) s.interiors[1] = s.interiors[2];
+    if (found <= 2) s.interiors[2] = s.interiors[3];
     s.count -= 1u;
     return s;
 }
 
 bool onStack(MediumStack s, uint material)
 {
-    return (s.count > 0u && s.materials[0] == material) || (s.count > 1u && s.materials[1] == material) ||
-           (s.count > 2u && s.materials[2] == material) || (s.count > 3u && s.materials[3] == material);
+    return (s.count > 0u && s.interiors[0] == material) || (s.count > 1u && s.interiors[1] == material) ||
+           (s.count > 2u && s.interiors[2] == material) || (s.count > 3u && s.interiors[3] == material);
 }
 
 // The stack as it stands at a surface, before its crossing. A ray that meets

@@ -40,8 +40,10 @@
         describe##Type(r, id, hit);
 
 #if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
-layout(scalar, binding = BINDING_TOP_NODES) readonly buffer TopNodeBlock { BvhNode topNodes[]; };
-layout(scalar, binding = BINDING_TOP_REFS) readonly buffer TopRefBlock { uint topRefs[]; };
+VKRT_READ_BUFFER(BINDING_TOP_NODES, TopNodeBlock, BvhNode, topNodes)
+#define topNodes VKRT_READ_ITEMS(BINDING_TOP_NODES, TopNodeBlock, topNodes)
+VKRT_READ_BUFFER(BINDING_TOP_REFS, TopRefBlock, uint, topRefs)
+#define topRefs VKRT_READ_ITEMS(BINDING_TOP_REFS, TopRefBlock, topRefs)
 
 // One record of the top-level BVH, TOP_REF(HIT_Type, index) (shared/SceneTypes.h):
 // every kind of the registry with bounded = 1, as the host builds it

@@ -30,7 +30,7 @@ const uint LANE_DONE = 3u;    // every frame of the run added
 //   1 rng dimension, loop counts (3)        10  shadow weight, -
 //   2 radiance, bsdfPdf                     11  shadow light, -
 //   3 throughput, cosinePdf                 12  shadow absorption, -
-//   4 media materials                       13  hit shape, index, t, primitive
+//   4 media interiors                       13  hit shape, index, t, primitive
 //   5 media count, refracted indices, specular  14 hit detail, found | front | shadow blocked
 //   6 ray origin, depth                     15-17 AOVs (albedo, depth; normal, hit; position, settled)
 //   7 ray dir, pathLength
@@ -58,7 +58,7 @@ PathTracer loadPath(uint slot)
     p.path.bsdfPdf = v2.w;
     p.path.throughput = v3.xyz;
     p.path.cosinePdf = v3.w;
-    p.path.media.materials = laneWords[laneBase(slot) + 4u];
+    p.path.media.interiors = laneWords[laneBase(slot) + 4u];
     p.path.media.count = v5.x;
     p.path.media.refractedIndices = uintBitsToFloat(v5.yz);
     p.path.specular = v5.w != 0u;
@@ -74,7 +74,7 @@ void storePath(uint slot, PathTracer p)
 {
     setLaneVec(slot, 2u, p.path.radiance, p.path.bsdfPdf);
     setLaneVec(slot, 3u, p.path.throughput, p.path.cosinePdf);
-    laneWords[laneBase(slot) + 4u] = p.path.media.materials;
+    laneWords[laneBase(slot) + 4u] = p.path.media.interiors;
     laneWords[laneBase(slot) + 5u] = uvec4(p.path.media.count, floatBitsToUint(p.path.media.refractedIndices),
                                            p.path.specular ? 1u : 0u);
     setLaneVec(slot, 6u, p.ray.origin, p.depth);

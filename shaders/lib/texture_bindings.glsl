@@ -3,8 +3,8 @@
 // VKRT_TEXTURE_CHUNKS GL_EXT_nonuniform_qualifier.
 //
 // textureWord(w) is word w of the texels' one address space. A scene whose
-// texels fit one storage buffer binds them as one array, as it always did;
-// a larger one (render/KernelVariant: VKRT_TEXTURE_CHUNKS buffers of
+// texels fit one storage buffer binds them as one array (read through its
+// device address in the render kernels, lib/scene_buffers.glsl); a larger one (render/KernelVariant: VKRT_TEXTURE_CHUNKS buffers of
 // 2^VKRT_TEXTURE_CHUNK_SHIFT words, texture/TextureAtlas.h) binds an array of
 // buffers, word w at index w & (2^shift - 1) of buffer w >> shift. Lanes of
 // one subgroup may read different buffers: the index is nonuniformEXT.
@@ -12,6 +12,7 @@
 #define VKRT_TEXTURE_BINDINGS_GLSL
 
 #include "shared/TextureTypes.h"
+#include "lib/scene_buffers.glsl"
 
 #ifdef VKRT_HAS_TEXTURES
 #ifdef VKRT_TEXTURE_CHUNKS
@@ -27,25 +28,12 @@ uint textureWord(uint word)
     return textureTexelChunks[nonuniformEXT(word >> VKRT_TEXTURE_CHUNK_SHIFT)].words[word & mask];
 }
 #else
-layout(scalar, binding = BINDING_TEXTURE_TEXELS) readonly buffer TextureTexelBlock { uint textureTexels[]; };
-#ifdef VKRT_TEXEL_ADDRESS
-// The render kernels read the words through the buffer's device address
-// (SceneUniforms::texelAddress): lavapipe compiles a storage-buffer load
-// whose offset differs between lanes into a loop over the lanes with a
-// bounds check, a device-address load into one gather. ClearCoatTest's
-// cold start on Mesa 25: 20.1 -> 14.8 s (docs/performance.md, "Staged
-// kernels"). The probe kernels keep the storage buffer.
-layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer TexelWords { uint words[]; };
-#define textureWord(word) TexelWords(u.texelAddress).words[word]
-#else
-// A macro, not a function: the one-buffer kernels' SPIR-V stays what it was.
+VKRT_READ_BUFFER(BINDING_TEXTURE_TEXELS, TextureTexelBlock, uint, textureTexels)
+#define textureTexels VKRT_READ_ITEMS(BINDING_TEXTURE_TEXELS, TextureTexelBlock, textureTexels)
 #define textureWord(word) textureTexels[word]
 #endif
-#endif
-layout(scalar, binding = BINDING_TEXTURE_RECORDS) readonly buffer TextureRecordBlock
-{
-    TextureRecord textureRecords[];
-};
+VKRT_READ_BUFFER(BINDING_TEXTURE_RECORDS, TextureRecordBlock, TextureRecord, textureRecords)
+#define textureRecords VKRT_READ_ITEMS(BINDING_TEXTURE_RECORDS, TextureRecordBlock, textureRecords)
 #endif
 
 #endif

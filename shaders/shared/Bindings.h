@@ -65,6 +65,10 @@ VKRT_CONSTANT(uint, BINDING_MESH_COLORS, BINDING_ENVIRONMENT + 20)
 VKRT_CONSTANT(uint, BINDING_MESH_UVS1, BINDING_ENVIRONMENT + 21)
 // LightPick[]: the light table of scenes with many lights (VKRT_LIGHT_TABLE).
 VKRT_CONSTANT(uint, BINDING_LIGHT_TABLE, BINDING_ENVIRONMENT + 22)
+// The render kernels read every read-only scene buffer through its device
+// address, SceneUniforms::bufferAddresses[binding] (lib/scene_buffers.glsl),
+// not through its descriptor: one slot per binding up to here.
+VKRT_CONSTANT(uint, ADDRESSED_BINDING_COUNT, BINDING_ENVIRONMENT + 23)
 // The staged kernels' lanes (lib/stages.glsl: StagedLane per pixel, after a
 // header of 4 words), in variants with VKRT_STAGE only.
 #if defined(__cplusplus) || defined(VKRT_STAGE)

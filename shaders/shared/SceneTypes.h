@@ -7,6 +7,7 @@
 #ifndef VKRT_SHARED_SCENE_TYPES_H
 #define VKRT_SHARED_SCENE_TYPES_H
 #include "Interop.h"
+#include "Bindings.h"
 #include "Kinds.h"
 
 VKRT_BEGIN_NAMESPACE
@@ -371,9 +372,9 @@ struct SceneUniforms {
     // shadow ray (lib/lights.glsl).
     uint lightTableCount;
     uint lightCandidates;
-    // The texel words' device address, low word first (lib/texture_bindings.glsl:
-    // read through it, not the storage buffer, when the texels are one buffer).
-    uvec2 texelAddress;
+    // Each read-only scene buffer's device address, low word first, at its
+    // binding (lib/scene_buffers.glsl; 0 where the variant has no such buffer).
+    uvec2 bufferAddresses[ADDRESSED_BINDING_COUNT];
 };
 
 /// Per-batch values (push constants), pushed once per submission: lavapipe

@@ -54,8 +54,11 @@ constexpr bool bindingsDistinct()
     return true;
 }
 static_assert(bindingsDistinct(), "shared/Bindings.h: every scene array needs its own binding below BINDING_COUNT");
-static_assert(sizeof(SceneUniforms) == 188 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT),
-              "SceneUniforms holds one count per shape and light kind");
+static_assert(sizeof(SceneUniforms) == 180 + 4 * (SHAPE_KIND_COUNT + LIGHT_KIND_COUNT) + 8 * ADDRESSED_BINDING_COUNT,
+              "SceneUniforms holds one count per shape and light kind and one address per read-only binding");
+// The read-only scene buffers' addresses sit at their bindings (lib/scene_buffers.glsl).
+static_assert(BINDING_LIGHT_TABLE < ADDRESSED_BINDING_COUNT && BINDING_MESH_UVS1 < ADDRESSED_BINDING_COUNT &&
+              BINDING_MATERIAL_ALPHA < ADDRESSED_BINDING_COUNT && ADDRESSED_BINDING_COUNT <= BINDING_COUNT);
 static_assert(MEDIUM_STACK_DEPTH == 4, "lib/media.glsl stores the stack in one uvec4");
 static_assert(sizeof(FrameConstants) == 8);
 static_assert(sizeof(LightPick) == 12);

@@ -21,6 +21,9 @@ namespace vkrt {
 namespace {
 
 constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffer;
+/// The scene's read-only buffers: the render kernels read them through
+/// their device addresses (lib/scene_buffers.glsl).
+constexpr vk::BufferUsageFlags kSceneRead = kStorage | vk::BufferUsageFlagBits::eShaderDeviceAddress;
 
 /// Several samples per invocation would share one loop budget on a device
 /// that caps an invocation's loop passes in total: refused there.
@@ -177,7 +180,7 @@ std::vector<KernelBinding> checkedKernelBindings(const VulkanContext& context, c
 template <typename T>
 Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records, bool uniform, uint32_t capacity)
 {
-    if (!uniform) return makeBufferFrom(context, records, kStorage);
+    if (!uniform) return makeBufferFrom(context, records, kSceneRead);
     VKRT_CHECK(records.size() <= capacity);
     records.resize(capacity);
     return makeBufferFrom(context, records, vk::BufferUsageFlagBits::eUniformBuffer);
@@ -381,8 +384,8 @@ void Renderer::uploadMeshBuffers()
     auto addBuffer = [&](uint32_t binding, const auto& records, vk::BufferUsageFlags extra = {}) {
         if (!m_kernel.uses(binding)) return;
         VKRT_CHECK(m_meshBuffers.size() < m_meshBuffers.capacity()); // a reallocation would move bound buffers
-        m_meshBuffers.push_back(makeBufferFrom(m_context, records, kStorage | extra));
-        m_kernel.bind(binding, m_meshBuffers.back());
+        m_meshBuffers.push_back(makeBufferFrom(m_context, records, kSceneRead | extra));
+        bindSceneRead(binding, m_meshBuffers.back());
     };
     m_meshBuffers.reserve(11); // bind() keeps references: no reallocation (one per addBuffer below)
     addBuffer(gpu::BINDING_MESH_NODES, m_static.meshNodes);
@@ -411,9 +414,8 @@ void Renderer::uploadTextureChunks()
     VKRT_CHECK(textures.chunking.count == m_kernel.countOf(gpu::BINDING_TEXTURE_TEXELS));
     m_textureChunks.reserve(textures.chunking.count); // bind() keeps references: no reallocation
     for (uint32_t chunk = 0; chunk < textures.chunking.count; ++chunk)
-        m_textureChunks.push_back(
-            makeBufferFrom(m_context, textures.chunk(chunk), kStorage | vk::BufferUsageFlagBits::eShaderDeviceAddress));
-    if (m_textureChunks.size() == 1) m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, m_textureChunks.front());
+        m_textureChunks.push_back(makeBufferFrom(m_context, textures.chunk(chunk), kSceneRead));
+    if (m_textureChunks.size() == 1) bindSceneRead(gpu::BINDING_TEXTURE_TEXELS, m_textureChunks.front());
     else m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, std::span<const Buffer>(m_textureChunks));
 }
 
@@ -436,8 +438,8 @@ void Renderer::bindCubemap()
     m_environmentSizes.cubeSize = faces[0].width;
     m_environmentSizes.constant = isConstantEnvironment(faces);
     if (m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) {
-        m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), kStorage));
-        m_kernel.bind(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
+        m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), kSceneRead));
+        bindSceneRead(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
     }
 }
 
@@ -452,8 +454,8 @@ void Renderer::bindLatLongMap()
     const LatLongDistribution distribution = latLongDistribution(map);
     m_environmentSizes.latLongGrid = {distribution.columns, distribution.rows};
     m_environmentSizes.latLongBlock = distribution.block;
-    m_environmentCdf.emplace(makeBufferFrom(m_context, distribution.cdf, kStorage));
-    m_kernel.bind(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
+    m_environmentCdf.emplace(makeBufferFrom(m_context, distribution.cdf, kSceneRead));
+    bindSceneRead(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
 }
 
 void Renderer::uploadSceneBuffers()
@@ -462,7 +464,8 @@ void Renderer::uploadSceneBuffers()
         if (!m_kernel.uses(binding)) return;
         bool uniform = m_variant.isUniformBinding(binding);
         m_sceneBuffers.push_back(makeSceneArrayBuffer(m_context, records, uniform, uniformCapacity));
-        m_kernel.bind(binding, m_sceneBuffers.back());
+        if (uniform) m_kernel.bind(binding, m_sceneBuffers.back());
+        else bindSceneRead(binding, m_sceneBuffers.back());
     };
     m_sceneBuffers.clear();
     m_sceneBuffers.reserve(gpu::BINDING_COUNT); // bind() keeps references: no reallocation
@@ -471,11 +474,6 @@ void Renderer::uploadSceneBuffers()
     m_data.uniforms.environmentGrid = m_environmentSizes.latLongGrid;
     m_data.uniforms.environmentBlock = m_environmentSizes.latLongBlock;
     if (m_environmentSizes.constant) m_data.uniforms.flags |= gpu::RENDER_FLAG_CONSTANT_ENVIRONMENT;
-    if (m_textureChunks.size() == 1) {
-        const vk::DeviceAddress texels = m_textureChunks.front().address(m_context);
-        m_data.uniforms.texelAddress = glm::uvec2(uint32_t(texels), uint32_t(texels >> 32));
-    }
-    addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
     addBuffer(gpu::BINDING_MATERIALS, m_data.materials, gpu::UNIFORM_MATERIALS);
 #define VKRT_UPLOAD_ARRAY(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     addBuffer(gpu::BINDING_##ARRAY, m_data.array, gpu::UNIFORM_##ARRAY);
@@ -484,14 +482,25 @@ void Renderer::uploadSceneBuffers()
 #undef VKRT_UPLOAD_ARRAY
     auto addStorage = [&](uint32_t binding, const auto& records) {
         if (!m_kernel.uses(binding)) return;
-        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, kStorage));
-        m_kernel.bind(binding, m_sceneBuffers.back());
+        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, kSceneRead));
+        bindSceneRead(binding, m_sceneBuffers.back());
     };
     addStorage(gpu::BINDING_TOP_NODES, m_data.topNodes);
     addStorage(gpu::BINDING_TOP_REFS, m_data.topRefs);
     addStorage(gpu::BINDING_EMITTERS, m_data.emitters);
     addStorage(gpu::BINDING_LIGHT_TABLE, m_data.lightTable);
     addStorage(gpu::BINDING_MATERIAL_TABLES, m_static.materialTables);
+    // Last: the uniforms carry the addresses of every buffer above.
+    std::copy(m_bufferAddresses.begin(), m_bufferAddresses.end(), m_data.uniforms.bufferAddresses);
+    addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
+}
+
+void Renderer::bindSceneRead(uint32_t binding, const Buffer& buffer)
+{
+    VKRT_CHECK(binding < m_bufferAddresses.size());
+    m_kernel.bind(binding, buffer);
+    const vk::DeviceAddress address = buffer.address(m_context);
+    m_bufferAddresses[binding] = glm::uvec2(uint32_t(address), uint32_t(address >> 32));
 }
 
 std::vector<std::span<const uint32_t>> Renderer::kernelStages() const

@@ -14,6 +14,7 @@
 #include "render/Tally.h"
 #include "shared/Bindings.h"
 
+#include <array>
 #include <filesystem>
 #include <optional>
 
@@ -143,6 +144,8 @@ private:
     std::vector<Buffer> m_meshBuffers;
     std::vector<Buffer> m_textureChunks; ///< the texel words, one buffer per chunk (TextureChunking)
     std::vector<Buffer> m_sceneBuffers;
+    /// SceneUniforms::bufferAddresses: each read-only scene buffer's, at its binding.
+    std::array<glm::uvec2, gpu::ADDRESSED_BINDING_COUNT> m_bufferAddresses{};
     BandedBuffer m_accumulation;
     Buffer m_stats;
     Buffer m_frameRun; ///< gpu::FrameRun of the run being dispatched
@@ -173,6 +176,8 @@ private:
     void uploadSceneBuffers();
     void uploadMeshBuffers();
     void uploadTextureChunks();
+    /// Binds one of the scene's read-only buffers and notes its device address for the uniforms.
+    void bindSceneRead(uint32_t binding, const Buffer& buffer);
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;
     void renderStagedRun(uint32_t firstFrame, uint32_t count);
     std::vector<std::span<const uint32_t>> kernelStages() const;

@@ -12,6 +12,7 @@
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_DIRECTIONAL_LIGHTS, DirectionalLightBlock, DirectionalLight, directionalLights,
                  UNIFORM_DIRECTIONAL_LIGHTS)
+#define directionalLights VKRT_SCENE_ITEMS(BINDING_DIRECTIONAL_LIGHTS, DirectionalLightBlock, directionalLights)
 #endif
 
 bool hitOneDirectionalLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }

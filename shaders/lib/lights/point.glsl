@@ -8,6 +8,7 @@
 
 #ifdef VKRT_HAS_POINT_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_POINT_LIGHTS, PointLightBlock, PointLight, pointLights, UNIFORM_POINT_LIGHTS)
+#define pointLights VKRT_SCENE_ITEMS(BINDING_POINT_LIGHTS, PointLightBlock, pointLights)
 #endif
 
 bool hitOnePointLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }

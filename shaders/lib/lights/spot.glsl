@@ -8,6 +8,7 @@
 
 #ifdef VKRT_HAS_SPOT_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_SPOT_LIGHTS, SpotLightBlock, SpotLight, spotLights, UNIFORM_SPOT_LIGHTS)
+#define spotLights VKRT_SCENE_ITEMS(BINDING_SPOT_LIGHTS, SpotLightBlock, spotLights)
 #endif
 
 bool hitOneSpotLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit) { return false; }

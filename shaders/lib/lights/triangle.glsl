@@ -9,6 +9,7 @@
 
 #ifdef VKRT_HAS_TRIANGLE_LIGHTS
 VKRT_SCENE_ARRAY(BINDING_TRIANGLE_LIGHTS, TriangleLightBlock, TriangleLight, triangleLights, UNIFORM_TRIANGLE_LIGHTS)
+#define triangleLights VKRT_SCENE_ITEMS(BINDING_TRIANGLE_LIGHTS, TriangleLightBlock, triangleLights)
 #endif
 
 bool hitOneTriangleLight(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)

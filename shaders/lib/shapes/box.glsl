@@ -5,6 +5,7 @@
 
 #ifdef VKRT_HAS_BOXES
 VKRT_SCENE_ARRAY(BINDING_BOXES, BoxBlock, Box, boxes, UNIFORM_BOXES)
+#define boxes VKRT_SCENE_ITEMS(BINDING_BOXES, BoxBlock, boxes)
 #endif
 
 bool hitOneBox(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)

@@ -6,6 +6,7 @@
 
 #ifdef VKRT_HAS_MESHES
 VKRT_SCENE_ARRAY(BINDING_MESHES, MeshBlock, Mesh, meshes, UNIFORM_MESHES)
+#define meshes VKRT_SCENE_ITEMS(BINDING_MESHES, MeshBlock, meshes)
 #endif
 
 // A mesh instance is traversed in its own coordinates: the ray is moved

@@ -5,6 +5,7 @@
 
 #ifdef VKRT_HAS_PLANES
 VKRT_SCENE_ARRAY(BINDING_PLANES, PlaneBlock, Plane, planes, UNIFORM_PLANES)
+#define planes VKRT_SCENE_ITEMS(BINDING_PLANES, PlaneBlock, planes)
 #endif
 
 bool hitOnePlane(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)

@@ -5,6 +5,7 @@
 
 #ifdef VKRT_HAS_SPHERES
 VKRT_SCENE_ARRAY(BINDING_SPHERES, SphereBlock, Sphere, spheres, UNIFORM_SPHERES)
+#define spheres VKRT_SCENE_ITEMS(BINDING_SPHERES, SphereBlock, spheres)
 #endif
 
 bool hitOneSphere(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)

@@ -5,6 +5,7 @@
 
 #ifdef VKRT_HAS_TRIANGLES
 VKRT_SCENE_ARRAY(BINDING_TRIANGLES, TriangleBlock, Triangle, triangles, UNIFORM_TRIANGLES)
+#define triangles VKRT_SCENE_ITEMS(BINDING_TRIANGLES, TriangleBlock, triangles)
 #endif
 
 bool hitOneTriangle(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout HitId hit)

@@ -29,6 +29,7 @@ Triangle triangles[1];
 Plane planes[1];
 // The probe's records are the globals above: the kinds' buffer declarations are left out.
 #define VKRT_SCENE_ARRAY(binding_, Block, Type, name, capacity)
+#define VKRT_SCENE_ITEMS(binding_, Block, name) name
 #include "lib/scene.glsl"
 
 void main()
