@@ -17,11 +17,9 @@
 #ifdef VKRT_TEXTURE_CHUNKS
 #extension GL_EXT_nonuniform_qualifier : require
 #endif
-// The scene's read-only buffers are read through their device addresses
-// (lib/scene_buffers.glsl); the layout test reflects them as storage buffers
-// (tests/gpu/shared_layout_test.cpp: the same scalar layout).
-#ifndef VKRT_TEST_DESCRIPTOR_READS
-#define VKRT_SCENE_ADDRESSES
+// The scene's read-only buffers read through their device addresses
+// (lib/scene_buffers.glsl), where the device has them.
+#ifdef VKRT_SCENE_ADDRESSES
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
 #endif

@@ -131,6 +131,11 @@ DeviceInfo describeDevice(const vk::raii::PhysicalDevice& device, uint32_t index
     info.unsuitableReason = unsuitableReason(device, info, surface);
     if (info.suitable()) info.rayQueryMissing = rayQueryMissing(device);
     if (info.suitable()) info.bufferArraysMissing = bufferArraysMissing(device);
+    if (info.suitable())
+        info.bufferDeviceAddress =
+            device.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan12Features>()
+                .get<vk::PhysicalDeviceVulkan12Features>()
+                .bufferDeviceAddress;
     return info;
 }
 
@@ -270,12 +275,12 @@ void VulkanContext::createDevice()
         chain.get<vk::PhysicalDeviceVulkan12Features>().setShaderStorageBufferArrayNonUniformIndexing(true);
     }
     chain.get<vk::DeviceCreateInfo>().setPEnabledFeatures(&core);
+    if (deviceInfo().bufferDeviceAddress) chain.get<vk::PhysicalDeviceVulkan12Features>().setBufferDeviceAddress(true);
     // The driver backend's extensions are enabled wherever they exist, so
     // that one context serves either backend (they cost nothing unused).
     const bool rayQuery = deviceInfo().rayQuery();
     if (rayQuery) {
         extensions.insert(extensions.end(), kRayQueryExtensions.begin(), kRayQueryExtensions.end());
-        chain.get<vk::PhysicalDeviceVulkan12Features>().setBufferDeviceAddress(true);
         chain.get<vk::PhysicalDeviceAccelerationStructureFeaturesKHR>().setAccelerationStructure(true);
         chain.get<vk::PhysicalDeviceRayQueryFeaturesKHR>().setRayQuery(true);
     } else {

@@ -37,6 +37,10 @@ struct DeviceInfo {
     /// texels exceed one storage buffer needs (texture/TextureAtlas.h). Empty
     /// when present; otherwise what is missing.
     std::string bufferArraysMissing = "not checked";
+    /// Loads through buffer device addresses (the Vulkan 1.2 feature
+    /// bufferDeviceAddress, enabled wherever it exists): the render kernels
+    /// read the scene's buffers through them (lib/scene_buffers.glsl).
+    bool bufferDeviceAddress = false;
 
     bool suitable() const { return unsuitableReason.empty(); }
     std::string typeName() const;

@@ -138,6 +138,7 @@ std::vector<std::pair<std::string, std::string>> KernelVariant::defines() const
         if (features.has(type)) result.emplace_back("VKRT_MATERIAL_" + upper(materialTypeName(type)), "1");
     if (uniformScene) result.emplace_back("VKRT_UNIFORM_SCENE", "1");
     if (groupLoopCount) result.emplace_back("VKRT_GROUP_LOOP_COUNT", "1");
+    if (sceneAddresses) result.emplace_back("VKRT_SCENE_ADDRESSES", "1");
     if (multiChunkTextures()) {
         result.emplace_back("VKRT_TEXTURE_CHUNKS", std::to_string(textureChunks));
         result.emplace_back("VKRT_TEXTURE_CHUNK_SHIFT", std::to_string(textureChunkShift));

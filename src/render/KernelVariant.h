@@ -38,13 +38,18 @@ struct KernelVariant {
     /// instead of vkrt's own BVH walk: a different kernel, so part of the
     /// defines and the SPIR-V cache key.
     bool driverAccel = false;
+    /// The path integrator in two kernels, trace and shade (lib/stages.glsl;
+    /// render --staged): the same defines, each stage compiled with VKRT_STAGE.
+    bool staged = false;
+    /// The scene's read-only buffers read through their device addresses
+    /// (VKRT_SCENE_ADDRESSES, lib/scene_buffers.glsl), wherever the device
+    /// has them: lavapipe compiles such loads many times faster than
+    /// divergent storage-buffer loads. The same arithmetic either way.
+    bool sceneAddresses = false;
     /// Storage buffers the texel words are split into (texture/TextureAtlas.h:
     /// TextureChunking). 1 (every scene whose texels fit one buffer) adds
     /// nothing, so those kernels are what they were; more adds
     /// VKRT_TEXTURE_CHUNKS and VKRT_TEXTURE_CHUNK_SHIFT (lib/texture_bindings.glsl).
-    /// The path integrator in two kernels, trace and shade (lib/stages.glsl;
-    /// render --staged): the same defines, each stage compiled with VKRT_STAGE.
-    bool staged = false;
     uint32_t textureChunks = 1;
     uint32_t textureChunkShift = 0; ///< log2 of the words of each chunk, with several
 

@@ -21,9 +21,6 @@ namespace vkrt {
 namespace {
 
 constexpr vk::BufferUsageFlags kStorage = vk::BufferUsageFlagBits::eStorageBuffer;
-/// The scene's read-only buffers: the render kernels read them through
-/// their device addresses (lib/scene_buffers.glsl).
-constexpr vk::BufferUsageFlags kSceneRead = kStorage | vk::BufferUsageFlagBits::eShaderDeviceAddress;
 
 /// Several samples per invocation would share one loop budget on a device
 /// that caps an invocation's loop passes in total: refused there.
@@ -136,6 +133,7 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
         throw InputError(scene.path + ": --staged runs the path integrator only; the scene's integrator is " +
                          integratorName(variant.features.integrator));
     variant.staged = options.staged;
+    variant.sceneAddresses = context.deviceInfo().bufferDeviceAddress;
     chooseTextureChunks(context, scene, options, variant);
     return variant;
 }
@@ -178,9 +176,10 @@ std::vector<KernelBinding> checkedKernelBindings(const VulkanContext& context, c
 /// A scene array's GPU buffer: padded to the block's fixed capacity when it
 /// is a uniform buffer, so the bound range covers the whole declared block.
 template <typename T>
-Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records, bool uniform, uint32_t capacity)
+Buffer makeSceneArrayBuffer(const VulkanContext& context, std::vector<T> records, bool uniform, uint32_t capacity,
+                            vk::BufferUsageFlags storageUsage)
 {
-    if (!uniform) return makeBufferFrom(context, records, kSceneRead);
+    if (!uniform) return makeBufferFrom(context, records, storageUsage);
     VKRT_CHECK(records.size() <= capacity);
     records.resize(capacity);
     return makeBufferFrom(context, records, vk::BufferUsageFlagBits::eUniformBuffer);
@@ -384,7 +383,7 @@ void Renderer::uploadMeshBuffers()
     auto addBuffer = [&](uint32_t binding, const auto& records, vk::BufferUsageFlags extra = {}) {
         if (!m_kernel.uses(binding)) return;
         VKRT_CHECK(m_meshBuffers.size() < m_meshBuffers.capacity()); // a reallocation would move bound buffers
-        m_meshBuffers.push_back(makeBufferFrom(m_context, records, kSceneRead | extra));
+        m_meshBuffers.push_back(makeBufferFrom(m_context, records, sceneReadUsage() | extra));
         bindSceneRead(binding, m_meshBuffers.back());
     };
     m_meshBuffers.reserve(11); // bind() keeps references: no reallocation (one per addBuffer below)
@@ -414,7 +413,7 @@ void Renderer::uploadTextureChunks()
     VKRT_CHECK(textures.chunking.count == m_kernel.countOf(gpu::BINDING_TEXTURE_TEXELS));
     m_textureChunks.reserve(textures.chunking.count); // bind() keeps references: no reallocation
     for (uint32_t chunk = 0; chunk < textures.chunking.count; ++chunk)
-        m_textureChunks.push_back(makeBufferFrom(m_context, textures.chunk(chunk), kSceneRead));
+        m_textureChunks.push_back(makeBufferFrom(m_context, textures.chunk(chunk), sceneReadUsage()));
     if (m_textureChunks.size() == 1) bindSceneRead(gpu::BINDING_TEXTURE_TEXELS, m_textureChunks.front());
     else m_kernel.bind(gpu::BINDING_TEXTURE_TEXELS, std::span<const Buffer>(m_textureChunks));
 }
@@ -438,7 +437,7 @@ void Renderer::bindCubemap()
     m_environmentSizes.cubeSize = faces[0].width;
     m_environmentSizes.constant = isConstantEnvironment(faces);
     if (m_kernel.uses(gpu::BINDING_ENVIRONMENT_CDF)) {
-        m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), kSceneRead));
+        m_environmentCdf.emplace(makeBufferFrom(m_context, environmentCdf(faces), sceneReadUsage()));
         bindSceneRead(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
     }
 }
@@ -454,7 +453,7 @@ void Renderer::bindLatLongMap()
     const LatLongDistribution distribution = latLongDistribution(map);
     m_environmentSizes.latLongGrid = {distribution.columns, distribution.rows};
     m_environmentSizes.latLongBlock = distribution.block;
-    m_environmentCdf.emplace(makeBufferFrom(m_context, distribution.cdf, kSceneRead));
+    m_environmentCdf.emplace(makeBufferFrom(m_context, distribution.cdf, sceneReadUsage()));
     bindSceneRead(gpu::BINDING_ENVIRONMENT_CDF, *m_environmentCdf);
 }
 
@@ -463,7 +462,7 @@ void Renderer::uploadSceneBuffers()
     auto addBuffer = [&](uint32_t binding, auto&& records, uint32_t uniformCapacity) {
         if (!m_kernel.uses(binding)) return;
         bool uniform = m_variant.isUniformBinding(binding);
-        m_sceneBuffers.push_back(makeSceneArrayBuffer(m_context, records, uniform, uniformCapacity));
+        m_sceneBuffers.push_back(makeSceneArrayBuffer(m_context, records, uniform, uniformCapacity, sceneReadUsage()));
         if (uniform) m_kernel.bind(binding, m_sceneBuffers.back());
         else bindSceneRead(binding, m_sceneBuffers.back());
     };
@@ -482,7 +481,7 @@ void Renderer::uploadSceneBuffers()
 #undef VKRT_UPLOAD_ARRAY
     auto addStorage = [&](uint32_t binding, const auto& records) {
         if (!m_kernel.uses(binding)) return;
-        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, kSceneRead));
+        m_sceneBuffers.push_back(makeBufferFrom(m_context, records, sceneReadUsage()));
         bindSceneRead(binding, m_sceneBuffers.back());
     };
     addStorage(gpu::BINDING_TOP_NODES, m_data.topNodes);
@@ -495,10 +494,16 @@ void Renderer::uploadSceneBuffers()
     addBuffer(gpu::BINDING_UNIFORMS, std::vector{m_data.uniforms}, 1);
 }
 
+vk::BufferUsageFlags Renderer::sceneReadUsage() const
+{
+    return m_variant.sceneAddresses ? kStorage | vk::BufferUsageFlagBits::eShaderDeviceAddress : kStorage;
+}
+
 void Renderer::bindSceneRead(uint32_t binding, const Buffer& buffer)
 {
     VKRT_CHECK(binding < m_bufferAddresses.size());
     m_kernel.bind(binding, buffer);
+    if (!m_variant.sceneAddresses) return;
     const vk::DeviceAddress address = buffer.address(m_context);
     m_bufferAddresses[binding] = glm::uvec2(uint32_t(address), uint32_t(address >> 32));
 }

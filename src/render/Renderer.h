@@ -176,6 +176,8 @@ private:
     void uploadSceneBuffers();
     void uploadMeshBuffers();
     void uploadTextureChunks();
+    /// The usage of the scene's read-only buffers: with device addresses where the kernels read them so.
+    vk::BufferUsageFlags sceneReadUsage() const;
     /// Binds one of the scene's read-only buffers and notes its device address for the uniforms.
     void bindSceneRead(uint32_t binding, const Buffer& buffer);
     void recordFrames(vk::CommandBuffer cmd, uint32_t firstFrame, uint32_t count) const;

@@ -16,12 +16,11 @@ namespace {
 
 std::map<std::string, int> reflectedOffsets()
 {
-    // The kernels read the scene's buffers through device addresses, which
-    // reflection does not see; the same blocks as storage buffers have the
-    // same scalar layout (lib/scene_buffers.glsl).
-    std::vector<Define> defines = KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines();
-    defines.emplace_back("VKRT_TEST_DESCRIPTOR_READS", "1");
-    KernelSource source{defaultShaderRoot(), "kernels/render.comp", defines};
+    // Reflection sees the scene's buffers as storage buffers (a variant
+    // without sceneAddresses); through device addresses they have the same
+    // scalar layout (lib/scene_buffers.glsl).
+    KernelSource source{defaultShaderRoot(), "kernels/render.comp",
+                        KernelVariant{FeatureSet::everything(Integrator::Whitted)}.defines()};
     std::map<std::string, int> offsets;
     for (const auto& [name, offset] : reflectBlockMemberOffsets(source)) offsets[name] = offset;
     return offsets;
