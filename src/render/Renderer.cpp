@@ -1,5 +1,7 @@
 #include "render/Renderer.h"
 
+#include "gpu/VectorWidth.h"
+
 #include "render/LightTable.h"
 #include "render/RenderMemory.h"
 
@@ -110,6 +112,17 @@ void chooseTextureChunks(const VulkanContext& context, const Scene& scene, const
     variant.textureChunkShift = chunks.shift;
 }
 
+} // namespace
+
+bool sceneAddressesPay(const DeviceInfo& device)
+{
+    if (!device.bufferDeviceAddress || device.driverId != vk::DriverId::eMesaLlvmpipe) return false;
+    const std::optional<std::pair<int, int>> mesa = mesaVersion(device);
+    return mesa && mesa->first < 26;
+}
+
+namespace {
+
 KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, const RenderOptions& options)
 {
     checkSamplesPerInvocation(context.loopCap(), options.samplesPerInvocation); // before any compilation
@@ -133,7 +146,11 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
         throw InputError(scene.path + ": --staged runs the path integrator only; the scene's integrator is " +
                          integratorName(variant.features.integrator));
     variant.staged = options.staged;
-    variant.sceneAddresses = context.deviceInfo().bufferDeviceAddress;
+    variant.sceneAddresses = options.sceneReads == SceneReads::Auto ? sceneAddressesPay(context.deviceInfo())
+                                                                    : options.sceneReads == SceneReads::Address;
+    if (variant.sceneAddresses && !context.deviceInfo().bufferDeviceAddress)
+        throw InputError("reading the scene through device addresses needs the bufferDeviceAddress feature, which " +
+                         context.deviceInfo().name + " lacks");
     chooseTextureChunks(context, scene, options, variant);
     return variant;
 }

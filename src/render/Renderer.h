@@ -20,6 +20,18 @@
 
 namespace vkrt {
 
+/// Through the buffers' device addresses, through their descriptors, or as
+/// measured fastest to compile on the device (sceneAddressesPay).
+enum class SceneReads { Auto, Address, Descriptor };
+
+/// Whether reading the scene's buffers through device addresses pays on
+/// this device: on lavapipe before Mesa 26, whose compiler turns every
+/// divergent storage-buffer load into a loop over the lanes (cold start-up
+/// 0.25-0.85x, docs/performance.md "Staged kernels"); Mesa 26 compiles
+/// descriptor reads as fast or faster (0.97-1.22x the other way), and other
+/// devices are not measured. Needs the bufferDeviceAddress feature.
+bool sceneAddressesPay(const DeviceInfo& device);
+
 struct RenderOptions {
     uint32_t seed = 0;
     bool jitter = true;
@@ -33,6 +45,9 @@ struct RenderOptions {
     /// The path integrator as two kernels (trace, shade) that take turns
     /// (KernelVariant::staged); the same image bit for bit.
     bool staged = false;
+    /// How the kernels read the scene's buffers (KernelVariant::sceneAddresses);
+    /// the same image either way. Auto: sceneAddressesPay on the device.
+    SceneReads sceneReads = SceneReads::Auto;
     uint32_t firstFrame = 0; ///< index of the first frame (sample) rendered: a shard's start
     /// Frames one invocation runs back to back per dispatch (path
     /// regeneration); 0: the device's default (samplesPerInvocationFor).
