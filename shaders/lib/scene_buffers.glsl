@@ -3,17 +3,18 @@
 //   VKRT_READ_BUFFER(BINDING_X, XBlock, X, xs)          declares the buffer;
 //   #define xs VKRT_READ_ITEMS(BINDING_X, XBlock, xs)   names its records.
 //
-// Code then reads xs[i] either way. With VKRT_SCENE_ADDRESSES (the render
-// kernels) the records are read through the buffer's device address,
+// Code then reads xs[i] either way. With VKRT_SCENE_ADDRESSES (render
+// kernels on devices where it pays: render/Renderer.h, sceneAddressesPay)
+// the records are read through the buffer's device address,
 // SceneUniforms::bufferAddresses[BINDING_X], which the host fills for every
-// buffer it binds (render/Renderer.cpp); elsewhere (the test probes) through
-// the storage-buffer descriptor. The descriptors stay bound either way.
+// buffer it binds (render/Renderer.cpp); otherwise (and in the test probes)
+// through the storage-buffer descriptor, which stays bound either way.
 //
-// Why: lavapipe compiles a storage-buffer load whose offset differs between
-// the lanes of a subgroup into a loop over the lanes, each with its bounds
-// check, and a device-address load into one gather. A kernel with a few
-// hundred such load sites spends most of its compile time on those loops
-// (docs/performance.md, "Staged kernels"; shared facts in NUMERICS).
+// Why: lavapipe before Mesa 26 compiles a storage-buffer load whose offset
+// differs between the lanes of a subgroup into a loop over the lanes, each
+// with its bounds check, and a device-address load into one gather. A
+// kernel with a few hundred such load sites spent most of its compile time
+// on those loops (docs/performance.md, "Staged kernels").
 //
 // The scene arrays of the shape and light kinds and the materials
 // (VKRT_SCENE_ARRAY, VKRT_SCENE_ITEMS) are uniform blocks in the
