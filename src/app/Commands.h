@@ -35,6 +35,8 @@ std::vector<Define> parseKernelDefines(const std::vector<std::string>& texts);
 /// Adds `--accel own|driver|auto` (the traversal backend, render/RenderSession.h:
 /// AccelChoice) to a command, writing the choice to `choice`.
 void addAccelOption(CLI::App& command, AccelChoice& choice);
+/// Adds --scene-reads (auto, address or descriptor: RenderOptions::sceneReads) to a command.
+void addSceneReadsOption(CLI::App& command, SceneReads& reads);
 
 /// Adds the hidden test hook `--max-texture-chunk-bytes N` (RenderOptions::
 /// maxTextureChunkBytes: a scene's texels split into buffers of at most N

@@ -28,6 +28,7 @@ struct InfoOptions {
     bool uber = false;
     bool staged = false;
     AccelChoice accel = AccelChoice::Auto;
+    SceneReads sceneReads = SceneReads::Auto;
     std::string json;                  ///< --json FILE, or "-" for standard output
     std::string sceneJson;             ///< --scene-json FILE, or "-" for standard output
     uint64_t maxTextureChunkBytes = 0; ///< test hook: texel buffers of at most this many bytes
@@ -381,6 +382,7 @@ JsonObject kernelJson(const RenderSession& session, const InfoOptions& options)
             {"compileSeconds", kernel.compileSeconds},
             {"cacheDirectory", session.renderOptions().cacheDirectory.string()},
             {"staged", variant.staged},
+            {"sceneAddresses", variant.sceneAddresses},
             {"traceStage", traceStageJson(session.renderer())}};
 }
 
@@ -431,6 +433,7 @@ int runInfo(const InfoOptions& options)
     config.uber = options.uber;
     config.staged = options.staged;
     config.accel = options.accel;
+    config.sceneReads = options.sceneReads;
     config.warmUp = false; // the first frame's time is what info measures
     config.maxTextureChunkBytes = options.maxTextureChunkBytes;
     // The variant info has always described: independent samples, no variance.
@@ -461,6 +464,7 @@ CommandRunner addInfoCommand(CLI::App& app)
     cmd->add_flag("--uber", options->uber, "Describe the all-features kernel instead");
     cmd->add_flag("--staged", options->staged, "Describe the staged kernels (trace and shade) instead");
     addAccelOption(*cmd, options->accel);
+    addSceneReadsOption(*cmd, options->sceneReads);
     cmd->add_option("--json", options->json,
                     "Also write these facts as one JSON object to FILE, or to standard output for - (the lines "
                     "above then go to stderr; docs/machine-output.md)");

@@ -61,6 +61,7 @@ struct RenderCommandOptions {
     bool sppGiven = false;
     std::string sampler = "auto";
     AccelChoice accel = AccelChoice::Auto;
+    SceneReads sceneReads = SceneReads::Auto;
     VectorWidthChoice vectorWidth = VectorWidthChoice::Auto;
     std::string shard;                      ///< "i/n" (docs/farm.md)
     uint32_t samplesPerInvocation = 0;      ///< 0: the device's default
@@ -152,6 +153,7 @@ SessionConfig sessionConfig(const RenderCommandOptions& options, const std::opti
     config.staged = options.staged;
     config.sampler = *samplerChoiceNamed(options.sampler); // CLI::IsMember checked it
     config.accel = options.accel;
+    config.sceneReads = options.sceneReads;
     config.variance = options.varianceNeeds();
     config.aov = !options.aovs.empty();
     config.stop = {shard ? shard->end - shard->begin : options.maxSpp(), options.timeBudget, options.targetError,
@@ -573,6 +575,7 @@ CommandRunner addRenderCommand(CLI::App& app)
                         std::to_string(gpu::VARIANCE_BATCHES) + " independently scrambled batches)")
         ->check(CLI::IsMember({"auto", "independent", "sobol"}));
     addAccelOption(*cmd, options->accel);
+    addSceneReadsOption(*cmd, options->sceneReads);
     addVectorWidthOption(*cmd, options->vectorWidth);
     cmd->add_option("--camera", options->gltf.camera,
                     "A glTF scene's camera to render through: its or its node's name, or its index (default: the "

@@ -103,6 +103,7 @@ RenderOptions renderOptionsFor(const VulkanContext& context, const Scene& scene,
     options.jitter = config.jitter;
     options.uber = config.uber;
     options.staged = config.staged;
+    options.sceneReads = config.sceneReads;
     options.variance = config.variance.any();
     options.aov = config.aov;
     options.extraDefines = config.extraDefines;

@@ -64,8 +64,9 @@ struct SessionConfig {
     uint32_t samplesPerInvocation = 0; ///< RenderOptions::samplesPerInvocation
     bool jitter = true;
     bool uber = false;
-    bool staged = false; ///< RenderOptions::staged
-    bool warmUp = true;  ///< render and discard a frame first, so timing excludes the driver's shader compile
+    bool staged = false;                      ///< RenderOptions::staged
+    SceneReads sceneReads = SceneReads::Auto; ///< RenderOptions::sceneReads
+    bool warmUp = true; ///< render and discard a frame first, so timing excludes the driver's shader compile
     SamplerChoice sampler = SamplerChoice::Auto;
     VarianceNeeds variance;
     bool aov = false;                      ///< average the AOVs too (RenderOptions::aov)

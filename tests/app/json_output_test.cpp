@@ -353,6 +353,35 @@ TEST_F(Json, InfoDescribesBothStagedKernels)
     EXPECT_FALSE(fs::exists(m_dir / "w.exr"));
 }
 
+// --scene-reads picks how the kernel reads the scene (a different kernel:
+// another cache key), and a name it does not know is refused naming it.
+TEST_F(Json, InfoReportsHowTheKernelReadsTheScene)
+{
+    const fs::path scene = fs::path(VKRT_TEST_SOURCE_DIR) / "scenes" / "validation" / "diffuse-box.toml";
+    const fs::path file = m_dir / "reads.json";
+    ProcessResult descriptor =
+        runVkrt(withDevice({"info", scene.string(), "--scene-reads", "descriptor", "--json", file.string()}));
+    ASSERT_EQ(descriptor.exitCode, 0) << descriptor.output;
+    const json byDescriptor = parseJson(readText(file));
+    EXPECT_EQ(byDescriptor["kernel"]["sceneAddresses"], false);
+    EXPECT_FALSE(byDescriptor["kernel"]["defines"].contains("VKRT_SCENE_ADDRESSES"));
+
+    ProcessResult address =
+        runVkrt(withDevice({"info", scene.string(), "--scene-reads", "address", "--json", file.string()}));
+    if (address.exitCode == 0) {
+        const json byAddress = parseJson(readText(file));
+        EXPECT_EQ(byAddress["kernel"]["sceneAddresses"], true);
+        EXPECT_TRUE(byAddress["kernel"]["defines"].contains("VKRT_SCENE_ADDRESSES"));
+        EXPECT_NE(byAddress["kernel"]["cacheKey"], byDescriptor["kernel"]["cacheKey"]);
+    } else {
+        EXPECT_NE(address.output.find("bufferDeviceAddress"), std::string::npos) << address.output;
+    }
+
+    ProcessResult unknown = runVkrt(withDevice({"info", scene.string(), "--scene-reads", "pointer"}));
+    EXPECT_EQ(unknown.exitCode, 2) << unknown.output;
+    EXPECT_NE(unknown.output.find("--scene-reads pointer"), std::string::npos) << unknown.output;
+}
+
 // Texture memory: its bytes and the storage buffers they take, one unless
 // they exceed a buffer (here forced by the hidden --max-texture-chunk-bytes).
 TEST_F(Json, InfoReportsTextureMemoryAndItsBuffers)
