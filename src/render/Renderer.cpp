@@ -1,5 +1,6 @@
 #include "render/Renderer.h"
 
+#include "gpu/SpirvFault.h"
 #include "gpu/VectorWidth.h"
 
 #include "render/LightTable.h"
@@ -146,8 +147,14 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
         throw InputError(scene.path + ": --staged runs the path integrator only; the scene's integrator is " +
                          integratorName(variant.features.integrator));
     variant.staged = options.staged;
-    variant.sceneAddresses = options.sceneReads == SceneReads::Auto ? sceneAddressesPay(context.deviceInfo())
-                                                                    : options.sceneReads == SceneReads::Address;
+    // An injected neighbour-load fault (--inject) changes storage-buffer loads
+    // only: auto reads the scene through descriptors then, so that the fault
+    // reaches every scene array as docs/regress.md says.
+    const std::optional<SpirvFault> fault = spirvFaultFromEnvironment();
+    const bool faultOnDescriptorLoads = fault && fault->kind == SpirvFaultKind::NeighbourLoad;
+    variant.sceneAddresses = options.sceneReads == SceneReads::Auto
+                                 ? sceneAddressesPay(context.deviceInfo()) && !faultOnDescriptorLoads
+                                 : options.sceneReads == SceneReads::Address;
     if (variant.sceneAddresses && !context.deviceInfo().bufferDeviceAddress)
         throw InputError("reading the scene through device addresses needs the bufferDeviceAddress feature, which " +
                          context.deviceInfo().name + " lacks");
