@@ -377,6 +377,13 @@ TEST_F(Json, InfoReportsHowTheKernelReadsTheScene)
         EXPECT_NE(address.output.find("bufferDeviceAddress"), std::string::npos) << address.output;
     }
 
+    // An injected neighbour-load fault changes descriptor loads only: auto then reads through descriptors.
+    setenv("VKRT_INJECT_FAULT", "neighbour-load", 1);
+    ProcessResult faulty = runVkrt(withDevice({"info", scene.string(), "--json", file.string()}));
+    unsetenv("VKRT_INJECT_FAULT");
+    ASSERT_EQ(faulty.exitCode, 0) << faulty.output;
+    EXPECT_EQ(parseJson(readText(file))["kernel"]["sceneAddresses"], false);
+
     ProcessResult unknown = runVkrt(withDevice({"info", scene.string(), "--scene-reads", "pointer"}));
     EXPECT_EQ(unknown.exitCode, 2) << unknown.output;
     EXPECT_NE(unknown.output.find("--scene-reads pointer"), std::string::npos) << unknown.output;
