@@ -156,8 +156,8 @@ KernelVariant chooseVariant(const VulkanContext& context, const Scene& scene, co
                                  ? sceneAddressesPay(context.deviceInfo()) && !faultOnDescriptorLoads
                                  : options.sceneReads == SceneReads::Address;
     if (variant.sceneAddresses && !context.deviceInfo().bufferDeviceAddress)
-        throw InputError("reading the scene through device addresses needs the bufferDeviceAddress feature, which " +
-                         context.deviceInfo().name + " lacks");
+        throw InputError("--scene-reads address needs the bufferDeviceAddress feature, which " +
+                         context.deviceInfo().name + " lacks; use --scene-reads descriptor or auto");
     chooseTextureChunks(context, scene, options, variant);
     return variant;
 }
