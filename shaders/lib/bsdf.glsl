@@ -20,6 +20,7 @@ struct BsdfSample {
     vec3 weight;      // f * cos / pdf (or the specular reflectance / transmittance)
     bool specular;    // a delta direction: lights cannot be sampled for it
     bool transmitted; // crossed the surface
+    bool evaluate;    // weight left to the caller: f * cos / pdf at dir (completedSample)
 };
 
 // The side of the surface a continuation ray leaves from (its offset
@@ -53,7 +54,15 @@ bool scattersIntoDeltasOnly(Material m)
     return isDeltaMaterial(m.type);
 }
 
-BsdfSample noScatter() { return BsdfSample(vec3(0.0, 0.0, 1.0), vec3(0.0), false, false); }
+BsdfSample noScatter() { return BsdfSample(vec3(0.0, 0.0, 1.0), vec3(0.0), false, false, false); }
+
+// A sampled direction whose weight f cos / pdf the caller computes, from the
+// one evaluation of the BSDF it shares with the light samples
+// (completedSample; lib/path.glsl: scatterAtVertex). lavapipe inlines every
+// call, so each call of evalBsdf or pdfBsdf is a whole copy of every
+// material's code: a sampler that evaluated its own sample doubled it
+// (docs/performance.md, "One evaluation site").
+BsdfSample sampleToEvaluate(vec3 wi) { return BsdfSample(wi, vec3(0.0), false, false, true); }
 
 // The materials whose surfaces bound a medium (lib/media.glsl): a sample
 // they transmit enters or leaves it. A thin-walled pbr surface transmits
@@ -104,7 +113,7 @@ vec3 evalLambert(Material m, vec3 n, vec3 wo, vec3 wi) { return m.diffuse * INV_
 float pdfLambert(Material m, vec3 n, vec3 wo, vec3 wi, float cosI) { return cosI * INV_PI; }
 BsdfSample sampleLambert(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
-    return BsdfSample(sampleCosineHemisphere(n, u.xy), m.diffuse, false, false);
+    return BsdfSample(sampleCosineHemisphere(n, u.xy), m.diffuse, false, false, false);
 }
 #else
 VKRT_ABSENT_MATERIAL(Lambert)
@@ -124,19 +133,14 @@ float pdfPhong(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
     return pd * cosI * INV_PI + (1.0 - pd) * phongLobePdf(dot(reflect(-wo, n), wi), m.exponent);
 }
 
-// One-sample mixture of the diffuse and lobe densities; weight = f cos / pdf.
+// One-sample mixture of the diffuse and lobe densities; weight = f cos / pdf
+// (the caller's: sampleToEvaluate).
 BsdfSample samplePhong(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
     float pd = phongDiffuseProbability(m);
     vec3 r = reflect(-wo, n);
     vec3 wi = u.z < pd ? sampleCosineHemisphere(n, u.xy) : samplePhongLobe(r, m.exponent, u.xy);
-    float cosI = dot(n, wi);
-    if (cosI <= 0.0)
-        return noScatter();
-    float pdf = pd * cosI * INV_PI + (1.0 - pd) * phongLobePdf(dot(r, wi), m.exponent);
-    if (!(pdf > 0.0))
-        return noScatter(); // a lobe sample rounded onto the lobe's edge
-    return BsdfSample(wi, evalBsdf(m, n, wo, wi) * cosI / pdf, false, false);
+    return sampleToEvaluate(wi);
 }
 #else
 VKRT_ABSENT_MATERIAL(Phong)
@@ -150,7 +154,7 @@ float pdfMirror(Material m, vec3 n, vec3 wo, vec3 wi, float cosI) { return 0.0; 
 BsdfSample sampleMirror(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
     return BsdfSample(reflect(-wo, n), m.specular * conductorLikeReflectance(m.fresnel, dot(n, wo), m.ior), true,
-                      false);
+                      false, false);
 }
 #else
 VKRT_ABSENT_MATERIAL(Mirror)
@@ -177,7 +181,7 @@ BsdfSample sampleGlossy(Material m, vec3 n, vec3 wo, float eta, vec3 u)
     if (cosI <= 0.0)
         return noScatter(); // the lobe dips below the surface: absorbed
     float fresnel = conductorLikeReflectance(m.fresnel, dot(n, wo), m.ior);
-    return BsdfSample(wi, m.specular * fresnel * ((m.exponent + 2.0) / (m.exponent + 1.0)) * cosI, false, false);
+    return BsdfSample(wi, m.specular * fresnel * ((m.exponent + 2.0) / (m.exponent + 1.0)) * cosI, false, false, false);
 }
 #else
 VKRT_ABSENT_MATERIAL(Glossy)
@@ -200,8 +204,8 @@ BsdfSample sampleDielectric(Material m, vec3 n, vec3 wo, float eta, vec3 u)
     float reflectance = dielectricReflectance(m.fresnel, dot(n, wo), eta);
     vec3 refracted = refractDirection(wo, n, eta);
     if (u.z < reflectance || refracted == vec3(0.0))
-        return BsdfSample(reflect(-wo, n), vec3(1.0), true, false);
-    return BsdfSample(refracted, vec3(1.0), true, true);
+        return BsdfSample(reflect(-wo, n), vec3(1.0), true, false, false);
+    return BsdfSample(refracted, vec3(1.0), true, true, false);
 }
 #else
 VKRT_ABSENT_MATERIAL(Dielectric)
@@ -274,14 +278,14 @@ BsdfSample sampleConductor(Material m, vec3 n, vec3 wo, float eta, vec3 u)
     if (lo.z <= 0.0)
         return noScatter();
     if (m.alphaX == 0.0)
-        return BsdfSample(reflect(-wo, n), m.specular * fresnelConductor(lo.z, m.eta, m.k), true, false);
+        return BsdfSample(reflect(-wo, n), m.specular * fresnelConductor(lo.z, m.eta, m.k), true, false, false);
     vec2 alpha = ggxAlpha(m);
     vec3 h = sampleGgxVisibleNormal(lo, alpha, u.xy);
     vec3 li = reflect(-lo, h);
     if (li.z <= 0.0)
         return noScatter();
     vec3 weight = m.specular * fresnelConductor(dot(lo, h), m.eta, m.k) * ggxG1(li, h, alpha);
-    return BsdfSample(fromFrame(f, li), weight, false, false);
+    return BsdfSample(fromFrame(f, li), weight, false, false, false);
 }
 #else
 VKRT_ABSENT_MATERIAL(Conductor)
@@ -331,11 +335,11 @@ BsdfSample sampleRoughDielectric(Material m, vec3 n, vec3 wo, float eta, vec3 u)
         vec3 li = reflect(-lo, h);
         if (li.z <= 0.0)
             return noScatter();
-        return BsdfSample(fromFrame(f, li), vec3(ggxG1(li, h, alpha)), false, false);
+        return BsdfSample(fromFrame(f, li), vec3(ggxG1(li, h, alpha)), false, false, false);
     }
     if (refracted.z >= 0.0)
         return noScatter();
-    return BsdfSample(fromFrame(f, refracted), vec3(ggxG1(refracted, h, alpha)), true, true);
+    return BsdfSample(fromFrame(f, refracted), vec3(ggxG1(refracted, h, alpha)), true, true, false);
 }
 #else
 VKRT_ABSENT_MATERIAL(RoughDielectric)
@@ -415,18 +419,14 @@ BsdfSample samplePlastic(Material m, vec3 n, vec3 wo, float eta, vec3 u)
     vec3 li;
     if (u.z < ps) {
         if (!roughCoating(m)) // the smooth coating's mirror reflection, weight F / ps
-            return BsdfSample(reflect(-wo, n), vec3(fresnelExact(lo.z, 1.0 / m.ior) / ps), true, false);
+            return BsdfSample(reflect(-wo, n), vec3(fresnelExact(lo.z, 1.0 / m.ior) / ps), true, false, false);
         li = reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy));
     } else {
         li = toFrame(f, sampleCosineHemisphere(n, u.xy));
     }
     if (li.z <= 0.0)
         return noScatter();
-    vec3 wi = fromFrame(f, li);
-    float pdf = pdfPlastic(m, n, wo, wi, li.z);
-    if (!(pdf > 0.0))
-        return noScatter();
-    return BsdfSample(wi, evalPlastic(m, n, wo, wi) * (li.z / pdf), false, false);
+    return sampleToEvaluate(fromFrame(f, li));
 }
 #else
 VKRT_ABSENT_MATERIAL(Plastic)
@@ -537,6 +537,7 @@ vec3 pbrMetalFresnel(Material m, float c)
     return withIridescence(m, m.diffuse + (vec3(1.0) - m.diffuse) * pow5(1.0 - c), c, m.diffuse);
 }
 
+#ifdef VKRT_PBR_SHEEN
 // The Charlie sheen (Estevez and Kulla 2017, the form KHR_materials_sheen
 // gives): D and the visibility's Lambda fit.
 float sheenAlpha(Material m) { return max(m.sheenRoughness * m.sheenRoughness, MIN_SHEEN_ALPHA); }
@@ -583,7 +584,9 @@ float sheenAlbedo(Material m, float mu)
     return 0.0;
 #endif
 }
+#endif
 
+#ifdef VKRT_PBR_CLEARCOAT
 // The coat's Fresnel weight seen from cosine cosO: clearcoat x Fc, with the
 // specification's |N.V| (wo can be below a coat's own normal: its lobe is then
 // 0, and the layers below keep 1 - clearcoat Fc).
@@ -591,6 +594,7 @@ float pbrCoatWeight(Material m, float cosO)
 {
     return m.clearcoat * (0.04 + 0.96 * pow5(1.0 - min(abs(cosO), 1.0)));
 }
+#endif
 
 // The Fresnel weight the dielectric's diffuse loses: max3(Fd(wo.h)) as the
 // specification's fresnel_mix has it. Seen from inside a volume (which the
@@ -609,6 +613,7 @@ float pbrDiffuseFresnel(Material m, vec3 fd, float cosO)
     return max3(fd);
 }
 
+#ifdef VKRT_PBR_SHEEN
 // What the sheen leaves of the layers below it between cosines cosO and cosI
 // (both of the sheen's side). The extension's visibility fit puts E above 1
 // for smooth sheen near grazing (roughness <= 0.25, cosines below ~0.05): the
@@ -620,6 +625,9 @@ float sheenScaling(Material m, float cosO, float cosI)
     float strength = max3(m.sheenColor);
     return max(min(1.0 - strength * sheenAlbedo(m, cosO), 1.0 - strength * sheenAlbedo(m, cosI)), 0.0);
 }
+#else
+float sheenScaling(Material m, float cosO, float cosI) { return 1.0; }
+#endif
 
 // The base's frame about n: its x axis the direction the anisotropy stretches
 // (KHR_materials_anisotropy, resolved at the hit by withAnisotropy), any
@@ -640,6 +648,7 @@ LocalFrame pbrFrame(Material m, vec3 n)
     return frameAround(n);
 }
 
+#ifdef VKRT_PBR_CLEARCOAT
 // The clear coat's frame: about its own shading normal (clearcoatNormalTexture,
 // or the normal a base normal map leaves untilted), turned to n's side, or
 // about n. Its lobe is isotropic: any frame around it.
@@ -661,6 +670,7 @@ float pbrCoatLobe(Material m, vec3 co, vec3 ci, float baseCosI)
         return 0.0;
     return ggxSpecularCorrelated(co, ci, normalize(co + ci), vec2(m.clearcoatAlpha)) * (ci.z / baseCosI);
 }
+#endif
 
 // f(wo, wi) of the reflection lobes. Transmission (KHR_materials_transmission)
 // takes its share of the dielectric's diffuse lobe: the specification's
@@ -675,21 +685,29 @@ vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
     vec3 fd = pbrDielectricFresnel(m, dot(lo, h));
     vec3 dielectric = fd * s + (1.0 - pbrDiffuseFresnel(m, fd, lo.z)) * (1.0 - pbrTransmission(m)) * m.diffuse * INV_PI;
     vec3 value = mix(dielectric, pbrMetalFresnel(m, dot(lo, h)) * s, m.metallic);
+#ifdef VKRT_PBR_SHEEN
     if (max3(m.sheenColor) > 0.0)
         value = m.sheenColor * sheenBrdf(lo, li, h, sheenAlpha(m)) + value * sheenScaling(m, lo.z, li.z);
+#endif
+#ifdef VKRT_PBR_CLEARCOAT
     if (m.clearcoat > 0.0) {
         LocalFrame fc = pbrCoatFrame(m, n);
         vec3 co = toFrame(fc, wo);
         float coat = pbrCoatWeight(m, co.z);
         value = (1.0 - coat) * value + coat * pbrCoatLobe(m, co, toFrame(fc, wi), li.z);
     }
+#endif
     return value;
 }
 
 // wo's cosine about the coat's normal; 0 without a coat.
 float pbrCoatCosine(Material m, vec3 n, vec3 wo)
 {
+#ifdef VKRT_PBR_CLEARCOAT
     return m.clearcoat > 0.0 ? toFrame(pbrCoatFrame(m, n), wo).z : 0.0;
+#else
+    return 0.0;
+#endif
 }
 
 // The lobe probabilities seen from cosO (the coat's lobe from coatCosO, wo's
@@ -697,7 +715,11 @@ float pbrCoatCosine(Material m, vec3 n, vec3 wo)
 // reflection, z the cosine lobe (diffuse and sheen), w transmission.
 vec4 pbrLobeProbabilities(Material m, float cosO, float coatCosO)
 {
+#ifdef VKRT_PBR_CLEARCOAT
     float coat = m.clearcoat > 0.0 && coatCosO > 0.0 ? pbrCoatWeight(m, coatCosO) : 0.0;
+#else
+    const float coat = 0.0;
+#endif
     float fd = max3(pbrDielectricFresnel(m, cosO));
     float specular = m.metallic + (1.0 - m.metallic) * fd;
     float below = (1.0 - m.metallic) * luminance(m.diffuse);
@@ -707,7 +729,11 @@ vec4 pbrLobeProbabilities(Material m, float cosO, float coatCosO)
     // Past the critical angle inside a volume Fd(cosO) is 1, yet microfacets
     // tilted towards wo still transmit: transmission keeps some probability.
     float transmitted = below * pbrTransmission(m) * max(1.0 - fd, 0.1);
+#ifdef VKRT_PBR_SHEEN
     float sheen = max3(m.sheenColor) > 0.0 ? max3(m.sheenColor) * sheenAlbedo(m, cosO) : 0.0;
+#else
+    const float sheen = 0.0;
+#endif
     float cosine = below * (1.0 - fdDiffuse) * (1.0 - pbrTransmission(m)) + sheen;
     float base = specular + cosine + transmitted;
     if (!(base > 0.0))
@@ -722,11 +748,13 @@ float pdfPbr(Material m, vec3 n, vec3 wo, vec3 wi, float cosI)
     vec4 p = pbrLobeProbabilities(m, lo.z, pbrCoatCosine(m, n, wo));
     vec3 h = normalize(lo + li);
     float pdf = p.y * ggxReflectionPdf(lo, h, ggxAlpha(m)) + p.z * li.z * INV_PI;
+#ifdef VKRT_PBR_CLEARCOAT
     if (p.x > 0.0) {
         LocalFrame fc = pbrCoatFrame(m, n);
         vec3 co = toFrame(fc, wo);
         pdf += p.x * ggxReflectionPdf(co, normalize(co + toFrame(fc, wi)), vec2(m.clearcoatAlpha));
     }
+#endif
     return pdf;
 }
 
@@ -758,9 +786,13 @@ BsdfSample samplePbrTransmission(Material m, LocalFrame f, vec3 lo, float coatCo
     float lambdaO = ggxLambdaOf(lo, alpha);
     float shadowing = (1.0 + lambdaO) / (1.0 + lambdaO + ggxLambdaOf(-li, alpha));
     float layers = (1.0 - m.metallic) * m.transmission * (1.0 - max3(pbrDielectricFresnel(m, dot(lo, h))));
-    layers *= sheenScaling(m, lo.z, -li.z) * (1.0 - (m.clearcoat > 0.0 ? pbrCoatWeight(m, coatCosO) : 0.0));
+    float coatKeeps = 1.0;
+#ifdef VKRT_PBR_CLEARCOAT
+    coatKeeps = 1.0 - (m.clearcoat > 0.0 ? pbrCoatWeight(m, coatCosO) : 0.0);
+#endif
+    layers *= sheenScaling(m, lo.z, -li.z) * coatKeeps;
     vec3 tint = pbrVolumetric(m) ? sqrt(m.diffuse) : m.diffuse;
-    return BsdfSample(fromFrame(f, li), tint * (layers * shadowing / chosen), true, true);
+    return BsdfSample(fromFrame(f, li), tint * (layers * shadowing / chosen), true, true, false);
 }
 #endif
 
@@ -773,11 +805,14 @@ BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
     float coatCosO = pbrCoatCosine(m, n, wo);
     vec4 p = pbrLobeProbabilities(m, lo.z, coatCosO);
     vec3 li;
+#ifdef VKRT_PBR_CLEARCOAT
     if (u.z < p.x) {
         LocalFrame fc = pbrCoatFrame(m, n);
         vec3 co = toFrame(fc, wo);
         li = toFrame(f, fromFrame(fc, reflect(-co, sampleGgxVisibleNormal(co, vec2(m.clearcoatAlpha), u.xy))));
-    } else if (u.z < p.x + p.y)
+    } else
+#endif
+    if (u.z < p.x + p.y)
         li = reflect(-lo, sampleGgxVisibleNormal(lo, ggxAlpha(m), u.xy));
 #ifdef VKRT_PBR_TRANSMISSION
     else if (u.z >= p.x + p.y + p.z && p.w > 0.0)
@@ -787,11 +822,7 @@ BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
         li = toFrame(f, sampleCosineHemisphere(n, u.xy));
     if (li.z <= 0.0)
         return noScatter();
-    vec3 wi = fromFrame(f, li);
-    float pdf = pdfPbr(m, n, wo, wi, li.z);
-    if (!(pdf > 0.0))
-        return noScatter();
-    return BsdfSample(wi, evalPbr(m, n, wo, wi) * (li.z / pdf), false, false);
+    return sampleToEvaluate(fromFrame(f, li));
 }
 #else
 vec3 evalPbr(Material m, vec3 n, vec3 wo, vec3 wi)
@@ -836,11 +867,7 @@ BsdfSample samplePbr(Material m, vec3 n, vec3 wo, float eta, vec3 u)
                   : toFrame(f, sampleCosineHemisphere(n, u.xy));
     if (li.z <= 0.0)
         return noScatter();
-    vec3 wi = fromFrame(f, li);
-    float pdf = pdfPbr(m, n, wo, wi, li.z);
-    if (!(pdf > 0.0))
-        return noScatter();
-    return BsdfSample(wi, evalPbr(m, n, wo, wi) * (li.z / pdf), false, false);
+    return sampleToEvaluate(fromFrame(f, li));
 }
 #endif // VKRT_PBR_LAYERS
 #else
@@ -879,11 +906,59 @@ float pdfBsdf(Material m, vec3 n, vec3 wo, vec3 wi)
     return 0.0;
 }
 
-// eta: n_incident / n_transmitted, used by dielectrics only.
+// eta: n_incident / n_transmitted, used by dielectrics only. A sample marked
+// `evaluate` gets its weight from completedSample.
 BsdfSample sampleBsdf(Material m, vec3 n, vec3 wo, float eta, vec3 u)
 {
     VKRT_MATERIAL_KINDS(VKRT_SAMPLE_OF_KIND)
     return noScatter();
+}
+
+// The BSDF at one pair of directions: f (when wantF) and the density of
+// sampling wi (when wantPdf), from one call site of each, so that a kernel
+// that evaluates through this function alone holds one copy of every
+// material's eval and pdf.
+struct BsdfValue {
+    vec3 f;
+    float pdf;
+};
+
+BsdfValue evaluateBsdf(Material m, vec3 n, vec3 wo, vec3 wi, bool wantF, bool wantPdf)
+{
+    BsdfValue v = BsdfValue(vec3(0.0), 0.0);
+    if (wantF)
+        v.f = evalBsdf(m, n, wo, wi);
+    if (wantPdf)
+        v.pdf = pdfBsdf(m, n, wo, wi);
+    return v;
+}
+
+// What evaluateBsdf must give for a BSDF sample: f where the sampler left its
+// weight to the caller, the pdf wherever the sample is not a delta (for MIS).
+bool sampleWantsF(BsdfSample s) { return s.evaluate; }
+bool sampleWantsPdf(BsdfSample s) { return !s.specular && (s.evaluate || s.weight != vec3(0.0)); }
+
+// The sample with its weight f cos / pdf where the sampler left it to the
+// caller (v = evaluateBsdf at s.dir with sampleWantsF and sampleWantsPdf).
+BsdfSample completedSample(BsdfSample s, vec3 n, BsdfValue v)
+{
+    if (!s.evaluate)
+        return s;
+    if (!(v.pdf > 0.0))
+        return noScatter(); // a lobe sample rounded onto the lobe's edge
+    s.weight = v.f * (dot(n, s.dir) / v.pdf);
+    s.evaluate = false;
+    return s;
+}
+
+// A BSDF sample with its weight, from its own evaluation site (the Whitted
+// integrator and the probes, which share none); pdf: its density, 0 for a delta.
+BsdfSample sampleBsdfWeighted(Material m, vec3 n, vec3 wo, float eta, vec3 u, out float pdf)
+{
+    BsdfSample s = sampleBsdf(m, n, wo, eta, u);
+    BsdfValue v = evaluateBsdf(m, n, wo, s.dir, sampleWantsF(s), sampleWantsPdf(s));
+    pdf = v.pdf;
+    return completedSample(s, n, v);
 }
 
 #endif

@@ -64,8 +64,8 @@ uint pickEmitter(float uSlot, float uAlias)
 
 // One emitter, chosen in proportion to power, through a uniformly sampled
 // point on it: an unbiased estimate of the direct light from every emitter,
-// MIS-weighted against BSDF sampling (path integrator).
-LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin)
+// with its solid-angle density for MIS against BSDF sampling (path integrator).
+LightArrival sampleEmitters(vec4 u4, SurfaceHit hit, vec3 ns, vec3 origin)
 {
 #ifdef VKRT_HAS_ALPHA
     uint index = pickEmitter(u4.x, u4.y);
@@ -90,13 +90,9 @@ LightSample sampleEmitters(vec4 u4, Material m, SurfaceHit hit, vec3 ns, vec3 wo
     le *= emitterCoverage(index, vec3(1.0 - s, s * (1.0 - u4.w), s * u4.w));
 #endif
     if (cosSurface <= 0.0 || cosLight == 0.0 || le == vec3(0.0) || !(e.pdf > 0.0) || distSq == 0.0)
-        return LightSample(vec3(0.0), target);
+        return noArrival(target);
     float lightPdf = emitterPdf(e, distSq, cosLight);
-    vec3 contribution = evalBsdf(m, ns, wo, wi) * le * (cosSurface / lightPdf);
-#ifdef VKRT_INTEGRATOR_PATH
-    contribution *= powerHeuristic(lightPdf, pdfBsdf(m, ns, wo, wi));
-#endif
-    return LightSample(contribution, target);
+    return LightArrival(wi, target, le / lightPdf, lightPdf);
 }
 #endif
 
@@ -108,7 +104,7 @@ vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Me
     if (u.emitterCount == 0u)
         return vec3(0.0);
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    LightSample s = sampleEmitters(sampleNext4D(rng), m, hit, ns, wo, origin);
+    LightSample s = litBy(m, ns, wo, sampleEmitters(sampleNext4D(rng), hit, ns, origin), false);
     if (s.unshadowed != vec3(0.0))
         return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
 #endif
@@ -116,15 +112,28 @@ vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Me
 }
 
 // All emitters as one more candidate of the path integrator's shadow ray: a
-// power-proportional choice of one of them (unbiased for their sum).
-void offerEmitterSample(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                        inout Sampler rng)
+// power-proportional choice of one of them (unbiased for their sum), with
+// the reservoir's number `pick`.
+LightArrival emitterCandidate(SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
 #ifdef VKRT_HAS_EMITTERS
-    if (u.emitterCount > 0u) {
-        vec4 u4 = sampleNext4D(rng);
-        offerLightSample(r, sampleEmitters(u4, m, hit, ns, wo, origin), sampleNext1D(rng));
-    }
+    vec4 u4 = sampleNext4D(rng);
+    LightArrival a = sampleEmitters(u4, hit, ns, origin);
+    pick = sampleNext1D(rng);
+    return a;
+#else
+    pick = 0.0;
+    return noArrival(origin);
+#endif
+}
+
+// 1 when the emitters are a candidate of the path integrator's shadow ray.
+uint emitterCandidates()
+{
+#ifdef VKRT_HAS_EMITTERS
+    return u.emitterCount > 0u ? 1u : 0u;
+#else
+    return 0u;
 #endif
 }
 

@@ -105,6 +105,25 @@ struct LightSample {
     vec3 target;
 };
 
+// What one sample of a light brings to a surface point, before the BSDF and
+// visibility: the direction towards it (unit), the point a shadow ray must
+// reach, its radiance over the density of the sample (for a delta light,
+// its irradiance at normal incidence over its selection density), and the
+// sample's solid-angle density for MIS against BSDF sampling (0 for a delta
+// light, which BSDF sampling cannot find). A light kind gives arrivals; the
+// BSDF is evaluated for them at one site (litBy, or the path integrator's
+// scatterAtVertex): lavapipe inlines every call, and a copy of the BSDF per
+// light kind made the kernels of lit scenes compile far slower
+// (docs/performance.md, "One evaluation site").
+struct LightArrival {
+    vec3 wi;
+    vec3 target;
+    vec3 radiance;
+    float pdf;
+};
+
+LightArrival noArrival(vec3 target) { return LightArrival(vec3(0.0, 0.0, 1.0), target, vec3(0.0), 0.0); }
+
 // Power-heuristic weight (Veach 1997, eq. 9.13) of a strategy with density
 // `pdf` against another with density `other`, one sample each.
 // Written as 1 / (1 + (other / pdf)^2): squaring a huge pdf (a light seen
@@ -117,6 +136,33 @@ float powerHeuristic(float pdf, float other)
     return isinf(pdf) ? (isinf(other) ? 0.5 : 1.0) : 1.0 / (1.0 + ratio * ratio);
 }
 
+// Whether an arrival lights the surface at all: radiance, from above the
+// shading plane. Only then is the BSDF evaluated for it (f, and its pdf
+// where `mis` weighs the light against BSDF sampling).
+bool arrivalLights(LightArrival a, vec3 ns) { return a.radiance != vec3(0.0) && dot(ns, a.wi) > 0.0; }
+bool arrivalWantsPdf(LightArrival a, vec3 ns, bool mis) { return mis && a.pdf > 0.0 && arrivalLights(a, ns); }
+
+// The light sample of an arrival, with v = evaluateBsdf at a.wi (f where
+// arrivalLights, the pdf where arrivalWantsPdf): f cos times its radiance,
+// MIS-weighted against BSDF sampling where `mis` and the light has a density.
+LightSample lightSampleOf(LightArrival a, vec3 ns, BsdfValue v, bool mis)
+{
+    if (!arrivalLights(a, ns) || v.f == vec3(0.0))
+        return LightSample(vec3(0.0), a.target);
+    vec3 contribution = v.f * a.radiance * dot(ns, a.wi);
+    if (mis && a.pdf > 0.0)
+        contribution *= powerHeuristic(a.pdf, v.pdf);
+    return LightSample(contribution, a.target);
+}
+
+// The light sample of an arrival with the BSDF evaluated here (the Whitted
+// integrator's sites; the path integrator has one of its own).
+LightSample litBy(Material m, vec3 ns, vec3 wo, LightArrival a, bool mis)
+{
+    BsdfValue v = evaluateBsdf(m, ns, wo, a.wi, arrivalLights(a, ns), arrivalWantsPdf(a, ns, mis));
+    return lightSampleOf(a, ns, v, mis);
+}
+
 // Picks one of a stream of light samples with probability proportional to its
 // weight (weighted reservoir sampling: candidate i replaces the kept one with
 // probability w_i / (w_1 + ... + w_i), decided by its own uniform number).
@@ -125,6 +171,8 @@ struct LightReservoir {
     float keptWeight;
     float totalWeight;
 };
+
+LightReservoir emptyReservoir() { return LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0); }
 
 void offerLightSample(inout LightReservoir r, LightSample s, float u)
 {
@@ -142,7 +190,7 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 }
 
 // Every light kind's sampling (the functions lib/surface.glsl lists, and
-// directFromType, offerTypeSamples), then the emitters all area lights share.
+// directFromType, lightCandidate), then the emitters all area lights share.
 // Every light function takes the geometric normal n (the side the shadow ray
 // leaves from, for offsets) and the shading normal ns on the same side (for
 // the BSDF and its cosine); ns == n except on meshes with vertex normals.
@@ -153,13 +201,13 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 #include "lights/directional.glsl"
 #include "lights/spot.glsl"
 
-// The loops every kind of light sampled one by one shares (point, spot and
+// The loop every kind of light sampled one by one shares (point, spot and
 // directional lights; triangle lights have none of their own: they are
 // emitters). A kind gives tableEntries<Type> (how many), whittedSample<Type>
 // and candidate<Type> (lib/lights/*.glsl); forgetting one fails the build.
 // directFrom<Type>: every light of the kind, each with its shadow ray (the
-// Whitted integrator). offer<Type>Samples: every light of the kind as a
-// candidate of the path integrator's one shadow ray.
+// Whitted integrator). The path integrator draws candidate<Type> through
+// lightCandidate.
 #define VKRT_LIGHT_LOOPS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded)                             \
     vec3 directFrom##Type(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng) \
     {                                                                                                                 \
@@ -167,21 +215,11 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
         vec3 origin = offsetRayOrigin(hit.position, hit.error, n);                                                    \
         for (uint i = 0u; i < tableEntries##Type(); ++i) {                                                            \
             ++g_loopIterations;                                                                                       \
-            LightSample s = whittedSample##Type(i, m, hit, ns, wo, origin, rng);                                      \
+            LightSample s = litBy(m, ns, wo, whittedSample##Type(i, hit, ns, origin, rng), false);                    \
             if (s.unshadowed != vec3(0.0))                                                                            \
                 radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);             \
         }                                                                                                             \
         return radiance;                                                                                              \
-    }                                                                                                                 \
-    void offer##Type##Samples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,      \
-                              inout Sampler rng)                                                                      \
-    {                                                                                                                 \
-        for (uint i = 0u; i < tableEntries##Type(); ++i) {                                                            \
-            ++g_loopIterations;                                                                                       \
-            float pick;                                                                                               \
-            LightSample s = candidate##Type(i, m, hit, ns, wo, origin, rng, pick);                                    \
-            offerLightSample(r, s, pick);                                                                             \
-        }                                                                                                             \
     }
 VKRT_LIGHT_KINDS(VKRT_LIGHT_LOOPS)
 #undef VKRT_LIGHT_LOOPS
@@ -229,32 +267,28 @@ uint tableEntry(int kind, uint i)
 // last entry samples every emitter (their pdfs carry that density already).
 #define VKRT_SAMPLE_TABLE_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     if (i < tableEntries##Type())                                                          \
-        return sampleTable##Type(i, selection, m, hit, ns, wo, origin, rnd);               \
+        return sampleTable##Type(i, selection, hit, ns, origin, rnd);                      \
     i -= tableEntries##Type();
-LightSample sampleTableEntry(uint entry, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, vec4 rnd)
+LightArrival sampleTableEntry(uint entry, SurfaceHit hit, vec3 ns, vec3 origin, vec4 rnd)
 {
     float selection = tableSelection(entry);
     if (!(selection > 0.0))
-        return LightSample(vec3(0.0), origin); // a light of no power: never drawn but by rounding
+        return noArrival(origin); // a light of no power: never drawn but by rounding
     uint i = entry;
     VKRT_LIGHT_KINDS(VKRT_SAMPLE_TABLE_KIND)
 #ifdef VKRT_HAS_EMITTERS
-    return sampleEmitters(rnd, m, hit, ns, wo, origin);
+    return sampleEmitters(rnd, hit, ns, origin);
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
-// The candidates drawn from the table, offered to the reservoir.
-void offerTableSamples(inout LightReservoir r, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                       inout Sampler rng)
+// One candidate drawn from the table, with the reservoir's number `pick`.
+LightArrival tableCandidate(SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
-    for (uint c = 0u; c < u.lightCandidates; ++c) {
-        ++g_loopIterations;
-        vec4 pick = sampleNext4D(rng); // table slot, alias, the reservoir's choice
-        LightSample s = sampleTableEntry(pickTableEntry(pick.x, pick.y), m, hit, ns, wo, origin, sampleNext4D(rng));
-        offerLightSample(r, s, pick.z);
-    }
+    vec4 draw = sampleNext4D(rng); // table slot, alias, the reservoir's choice
+    pick = draw.z;
+    return sampleTableEntry(pickTableEntry(draw.x, draw.y), hit, ns, origin, sampleNext4D(rng));
 }
 #endif
 
@@ -269,8 +303,6 @@ float lightSelection(int kind, uint i)
 
 #define VKRT_DIRECT_FROM_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     +directFrom##Type(m, hit, n, ns, wo, media, rng)
-#define VKRT_OFFER_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
-    offer##Type##Samples(r, m, hit, ns, wo, origin, rng);
 
 #ifdef VKRT_ENVIRONMENT_SAMPLING
 bool constantEnvironment() { return (u.flags & RENDER_FLAG_CONSTANT_ENVIRONMENT) != 0u; }
@@ -284,13 +316,11 @@ bool constantEnvironment() { return (u.flags & RENDER_FLAG_CONSTANT_ENVIRONMENT)
 float constantEnvironmentPdf(vec3 ns, vec3 dir) { return max(dot(ns, dir), 0.0) * INV_PI; }
 
 // One direction drawn from the environment map (a constant one: from the
-// cosine lobe about ns, constantEnvironmentPdf) and its light at a surface
-// before visibility, MIS-weighted against BSDF sampling (which finds the same
-// light when a ray escapes: environmentOnEscape) when `bsdfFollows`; false at
-// a vertex no ray leaves (the Whitted integrator's last), where the light
-// sample is all the estimate has. The shadow ray's target is far along the
-// direction (FAR_LIGHT_DISTANCE).
-LightSample sampleEnvironmentLight(Material m, vec3 ns, vec3 wo, vec3 origin, bool bsdfFollows, vec3 rnd)
+// cosine lobe about ns, constantEnvironmentPdf) and its light, with its
+// density for MIS against BSDF sampling (which finds the same light when a
+// ray escapes: environmentOnEscape). The shadow ray's target is far along
+// the direction (FAR_LIGHT_DISTANCE).
+LightArrival sampleEnvironmentLight(vec3 ns, vec3 origin, vec3 rnd)
 {
     float pdf;
     vec3 wi;
@@ -301,25 +331,23 @@ LightSample sampleEnvironmentLight(Material m, vec3 ns, vec3 wo, vec3 origin, bo
         wi = sampleEnvironment(rnd, pdf);
     }
     vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
-    float cosI = dot(ns, wi);
-    if (pdf <= 0.0 || cosI <= 0.0)
-        return LightSample(vec3(0.0), target);
-    vec3 f = evalBsdf(m, ns, wo, wi);
-    if (f == vec3(0.0))
-        return LightSample(vec3(0.0), target);
-    float weight = bsdfFollows ? powerHeuristic(pdf, pdfBsdf(m, ns, wo, wi)) : 1.0;
-    return LightSample(f * environmentRadiance(wi) * (cosI * weight / pdf), target);
+    if (!(pdf > 0.0))
+        return noArrival(target);
+    return LightArrival(wi, target, environmentRadiance(wi) / pdf, pdf);
 }
 #endif
 
 // The environment map with a shadow ray of its own (the Whitted integrator;
-// the path integrator offers it to its one shadow ray with the lights).
+// the path integrator offers it to its one shadow ray with the lights),
+// MIS-weighted against BSDF sampling when `bsdfFollows`: false at a vertex
+// no ray leaves (the Whitted integrator's last), where the light sample is
+// all the estimate has.
 vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, bool bsdfFollows,
                            inout Sampler rng)
 {
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    LightSample s = sampleEnvironmentLight(m, ns, wo, origin, bsdfFollows, sampleNext4D(rng).xyz);
+    LightSample s = litBy(m, ns, wo, sampleEnvironmentLight(ns, origin, sampleNext4D(rng).xyz), bsdfFollows);
     if (s.unshadowed != vec3(0.0))
         return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
 #endif
@@ -349,8 +377,13 @@ vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Medi
 {
 #ifdef VKRT_LIGHT_TABLE
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
-    offerTableSamples(r, m, hit, ns, wo, origin, rng);
+    LightReservoir r = emptyReservoir();
+    for (uint c = 0u; c < u.lightCandidates; ++c) {
+        ++g_loopIterations;
+        float pick;
+        LightArrival a = tableCandidate(hit, ns, origin, rng, pick);
+        offerLightSample(r, litBy(m, ns, wo, a, false), pick);
+    }
     if (r.totalWeight == 0.0)
         return vec3(0.0);
     return r.kept.unshadowed * (r.totalWeight / r.keptWeight) *
@@ -360,6 +393,7 @@ vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Medi
 #endif
 }
 
+// ------------------------------------------- the path integrator's candidates
 // Next-event estimation from every light kind, the emitters and the
 // environment map with one shadow ray (the path integrator). Each light
 // offers its sample as in the Whitted sums above, but only one is tested for
@@ -369,24 +403,51 @@ vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Medi
 // all lights are visible it equals that sum up to the lights' colour
 // differences (no added variance), and under partial occlusion it adds some:
 // measured as a whole, 1.09-1.27x more efficient on the validation scenes
-// (docs/performance.md). This draws the samples and keeps one; the caller
-// (lib/path.glsl) traces its shadow ray: r.totalWeight == 0 when no light
-// adds anything.
-LightReservoir lightsForOneShadowRay(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng)
+// (docs/performance.md). The candidates are numbered, so that one loop
+// (lib/path.glsl: scatterAtVertex) draws them all and evaluates the BSDF for
+// each at one site: every light of every kind in the registry's order (or
+// u.lightCandidates draws from the light table), the emitters, then the
+// environment map.
+#define VKRT_PLUS_ENTRIES_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) +tableEntries##Type()
+
+uint lightCandidateCount()
 {
-    LightReservoir r = LightReservoir(LightSample(vec3(0.0), vec3(0.0)), 0.0, 0.0);
 #ifdef VKRT_LIGHT_TABLE
-    offerTableSamples(r, m, hit, ns, wo, origin, rng);
+    uint count = u.lightCandidates;
 #else
-    VKRT_LIGHT_KINDS(VKRT_OFFER_KIND)
-    offerEmitterSample(r, m, hit, ns, wo, origin, rng);
+    uint count = 0u VKRT_LIGHT_KINDS(VKRT_PLUS_ENTRIES_OF_KIND) + emitterCandidates();
+#endif
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    ++count;
+#endif
+    return count;
+}
+
+// Candidate c (< lightCandidateCount()), drawing its numbers from rng in
+// the candidates' order, with the reservoir's number `pick`.
+#define VKRT_CANDIDATE_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if (c < tableEntries##Type())                                                          \
+        return candidate##Type(c, hit, ns, origin, rng, pick);                             \
+    c -= tableEntries##Type();
+LightArrival lightCandidate(uint c, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
+{
+#ifdef VKRT_LIGHT_TABLE
+    if (c < u.lightCandidates)
+        return tableCandidate(hit, ns, origin, rng, pick);
+#else
+    VKRT_LIGHT_KINDS(VKRT_CANDIDATE_OF_KIND)
+    if (c < emitterCandidates())
+        return emitterCandidate(hit, ns, origin, rng, pick);
 #endif
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     // The environment map is one more candidate: one shadow ray for all light.
     vec4 u4 = sampleNext4D(rng);
-    offerLightSample(r, sampleEnvironmentLight(m, ns, wo, origin, true, u4.xyz), u4.w);
+    pick = u4.w;
+    return sampleEnvironmentLight(ns, origin, u4.xyz);
+#else
+    pick = 0.0;
+    return noArrival(origin);
 #endif
-    return r;
 }
 
 #endif

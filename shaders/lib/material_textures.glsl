@@ -189,16 +189,23 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
 #ifdef VKRT_PBR_LAYERS
         else if (k == TEXTURE_SLOT_SPECULAR_FACTOR) {
             m.specularFactor *= channelOf(texel, slot.channel);
-        } else if (k == TEXTURE_SLOT_SHEEN_COLOR) {
+        }
+#ifdef VKRT_PBR_SHEEN
+        else if (k == TEXTURE_SLOT_SHEEN_COLOR) {
             m.sheenColor *= clamp(texel.rgb, 0.0, 1.0);
         } else if (k == TEXTURE_SLOT_SHEEN_ROUGHNESS) {
             m.sheenRoughness *= channelOf(texel, slot.channel);
-        } else if (k == TEXTURE_SLOT_CLEARCOAT) {
+        }
+#endif
+#ifdef VKRT_PBR_CLEARCOAT
+        else if (k == TEXTURE_SLOT_CLEARCOAT) {
             m.clearcoat *= channelOf(texel, slot.channel);
         } else if (k == TEXTURE_SLOT_CLEARCOAT_ROUGHNESS) {
             float r = channelOf(texel, slot.channel);
             m.clearcoatAlpha = max(m.clearcoatAlpha * r * r, MIN_GGX_ALPHA);
-        } else if (k == TEXTURE_SLOT_TRANSMISSION) {
+        }
+#endif
+        else if (k == TEXTURE_SLOT_TRANSMISSION) {
             m.transmission *= channelOf(texel, slot.channel);
         } else if (k == TEXTURE_SLOT_IRIDESCENCE) {
             m.iridescence *= channelOf(texel, slot.channel);
@@ -209,14 +216,16 @@ Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float path
         }
 #ifdef VKRT_HAS_NORMAL_MAPS
         else if (k == TEXTURE_SLOT_CLEARCOAT_NORMAL) {
+#ifdef VKRT_PBR_CLEARCOAT
             // Before the base's normal map (a later slot) has tilted hit.shading.
             m.clearcoatNormal = normalMapped(hit, texel.rgb, materialTextures[hit.material].clearcoatNormalStrength);
+#endif
         }
 #endif
 #endif
 #ifdef VKRT_HAS_NORMAL_MAPS
         else {
-#ifdef VKRT_PBR_LAYERS
+#ifdef VKRT_PBR_CLEARCOAT
             // KHR_materials_clearcoat: a coat without a normal map of its own
             // keeps the normal the base's map does not tilt.
             if (m.clearcoat > 0.0 && m.clearcoatNormal == vec3(0.0))

@@ -85,14 +85,11 @@ struct ShadowTest {
 };
 
 #ifdef VKRT_HAS_MATERIALS
-// Adds a non-specular vertex's next-event estimate (lib/lights.glsl:
-// lightsForOneShadowRay) where no ray need be traced, else sets up its
+// Adds a non-specular vertex's next-event estimate (its light candidates'
+// reservoir r, lightCandidate) where no ray need be traced, else sets up its
 // shadow ray for advancePath to trace.
-void estimateDirectLight(inout PathTracer p, Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo,
-                         inout Sampler rng, inout ShadowTest shadow)
+void estimateDirectLight(inout PathTracer p, LightReservoir r, vec3 n, vec3 ns, vec3 origin, inout ShadowTest shadow)
 {
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    LightReservoir r = lightsForOneShadowRay(m, hit, ns, wo, origin, rng);
     vec3 weight = sampleWeight(p.path.throughput, p.path.media);
     if (r.totalWeight == 0.0) {
         p.path.radiance += weight * vec3(0.0); // as before: NaN for a NaN weight
@@ -106,6 +103,50 @@ void estimateDirectLight(inout PathTracer p, Material m, SurfaceHit hit, vec3 n,
         return;
     }
     shadow = ShadowTest(true, Ray(origin, dir), dist, weight, light, mediumAbsorption(p.path.media));
+}
+
+// A vertex's light candidates (lib/lights.glsl: lightCandidate; none for a
+// material that scatters into deltas only) and then its BSDF sample, in one
+// loop whose every pass evaluates the BSDF at the same call site. lavapipe
+// inlines every call, so each site that evaluates the BSDF is a copy of every
+// material's eval and pdf; with one site a textured glTF kernel compiles in
+// about half the time (docs/performance.md, "One evaluation site"). The
+// candidates draw their numbers first and the sample after them, as when
+// each had its own site. Returns the sample with its weight and sets
+// `bsdfPdf` (0 for a delta) and the reservoir.
+BsdfSample scatterAtVertex(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, float eta, bool lit,
+                           inout Sampler rng, out LightReservoir r, out float bsdfPdf, out float roulette)
+{
+    r = emptyReservoir();
+    uint candidates = lit ? lightCandidateCount() : 0u;
+    for (uint c = 0u;; ++c) {
+        bool sampling = c == candidates; // the last pass: the BSDF sample
+        LightArrival a;
+        BsdfSample s;
+        float pick;
+        bool wantF, wantPdf;
+        if (!sampling) {
+            ++g_loopIterations;
+            a = lightCandidate(c, hit, ns, origin, rng, pick);
+            wantF = arrivalLights(a, ns);
+            wantPdf = arrivalWantsPdf(a, ns, true);
+        } else {
+            vec4 u4 = sampleNext4D(rng);
+            roulette = u4.w;
+            s = sampleBsdf(m, ns, wo, eta, u4.xyz);
+            a.wi = s.dir;
+            wantF = sampleWantsF(s);
+            wantPdf = sampleWantsPdf(s);
+        }
+        BsdfValue v = evaluateBsdf(m, ns, wo, a.wi, wantF, wantPdf);
+        if (!sampling) {
+            offerLightSample(r, lightSampleOf(a, ns, v, true), pick);
+            continue;
+        }
+        bsdfPdf = v.pdf;
+        return completedSample(s, ns, v);
+    }
+    return noScatter(); // not reached
 }
 #endif
 
@@ -149,20 +190,22 @@ bool scatterAtHit(inout PathTracer p, bool found, SurfaceHit hit, inout Sampler 
     m = withInterfaceEta(m, surfaceEta(p.path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
     aovScatter(m, ns);
-    if (!scattersIntoDeltasOnly(m))
-        estimateDirectLight(p, m, hit, n, ns, wo, rng, shadow);
-    vec4 u4 = sampleNext4D(rng);
-    float eta = surfaceEta(p.path.media, hit);
-    BsdfSample s = sampleBsdf(m, ns, wo, eta, u4.xyz);
+    bool lit = !scattersIntoDeltasOnly(m);
+    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    LightReservoir r;
+    float bsdfPdf, roulette;
+    BsdfSample s = scatterAtVertex(m, hit, ns, wo, origin, surfaceEta(p.path.media, hit), lit, rng, r, bsdfPdf, roulette);
+    if (lit)
+        estimateDirectLight(p, r, n, ns, origin, shadow);
     if (s.weight == vec3(0.0))
         return false;
     p.path.throughput *= s.weight;
     p.path.specular = s.specular;
-    p.path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
+    p.path.bsdfPdf = s.specular ? 0.0 : bsdfPdf;
     p.path.cosinePdf = max(dot(ns, s.dir), 0.0) * INV_PI;
     if (s.transmitted && boundsMedium(m))
         p.path.media = refractThrough(p.path.media, hit);
-    if (!survivesRoulette(p.path, p.depth, u4.w))
+    if (!survivesRoulette(p.path, p.depth, roulette))
         return false;
     p.ray = Ray(offsetRayOrigin(hit.position, hit.error, continuationSide(n, ns, s)), s.dir);
     ++p.depth;

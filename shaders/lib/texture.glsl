@@ -74,8 +74,13 @@ vec4 fetchTexel(uint format, uint offset, uint width, uint x, uint y)
 }
 
 /// Lookup in one mip level: the nearest texel, or bilinear between the four nearest.
-/// The nearest texel is the bilinear's first fetch at its own coordinates, so
-/// that a copy of this function inlines four texel fetches, not five.
+/// The taps are fetched in a loop (one pass for the nearest texel, four for
+/// bilinear) so that a copy of this function inlines one texel fetch, not
+/// four: lavapipe inlines every call, and each fetch (two wrapped indices, a
+/// load and a decode by format) costs the driver's compile time in every
+/// kernel that reads a texture (docs/performance.md, "One evaluation site").
+/// The bilinear weights are applied after the loop, as a straight mix of the
+/// four texels.
 vec4 filterTextureLevel(uint textureIndex, vec2 uv, uint level, bool nearest)
 {
     uint format = textureRecords[textureIndex].format;
@@ -90,15 +95,25 @@ vec4 filterTextureLevel(uint textureIndex, vec2 uv, uint level, bool nearest)
     vec2 st = nearest ? image * vec2(size) : image * vec2(size) - 0.5;
     vec2 base = floor(st);
     ivec2 i0 = ivec2(base);
-    uint x0 = uint(wrapTexelIndex(i0.x, size.x, wrapU)), y0 = uint(wrapTexelIndex(i0.y, size.y, wrapV));
-    vec4 topLeft = fetchTexel(format, offset, w, x0, y0);
+    vec4 topLeft, topRight, bottomLeft, bottomRight;
+    uint taps = nearest ? 1u : 4u;
+    [[dont_unroll]] for (uint tap = 0u; tap < taps; ++tap) {
+        ivec2 at = i0 + ivec2(tap & 1u, tap >> 1u);
+        vec4 texel = fetchTexel(format, offset, w, uint(wrapTexelIndex(at.x, size.x, wrapU)),
+                                uint(wrapTexelIndex(at.y, size.y, wrapV)));
+        if (tap == 0u)
+            topLeft = texel;
+        else if (tap == 1u)
+            topRight = texel;
+        else if (tap == 2u)
+            bottomLeft = texel;
+        else
+            bottomRight = texel;
+    }
     if (nearest)
         return topLeft;
     vec2 f = st - base;
-    uint x1 = uint(wrapTexelIndex(i0.x + 1, size.x, wrapU)), y1 = uint(wrapTexelIndex(i0.y + 1, size.y, wrapV));
-    vec4 top = mix(topLeft, fetchTexel(format, offset, w, x1, y0), f.x);
-    vec4 bottom = mix(fetchTexel(format, offset, w, x0, y1), fetchTexel(format, offset, w, x1, y1), f.x);
-    return mix(top, bottom, f.y);
+    return mix(mix(topLeft, topRight, f.x), mix(bottomLeft, bottomRight, f.x), f.y);
 }
 
 /// Lookup in one mip level with the record's magnification filter (bilinear

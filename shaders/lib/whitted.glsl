@@ -98,14 +98,15 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         if (depth == u.maxDepth)
             break;
         float eta = surfaceEta(path.media, hit);
-        BsdfSample s = sampleBsdf(m, ns, wo, eta, sampleNext4D(rng).xyz);
+        float bsdfPdf;
+        BsdfSample s = sampleBsdfWeighted(m, ns, wo, eta, sampleNext4D(rng).xyz, bsdfPdf);
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;
         path.countEmission = path.countEmission && s.specular;
 #ifdef VKRT_ENVIRONMENT_SAMPLING
         path.specular = s.specular;
-        path.bsdfPdf = s.specular ? 0.0 : pdfBsdf(m, ns, wo, s.dir);
+        path.bsdfPdf = s.specular ? 0.0 : bsdfPdf;
         path.cosinePdf = max(dot(ns, s.dir), 0.0) * INV_PI;
 #endif
         if (s.transmitted && boundsMedium(m))

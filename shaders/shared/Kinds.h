@@ -54,6 +54,21 @@
     X(DIRECTIONAL, DirectionalLight, directional, 2, directionalLight, directionalLights, DIRECTIONAL_LIGHTS, 512, 0) \
     X(SPOT, SpotLight, spot, 3, spotLight, spotLights, SPOT_LIGHTS, 372, 0)
 
+// The pbr material's glTF extension lobes that a kernel compiles only where
+// some pbr material of the scene has one: X(LOBE, Lobe, name, value). Each is
+// the define VKRT_PBR_LOBE of the variants that use it (lib/bsdf.glsl guards
+// the lobe's code with it), the feature "pbr-name" of `vkrt info`, bit
+// `value` of FeatureSet::pbrLobes, and a case of PbrLayers::has
+// (src/scene/Scene.h), which the compiler requires for every lobe. The other
+// layers (KHR_materials_specular, _ior) are a few multiplications: they come
+// with VKRT_PBR_LAYERS.
+#define VKRT_PBR_LOBES(X)                          \
+    X(TRANSMISSION, Transmission, transmission, 0) \
+    X(IRIDESCENCE, Iridescence, iridescence, 1)    \
+    X(ANISOTROPY, Anisotropy, anisotropy, 2)       \
+    X(SHEEN, Sheen, sheen, 3)                      \
+    X(CLEARCOAT, Clearcoat, clearcoat, 4)
+
 // ------------------------------------------------------ derived constants
 
 #define VKRT_PLUS_ONE_MATERIAL(KIND, Type, name, value, delta) +1

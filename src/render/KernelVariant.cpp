@@ -70,9 +70,13 @@ std::vector<OptionalFeature> optionalFeatures(const KernelVariant& v)
     // The glTF extension layers of pbr materials (their sheen table is a material table too).
     const bool pbrLayers = f.has(MaterialType::Pbr) && f.pbrLayers;
     list.push_back({pbrLayers, "VKRT_PBR_LAYERS", -1, "pbr-layers"});
-    list.push_back({pbrLayers && f.pbrTransmission, "VKRT_PBR_TRANSMISSION", -1, "pbr-transmission"});
-    list.push_back({pbrLayers && f.pbrIridescence, "VKRT_PBR_IRIDESCENCE", -1, "pbr-iridescence"});
-    list.push_back({pbrLayers && f.textures && f.pbrAnisotropy, "VKRT_PBR_ANISOTROPY", -1, "pbr-anisotropy"});
+    // Each lobe of the registry (shared/Kinds.h) where some material has it;
+    // an anisotropic one also needs the textured variants' tangent frames.
+#define VKRT_PBR_LOBE_FEATURE(LOBE, Lobe, name, value)                                                         \
+    list.push_back({pbrLayers && f.has(PbrLobe::Lobe) && (PbrLobe::Lobe != PbrLobe::Anisotropy || f.textures), \
+                    "VKRT_PBR_" #LOBE, -1, "pbr-" #name});
+    VKRT_PBR_LOBES(VKRT_PBR_LOBE_FEATURE)
+#undef VKRT_PBR_LOBE_FEATURE
     list.push_back({f.has(MaterialType::Plastic) || (f.has(MaterialType::Pbr) && f.pbrLayers),
                     "VKRT_HAS_MATERIAL_TABLES", int(gpu::BINDING_MATERIAL_TABLES), ""});
     list.push_back({f.thinLens, "VKRT_THIN_LENS", -1, "thin-lens"});

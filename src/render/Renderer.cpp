@@ -49,9 +49,7 @@ FeatureSet uberFeatures(const Scene& scene)
     features.emissionTextures = own.emissionTextures;
     features.secondUvs = own.secondUvs;
     features.pbrLayers = own.pbrLayers;
-    features.pbrTransmission = own.pbrTransmission;
-    features.pbrIridescence = own.pbrIridescence;
-    features.pbrAnisotropy = own.pbrAnisotropy;
+    features.pbrLobes = own.pbrLobes;
     features.lightTable = own.lightTable; // the scene's lights decide how they are sampled
     return features;
 }

@@ -44,9 +44,7 @@ FeatureSet FeatureSet::everything(Integrator integrator)
     all.vertexColors = true;
     all.secondUvs = true;
     all.pbrLayers = true;
-    all.pbrTransmission = true;
-    all.pbrIridescence = true;
-    all.pbrAnisotropy = true;
+    all.pbrLobes.fill(true);
     all.thinLens = true;
     all.orthographic = true;
     all.alpha = true;
@@ -69,9 +67,8 @@ void markMaterialsUsed(const Scene& scene, FeatureSet& set)
         set.normalMaps = set.normalMaps || material.hasNormalMap();
         set.secondUvs = set.secondUvs || material.readsUvSet(1);
         set.pbrLayers = set.pbrLayers || material.hasPbrLayers();
-        set.pbrTransmission = set.pbrTransmission || material.pbrTransmits();
-        set.pbrIridescence = set.pbrIridescence || material.pbrIridescent();
-        set.pbrAnisotropy = set.pbrAnisotropy || material.pbrAnisotropic();
+        for (size_t lobe = 0; lobe < kPbrLobeCount; ++lobe)
+            set.pbrLobes[lobe] = set.pbrLobes[lobe] || material.hasPbrLobe(PbrLobe(lobe));
     };
 #define VKRT_MARK_SHAPE_MATERIALS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     for (const auto& shape : scene.array) markUsed(shape.material);

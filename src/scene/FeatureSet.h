@@ -25,14 +25,13 @@ struct FeatureSet {
     bool fileMaterials = false;       ///< some mesh uses its file's materials (one per triangle)
     bool vertexColors = false;        ///< ... and its file's vertex colours (glTF COLOR_0)
     bool pbrLayers = false;           ///< some pbr material has a glTF extension layer (Material::hasPbrLayers)
-    bool pbrTransmission = false;     ///< ... transmission (Material::pbrTransmits)
-    bool pbrIridescence = false;      ///< ... iridescence (Material::pbrIridescent)
-    bool pbrAnisotropy = false;       ///< ... anisotropy (Material::pbrAnisotropic: needs the hit's tangent frame)
-    bool secondUvs = false;           ///< some material in use reads a mesh's second uv set (glTF TEXCOORD_1)
-    bool thinLens = false;            ///< the camera has an aperture (depth of field)
-    bool orthographic = false;        ///< the camera projects orthographically (parallel rays)
-    bool alpha = false;               ///< some mesh material is alpha-tested (glTF alphaMode MASK or BLEND)
-    bool lightTable = false; ///< more lights than kMaxEnumeratedLights: sampled from a table (render/LightTable.h)
+    /// ... the lobe, indexed by PbrLobe (Material::hasPbrLobe; anisotropy needs the hit's tangent frame)
+    std::array<bool, kPbrLobeCount> pbrLobes{};
+    bool secondUvs = false;    ///< some material in use reads a mesh's second uv set (glTF TEXCOORD_1)
+    bool thinLens = false;     ///< the camera has an aperture (depth of field)
+    bool orthographic = false; ///< the camera projects orthographically (parallel rays)
+    bool alpha = false;        ///< some mesh material is alpha-tested (glTF alphaMode MASK or BLEND)
+    bool lightTable = false;   ///< more lights than kMaxEnumeratedLights: sampled from a table (render/LightTable.h)
     Integrator integrator = Integrator::Whitted;
 
     /// Every feature on: the "uber" kernel, for comparison (`--uber`).
@@ -40,10 +39,11 @@ struct FeatureSet {
 
     bool anyPrimitive() const;
     /// Some material needs the surfaces' tangent frames: a normal map, or a pbr anisotropy.
-    bool tangentFrames() const { return normalMaps || pbrAnisotropy; }
+    bool tangentFrames() const { return normalMaps || has(PbrLobe::Anisotropy); }
     bool has(ShapeKind kind) const { return shapes[size_t(kind)]; }
     bool has(LightKind kind) const { return lights[size_t(kind)]; }
     bool has(MaterialType type) const { return materialTypes[size_t(type)]; }
+    bool has(PbrLobe lobe) const { return pbrLobes[size_t(lobe)]; }
 
     bool operator==(const FeatureSet&) const = default;
 };

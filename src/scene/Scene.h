@@ -78,6 +78,14 @@ enum class ShapeKind : uint32_t { VKRT_SHAPE_KINDS(VKRT_KIND_ENUMERATOR) };
 /// A light kind; the values are the GPU's LIGHT_* constants.
 enum class LightKind : uint32_t { VKRT_LIGHT_KINDS(VKRT_KIND_ENUMERATOR) };
 
+/// A glTF extension lobe of pbr materials the kernel compiles only where used.
+enum class PbrLobe : uint32_t { VKRT_PBR_LOBES(VKRT_KIND_ENUMERATOR) };
+#define VKRT_PLUS_ONE_LOBE(...) +1
+inline constexpr size_t kPbrLobeCount = 0 VKRT_PBR_LOBES(VKRT_PLUS_ONE_LOBE);
+#undef VKRT_PLUS_ONE_LOBE
+/// The lobes' names (the feature "pbr-name" of `vkrt info`), indexed by value.
+inline constexpr std::array<std::string_view, kPbrLobeCount> kPbrLobeNames{VKRT_PBR_LOBES(VKRT_KIND_NAME)};
+
 inline constexpr size_t kMaterialKindCount = gpu::MATERIAL_KIND_COUNT;
 inline constexpr size_t kShapeKindCount = gpu::SHAPE_KIND_COUNT;
 inline constexpr size_t kLightKindCount = gpu::LIGHT_KIND_COUNT;
@@ -217,6 +225,18 @@ struct PbrLayers {
     double anisotropyRotation = 0.0;
 
     bool sheen() const { return sheenColor != Color(0.0); }
+    /// Whether these layers use a lobe (shared/Kinds.h: VKRT_PBR_LOBES).
+    bool has(PbrLobe lobe) const
+    {
+        switch (lobe) {
+        case PbrLobe::Transmission: return transmits();
+        case PbrLobe::Iridescence: return iridescence > 0.0;
+        case PbrLobe::Anisotropy: return anisotropy > 0.0;
+        case PbrLobe::Sheen: return sheen();
+        case PbrLobe::Clearcoat: return clearcoat > 0.0;
+        }
+        return false;
+    }
     /// Light crosses the surface (the kernel's VKRT_PBR_TRANSMISSION).
     bool transmits() const { return transmission > 0.0; }
     /// The surface bounds a refracting, absorbing volume.
@@ -276,10 +296,11 @@ struct Material {
     }
     /// A pbr material with a glTF extension layer (or a KHR_materials_ior index other than 1.5).
     bool hasPbrLayers() const;
-    bool pbrTransmits() const { return type == MaterialType::Pbr && layers.transmits(); }
-    bool pbrIridescent() const { return type == MaterialType::Pbr && layers.iridescence > 0.0; }
-    /// Its base's GGX lobe is anisotropic along the hit's tangent frame.
-    bool pbrAnisotropic() const { return type == MaterialType::Pbr && layers.anisotropy > 0.0; }
+    /// A pbr material with the lobe (an anisotropic one: its base's GGX lobe
+    /// stretches along the hit's tangent frame).
+    bool hasPbrLobe(PbrLobe lobe) const { return type == MaterialType::Pbr && layers.has(lobe); }
+    bool pbrTransmits() const { return hasPbrLobe(PbrLobe::Transmission); }
+    bool pbrAnisotropic() const { return hasPbrLobe(PbrLobe::Anisotropy); }
     bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 };
 

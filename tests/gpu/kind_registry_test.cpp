@@ -12,7 +12,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <set>
 
@@ -90,6 +93,32 @@ TEST(KindRegistry, EveryKindHasADefineAndABinding)
     std::vector<uint32_t> bindings = uber.bindings();
     for (const auto& a : sceneArrayBindings())
         EXPECT_NE(std::find(bindings.begin(), bindings.end(), a.binding), bindings.end()) << a.binding;
+}
+
+// Every pbr lobe of the registry is a define of the all-features variant, and
+// the shader library guards code with it: a lobe added to the registry
+// without its GLSL fails here.
+TEST(KindRegistry, EveryPbrLobeIsADefineTheShadersUse)
+{
+    FeatureSet everything = FeatureSet::everything(Integrator::Path);
+    std::string defines = describeDefines(KernelVariant(everything).defines());
+    std::string library;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(defaultShaderRoot() / "lib"))
+        if (entry.is_regular_file()) {
+            std::ifstream in(entry.path());
+            library += std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        }
+    ASSERT_EQ(kPbrLobeNames.size(), kPbrLobeCount);
+    for (std::string_view name : kPbrLobeNames) {
+        std::string define = "VKRT_PBR_" + std::string(name);
+        for (char& c : define) c = char(std::toupper(static_cast<unsigned char>(c)));
+        EXPECT_NE(defines.find(define), std::string::npos) << define << " in " << defines;
+        EXPECT_NE(library.find("#ifdef " + define), std::string::npos) << define << " guards no shader code";
+    }
+    // A scene without the lobe leaves it out of its variant.
+    FeatureSet plain = everything;
+    plain.pbrLobes[size_t(PbrLobe::Sheen)] = false;
+    EXPECT_EQ(describeDefines(KernelVariant(plain).defines()).find("VKRT_PBR_SHEEN"), std::string::npos);
 }
 
 const char* kCamera = "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov = 40\n";

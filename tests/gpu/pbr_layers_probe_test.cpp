@@ -33,7 +33,10 @@ namespace {
 constexpr uint32_t kSamples = 1u << 18;
 constexpr size_t kSheenTableAt = 128; // bsdf_probe.comp's layout with VKRT_PBR_LAYERS
 
-const std::vector<Define> kLayers{{"VKRT_PBR_LAYERS", "1"}, {"VKRT_PBR_ANISOTROPY", "1"}};
+const std::vector<Define> kLayers{{"VKRT_PBR_LAYERS", "1"},
+                                  {"VKRT_PBR_ANISOTROPY", "1"},
+                                  {"VKRT_PBR_SHEEN", "1"},
+                                  {"VKRT_PBR_CLEARCOAT", "1"}};
 
 struct LayerCase {
     std::string name;

@@ -42,7 +42,10 @@ namespace {
 constexpr size_t kSheenTableAt = 128;  // bsdf_probe.comp's layout with VKRT_PBR_LAYERS
 constexpr size_t kTransmissionAt = 38; // ... and with VKRT_PBR_TRANSMISSION: transmission, pbrFlags
 
-const std::vector<Define> kTransmission{{"VKRT_PBR_LAYERS", "1"}, {"VKRT_PBR_TRANSMISSION", "1"}};
+const std::vector<Define> kTransmission{{"VKRT_PBR_LAYERS", "1"},
+                                        {"VKRT_PBR_TRANSMISSION", "1"},
+                                        {"VKRT_PBR_SHEEN", "1"},
+                                        {"VKRT_PBR_CLEARCOAT", "1"}};
 
 /// A transmitting pbr material seen from one side of its surface.
 struct TransmissionCase {

@@ -130,7 +130,7 @@ TEST(GltfMaterialImport, TransmissionAndIridescenceTakeTheirFactorsAndTextures)
         EXPECT_EQ(m.texture(slot)->channel, channel) << int(slot);
     }
     const FeatureSet features = featuresOf(scene);
-    EXPECT_TRUE(features.pbrTransmission && features.pbrIridescence);
+    EXPECT_TRUE(features.has(PbrLobe::Transmission) && features.has(PbrLobe::Iridescence));
 }
 
 TEST(GltfMaterialImport, AnisotropyAndTheCoatsNormalMapTakeTheirFactorsAndTextures)
@@ -149,7 +149,7 @@ TEST(GltfMaterialImport, AnisotropyAndTheCoatsNormalMapTakeTheirFactorsAndTextur
     EXPECT_EQ(m.clearcoatNormalStrength, 0.5);
     EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
     const FeatureSet features = featuresOf(scene);
-    EXPECT_TRUE(features.pbrAnisotropy && features.tangentFrames());
+    EXPECT_TRUE(features.has(PbrLobe::Anisotropy) && features.tangentFrames());
 
     // Without a strength the direction texture changes nothing: no anisotropic kernel for it.
     const Scene none = importOne("none", R"({"extensions": {"KHR_materials_anisotropy": {

@@ -185,7 +185,7 @@ TEST(GltfScene, AnisotropySpheresCarryTheirStrengthsRotationsAndTangents)
     ASSERT_FALSE(scene.meshes.empty());
     EXPECT_FALSE(scene.meshes[0].geometry->data.tangents.empty()) << "the file's TANGENT";
     const FeatureSet features = featuresOf(scene);
-    EXPECT_TRUE(features.pbrAnisotropy && features.tangentFrames());
+    EXPECT_TRUE(features.has(PbrLobe::Anisotropy) && features.tangentFrames());
 }
 
 TEST(GltfScene, CamerasAreListedInFileOrderAndOrthographicOnesKeepTheirView)

@@ -309,7 +309,7 @@ material = "bubble"
     EXPECT_DOUBLE_EQ(bubble.layers.iridescenceIor, 1.4);
     EXPECT_DOUBLE_EQ(bubble.layers.iridescenceThicknessMax, 550.0);
     const FeatureSet features = featuresOf(scene);
-    EXPECT_TRUE(features.pbrLayers && features.pbrTransmission && features.pbrIridescence);
+    EXPECT_TRUE(features.pbrLayers && features.has(PbrLobe::Transmission) && features.has(PbrLobe::Iridescence));
 }
 
 TEST(SceneParserValid, PbrAnisotropyIsReadInDegreesAndTurnsOnItsVariant)
@@ -335,7 +335,7 @@ material = "brushed"
     EXPECT_FALSE(scene.materials.at(1).hasPbrLayers());
     // The lobe turns with the hit's tangent frame, which the textured variants compute.
     const FeatureSet features = featuresOf(scene);
-    EXPECT_TRUE(features.pbrAnisotropy && features.textures && features.tangentFrames());
+    EXPECT_TRUE(features.has(PbrLobe::Anisotropy) && features.textures && features.tangentFrames());
 }
 
 TEST(SceneParserValid, ShapesReferToMaterialIndices)

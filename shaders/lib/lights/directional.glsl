@@ -46,31 +46,21 @@ vec3 sampleSunCone(DirectionalLight light, vec2 rnd)
     return fromLocal(vec3(sinTheta * cos(phi), sinTheta * sin(phi), 1.0 - t), light.toLight);
 }
 
-// One sun's light at a surface point before visibility: f * E * cos for a
-// delta sun, f * L * cos / pdf (MIS-weighted in the path integrator) for a
-// direction drawn in a soft sun's cone; both divided by `selection`, the
-// density of having chosen this sun (1 where every sun is sampled; lib/lights.glsl:
-// tableSelection). The shadow ray's target is far along the direction (FAR_LIGHT_DISTANCE).
-LightSample sampleDirectionalLight(DirectionalLight light, float selection, Material m, SurfaceHit hit, vec3 ns,
-                                   vec3 wo, vec3 origin, vec2 rnd)
+// One sun's light at a surface point: E for a delta sun (no density), L /
+// pdf for a direction drawn in a soft sun's cone (pdf: its density, for MIS
+// in the path integrator); both divided by `selection`, the density of
+// having chosen this sun (1 where every sun is sampled; lib/lights.glsl:
+// tableSelection). The shadow ray's target is far along the direction
+// (FAR_LIGHT_DISTANCE).
+LightArrival sampleDirectionalLight(DirectionalLight light, float selection, vec3 origin, vec2 rnd)
 {
     bool soft = light.oneMinusCos > 0.0;
     vec3 wi = soft ? sampleSunCone(light, rnd) : light.toLight;
     vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
-    float cosTheta = dot(ns, wi);
-    if (cosTheta <= 0.0)
-        return LightSample(vec3(0.0), target);
-    vec3 contribution = evalBsdf(m, ns, wo, wi) * light.radiance * cosTheta;
-    if (soft) {
-        float lightPdf = sunConePdf(light) * selection;
-        contribution /= lightPdf;
-#ifdef VKRT_INTEGRATOR_PATH
-        contribution *= powerHeuristic(lightPdf, pdfBsdf(m, ns, wo, wi));
-#endif
-    } else {
-        contribution /= selection;
-    }
-    return LightSample(contribution, target);
+    if (!soft)
+        return LightArrival(wi, target, light.radiance / selection, 0.0);
+    float lightPdf = sunConePdf(light) * selection;
+    return LightArrival(wi, target, light.radiance / lightPdf, lightPdf);
 }
 #endif
 
@@ -85,13 +75,12 @@ uint tableEntriesDirectionalLight()
 }
 
 // Sun i drawn from the light table with density `selection`.
-LightSample sampleTableDirectionalLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo,
-                                        vec3 origin, vec4 rnd)
+LightArrival sampleTableDirectionalLight(uint i, float selection, SurfaceHit hit, vec3 ns, vec3 origin, vec4 rnd)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    return sampleDirectionalLight(directionalLights[i], selection, m, hit, ns, wo, origin, rnd.xy);
+    return sampleDirectionalLight(directionalLights[i], selection, origin, rnd.xy);
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
@@ -101,26 +90,24 @@ float lightSelection(int kind, uint i);
 // Sun i for the Whitted integrator (its cone sampled with 2 numbers) and as
 // a candidate of the path integrator's one shadow ray (4 numbers: the cone's
 // 2 and the reservoir's; lib/lights.glsl: VKRT_LIGHT_LOOPS).
-LightSample whittedSampleDirectionalLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                          inout Sampler rng)
+LightArrival whittedSampleDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    return sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, sampleNext2D(rng));
+    return sampleDirectionalLight(directionalLights[i], 1.0, origin, sampleNext2D(rng));
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
-LightSample candidateDirectionalLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                      inout Sampler rng, out float pick)
+LightArrival candidateDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
     vec4 u4 = sampleNext4D(rng);
     pick = u4.z;
-    return sampleDirectionalLight(directionalLights[i], 1.0, m, hit, ns, wo, origin, u4.xy);
+    return sampleDirectionalLight(directionalLights[i], 1.0, origin, u4.xy);
 #else
     pick = 0.0;
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 

@@ -21,19 +21,14 @@ void describePointLight(Ray r, HitId id, inout SurfaceHit hit) {}
 #define VKRT_LIGHT_POINT_SAMPLING
 
 #ifdef VKRT_HAS_POINT_LIGHTS
-// One point light: f * I * cos / d^2. Geometry from the surface point itself;
-// only the shadow ray starts at the offset origin (measuring from it would
-// bias 1/d^2 by the offset).
-LightSample samplePointLight(PointLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo)
+// One point light: I / d^2 from its direction (a delta: no density).
+// Geometry from the surface point itself; only the shadow ray starts at the
+// offset origin (measuring from it would bias 1/d^2 by the offset).
+LightArrival arrivalFromPointLight(PointLight light, SurfaceHit hit)
 {
     vec3 toLight = light.position - hit.position;
     float distSq = dot(toLight, toLight);
-    vec3 wi = toLight * inversesqrt(distSq);
-    float cosTheta = dot(ns, wi);
-    if (cosTheta <= 0.0)
-        return LightSample(vec3(0.0), light.position);
-    vec3 f = evalBsdf(m, ns, wo, wi);
-    return LightSample(f * light.intensity * (cosTheta / distSq), light.position);
+    return LightArrival(toLight * inversesqrt(distSq), light.position, light.intensity / distSq, 0.0);
 }
 #endif
 
@@ -49,36 +44,34 @@ uint tableEntriesPointLight()
 
 // Point light i drawn from the light table with density `selection`
 // (lib/lights.glsl: tableSelection): its sample divided by it.
-LightSample sampleTablePointLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                  vec4 rnd)
+LightArrival sampleTablePointLight(uint i, float selection, SurfaceHit hit, vec3 ns, vec3 origin, vec4 rnd)
 {
 #ifdef VKRT_HAS_POINT_LIGHTS
-    LightSample s = samplePointLight(pointLights[i], m, hit, ns, wo);
-    s.unshadowed /= selection;
-    return s;
+    LightArrival a = arrivalFromPointLight(pointLights[i], hit);
+    a.radiance /= selection;
+    return a;
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
 // Point light i as the Whitted integrator samples it (its own shadow ray)
 // and as a candidate of the path integrator's one shadow ray, with the
 // reservoir's number `pick` (lib/lights.glsl: VKRT_LIGHT_LOOPS).
-LightSample whittedSamplePointLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng)
+LightArrival whittedSamplePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_POINT_LIGHTS
-    return samplePointLight(pointLights[i], m, hit, ns, wo);
+    return arrivalFromPointLight(pointLights[i], hit);
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
-LightSample candidatePointLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng,
-                                out float pick)
+LightArrival candidatePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
-    LightSample s = whittedSamplePointLight(i, m, hit, ns, wo, origin, rng);
+    LightArrival a = whittedSamplePointLight(i, hit, ns, origin, rng);
     pick = sampleNext1D(rng);
-    return s;
+    return a;
 }
 
 #endif

@@ -31,19 +31,17 @@ float spotFalloff(SpotLight light, vec3 toPoint)
     return t * t;
 }
 
-// One spot light: f * I * falloff * cos / d^2, as a point light
-// (lib/lights/point.glsl: geometry from the surface point itself).
-LightSample sampleSpotLight(SpotLight light, Material m, SurfaceHit hit, vec3 ns, vec3 wo)
+// One spot light: I * falloff / d^2, as a point light (lib/lights/point.glsl:
+// geometry from the surface point itself).
+LightArrival arrivalFromSpotLight(SpotLight light, SurfaceHit hit)
 {
     vec3 toLight = light.position - hit.position;
     float distSq = dot(toLight, toLight);
     vec3 wi = toLight * inversesqrt(distSq);
-    float cosTheta = dot(ns, wi);
     float falloff = spotFalloff(light, -wi);
-    if (cosTheta <= 0.0 || falloff == 0.0)
-        return LightSample(vec3(0.0), light.position);
-    vec3 f = evalBsdf(m, ns, wo, wi);
-    return LightSample(f * light.intensity * (falloff * cosTheta / distSq), light.position);
+    if (falloff == 0.0)
+        return noArrival(light.position);
+    return LightArrival(wi, light.position, light.intensity * (falloff / distSq), 0.0);
 }
 #endif
 
@@ -58,35 +56,33 @@ uint tableEntriesSpotLight()
 }
 
 // Spot light i drawn from the light table with density `selection`.
-LightSample sampleTableSpotLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                 vec4 rnd)
+LightArrival sampleTableSpotLight(uint i, float selection, SurfaceHit hit, vec3 ns, vec3 origin, vec4 rnd)
 {
 #ifdef VKRT_HAS_SPOT_LIGHTS
-    LightSample s = sampleSpotLight(spotLights[i], m, hit, ns, wo);
-    s.unshadowed /= selection;
-    return s;
+    LightArrival a = arrivalFromSpotLight(spotLights[i], hit);
+    a.radiance /= selection;
+    return a;
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
 // Spot light i for the Whitted integrator and as a candidate of the path
 // integrator's one shadow ray (lib/lights.glsl: VKRT_LIGHT_LOOPS).
-LightSample whittedSampleSpotLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng)
+LightArrival whittedSampleSpotLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_SPOT_LIGHTS
-    return sampleSpotLight(spotLights[i], m, hit, ns, wo);
+    return arrivalFromSpotLight(spotLights[i], hit);
 #else
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 #endif
 }
 
-LightSample candidateSpotLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin, inout Sampler rng,
-                               out float pick)
+LightArrival candidateSpotLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
-    LightSample s = whittedSampleSpotLight(i, m, hit, ns, wo, origin, rng);
+    LightArrival a = whittedSampleSpotLight(i, hit, ns, origin, rng);
     pick = sampleNext1D(rng);
-    return s;
+    return a;
 }
 
 #endif

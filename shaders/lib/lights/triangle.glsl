@@ -50,26 +50,23 @@ void describeTriangleLight(Ray r, HitId id, inout SurfaceHit hit)
 
 // Sampled with every emitter (lib/emitters.glsl), not on their own: no
 // lights of their own to loop over (tableEntriesTriangleLight is 0).
-LightSample whittedSampleTriangleLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                       inout Sampler rng)
+LightArrival whittedSampleTriangleLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 }
 
-LightSample candidateTriangleLight(uint i, Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 origin,
-                                   inout Sampler rng, out float pick)
+LightArrival candidateTriangleLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
     pick = 0.0;
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 }
 
 // No entries of their own in the light table: its last entry is every emitter.
 uint tableEntriesTriangleLight() { return 0u; }
 
-LightSample sampleTableTriangleLight(uint i, float selection, Material m, SurfaceHit hit, vec3 ns, vec3 wo,
-                                     vec3 origin, vec4 rnd)
+LightArrival sampleTableTriangleLight(uint i, float selection, SurfaceHit hit, vec3 ns, vec3 origin, vec4 rnd)
 {
-    return LightSample(vec3(0.0), origin);
+    return noArrival(origin);
 }
 
 
