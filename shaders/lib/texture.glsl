@@ -97,7 +97,7 @@ vec4 filterTextureLevel(uint textureIndex, vec2 uv, uint level, bool nearest)
     ivec2 i0 = ivec2(base);
     vec4 topLeft, topRight, bottomLeft, bottomRight;
     uint taps = nearest ? 1u : 4u;
-    [[dont_unroll]] for (uint tap = 0u; tap < taps; ++tap) {
+    for (uint tap = 0u; tap < taps; ++tap) {
         ivec2 at = i0 + ivec2(tap & 1u, tap >> 1u);
         vec4 texel = fetchTexel(format, offset, w, uint(wrapTexelIndex(at.x, size.x, wrapU)),
                                 uint(wrapTexelIndex(at.y, size.y, wrapV)));
