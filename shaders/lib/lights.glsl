@@ -331,7 +331,9 @@ LightArrival sampleEnvironmentLight(vec3 ns, vec3 origin, vec3 rnd)
         wi = sampleEnvironment(rnd, pdf);
     }
     vec3 target = origin + wi * FAR_LIGHT_DISTANCE;
-    if (!(pdf > 0.0))
+    // Below the shading plane it lights nothing: no look-up (a sky model's
+    // costs as much as the rest of the sample).
+    if (!(pdf > 0.0) || dot(ns, wi) <= 0.0)
         return noArrival(target);
     return LightArrival(wi, target, environmentRadiance(wi) / pdf, pdf);
 }
