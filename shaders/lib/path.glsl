@@ -118,7 +118,13 @@ BsdfSample scatterAtVertex(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 or
                            inout Sampler rng, out LightReservoir r, out float bsdfPdf, out float roulette)
 {
     r = emptyReservoir();
-    uint candidates = lit ? lightCandidateCount() : 0u;
+    // Every lane makes the same passes (the count is uniform), so that lanes
+    // whose materials have no light samples (deltas: `lit` false) reach the
+    // BSDF sample in the same pass as the others: with as many passes as
+    // candidates of its own, a lane of a mirror sampled its BSDF while its
+    // neighbours drew light candidates, and the sampling code ran twice per
+    // subgroup (0.82-0.93x the samples/s of validation/mirror).
+    uint candidates = lightCandidateCount();
     for (uint c = 0u;; ++c) {
         bool sampling = c == candidates; // the last pass: the BSDF sample
         LightArrival a;
@@ -126,6 +132,8 @@ BsdfSample scatterAtVertex(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 or
         float pick;
         bool wantF, wantPdf;
         if (!sampling) {
+            if (!lit)
+                continue; // draws nothing: as before, no light numbers for a delta material
             ++g_loopIterations;
             a = lightCandidate(c, hit, ns, origin, rng, pick);
             wantF = arrivalLights(a, ns);
