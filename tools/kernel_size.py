@@ -83,8 +83,8 @@ def main():
     parser.add_argument("--vkrt", default="build/vkrt")
     parser.add_argument("--top", type=int, default=30)
     parser.add_argument("--json", help="also write the table as JSON here")
-    parser.add_argument("extra", nargs="*", help="more `vkrt info` options (after --)")
-    args = parser.parse_args()
+    args, extra = parser.parse_known_args()
+    args.extra = [a for a in extra if a != "--"]  # more `vkrt info` options, after --
     with tempfile.TemporaryDirectory(prefix="kernel-size-") as cache:
         info_json = os.path.join(cache, "info.json")
         env = dict(os.environ, VKRT_CACHE_DIR=cache)

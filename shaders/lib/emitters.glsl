@@ -96,21 +96,6 @@ LightArrival sampleEmitters(vec4 u4, SurfaceHit hit, vec3 ns, vec3 origin)
 }
 #endif
 
-// One sample of all emitters with its shadow ray (the Whitted integrator;
-// with the light table they are one of its entries: directFromLights).
-vec3 directFromEmitters(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
-{
-#if defined(VKRT_HAS_EMITTERS) && !defined(VKRT_LIGHT_TABLE)
-    if (u.emitterCount == 0u)
-        return vec3(0.0);
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    LightSample s = litBy(m, ns, wo, sampleEmitters(sampleNext4D(rng), hit, ns, origin), false);
-    if (s.unshadowed != vec3(0.0))
-        return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
-#endif
-    return vec3(0.0);
-}
-
 // All emitters as one more candidate of the path integrator's shadow ray: a
 // power-proportional choice of one of them (unbiased for their sum), with
 // the reservoir's number `pick`.

@@ -190,7 +190,7 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 }
 
 // Every light kind's sampling (the functions lib/surface.glsl lists, and
-// directFromType, lightCandidate), then the emitters all area lights share.
+// whittedCandidate, lightCandidate), then the emitters all area lights share.
 // Every light function takes the geometric normal n (the side the shadow ray
 // leaves from, for offsets) and the shading normal ns on the same side (for
 // the BSDF and its cosine); ns == n except on meshes with vertex normals.
@@ -201,28 +201,12 @@ void offerLightSample(inout LightReservoir r, LightSample s, float u)
 #include "lights/directional.glsl"
 #include "lights/spot.glsl"
 
-// The loop every kind of light sampled one by one shares (point, spot and
-// directional lights; triangle lights have none of their own: they are
-// emitters). A kind gives tableEntries<Type> (how many), whittedSample<Type>
-// and candidate<Type> (lib/lights/*.glsl); forgetting one fails the build.
-// directFrom<Type>: every light of the kind, each with its shadow ray (the
-// Whitted integrator). The path integrator draws candidate<Type> through
-// lightCandidate.
-#define VKRT_LIGHT_LOOPS(KIND, Type, name, value, field, array, ARRAY, capacity, bounded)                             \
-    vec3 directFrom##Type(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng) \
-    {                                                                                                                 \
-        vec3 radiance = vec3(0.0);                                                                                    \
-        vec3 origin = offsetRayOrigin(hit.position, hit.error, n);                                                    \
-        for (uint i = 0u; i < tableEntries##Type(); ++i) {                                                            \
-            ++g_loopIterations;                                                                                       \
-            LightSample s = litBy(m, ns, wo, whittedSample##Type(i, hit, ns, origin, rng), false);                    \
-            if (s.unshadowed != vec3(0.0))                                                                            \
-                radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);             \
-        }                                                                                                             \
-        return radiance;                                                                                              \
-    }
-VKRT_LIGHT_KINDS(VKRT_LIGHT_LOOPS)
-#undef VKRT_LIGHT_LOOPS
+// Every kind of light sampled one by one (point, spot and directional
+// lights; triangle lights have none of their own: they are emitters) gives
+// tableEntries<Type> (how many), whittedSample<Type> and candidate<Type>
+// (lib/lights/*.glsl); forgetting one fails the build. The Whitted
+// integrator draws whittedSample<Type> through whittedCandidate, the path
+// integrator candidate<Type> through lightCandidate.
 
 // ------------------------------------------------------------ the light table
 // Scenes with more point, spot and directional lights than the host lets the
@@ -301,9 +285,6 @@ float lightSelection(int kind, uint i)
 #endif
 }
 
-#define VKRT_DIRECT_FROM_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
-    +directFrom##Type(m, hit, n, ns, wo, media, rng)
-
 #ifdef VKRT_ENVIRONMENT_SAMPLING
 bool constantEnvironment() { return (u.flags & RENDER_FLAG_CONSTANT_ENVIRONMENT) != 0u; }
 
@@ -339,23 +320,6 @@ LightArrival sampleEnvironmentLight(vec3 ns, vec3 origin, vec3 rnd)
 }
 #endif
 
-// The environment map with a shadow ray of its own (the Whitted integrator;
-// the path integrator offers it to its one shadow ray with the lights),
-// MIS-weighted against BSDF sampling when `bsdfFollows`: false at a vertex
-// no ray leaves (the Whitted integrator's last), where the light sample is
-// all the estimate has.
-vec3 directFromEnvironment(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, bool bsdfFollows,
-                           inout Sampler rng)
-{
-#ifdef VKRT_ENVIRONMENT_SAMPLING
-    vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
-    LightSample s = litBy(m, ns, wo, sampleEnvironmentLight(ns, origin, sampleNext4D(rng).xyz), bsdfFollows);
-    if (s.unshadowed != vec3(0.0))
-        return s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
-#endif
-    return vec3(0.0);
-}
-
 // Environment radiance found by a ray that escaped after a scattering of
 // solid-angle density bsdfPdf (`specular`: a delta event, or the camera),
 // MIS-weighted when the environment is also sampled directly; cosinePdf is
@@ -371,14 +335,62 @@ vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf, float cosinePdf
     return le;
 }
 
-// Direct light from every light kind, each light with its own shadow ray
-// (the Whitted integrator, which adds one sample of the emitters to it). With
-// the light table: its candidates, one of them with a shadow ray, emitters
-// included (directFromEmitters adds nothing then).
-vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, inout Sampler rng)
+// ------------------------------------------------ the Whitted integrator's lights
+// Direct light with a shadow ray per light sample (the Whitted integrator):
+// every light of every kind in the registry's order, one sample of the
+// emitters, and one direction of the environment map (MIS-weighted against
+// BSDF sampling when `bsdfFollows`: false at a vertex no ray leaves, the
+// integrator's last, where the light sample is all the estimate has). They
+// are the passes of one loop, so that the kernel holds one copy of the BSDF
+// evaluation and one of the shadow ray's trace (lavapipe inlines every call;
+// a copy per light kind made the Whitted kernels, the uber kernel most of
+// all, compile far slower: docs/performance.md, "One evaluation site").
+// With the light table, its candidates, one of them with a shadow ray,
+// emitters included, come first.
+#define VKRT_PLUS_WHITTED_ENTRIES(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) +tableEntries##Type()
+
+uint whittedCandidateCount()
 {
 #ifdef VKRT_LIGHT_TABLE
+    uint count = 0u;
+#else
+    uint count = 0u VKRT_LIGHT_KINDS(VKRT_PLUS_WHITTED_ENTRIES) + emitterCandidates();
+#endif
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    ++count;
+#endif
+    return count;
+}
+
+#define VKRT_WHITTED_CANDIDATE_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
+    if (c < tableEntries##Type())                                                                  \
+        return whittedSample##Type(c, hit, ns, origin, rng);                                       \
+    c -= tableEntries##Type();
+LightArrival whittedCandidate(uint c, SurfaceHit hit, vec3 ns, vec3 origin, bool bsdfFollows, inout Sampler rng,
+                              out bool mis)
+{
+    mis = false;
+#ifndef VKRT_LIGHT_TABLE
+    VKRT_LIGHT_KINDS(VKRT_WHITTED_CANDIDATE_OF_KIND)
+#ifdef VKRT_HAS_EMITTERS
+    if (c < emitterCandidates())
+        return sampleEmitters(sampleNext4D(rng), hit, ns, origin);
+#endif
+#endif
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    mis = bsdfFollows;
+    return sampleEnvironmentLight(ns, origin, sampleNext4D(rng).xyz);
+#else
+    return noArrival(origin);
+#endif
+}
+
+vec3 whittedDirectLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, MediumStack media, bool bsdfFollows,
+                        inout Sampler rng)
+{
     vec3 origin = offsetRayOrigin(hit.position, hit.error, n);
+    vec3 radiance = vec3(0.0);
+#ifdef VKRT_LIGHT_TABLE
     LightReservoir r = emptyReservoir();
     for (uint c = 0u; c < u.lightCandidates; ++c) {
         ++g_loopIterations;
@@ -386,13 +398,20 @@ vec3 directFromLights(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Medi
         LightArrival a = tableCandidate(hit, ns, origin, rng, pick);
         offerLightSample(r, litBy(m, ns, wo, a, false), pick);
     }
-    if (r.totalWeight == 0.0)
-        return vec3(0.0);
-    return r.kept.unshadowed * (r.totalWeight / r.keptWeight) *
-           transmittanceFromSurface(hit, n, ns, origin, r.kept.target, media);
-#else
-    return vec3(0.0) VKRT_LIGHT_KINDS(VKRT_DIRECT_FROM_KIND);
+    if (r.totalWeight != 0.0)
+        radiance = r.kept.unshadowed * (r.totalWeight / r.keptWeight) *
+                   transmittanceFromSurface(hit, n, ns, origin, r.kept.target, media);
 #endif
+    uint count = whittedCandidateCount();
+    for (uint c = 0u; c < count; ++c) {
+        ++g_loopIterations;
+        bool mis;
+        LightArrival a = whittedCandidate(c, hit, ns, origin, bsdfFollows, rng, mis);
+        LightSample s = litBy(m, ns, wo, a, mis);
+        if (s.unshadowed != vec3(0.0))
+            radiance += s.unshadowed * transmittanceFromSurface(hit, n, ns, origin, s.target, media);
+    }
+    return radiance;
 }
 
 // ------------------------------------------- the path integrator's candidates

@@ -87,14 +87,9 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         m = withInterfaceEta(m, surfaceEta(path.media, hit)); // its eval and pdf need the crossing's eta
 #endif
         aovScatter(m, ns);
-        if (!scattersIntoDeltasOnly(m)) {
-            path.radiance += path.throughput * directFromLights(m, hit, n, ns, wo, path.media, rng);
-            path.radiance += path.throughput * directFromEmitters(m, hit, n, ns, wo, path.media, rng);
-#ifdef VKRT_ENVIRONMENT_SAMPLING
+        if (!scattersIntoDeltasOnly(m))
             path.radiance +=
-                path.throughput * directFromEnvironment(m, hit, n, ns, wo, path.media, depth < u.maxDepth, rng);
-#endif
-        }
+                path.throughput * whittedDirectLight(m, hit, n, ns, wo, path.media, depth < u.maxDepth, rng);
         if (depth == u.maxDepth)
             break;
         float eta = surfaceEta(path.media, hit);

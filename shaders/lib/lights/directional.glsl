@@ -89,7 +89,7 @@ float lightSelection(int kind, uint i);
 
 // Sun i for the Whitted integrator (its cone sampled with 2 numbers) and as
 // a candidate of the path integrator's one shadow ray (4 numbers: the cone's
-// 2 and the reservoir's; lib/lights.glsl: VKRT_LIGHT_LOOPS).
+// 2 and the reservoir's; lib/lights.glsl: whittedCandidate, lightCandidate).
 LightArrival whittedSampleDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS

@@ -57,7 +57,7 @@ LightArrival sampleTablePointLight(uint i, float selection, SurfaceHit hit, vec3
 
 // Point light i as the Whitted integrator samples it (its own shadow ray)
 // and as a candidate of the path integrator's one shadow ray, with the
-// reservoir's number `pick` (lib/lights.glsl: VKRT_LIGHT_LOOPS).
+// reservoir's number `pick` (lib/lights.glsl: whittedCandidate, lightCandidate).
 LightArrival whittedSamplePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_POINT_LIGHTS

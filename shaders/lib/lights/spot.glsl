@@ -68,7 +68,7 @@ LightArrival sampleTableSpotLight(uint i, float selection, SurfaceHit hit, vec3 
 }
 
 // Spot light i for the Whitted integrator and as a candidate of the path
-// integrator's one shadow ray (lib/lights.glsl: VKRT_LIGHT_LOOPS).
+// integrator's one shadow ray (lib/lights.glsl: whittedCandidate, lightCandidate).
 LightArrival whittedSampleSpotLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_SPOT_LIGHTS
