@@ -952,11 +952,12 @@ BsdfSample completedSample(BsdfSample s, vec3 n, BsdfValue v)
 }
 
 // A BSDF sample with its weight, from its own evaluation site (the Whitted
-// integrator and the probes, which share none); pdf: its density, 0 for a delta.
-BsdfSample sampleBsdfWeighted(Material m, vec3 n, vec3 wo, float eta, vec3 u, out float pdf)
+// integrator and the probes, which share none); pdf: its density where
+// `wantPdf` or the weight needs it, 0 for a delta.
+BsdfSample sampleBsdfWeighted(Material m, vec3 n, vec3 wo, float eta, vec3 u, bool wantPdf, out float pdf)
 {
     BsdfSample s = sampleBsdf(m, n, wo, eta, u);
-    BsdfValue v = evaluateBsdf(m, n, wo, s.dir, sampleWantsF(s), sampleWantsPdf(s));
+    BsdfValue v = evaluateBsdf(m, n, wo, s.dir, sampleWantsF(s), s.evaluate || (wantPdf && sampleWantsPdf(s)));
     pdf = v.pdf;
     return completedSample(s, n, v);
 }

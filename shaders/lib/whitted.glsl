@@ -93,8 +93,13 @@ vec3 traceWhitted(Ray ray, inout Sampler rng)
         if (depth == u.maxDepth)
             break;
         float eta = surfaceEta(path.media, hit);
-        float bsdfPdf;
-        BsdfSample s = sampleBsdfWeighted(m, ns, wo, eta, sampleNext4D(rng).xyz, bsdfPdf);
+        float bsdfPdf; // for MIS against the environment's samples only
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+        const bool wantPdf = true;
+#else
+        const bool wantPdf = false;
+#endif
+        BsdfSample s = sampleBsdfWeighted(m, ns, wo, eta, sampleNext4D(rng).xyz, wantPdf, bsdfPdf);
         if (s.weight == vec3(0.0))
             break;
         path.throughput *= s.weight;

@@ -92,7 +92,7 @@ void main()
         uvec4 bits = pcg4d(uvec4(i, uint(inputs[30]), 0x9e3779b9u, 7u));
         vec3 u = vec3(bits.xyz >> 8u) * (1.0 / 16777216.0);
         float sampledPdf;
-        BsdfSample s = sampleBsdfWeighted(m, n, wo, eta, u, sampledPdf);
+        BsdfSample s = sampleBsdfWeighted(m, n, wo, eta, u, false, sampledPdf);
         bool none = s.weight == vec3(0.0);
         float pdf = (none || s.specular || s.transmitted) ? 0.0 : pdfBsdf(m, n, wo, s.dir);
         outputs[8 * i + 0] = s.dir.x;
