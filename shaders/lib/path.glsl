@@ -109,8 +109,8 @@ void estimateDirectLight(inout PathTracer p, LightReservoir r, vec3 n, vec3 ns, 
 // material that scatters into deltas only) and then its BSDF sample, in one
 // loop whose every pass evaluates the BSDF at the same call site. lavapipe
 // inlines every call, so each site that evaluates the BSDF is a copy of every
-// material's eval and pdf; with one site a textured glTF kernel compiles in
-// about half the time (docs/performance.md, "One evaluation site"). The
+// material's eval and pdf, and the driver's compile time grows far faster
+// than the inlined size (docs/performance.md, "One evaluation site"). The
 // candidates draw their numbers first and the sample after them, as when
 // each had its own site. Returns the sample with its weight and sets
 // `bsdfPdf` (0 for a delta) and the reservoir.
@@ -123,7 +123,7 @@ BsdfSample scatterAtVertex(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 or
     // BSDF sample in the same pass as the others: with as many passes as
     // candidates of its own, a lane of a mirror sampled its BSDF while its
     // neighbours drew light candidates, and the sampling code ran twice per
-    // subgroup (0.82-0.93x the samples/s of validation/mirror).
+    // subgroup (docs/performance.md, "Lanes in step").
     uint candidates = lightCandidateCount();
     for (uint c = 0u;; ++c) {
         bool sampling = c == candidates; // the last pass: the BSDF sample
