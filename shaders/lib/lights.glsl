@@ -422,9 +422,9 @@ vec3 whittedDirectLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Me
 // over their total, and scaled by 1 / p_i. The expectation is the sum of
 // every sample times its visibility, so the estimate stays unbiased; where
 // all lights are visible it equals that sum up to the lights' colour
-// differences (no added variance), and under partial occlusion it adds some:
-// measured as a whole, 1.09-1.27x more efficient on the validation scenes
-// (docs/performance.md). The candidates are numbered, so that one loop
+// differences (no added variance), and under partial occlusion it adds some,
+// less than the shadow rays it saves cost (docs/performance.md has the
+// efficiency measured). The candidates are numbered, so that one loop
 // (lib/path.glsl: scatterAtVertex) draws them all and evaluates the BSDF for
 // each at one site: every light of every kind in the registry's order (or
 // u.lightCandidates draws from the light table), the emitters, then the

@@ -135,10 +135,10 @@ Material withAnisotropy(Material m, SurfaceHit hit, vec3 n, vec3 texel)
 // from the camera to this hit.
 //
 // One lookup for all slots, in a loop that is not unrolled: lavapipe inlines
-// every call, and a lookup (two mip levels of four texels, each decoded by
-// format) inlined once per slot cost about 1.5 s of compile each on Mesa 25
-// (the textured scene's cold first frame: 10.8 s with five copies). Its
-// passes count against Mesa 22's loop budget like every loop's.
+// every call, and a lookup (two mip levels, each texel decoded by format)
+// inlined once per slot multiplies the driver's compile time
+// (docs/performance.md, round four). Its passes count against Mesa 22's loop
+// budget like every loop's.
 Material texturedMaterial(Material m, inout SurfaceHit hit, vec3 dir, float pathLength)
 {
     float coneWidth = pixelSpreadAngle() * pathLength;

@@ -233,13 +233,12 @@ void addShadowedLight(inout PathTracer p, ShadowTest shadow, bool blocked)
 
 // Kernels that walk vkrt's own BVH trace the segment and the shadow ray from
 // one call site (a loop of one or two passes): a driver that inlines every
-// call, as lavapipe does, then compiles the walk once instead of twice,
-// 0.69-0.83x the cold start of the Khronos models on Mesa 25
-// (docs/performance.md, round four; tests/gpu/inline_copies_test.cpp), for
-// 0.96-0.98x their samples/s on Mesa 26. The others trace each ray at its own
+// call, as lavapipe does, then compiles the walk once instead of twice
+// (tests/gpu/inline_copies_test.cpp). The others trace each ray at its own
 // site: without meshes the records' loop is short and the loop's own cost
-// showed instead (0.91x the samples/s of diffuse-box on Mesa 26), and a ray
-// query compiled no faster from one site on Mesa 25 while its samples/s fell.
+// outweighed the smaller kernel, and a ray query compiled no faster from one
+// site while its samples/s fell (docs/performance.md, round four, has the
+// figures).
 #if defined(VKRT_HAS_MESHES) && !defined(VKRT_ACCEL_DRIVER)
 #define VKRT_ONE_TRACE_SITE
 #endif

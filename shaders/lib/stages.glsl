@@ -23,9 +23,8 @@ const uint LANE_DONE = 3u;    // every frame of the run added
 // What a lane keeps between dispatches: STAGED_LANE_VEC4S words of 16
 // bytes (shared/Bindings.h). lavapipe turns every buffer access whose
 // address differs between lanes into a loop over the 8 lanes, so the state
-// moves as whole vec4s: with one access per member the shade stage compiled
-// 3-4x slower per instruction than the megakernel and ran slower too
-// (docs/performance.md, "Staged kernels").
+// moves as whole vec4s: one access per member made the shade stage compile
+// and run slower (docs/performance.md, "Staged kernels").
 //   0 phase, runFirst, runEnd, frameIndex    9  shadow dir, pending
 //   1 rng dimension, loop counts (3)        10  shadow weight, -
 //   2 radiance, bsdfPdf                     11  shadow light, -

@@ -77,11 +77,15 @@ CallGraph callGraph(const std::vector<uint32_t>& spirv)
     return graph;
 }
 
-CallGraph pathKernelCalls()
+CallGraph kernelCalls(Integrator integrator, bool lightTable = true)
 {
-    KernelVariant variant{FeatureSet::everything(Integrator::Path)};
+    FeatureSet features = FeatureSet::everything(integrator);
+    features.lightTable = lightTable;
+    KernelVariant variant{features};
     return callGraph(compileGlsl(KernelSource{defaultShaderRoot(), "kernels/render.comp", variant.defines()}));
 }
+
+CallGraph pathKernelCalls() { return kernelCalls(Integrator::Path); }
 
 TEST(InlineCopies, PathKernelHoldsOneCopyOfTheOwnBvhWalk)
 {
@@ -91,6 +95,38 @@ TEST(InlineCopies, PathKernelHoldsOneCopyOfTheOwnBvhWalk)
     EXPECT_GT(graph.copiesOf("advancePath"), 0);
     EXPECT_EQ(graph.copiesOf("traverseTop"), 1);
     EXPECT_EQ(graph.copiesOf("traverseMesh"), 1);
+}
+
+// Every material's eval and pdf once in the path kernel: the light candidates
+// and the BSDF sample share one evaluation site (shaders/lib/path.glsl:
+// scatterAtVertex), with every kind of light, the emitters and the
+// environment map in the variant.
+TEST(InlineCopies, PathKernelEvaluatesTheBsdfAtOneSite)
+{
+    CallGraph graph = pathKernelCalls();
+    EXPECT_GT(graph.copiesOf("lightCandidate"), 0);
+    EXPECT_EQ(graph.copiesOf("evalBsdf"), 1);
+    EXPECT_EQ(graph.copiesOf("pdfBsdf"), 1);
+    EXPECT_EQ(graph.copiesOf("evalPbr"), 1);
+    // The bilinear lookup's four taps come from one fetch site per lookup.
+    EXPECT_EQ(graph.copiesOf("fetchTexel"), graph.copiesOf("filterTextureLevel"));
+}
+
+// The Whitted kernel's lights are one loop (shaders/lib/lights.glsl:
+// whittedDirectLight): one evaluation site there and one for the BSDF sample,
+// and one shadow-ray walk beside the camera and bounce rays' one. The light
+// table's reservoir, in the variants of scenes with many lights, adds one of
+// each.
+TEST(InlineCopies, WhittedKernelEvaluatesEachLightAtOneSite)
+{
+    CallGraph graph = kernelCalls(Integrator::Whitted, false);
+    EXPECT_GT(graph.copiesOf("whittedDirectLight"), 0);
+    EXPECT_EQ(graph.copiesOf("evalBsdf"), 2);
+    EXPECT_EQ(graph.copiesOf("transmittanceFromSurface"), 1);
+    EXPECT_EQ(graph.copiesOf("findHit"), 2);
+    CallGraph table = kernelCalls(Integrator::Whitted, true);
+    EXPECT_EQ(table.copiesOf("evalBsdf"), 3);
+    EXPECT_EQ(table.copiesOf("findHit"), 3);
 }
 
 } // namespace

@@ -219,9 +219,9 @@ bool hitOneMesh(Ray r, TriangleRay tr, uint i, bool anyHit, float tMax, inout Hi
 // No loop over the mesh records: a scene with meshes always has the
 // top-level BVH (own backend) or the driver's structures, and the loops over
 // every kind (lib/scene.glsl) run only without them, when there is no mesh.
-// lavapipe inlines every call, so that never-taken loop cost two more copies
-// of the mesh walk (closest and any hit): mesh-bunny-glass's cold first frame
-// was 4.0-4.2 s on Mesa 25 with them.
+// lavapipe inlines every call, so that never-taken loop would cost two more
+// copies of the mesh walk (closest and any hit) in every mesh kernel's
+// compile (docs/performance.md has the figures).
 VKRT_NO_RECORDS(Mesh)
 
 #ifdef VKRT_HAS_MESH_UVS
