@@ -347,20 +347,30 @@ vec3 environmentOnEscape(vec3 dir, bool specular, float bsdfPdf, float cosinePdf
 // all, compile far slower: docs/performance.md, "One evaluation site").
 // With the light table, its candidates, one of them with a shadow ray,
 // emitters included, come first.
-#define VKRT_PLUS_WHITTED_ENTRIES(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) +tableEntries##Type()
+// The lights sampled one by one, each a candidate of both integrators: every
+// light of every kind and one sample of the emitters (none with the light
+// table, whose entries they are); then the environment map, one more.
+#define VKRT_PLUS_ENTRIES_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) +tableEntries##Type()
 
-uint whittedCandidateCount()
+uint enumeratedCandidates()
 {
 #ifdef VKRT_LIGHT_TABLE
-    uint count = 0u;
+    return 0u;
 #else
-    uint count = 0u VKRT_LIGHT_KINDS(VKRT_PLUS_WHITTED_ENTRIES) + emitterCandidates();
+    return 0u VKRT_LIGHT_KINDS(VKRT_PLUS_ENTRIES_OF_KIND) + emitterCandidates();
 #endif
-#ifdef VKRT_ENVIRONMENT_SAMPLING
-    ++count;
-#endif
-    return count;
 }
+
+uint environmentCandidates()
+{
+#ifdef VKRT_ENVIRONMENT_SAMPLING
+    return 1u;
+#else
+    return 0u;
+#endif
+}
+
+uint whittedCandidateCount() { return enumeratedCandidates() + environmentCandidates(); }
 
 #define VKRT_WHITTED_CANDIDATE_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     if (c < tableEntries##Type())                                                                  \
@@ -429,19 +439,13 @@ vec3 whittedDirectLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Me
 // each at one site: every light of every kind in the registry's order (or
 // u.lightCandidates draws from the light table), the emitters, then the
 // environment map.
-#define VKRT_PLUS_ENTRIES_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) +tableEntries##Type()
-
 uint lightCandidateCount()
 {
 #ifdef VKRT_LIGHT_TABLE
-    uint count = u.lightCandidates;
+    return u.lightCandidates + environmentCandidates();
 #else
-    uint count = 0u VKRT_LIGHT_KINDS(VKRT_PLUS_ENTRIES_OF_KIND) + emitterCandidates();
+    return enumeratedCandidates() + environmentCandidates();
 #endif
-#ifdef VKRT_ENVIRONMENT_SAMPLING
-    ++count;
-#endif
-    return count;
 }
 
 // Candidate c (< lightCandidateCount()), drawing its numbers from rng in
