@@ -99,12 +99,11 @@ LightArrival whittedSampleDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3
 #endif
 }
 
-LightArrival candidateDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
+LightArrival candidateDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, vec4 d, out float pick)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    vec4 u4 = sampleNext4D(rng);
-    pick = u4.z;
-    return sampleDirectionalLight(directionalLights[i], 1.0, origin, u4.xy);
+    pick = d.z;
+    return sampleDirectionalLight(directionalLights[i], 1.0, origin, d.xy);
 #else
     pick = 0.0;
     return noArrival(origin);
