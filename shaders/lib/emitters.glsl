@@ -97,13 +97,15 @@ LightArrival sampleEmitters(vec4 u4, SurfaceHit hit, vec3 ns, vec3 origin)
 #endif
 
 // All emitters as one more candidate of the path integrator's shadow ray: a
-// power-proportional choice of one of them (unbiased for their sum), from
-// two 4D draws: d0 for the sample, d1.x the reservoir's number `pick`.
-LightArrival emitterCandidate(SurfaceHit hit, vec3 ns, vec3 origin, vec4 d0, vec4 d1, out float pick)
+// power-proportional choice of one of them (unbiased for their sum), with
+// the reservoir's number `pick`.
+LightArrival emitterCandidate(SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
 #ifdef VKRT_HAS_EMITTERS
-    pick = d1.x;
-    return sampleEmitters(d0, hit, ns, origin);
+    vec4 u4 = sampleNext4D(rng);
+    LightArrival a = sampleEmitters(u4, hit, ns, origin);
+    pick = sampleNext1D(rng);
+    return a;
 #else
     pick = 0.0;
     return noArrival(origin);

@@ -267,12 +267,12 @@ LightArrival sampleTableEntry(uint entry, SurfaceHit hit, vec3 ns, vec3 origin, 
 #endif
 }
 
-// One candidate drawn from the table, from two 4D draws: d0 the table slot,
-// the alias and the reservoir's number `pick`, d1 the light's sample.
-LightArrival tableCandidate(SurfaceHit hit, vec3 ns, vec3 origin, vec4 d0, vec4 d1, out float pick)
+// One candidate drawn from the table, with the reservoir's number `pick`.
+LightArrival tableCandidate(SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
-    pick = d0.z;
-    return sampleTableEntry(pickTableEntry(d0.x, d0.y), hit, ns, origin, d1);
+    vec4 draw = sampleNext4D(rng); // table slot, alias, the reservoir's choice
+    pick = draw.z;
+    return sampleTableEntry(pickTableEntry(draw.x, draw.y), hit, ns, origin, sampleNext4D(rng));
 }
 #endif
 
@@ -405,8 +405,7 @@ vec3 whittedDirectLight(Material m, SurfaceHit hit, vec3 n, vec3 ns, vec3 wo, Me
     for (uint c = 0u; c < u.lightCandidates; ++c) {
         ++g_loopIterations;
         float pick;
-        vec4 d0 = sampleNext4D(rng);
-        LightArrival a = tableCandidate(hit, ns, origin, d0, sampleNext4D(rng), pick);
+        LightArrival a = tableCandidate(hit, ns, origin, rng, pick);
         offerLightSample(r, litBy(m, ns, wo, a, false), pick);
     }
     if (r.totalWeight != 0.0)
@@ -449,41 +448,27 @@ uint lightCandidateCount()
 #endif
 }
 
-// How many 4D draws candidate c takes, in the candidates' order: two for a
-// light-table entry (its choice, its sample) and for the emitters (their
-// sample, the reservoir's number), one for every other. The caller draws
-// them at one site (lib/path.glsl: scatterAtVertex), as each candidate drew
-// its own before: the same numbers, and one copy of the sampler's code.
-uint lightCandidateDraws(uint c)
-{
-#ifdef VKRT_LIGHT_TABLE
-    return c < u.lightCandidates ? 2u : 1u;
-#else
-    uint ownLights = enumeratedCandidates() - emitterCandidates();
-    return c >= ownLights && c < enumeratedCandidates() ? 2u : 1u;
-#endif
-}
-
-// Candidate c (< lightCandidateCount()) from its draws d0 (and d1, where
-// lightCandidateDraws says two), with the reservoir's number `pick`.
+// Candidate c (< lightCandidateCount()), drawing its numbers from rng in
+// the candidates' order, with the reservoir's number `pick`.
 #define VKRT_CANDIDATE_OF_KIND(KIND, Type, name, value, field, array, ARRAY, capacity, bounded) \
     if (c < tableEntries##Type())                                                          \
-        return candidate##Type(c, hit, ns, origin, d0, pick);                              \
+        return candidate##Type(c, hit, ns, origin, rng, pick);                             \
     c -= tableEntries##Type();
-LightArrival lightCandidate(uint c, SurfaceHit hit, vec3 ns, vec3 origin, vec4 d0, vec4 d1, out float pick)
+LightArrival lightCandidate(uint c, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
 #ifdef VKRT_LIGHT_TABLE
     if (c < u.lightCandidates)
-        return tableCandidate(hit, ns, origin, d0, d1, pick);
+        return tableCandidate(hit, ns, origin, rng, pick);
 #else
     VKRT_LIGHT_KINDS(VKRT_CANDIDATE_OF_KIND)
     if (c < emitterCandidates())
-        return emitterCandidate(hit, ns, origin, d0, d1, pick);
+        return emitterCandidate(hit, ns, origin, rng, pick);
 #endif
 #ifdef VKRT_ENVIRONMENT_SAMPLING
     // The environment map is one more candidate: one shadow ray for all light.
-    pick = d0.w;
-    return sampleEnvironmentLight(ns, origin, d0.xyz);
+    vec4 u4 = sampleNext4D(rng);
+    pick = u4.w;
+    return sampleEnvironmentLight(ns, origin, u4.xyz);
 #else
     pick = 0.0;
     return noArrival(origin);

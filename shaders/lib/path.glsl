@@ -131,21 +131,17 @@ BsdfSample scatterAtVertex(Material m, SurfaceHit hit, vec3 ns, vec3 wo, vec3 or
         BsdfSample s;
         float pick;
         bool wantF, wantPdf;
-        if (!sampling && !lit)
-            continue; // draws nothing: as before, no light numbers for a delta material
-        // The pass's random numbers from two call sites of the sampler, not
-        // one per candidate kind (a Sobol' draw is a large function to inline).
-        vec4 d0 = sampleNext4D(rng), d1 = vec4(0.0);
-        if (!sampling && lightCandidateDraws(c) == 2u)
-            d1 = sampleNext4D(rng);
         if (!sampling) {
+            if (!lit)
+                continue; // draws nothing: as before, no light numbers for a delta material
             ++g_loopIterations;
-            a = lightCandidate(c, hit, ns, origin, d0, d1, pick);
+            a = lightCandidate(c, hit, ns, origin, rng, pick);
             wantF = arrivalLights(a, ns);
             wantPdf = arrivalWantsPdf(a, ns, true);
         } else {
-            roulette = d0.w;
-            s = sampleBsdf(m, ns, wo, eta, d0.xyz);
+            vec4 u4 = sampleNext4D(rng);
+            roulette = u4.w;
+            s = sampleBsdf(m, ns, wo, eta, u4.xyz);
             a.wi = s.dir;
             wantF = sampleWantsF(s);
             wantPdf = sampleWantsPdf(s);

@@ -99,11 +99,12 @@ LightArrival whittedSampleDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3
 #endif
 }
 
-LightArrival candidateDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, vec4 d, out float pick)
+LightArrival candidateDirectionalLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
 #ifdef VKRT_HAS_DIRECTIONAL_LIGHTS
-    pick = d.z;
-    return sampleDirectionalLight(directionalLights[i], 1.0, origin, d.xy);
+    vec4 u4 = sampleNext4D(rng);
+    pick = u4.z;
+    return sampleDirectionalLight(directionalLights[i], 1.0, origin, u4.xy);
 #else
     pick = 0.0;
     return noArrival(origin);

@@ -56,9 +56,8 @@ LightArrival sampleTablePointLight(uint i, float selection, SurfaceHit hit, vec3
 }
 
 // Point light i as the Whitted integrator samples it (its own shadow ray)
-// and as a candidate of the path integrator's one shadow ray, from the
-// candidate's draw `d` (one 4D draw: the reservoir's number `pick` is d.x;
-// lib/lights.glsl: whittedCandidate, lightCandidate).
+// and as a candidate of the path integrator's one shadow ray, with the
+// reservoir's number `pick` (lib/lights.glsl: whittedCandidate, lightCandidate).
 LightArrival whittedSamplePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng)
 {
 #ifdef VKRT_HAS_POINT_LIGHTS
@@ -68,14 +67,11 @@ LightArrival whittedSamplePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origi
 #endif
 }
 
-LightArrival candidatePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, vec4 d, out float pick)
+LightArrival candidatePointLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
-    pick = d.x;
-#ifdef VKRT_HAS_POINT_LIGHTS
-    return arrivalFromPointLight(pointLights[i], hit);
-#else
-    return noArrival(origin);
-#endif
+    LightArrival a = whittedSamplePointLight(i, hit, ns, origin, rng);
+    pick = sampleNext1D(rng);
+    return a;
 }
 
 #endif

@@ -78,14 +78,11 @@ LightArrival whittedSampleSpotLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin
 #endif
 }
 
-LightArrival candidateSpotLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, vec4 d, out float pick)
+LightArrival candidateSpotLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
-    pick = d.x;
-#ifdef VKRT_HAS_SPOT_LIGHTS
-    return arrivalFromSpotLight(spotLights[i], hit);
-#else
-    return noArrival(origin);
-#endif
+    LightArrival a = whittedSampleSpotLight(i, hit, ns, origin, rng);
+    pick = sampleNext1D(rng);
+    return a;
 }
 
 #endif

@@ -55,7 +55,7 @@ LightArrival whittedSampleTriangleLight(uint i, SurfaceHit hit, vec3 ns, vec3 or
     return noArrival(origin);
 }
 
-LightArrival candidateTriangleLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, vec4 d, out float pick)
+LightArrival candidateTriangleLight(uint i, SurfaceHit hit, vec3 ns, vec3 origin, inout Sampler rng, out float pick)
 {
     pick = 0.0;
     return noArrival(origin);
